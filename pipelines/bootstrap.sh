@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs what the toolchain needs from Debian 12's packages (only when something is
+# missing, so re-running is cheap) and builds it into build/ (Release).
+# Used by the README's two commands; safe to run again at any time.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  cmake g++ make pkg-config git
+  libtinygltf-dev libstb-dev libglm-dev libopenexr-dev openexr libopenimageio-dev openimageio-tools
+  libosmesa6-dev libembree-dev libtbb-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev ffmpeg
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "bootstrap: installing ${missing[*]}" >&2
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >&2
+fi
+
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$jobs"
