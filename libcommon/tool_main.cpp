@@ -32,17 +32,28 @@ int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** ar
   return -1;
 }
 
+namespace {
+// Messages from libraries (OpenEXR, tinygltf) may span lines; ours are one line by contract.
+std::string oneLine(std::string s) {
+  for (char& c : s) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+}  // namespace
+
 int runTool(const std::string& tool, const std::function<int()>& body) {
   try {
     return body();
   } catch (const Error& e) {
-    std::cerr << tool << ": " << e.what() << "\n";
+    std::cerr << tool << ": " << oneLine(e.what()) << "\n";
     return int(e.code());
   } catch (const std::bad_alloc&) {
     std::cerr << tool << ": out of memory\n";
     return int(ExitCode::kEnvironment);
   } catch (const std::exception& e) {
-    std::cerr << tool << ": internal error: " << e.what() << "\n";
+    std::cerr << tool << ": internal error: " << oneLine(e.what()) << "\n";
     return int(ExitCode::kInternal);
   }
 }
