@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -186,6 +187,50 @@ TEST(ItemBuffer, RejectsBadInput) {
   EXPECT_THROW(r.render(axisCamera(), {}), Error);  // transform count
 }
 
+TEST(ItemBuffer, DepthOrderHoldsWithTinyNearPlaneAndFarObjects) {
+  // Reversed-Z float depth keeps relative precision: 1 mm near plane, quads 2 m apart at 2 km.
+  CameraView v = axisCamera();
+  v.lens.znear = 0.001;
+  ItemObject o;
+  addRect(o, v, kSize, 10, 10, 40, 30, 2000.0, 1);
+  addRect(o, v, kSize, 20, 15, 50, 40, 2002.0, 2);  // behind, drawn after
+  addRect(o, v, kSize, 5, 30, 15, 45, 0.002, 3);    // 2 mm from the eye
+  ItemBufferRenderer r(kSize);
+  r.setGeometry({o});
+  ItemBuffer b = r.render(v, {glm::dmat4(1.0)});
+  EXPECT_EQ(countId(b, 1), 30 * 20);
+  EXPECT_EQ(countId(b, 2), 30 * 25 - 20 * 15);
+  EXPECT_EQ(countId(b, 3), 10 * 15);
+  EXPECT_NEAR(b.depthAt(30, 20), 2000.0, 2000.0 * 1e-4);
+  EXPECT_NEAR(b.depthAt(45, 35), 2002.0, 2002.0 * 1e-4);
+  EXPECT_NEAR(b.depthAt(10, 40), 0.002, 0.002 * 1e-4);
+}
+
+TEST(ItemBuffer, Orthographic) {
+  CameraView v;
+  v.lens.perspective = false;
+  v.lens.xmag = 3.2;  // 10 pixels per metre on a 64 x 48 image
+  v.lens.ymag = 2.4;
+  v.lens.znear = 0.5;
+  v.lens.zfar = 50.0;
+  ItemObject o;
+  // Square [0, 1] x [0, 1] at z = -10: columns 32..41, rows 14..23 (row 0 at the top).
+  o.addTriangle({0, 0, -10}, {1, 0, -10}, {1, 1, -10}, 4);
+  o.addTriangle({0, 0, -10}, {1, 1, -10}, {0, 1, -10}, 4);
+  o.addTriangle({0, 0, -60}, {1, 0, -60}, {1, 1, -60}, 5);  // beyond zfar
+  ItemBuffer b = renderItemBuffer({{{o.triangles[0][0], o.triangles[0][1], o.triangles[0][2]}, 4},
+                                   {{o.triangles[1][0], o.triangles[1][1], o.triangles[1][2]}, 4},
+                                   {{o.triangles[2][0], o.triangles[2][1], o.triangles[2][2]}, 5}},
+                                  v, kSize);
+  EXPECT_EQ(countId(b, 4), 100);
+  EXPECT_EQ(countId(b, 5), 0);
+  EXPECT_EQ(b.idAt(32, 14), 4u);
+  EXPECT_EQ(b.idAt(41, 23), 4u);
+  EXPECT_EQ(b.idAt(31, 14), kNoItem);
+  EXPECT_EQ(b.idAt(32, 24), kNoItem);
+  EXPECT_NEAR(b.depthAt(35, 20), 10.0, 10.0 * 1e-4);
+}
+
 // ---------------------------------------------------------------------------------------------
 // A non-trivial scene: overlapping random triangles at different depths, some facing away.
 
@@ -209,8 +254,7 @@ RandomScene randomScene(int count, uint32_t seed) {
     glm::dvec3 c(uniform(-3, 3), uniform(-2, 2), uniform(-3, 3));
     double size = uniform(0.5, 2.5);
     ItemTriangle t;
-    for (auto& p : t.p)
-      p = c + size * glm::dvec3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+    for (auto& p : t.p) p = c + size * glm::dvec3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
     // Most face the camera; every fifth faces away and must be culled by both renderers.
     glm::dvec3 n = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
     bool facing = glm::dot(n, eye - t.p[0]) > 0.0;
@@ -291,6 +335,41 @@ struct EmbreeScene {
   }
 };
 
+// Distance in pixels from a pixel centre to the nearest projected edge of triangle `id`
+// (+inf when it has a vertex behind the eye, where projected edges mean nothing).
+double edgeDistance(const RandomScene& s, ImageSize size, int col, int row, uint32_t id) {
+  if (id == kNoItem) return std::numeric_limits<double>::infinity();
+  const ItemTriangle& t = s.triangles[id - 1];
+  glm::dvec2 c(col + 0.5, row + 0.5);
+  std::array<glm::dvec2, 3> q;
+  for (int k = 0; k < 3; ++k) {
+    ProjectedPoint p = projectToPixel(s.view, size, t.p[k]);
+    if (!p.inFront) return std::numeric_limits<double>::infinity();
+    q[k] = p.pixel;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    glm::dvec2 a = q[k], e = q[(k + 1) % 3] - q[k];
+    double u = glm::clamp(glm::dot(c - a, e) / glm::dot(e, e), 0.0, 1.0);
+    best = std::min(best, glm::length(c - (a + u * e)));
+  }
+  return best;
+}
+
+// A disagreement is acceptable on an edge: the ray's id appears within one pixel in the buffer,
+// or the pixel centre lies within one pixel of an edge of either triangle (also covers edges
+// at the image border, whose outer neighbours are not in the buffer).
+bool onAnEdge(const RandomScene& s, const ItemBuffer& b, int col, int row, uint32_t expected) {
+  for (int dr = -1; dr <= 1; ++dr)
+    for (int dc = -1; dc <= 1; ++dc) {
+      int c = col + dc, r = row + dr;
+      if (c >= 0 && r >= 0 && c < b.width && r < b.height && b.idAt(c, r) == expected) return true;
+    }
+  ImageSize size{b.width, b.height};
+  return edgeDistance(s, size, col, row, b.idAt(col, row)) <= 1.0 ||
+         edgeDistance(s, size, col, row, expected) <= 1.0;
+}
+
 TEST(ItemBuffer, AgreesWithEmbreeRayCasting) {
   const ImageSize size{352, 240};
   RandomScene s = randomScene(120, 11);
@@ -309,14 +388,7 @@ TEST(ItemBuffer, AgreesWithEmbreeRayCasting) {
       ++agree;
       continue;
     }
-    // A disagreement must sit on an edge: the ray's id appears within one pixel in the buffer.
-    bool nearEdge = false;
-    for (int dr = -1; dr <= 1; ++dr)
-      for (int dc = -1; dc <= 1; ++dc) {
-        int c = col + dc, r = row + dr;
-        if (c >= 0 && r >= 0 && c < size.width && r < size.height && b.idAt(c, r) == expected)
-          nearEdge = true;
-      }
+    bool nearEdge = onAnEdge(s, b, col, row, expected);
     EXPECT_TRUE(nearEdge) << "pixel " << col << "," << row << ": gl " << got << ", embree "
                           << expected;
   }
@@ -324,6 +396,23 @@ TEST(ItemBuffer, AgreesWithEmbreeRayCasting) {
               samples, hits);
   EXPECT_GT(hits, samples / 3) << "scene should cover a good part of the image";
   EXPECT_GE(agree, int(std::ceil(0.995 * samples)));
+
+  // Stronger: every pixel of the image, so edges are certainly exercised.
+  int mismatches = 0, farFromEdge = 0;
+  for (int row = 0; row < size.height; ++row)
+    for (int col = 0; col < size.width; ++col) {
+      uint32_t expected = embree.cast(pixelCentreRay(s.view, size, col, row), s.triangles);
+      if (b.idAt(col, row) == expected) continue;
+      ++mismatches;
+      bool nearEdge = onAnEdge(s, b, col, row, expected);
+      farFromEdge += !nearEdge;
+      EXPECT_TRUE(nearEdge) << "pixel " << col << "," << row << ": gl " << b.idAt(col, row)
+                            << ", embree " << expected;
+    }
+  std::printf("item buffer vs embree, all %d pixels: %d differ, %d of them away from an edge\n",
+              size.width * size.height, mismatches, farFromEdge);
+  EXPECT_EQ(farFromEdge, 0);
+  EXPECT_LE(mismatches, int(0.005 * size.width * size.height));
 }
 
 TEST(ItemBuffer, VisiblePixelsNeverExceedProjectedArea) {
@@ -391,6 +480,24 @@ TEST(ItemBuffer, FrameTime352x240With400Triangles) {
   std::printf("item buffer 352x240, 400 triangles, 4 objects: %.3f ms/frame\n", ms);
   RecordProperty("ms_per_frame", std::to_string(ms));
   EXPECT_GT(countId(b, kNoItem), 0);
+}
+
+TEST(ItemBuffer, RenderersOnSeveralThreadsAgree) {
+  // One renderer (and GL context) per thread, rendering concurrently.
+  const ImageSize size{352, 240};
+  RandomScene s = randomScene(400, 5);
+  ItemBuffer reference = renderItemBuffer(s.triangles, s.view, size);
+  std::vector<ItemBuffer> results(3);
+  std::vector<std::thread> threads;
+  for (size_t i = 0; i < results.size(); ++i)
+    threads.emplace_back([&, i] {
+      for (int k = 0; k < 5; ++k) results[i] = renderItemBuffer(s.triangles, s.view, size);
+    });
+  for (auto& t : threads) t.join();
+  for (const ItemBuffer& r : results) {
+    EXPECT_TRUE(r.id == reference.id);
+    EXPECT_EQ(std::memcmp(r.depth.data(), reference.depth.data(), r.depth.size() * 4), 0);
+  }
 }
 
 }  // namespace
