@@ -3,6 +3,9 @@
 
 #include <array>
 #include <cmath>
+#include <string>
+
+#include "libcommon/error.h"
 
 namespace rad {
 namespace {
@@ -55,7 +58,10 @@ void clipAgainst(const ClipPolygon& in, int plane, ClipPolygon& out) {
 
 double projectedAreaPixels(const glm::dmat4& clipFromPolygon, ImageSize size,
                            const glm::dvec3* points, int count) {
-  if (count < 3 || count > kMaxVertices - 6) return 0.0;
+  if (count > kMaxVertices - 6)
+    throw Error(ExitCode::kInternal, "projected area",
+                std::to_string(count) + " vertices; at most " + std::to_string(kMaxVertices - 6));
+  if (count < 3) return 0.0;
   ClipPolygon a, b;
   a.count = count;
   for (int i = 0; i < count; ++i) a.v[i] = clipFromPolygon * glm::dvec4(points[i], 1.0);

@@ -21,7 +21,8 @@ namespace rad {
 double projectedAreaPixels(const CameraView& view, ImageSize size, const Polygon& world);
 
 // Same with a precomputed clip-from-world (clipFromWorld(view, size), times a model matrix for
-// a polygon given in its local frame) for tight loops over many patches.
+// a polygon given in its local frame) for tight loops over many patches. Convex polygons of
+// up to 10 vertices (more throws rad::Error(kInternal)).
 double projectedAreaPixels(const glm::dmat4& clipFromPolygon, ImageSize size,
                            const glm::dvec3* points, int count);
 
