@@ -31,7 +31,7 @@ namespace rad {
 
 struct VisibilityTriangle {
   glm::dvec3 v[3];
-  std::uint32_t surface = 0;  // caller's id, returned by nothing but used to ignore end patches
+  std::uint32_t surface = 0;  // caller's patch id; queries name the ids of their end patches
 };
 
 struct VisibilityQuery {
