@@ -1,0 +1,338 @@
+// Form factors against the exact references in tests/data/reference (see its README).
+#include "libcommon/form_factor.h"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace rad {
+namespace {
+
+using Json = nlohmann::json;
+constexpr double kPi = 3.14159265358979323846;
+
+const Json& formFactors() {
+  static const Json j = [] {
+    std::ifstream in(std::string(RAD_TEST_DATA) + "/reference/formfactors.json");
+    EXPECT_TRUE(in.good());
+    return Json::parse(in);
+  }();
+  return j;
+}
+
+const Json& furnace() {
+  static const Json j = [] {
+    std::ifstream in(std::string(RAD_TEST_DATA) + "/reference/furnace.json");
+    EXPECT_TRUE(in.good());
+    return Json::parse(in);
+  }();
+  return j;
+}
+
+glm::dvec3 vec(const Json& a) {
+  return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
+}
+
+std::vector<glm::dvec3> poly(const Json& a) {
+  std::vector<glm::dvec3> v;
+  for (const auto& x : a) v.push_back(vec(x));
+  return v;
+}
+
+Polygon toPolygon(const std::vector<glm::dvec3>& v) {
+  Polygon p;
+  p.count = static_cast<int>(v.size());
+  for (int i = 0; i < p.count; ++i) p.v[i] = v[i];
+  return p;
+}
+
+std::vector<glm::dvec3> scaled(const std::vector<glm::dvec3>& v, double s,
+                               const glm::dvec3& offset = glm::dvec3(0.0)) {
+  std::vector<glm::dvec3> out;
+  for (const auto& x : v) out.push_back(x * s + offset);
+  return out;
+}
+
+// Allowed absolute error from the case's suggested_tolerance (first matching key).
+double allowedError(const Json& tol, double exact) {
+  for (const char* key : {"exact_formula_double_rel", "polygon_exact_rel"}) {
+    if (tol.contains(key)) return tol[key].get<double>() * std::abs(exact);
+  }
+  if (tol.contains("exact_formula_double_abs"))
+    return tol["exact_formula_double_abs"].get<double>();
+  ADD_FAILURE() << "unknown tolerance " << tol.dump();
+  return 0.0;
+}
+
+TEST(FormFactorReference, EveryPointToPolygonCase) {
+  int n = 0;
+  double maxRel = 0.0, maxAbs = 0.0;
+  for (const auto& c : formFactors()["cases"]) {
+    if (c["kind"] != "point_to_polygon") continue;
+    ++n;
+    const std::string name = c["name"];
+    glm::dvec3 p = vec(c["receiver"]["point"]);
+    glm::dvec3 nrm = vec(c["receiver"]["normal"]);
+    std::vector<glm::dvec3> v = poly(c["polygon"]);
+    double exact = c["exact"]["value"];
+    double f = pointToPolygonFormFactor(p, nrm, v);
+    double tol = allowedError(c["suggested_tolerance"], exact);
+    ASSERT_TRUE(std::isfinite(f)) << name;
+    EXPECT_LE(std::abs(f - exact), tol) << name << " F=" << f << " exact=" << exact;
+    if (v.size() <= 4) {
+      EXPECT_EQ(f, pointToPolygonFormFactor(p, nrm, toPolygon(v))) << name;
+    }
+    if (name == "pt_coplanar_edge_on") {
+      EXPECT_EQ(f, 0.0);
+    }
+    maxAbs = std::max(maxAbs, std::abs(f - exact));
+    if (exact != 0.0) maxRel = std::max(maxRel, std::abs(f - exact) / exact);
+  }
+  EXPECT_EQ(n, 23);
+  std::cout << "point_to_polygon: " << n << " cases, max abs err " << maxAbs << ", max rel err "
+            << maxRel << "\n";
+}
+
+// The fixed n x n rules are the reference's own rules: the error must be within 2x the
+// tabulated error for each tabulated n (the README's tolerance for area quadrature).
+TEST(FormFactorReference, FixedOrderGaussLegendreMatchesErrorTable) {
+  int checked = 0;
+  for (const auto& c : formFactors()["cases"]) {
+    if (c["kind"] != "polygon_to_polygon") continue;
+    const std::string name = c["name"];
+    auto a = poly(c["polygon_1"]), b = poly(c["polygon_2"]);
+    double exact = c["exact"]["value"];
+    for (const auto& [order, entry] : c["gauss_legendre_outer_quadrature"]["n"].items()) {
+      int n = std::stoi(order);
+      double f = polygonToPolygonFormFactor(a, b, n);
+      double tabulated = std::abs(entry["abs_err"].get<double>());
+      // 2x the table, with a floor of 2e-15 relative: table entries below that are rounding noise
+      // of a sum over up to 32 x 32 nodes (the reference lists 1e-15 there itself).
+      double tol = 2.0 * tabulated + 2e-15 * std::abs(exact);
+      EXPECT_LE(std::abs(f - exact), tol) << name << " n=" << n << " F=" << f;
+      // Same rule as the reference's: the value itself should agree closely.
+      EXPECT_NEAR(f, entry["value"].get<double>(), 1e-12 * std::abs(exact) + 1e-15)
+          << name << " n=" << n;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
+// Every polygon_to_polygon case at its suggested tolerance, with the adaptive quadrature,
+// both directions (F21 against exact_reverse_F21).
+TEST(FormFactorReference, EveryPolygonToPolygonCaseAdaptive) {
+  int n = 0;
+  for (const auto& c : formFactors()["cases"]) {
+    if (c["kind"] != "polygon_to_polygon") continue;
+    ++n;
+    const std::string name = c["name"];
+    auto a = poly(c["polygon_1"]), b = poly(c["polygon_2"]);
+    double exact = c["exact"]["value"];
+    double exact21 = c["exact_reverse_F21"]["value"];
+    double tol = allowedError(c["suggested_tolerance"], exact);
+    double tol21 = allowedError(c["suggested_tolerance"], exact21);
+    AdaptiveFormFactor f12 = polygonToPolygonFormFactorAdaptive(a, b, 1e-12);
+    AdaptiveFormFactor f21 = polygonToPolygonFormFactorAdaptive(b, a, 1e-12);
+    EXPECT_TRUE(f12.converged) << name;
+    EXPECT_TRUE(f21.converged) << name;
+    EXPECT_LE(std::abs(f12.value - exact), tol) << name << " F12=" << f12.value;
+    EXPECT_LE(std::abs(f21.value - exact21), tol21) << name << " F21=" << f21.value;
+    // The error estimate is honest (conservative).
+    EXPECT_LE(std::abs(f12.value - exact), f12.errorEstimate + 1e-15 * exact) << name;
+    if (c.contains("disk_closed_form")) {
+      double disk = c["disk_closed_form"]["value"];
+      EXPECT_LE(std::abs(f12.value - disk),
+                c["suggested_tolerance"]["vs_disk_closed_form_rel"].get<double>() * disk)
+          << name;
+    }
+    // Reciprocity A1 F12 = A2 F21.
+    double a1 = polygonArea(a.data(), a.size()), a2 = polygonArea(b.data(), b.size());
+    EXPECT_LE(std::abs(a1 * f12.value - a2 * f21.value), 2e-12 * std::max(a1 * f12.value, 1e-300))
+        << name;
+    std::cout << std::setw(34) << std::left << name << " rel err F12 " << std::setw(10)
+              << std::abs(f12.value - exact) / exact << " F21 " << std::setw(10)
+              << std::abs(f21.value - exact21) / exact21 << " cells " << f12.cells << "/"
+              << f21.cells << "\n";
+  }
+  EXPECT_EQ(n, 20);
+}
+
+TEST(FormFactor, FixedOrderReciprocityFarAndModerate) {
+  // Far from contact a modest fixed order is already reciprocal to the table's error scale.
+  for (const char* name : {"par_unit_squares_d1", "par_rect_offset",
+                           "perp_rect_offset_no_common_edge", "coax_64gon_r1_r2_h1"}) {
+    for (const auto& c : formFactors()["cases"]) {
+      if (c["name"] != name) continue;
+      auto a = poly(c["polygon_1"]), b = poly(c["polygon_2"]);
+      double a1 = polygonArea(a.data(), a.size()), a2 = polygonArea(b.data(), b.size());
+      double f12 = polygonToPolygonFormFactor(a, b, 16);
+      double f21 = polygonToPolygonFormFactor(b, a, 16);
+      EXPECT_NEAR(a1 * f12, a2 * f21, 1e-12 * a1 * f12) << name;
+    }
+  }
+}
+
+TEST(FormFactor, ScaleInvariance) {
+  // The same geometry at 1e-3 m and 1e4 m (and moved away from the origin) gives the same F.
+  for (const auto& c : formFactors()["cases"]) {
+    const std::string name = c["name"];
+    if (c["kind"] == "point_to_polygon") {
+      glm::dvec3 p = vec(c["receiver"]["point"]), n = vec(c["receiver"]["normal"]);
+      auto v = poly(c["polygon"]);
+      double f = pointToPolygonFormFactor(p, n, v);
+      for (double s : {1e-3, 1e4}) {
+        glm::dvec3 off(3.0 * s, -7.0 * s, 5.0 * s);
+        double fs = pointToPolygonFormFactor(p * s + off, n, scaled(v, s, off));
+        // Near-edge cases are discontinuous at contact and conditioned like 1/delta; the
+        // reference's own tolerance applies there.
+        double tol =
+            c["difficulty"] == "near_edge" || c["difficulty"] == "near_vertex" ? 1e-10 : 1e-12 * f;
+        EXPECT_NEAR(fs, f, tol) << name << " scale " << s;
+      }
+    } else if (name == "par_unit_squares_d1" || name == "perp_unit_squares_common_edge" ||
+               name == "tetra_face_to_face" || name == "perp_rect_offset_no_common_edge") {
+      auto a = poly(c["polygon_1"]), b = poly(c["polygon_2"]);
+      double f = polygonToPolygonFormFactor(a, b, 8);
+      for (double s : {1e-3, 1e4}) {
+        double fs = polygonToPolygonFormFactor(scaled(a, s), scaled(b, s), 8);
+        EXPECT_NEAR(fs, f, 1e-12 * f) << name << " scale " << s;
+      }
+    }
+  }
+}
+
+TEST(FormFactor, PointsOnEdgesVerticesAndPlanesAreFinite) {
+  std::vector<glm::dvec3> sq = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};  // front +z
+  std::vector<glm::dvec3> points = {{0.5, 0, 0},    {0, 0, 0},         {0.5, 0.5, 0},
+                                    {2, 2, 0},      {0.5, -1, 0},      {0.5, 0, 1e-300},
+                                    {0, 0, 1e-300}, {0.5, 0.5, 1e-12}, {1e-17, 0.5, 1e-17}};
+  std::vector<glm::dvec3> normals = {{0, 0, 1}, {0, 0, -1}, {0, 1, 0},
+                                     {1, 0, 0}, {0, -1, 0}, glm::normalize(glm::dvec3(1, 1, -1)),
+                                     {0, 0, 0}};
+  for (const auto& p : points) {
+    for (const auto& n : normals) {
+      double f = pointToPolygonFormFactor(p, n, sq);
+      EXPECT_TRUE(std::isfinite(f));
+      EXPECT_GE(f, 0.0);
+      EXPECT_LE(f, 1.0);
+      if (p.z == 0.0) {
+        EXPECT_EQ(f, 0.0) << "in the polygon's plane";
+      }
+    }
+  }
+  // Behind the one-sided polygon: 0.
+  EXPECT_EQ(pointToPolygonFormFactor({0.5, 0.5, -1}, {0, 0, 1}, sq), 0.0);
+  EXPECT_EQ(pointToPolygonFormFactor({0.5, 0.5, -1}, {0, 0, -1}, sq), 0.0);
+  // Element facing away: 0.
+  EXPECT_EQ(pointToPolygonFormFactor({0.5, 0.5, 1}, {0, 0, 1}, sq), 0.0);
+  // Just above the centre, facing it: -> 1.
+  EXPECT_NEAR(pointToPolygonFormFactor({0.5, 0.5, 1e-12}, {0, 0, -1}, sq), 1.0, 1e-11);
+  // Far field: F ~ A cos cos / (pi d^2), d/size = 1e6.
+  double d = 1e6;
+  double far = pointToPolygonFormFactor({0.5, 0.5, d}, {0, 0, -1}, sq);
+  EXPECT_NEAR(far, 1.0 / (kPi * d * d), 1e-9 / (kPi * d * d));
+  // Polygons touching along an edge: the quadrature never samples the boundary.
+  std::vector<glm::dvec3> wall = {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}};  // x=0, +x
+  for (int order : {1, 2, 3, 8, 33}) {
+    double f = polygonToPolygonFormFactor(sq, wall, order);
+    EXPECT_TRUE(std::isfinite(f));
+    EXPECT_GT(f, 0.0);
+    EXPECT_LT(f, 1.0);
+  }
+  // Coplanar and back-to-back polygons: 0.
+  std::vector<glm::dvec3> next = {{1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}};
+  EXPECT_EQ(polygonToPolygonFormFactor(sq, next, 4), 0.0);
+  EXPECT_EQ(polygonToPolygonFormFactorAdaptive(sq, next).value, 0.0);
+  std::vector<glm::dvec3> below = {{0, 0, -1}, {1, 0, -1}, {1, 1, -1}, {0, 1, -1}};  // +z
+  EXPECT_EQ(polygonToPolygonFormFactor(sq, below, 4), 0.0);
+  EXPECT_EQ(polygonToPolygonFormFactor(below, sq, 4), 0.0);  // sq's back faces `below`
+  // Sliver triangle.
+  std::vector<glm::dvec3> sliver = {{0, 0, 1}, {0, 1, 1}, {1e-9, 0.5, 1}};  // faces -z
+  double fs = polygonToPolygonFormFactor(sq, sliver, 8);
+  EXPECT_TRUE(std::isfinite(fs));
+  EXPECT_GE(fs, 0.0);
+  EXPECT_LT(fs, 1e-8);
+}
+
+TEST(FormFactorFurnace, UnitCubeSixRowSumsAndExactMatrix) {
+  const Json& g = furnace()["geometries"]["unit_cube_6"];
+  std::vector<std::vector<glm::dvec3>> patches;
+  for (const auto& p : g["patches"]) patches.push_back(poly(p));
+  const std::size_t n = patches.size();
+  ASSERT_EQ(n, 6u);
+  for (int order : {16, 0}) {
+    for (std::size_t i = 0; i < n; ++i) {
+      double row = 0.0;
+      for (std::size_t j = 0; j < n; ++j) {
+        double f = polygonToPolygonFormFactor(patches[i], patches[j], order == 0 ? 16 : order);
+        double exact = g["F"][i][j];
+        EXPECT_NEAR(f, exact, 1e-12) << i << "," << j;
+        row += f;
+      }
+      EXPECT_NEAR(row, 1.0, 1e-9) << "row " << i;
+    }
+  }
+  // Adaptive, and with Polygon inputs.
+  for (std::size_t i = 0; i < n; ++i) {
+    double row = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      double f =
+          polygonToPolygonFormFactorAdaptive(toPolygon(patches[i]), toPolygon(patches[j])).value;
+      EXPECT_NEAR(f, g["F"][i][j].get<double>(), 1e-12) << i << "," << j;
+      row += f;
+    }
+    EXPECT_NEAR(row, 1.0, 1e-9) << "row " << i;
+  }
+}
+
+TEST(FormFactorFurnace, OtherEnclosuresRowSums) {
+  for (const char* name : {"box_1x2x3_6", "unit_cube_24", "icosahedron_20"}) {
+    const Json& g = furnace()["geometries"][name];
+    std::vector<std::vector<glm::dvec3>> patches;
+    for (const auto& p : g["patches"]) patches.push_back(poly(p));
+    double maxErr = 0.0;
+    auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < patches.size(); ++i) {
+      double row = 0.0;
+      for (std::size_t j = 0; j < patches.size(); ++j) {
+        double f = polygonToPolygonFormFactorAdaptive(patches[i], patches[j], 1e-11).value;
+        maxErr = std::max(maxErr, std::abs(f - g["F"][i][j].get<double>()));
+        row += f;
+      }
+      EXPECT_NEAR(row, 1.0, 1e-9) << name << " row " << i;
+    }
+    EXPECT_LT(maxErr, 1e-10) << name;
+    std::cout << name << ": max |F - exact| " << maxErr << " in "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+              << " s\n";
+  }
+}
+
+TEST(FormFactor, AutoOrderAndEstimate) {
+  std::vector<glm::dvec3> a = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (double d : {0.1, 1.0, 3.0, 10.0, 100.0}) {
+    std::vector<glm::dvec3> b = {{0, 0, d}, {0, 1, d}, {1, 1, d}, {1, 0, d}};
+    double exact = polygonToPolygonFormFactorAdaptive(a, b).value;
+    double autoF = polygonToPolygonFormFactor(a, b, kAutoOrder);
+    if (d >= 1.0) {
+      EXPECT_NEAR(autoF, exact, 1e-6 * exact) << d;
+    }
+    double est = formFactorEstimate(toPolygon(a), toPolygon(b));
+    EXPECT_GT(est, 0.0);
+    if (d >= 10.0) {
+      EXPECT_NEAR(est, exact, 1e-2 * exact) << d;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rad
