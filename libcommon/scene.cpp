@@ -147,10 +147,16 @@ bool channelChanges(const AnimationChannel& ch, double t0, double t1) {
   const size_t keys = ch.times.size();
   if (keys < 2) return false;
   if (t1 <= ch.times.front() || t0 >= ch.times.back()) return false;  // held value
-  // Keys lo..hi bound every segment that overlaps (t0, t1].
+  // Keys lo..hi determine every value taken on [t0, t1]: lo is the last key at or before t0;
+  // hi is the first key at or after t1 (interpolating) or the last key at or before t1 (STEP,
+  // which reaches key k's value only at t_k).
   size_t lo = 0, hi = keys - 1;
   while (lo + 1 < keys && ch.times[lo + 1] <= t0) ++lo;
-  while (hi > 0 && ch.times[hi - 1] >= t1) --hi;
+  if (ch.interpolation == Interpolation::kStep) {
+    while (hi > 0 && ch.times[hi] > t1) --hi;
+  } else {
+    while (hi > 0 && ch.times[hi - 1] >= t1) --hi;
+  }
   const double* v0 = keyElement(ch, lo);
   const int n = componentCount(ch.path);
   for (size_t k = lo; k <= hi; ++k) {
