@@ -645,10 +645,25 @@ void Reader::readAnimations(Scene& scene) {
 Scene readGltfScene(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw inputError(path, "cannot open file");
-  char magic[4] = {0, 0, 0, 0};
-  file.read(magic, 4);
+  unsigned char header[12] = {0};
+  file.read(reinterpret_cast<char*>(header), 12);
+  const std::streamsize got = file.gcount();
+  file.clear();
+  file.seekg(0, std::ios::end);
+  const uint64_t fileSize = uint64_t(file.tellg());
   file.close();
-  const bool binary = std::memcmp(magic, "glTF", 4) == 0;
+  const bool binary = got >= 4 && std::memcmp(header, "glTF", 4) == 0;
+  if (binary) {  // GLB header (glTF §4.4.2): magic, version, total length, little-endian u32
+    if (got < 12) throw inputError(path, "truncated glb: " + std::to_string(fileSize) + " bytes");
+    uint32_t version, length;
+    std::memcpy(&version, header + 4, 4);
+    std::memcpy(&length, header + 8, 4);
+    if (version != 2)
+      throw inputError(path, "glb version " + std::to_string(version) + ", expected 2");
+    if (length > fileSize)
+      throw inputError(path, "truncated glb: header declares " + std::to_string(length) +
+                                 " bytes, file has " + std::to_string(fileSize));
+  }
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   std::string err, warn;

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "formats/gltf_scene.h"
@@ -412,6 +413,16 @@ TEST_F(BadInput, InvalidJson) {
 TEST_F(BadInput, TruncatedBin) {
   write("tri.bin", triangleBin().substr(0, 20));  // declared 44 bytes
   expectBadInput(write("trunc.gltf", triangleGltf()), "");
+}
+
+TEST_F(BadInput, TruncatedGlb) {
+  std::ifstream in(kExternal + "khronos_BoxAnimated/BoxAnimated.glb", std::ios::binary);
+  std::string glb((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(glb.size(), 1000u);
+  expectBadInput(write("cut.glb", glb.substr(0, 1000)), "truncated glb");
+  std::string v3 = glb;
+  v3[4] = 3;
+  expectBadInput(write("v3.glb", v3), "glb version 3, expected 2");
 }
 
 TEST_F(BadInput, NanPosition) {
