@@ -378,7 +378,7 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
     if (mat && mat->baseColorTexture >= 0) {
       auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(mat->baseColorTexCoord));
       if (tc != prim.attributes.end()) {
-        // glTF §3.7.2.1: TEXCOORD is float or normalized unsigned byte/short.
+        // glTF §3.7.2: TEXCOORD is float or normalized unsigned byte/short.
         const int ct = tc->second >= 0 && tc->second < int(m_.accessors.size())
                            ? m_.accessors[size_t(tc->second)].componentType
                            : TINYGLTF_COMPONENT_TYPE_FLOAT;
@@ -413,7 +413,7 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
       idx.resize(vertexCount);
       for (size_t i = 0; i < vertexCount; ++i) idx[i] = uint32_t(i);
     }
-    // Triangle list per glTF §3.7.2.1 (strip: p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}};
+    // Triangle list per glTF §3.7.2 (strip: p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}};
     // fan: p_i = {v_{i+1}, v_{i+2}, v_0}).
     std::vector<std::array<uint32_t, 3>> tris;
     if (mode == TINYGLTF_MODE_TRIANGLES) {
@@ -451,7 +451,7 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
 }
 
 int Reader::material(int index, Scene& scene) {
-  if (index < 0) return -1;  // glTF default material (§3.9.1): white, not emissive
+  if (index < 0) return -1;  // glTF default material (§3.9.6): white, not emissive
   if (index >= int(m_.materials.size()))
     fail("material " + std::to_string(index) + " out of range");
   auto it = materialMap_.find(index);
@@ -552,7 +552,7 @@ void Reader::readCameras(Scene& scene) {
     const std::string where = "camera " + std::to_string(i);
     Camera c;
     c.name = g.name;
-    if (g.type == "perspective") {  // glTF §3.10.2
+    if (g.type == "perspective") {  // glTF §3.10
       c.perspective = true;
       c.yfov = g.perspective.yfov;
       c.aspectRatio = g.perspective.aspectRatio;
@@ -564,7 +564,7 @@ void Reader::readCameras(Scene& scene) {
       if (!(c.znear > 0.0) || !std::isfinite(c.znear)) fail(where + ": znear must be > 0");
       if (!(c.zfar == 0.0 || (c.zfar > c.znear && std::isfinite(c.zfar))))
         fail(where + ": zfar must be greater than znear");
-    } else if (g.type == "orthographic") {  // glTF §3.10.3
+    } else if (g.type == "orthographic") {  // glTF §3.10
       c.perspective = false;
       c.xmag = g.orthographic.xmag;
       c.ymag = g.orthographic.ymag;

@@ -152,8 +152,8 @@ class Scene {
   // by mesh node, then triangle order.
   std::vector<InputPolygon> inputPolygons() const;
 
-  // Camera nodes reachable from roots, in ascending index order; cameraNode("") is the first, or -1
-  // if none.
+  // Camera nodes reachable from roots, in ascending index order. cameraNode("") is the first;
+  // cameraNode(name) matches a node name first, then a camera name; -1 if none.
   std::vector<int> cameraNodes() const;
   int cameraNode(const std::string& name) const;
   CameraView cameraAt(int node, double t) const;

@@ -507,7 +507,7 @@ TEST_F(BadInput, StripSparseAndNormalisedTexcoords) {
   Scene s = readGltfScene(write("strip.gltf", gltf));
   EXPECT_EQ(s.roots, (std::vector<int>{0}));  // no scenes: all root nodes
   ASSERT_EQ(s.meshes[0].triangles.size(), 2u);
-  // Strip (glTF §3.7.2.1): p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}}: (0,1,2), then (1,3,2).
+  // Strip (glTF §3.7.2): p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}}: (0,1,2), then (1,3,2).
   EXPECT_EQ(s.meshes[0].triangles[0].p[2], glm::dvec3(0, 1, 0));
   EXPECT_EQ(s.meshes[0].triangles[1].p[0], glm::dvec3(1, 0, 0));
   EXPECT_EQ(s.meshes[0].triangles[1].p[1], glm::dvec3(1, 1, 0));
