@@ -57,8 +57,8 @@ struct Mesh {
 struct Camera {
   std::string name;
   bool perspective = true;
-  double yfov = 0.8;         // radians (perspective)
-  double aspectRatio = 0.0;  // 0 = take the image's aspect ratio
+  double yfov = 0.8;              // radians (perspective)
+  double aspectRatio = 0.0;       // 0 = take the image's aspect ratio
   double xmag = 1.0, ymag = 1.0;  // orthographic half extents
   double znear = 0.01;
   double zfar = 0.0;  // 0 = infinite (perspective only)
@@ -110,7 +110,7 @@ class Scene {
  public:
   std::string path;  // file it was read from (for messages)
   std::vector<Node> nodes;
-  std::vector<int> roots;  // root nodes of the displayed scene
+  std::vector<int> roots;  // root nodes of the displayed scene (empty: every parentless node)
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
   std::vector<Texture> textures;
@@ -128,20 +128,32 @@ class Scene {
   double endTime() const;
   double duration() const { return endTime() - startTime(); }
 
+  // Nodes reachable from roots (or from every parentless node when roots is empty),
+  // in ascending index order.
+  std::vector<int> reachableNodes() const;
   // Nodes that carry a mesh and are reachable from roots, in ascending index order.
   std::vector<int> meshNodes() const;
   // True when the node's world transform changes somewhere in [t0, t1].
   bool isDynamic(int node, double t0, double t1) const;
   // World-space axis-aligned bounds swept by a mesh node's geometry over [t0, t1]:
   // {min, max}. Conservative (exact for static nodes).
+  // Static nodes: bounds of the transformed vertices. Dynamic nodes: the 8 corners of the
+  // local box at sampleTimes(node, t0, t1, 32), padded by the largest distance a corner moves
+  // between consecutive samples (conservative while the path between two samples is at most
+  // twice as long as its chord, which dense sampling of glTF curves guarantees in practice).
   std::array<glm::dvec3, 2> sweptBounds(int node, double t0, double t1) const;
+  // Sorted distinct times in [t0, t1]: 65 uniform samples, plus perSegment + 1 samples over
+  // every key segment of the channels animating the node or its ancestors (and the instant
+  // before each key, where STEP jumps).
+  std::vector<double> sampleTimes(int node, double t0, double t1, int perSegment) const;
 
   // Top-level patches of all mesh nodes: triangles, with coplanar adjacent pairs that form a
   // convex quad merged; doubleSided materials add a reversed copy. Deterministic order:
   // by mesh node, then triangle order.
   std::vector<InputPolygon> inputPolygons() const;
 
-  // Camera nodes in ascending index order; cameraNode("") is the first, or -1 if none.
+  // Camera nodes reachable from roots, in ascending index order. cameraNode("") is the first;
+  // cameraNode(name) matches a node name first, then a camera name; -1 if none.
   std::vector<int> cameraNodes() const;
   int cameraNode(const std::string& name) const;
   CameraView cameraAt(int node, double t) const;
