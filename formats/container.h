@@ -52,7 +52,7 @@ constexpr DType dtypeOf() {
 struct ArrayInfo {
   std::string name;
   DType dtype = DType::kU8;
-  std::vector<uint64_t> shape;  // row-major (C order); {} is a scalar (1 element)
+  std::vector<uint64_t> shape;  // row-major (C order); a read shape [] holds 1 element
   uint64_t offset = 0;          // from the start of the data section; multiple of 64
   uint64_t nbytes = 0;          // == dtypeSize(dtype) * product(shape)
   std::string hash;             // "fnv1a64:<16 hex>" of the nbytes bytes
@@ -70,7 +70,8 @@ class ContainerWriter {
   // Free JSON object whose keys the kind defines; starts as {}.
   nlohmann::json& metadata() { return metadata_; }
 
-  // Copies `values` as array `name`. `shape` defaults to {values.size()}; its product must equal
+  // Copies `values` as array `name`. An empty `shape` means 1-D {values.size()} (scalars belong
+  // in metadata); otherwise its product must equal
   // values.size(). A duplicate name or a wrong shape is a programming error
   // (rad::Error kInternal).
   template <class T>
