@@ -50,8 +50,8 @@ void AtomicFile::commit() {
   // name with incomplete content.
   int fd = ::open(tempPath_.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
-    throw outputError(path_, "cannot open temporary file " + tempPath_ + ": " +
-                                 std::strerror(errno));
+    throw outputError(path_,
+                      "cannot open temporary file " + tempPath_ + ": " + std::strerror(errno));
   }
   if (::fsync(fd) != 0) {
     const int err = errno;
@@ -60,8 +60,8 @@ void AtomicFile::commit() {
   }
   ::close(fd);
   if (::rename(tempPath_.c_str(), path_.c_str()) != 0) {
-    throw outputError(path_, std::string("cannot rename temporary file into place: ") +
-                                 std::strerror(errno));
+    throw outputError(
+        path_, std::string("cannot rename temporary file into place: ") + std::strerror(errno));
   }
   committed_ = true;
   // Make the rename itself durable; failure here is not worth failing the stage for.

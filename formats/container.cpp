@@ -25,6 +25,9 @@ constexpr uint64_t kPreambleSize = 32;
 constexpr uint64_t kChecksummedPreamble = 24;
 // More dimensions than this is certainly corruption; keeps shape products cheap to check.
 constexpr std::size_t kMaxDims = 16;
+// Provenance histories nest about 3 levels per tool in the chain; 200 leaves room for long
+// pipelines while bounding recursion in nlohmann::json.
+constexpr int kMaxJsonDepth = 200;
 
 uint64_t alignUp(uint64_t x) {
   return (x + kContainerAlignment - 1) / kContainerAlignment * kContainerAlignment;
@@ -79,7 +82,44 @@ std::vector<uint8_t> readWholeFile(const std::string& path) {
   return bytes;
 }
 
-bool isUnsigned(const nlohmann::json& j) { return j.is_number_unsigned(); }
+// Deepest bracket nesting in JSON text. nlohmann::json parses iteratively but copies, compares,
+// dumps and (before 3.11) destroys recursively, so a hostile header of a million '[' would
+// overflow the stack; the header is refused before parsing instead. Exact for valid JSON, which
+// is all that matters since invalid JSON fails to parse anyway.
+int jsonDepth(const uint8_t* text, uint64_t size) {
+  int depth = 0, maxDepth = 0;
+  bool inString = false, escaped = false;
+  for (uint64_t i = 0; i < size; ++i) {
+    const uint8_t c = text[i];
+    if (inString) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      maxDepth = std::max(maxDepth, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return maxDepth;
+}
+
+// Names go into one-line error messages and rad-inspect tables.
+bool hasControlCharacter(const std::string& s) {
+  for (unsigned char c : s) {
+    if (c < 0x20 || c == 0x7f) return true;
+  }
+  return false;
+}
+
+bool isUnsigned(const nlohmann::json& j) {
+  return j.is_number_unsigned();
+}
 
 // Member `key` of `obj`, or null when absent: const operator[] on a missing key is undefined
 // behaviour in nlohmann::json, and the non-const one would insert it.
@@ -94,28 +134,40 @@ const nlohmann::json& field(const nlohmann::json& obj, const char* key) {
 
 const char* dtypeName(DType t) {
   switch (t) {
-    case DType::kU8: return "u8";
-    case DType::kU16: return "u16";
-    case DType::kU32: return "u32";
-    case DType::kU64: return "u64";
-    case DType::kI32: return "i32";
-    case DType::kI64: return "i64";
-    case DType::kF32: return "f32";
-    case DType::kF64: return "f64";
+    case DType::kU8:
+      return "u8";
+    case DType::kU16:
+      return "u16";
+    case DType::kU32:
+      return "u32";
+    case DType::kU64:
+      return "u64";
+    case DType::kI32:
+      return "i32";
+    case DType::kI64:
+      return "i64";
+    case DType::kF32:
+      return "f32";
+    case DType::kF64:
+      return "f64";
   }
   return "?";
 }
 
 std::size_t dtypeSize(DType t) {
   switch (t) {
-    case DType::kU8: return 1;
-    case DType::kU16: return 2;
+    case DType::kU8:
+      return 1;
+    case DType::kU16:
+      return 2;
     case DType::kU32:
     case DType::kI32:
-    case DType::kF32: return 4;
+    case DType::kF32:
+      return 4;
     case DType::kU64:
     case DType::kI64:
-    case DType::kF64: return 8;
+    case DType::kF64:
+      return 8;
   }
   return 1;
 }
@@ -150,14 +202,15 @@ void ContainerWriter::addRaw(const std::string& name, DType dtype, std::vector<u
                              const void* data, std::size_t nbytes) {
   if (name.empty()) throw Error(ExitCode::kInternal, kind_, "array with an empty name");
   for (const auto& p : arrays_) {
-    if (p.info.name == name) throw Error(ExitCode::kInternal, kind_, "duplicate array '" + name + "'");
+    if (p.info.name == name)
+      throw Error(ExitCode::kInternal, kind_, "duplicate array '" + name + "'");
   }
   uint64_t count = 1;
   for (uint64_t d : shape) count *= d;
   if (shape.size() > kMaxDims || count * dtypeSize(dtype) != nbytes) {
-    throw Error(ExitCode::kInternal, kind_,
-                "array '" + name + "': shape does not match its " + std::to_string(nbytes) +
-                    " bytes");
+    throw Error(
+        ExitCode::kInternal, kind_,
+        "array '" + name + "': shape does not match its " + std::to_string(nbytes) + " bytes");
   }
   Pending p;
   p.info.name = name;
@@ -216,8 +269,8 @@ void ContainerWriter::write(const std::string& path) const {
   AtomicFile file(path);
   int fd = ::open(file.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) {
-    throw outputError(path, "cannot create temporary file " + file.tempPath() + ": " +
-                                std::strerror(errno));
+    throw outputError(
+        path, "cannot create temporary file " + file.tempPath() + ": " + std::strerror(errno));
   }
   const bool ok = writeAll(fd, bytes.data(), bytes.size());
   const int err = errno;
@@ -263,7 +316,8 @@ void ContainerReader::validate() {
   // Preamble. Magic and version come first: they are the part of the layout that never changes,
   // so a newer file is reported as newer rather than as corrupt.
   const std::size_t magicLen = static_cast<std::size_t>(std::min<uint64_t>(size, sizeof kMagic));
-  if (std::memcmp(b, kMagic, magicLen) != 0) throw inputError(p, "bad magic: not a rad container");
+  if (magicLen > 0 && std::memcmp(b, kMagic, magicLen) != 0)
+    throw inputError(p, "bad magic: not a rad container");
   if (size < kPreambleSize) {
     throw inputError(p, "truncated: " + std::to_string(size) + " bytes, shorter than the " +
                             std::to_string(kPreambleSize) + "-byte preamble");
@@ -290,18 +344,23 @@ void ContainerReader::validate() {
   }
   const uint64_t storedSum = loadLE<uint64_t>(b + 24);
   const uint64_t sum = fnv1a64(b + kPreambleSize, headerLength, fnv1a64(b, kChecksummedPreamble));
-  if (sum != storedSum) throw inputError(p, "header checksum mismatch: preamble or header corrupted");
+  if (sum != storedSum)
+    throw inputError(p, "header checksum mismatch: preamble or header corrupted");
   dataStart_ = alignUp(kPreambleSize + headerLength);
 
   // JSON header.
+  if (jsonDepth(b + kPreambleSize, headerLength) > kMaxJsonDepth) {
+    throw inputError(p, "header nests deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+  }
   header_ = nlohmann::json::parse(b + kPreambleSize, b + kPreambleSize + headerLength, nullptr,
                                   /*allow_exceptions=*/false);
   if (header_.is_discarded()) throw inputError(p, "header is not valid JSON");
   if (!header_.is_object()) throw inputError(p, "header is not a JSON object");
 
   const auto& kind = field(header_, "kind");
-  if (!kind.is_string() || kind.get_ref<const std::string&>().empty()) {
-    throw inputError(p, "header: missing or empty \"kind\"");
+  if (!kind.is_string() || kind.get_ref<const std::string&>().empty() ||
+      hasControlCharacter(kind.get_ref<const std::string&>())) {
+    throw inputError(p, "header: missing, empty or unprintable \"kind\"");
   }
   kind_ = kind.get<std::string>();
   const auto& kv = field(header_, "kind_version");
@@ -311,7 +370,8 @@ void ContainerReader::validate() {
     throw inputError(p, "header: \"kind_version\" is not [major, minor]");
   }
   kindVersion_ = {kv[0].get<int>(), kv[1].get<int>()};
-  if (!field(header_, "metadata").is_object()) throw inputError(p, "header: \"metadata\" is not an object");
+  if (!field(header_, "metadata").is_object())
+    throw inputError(p, "header: \"metadata\" is not an object");
   const auto& prov = field(header_, "provenance");
   if (!prov.is_null()) provenance_ = Provenance::fromJson(prov, p + ": provenance");
 
@@ -325,8 +385,9 @@ void ContainerReader::validate() {
     if (!e.is_object()) throw inputError(p, at + " is not an object");
     ArrayInfo a;
     const auto& name = field(e, "name");
-    if (!name.is_string() || name.get_ref<const std::string&>().empty()) {
-      throw inputError(p, at + ": missing or empty name");
+    if (!name.is_string() || name.get_ref<const std::string&>().empty() ||
+        hasControlCharacter(name.get_ref<const std::string&>())) {
+      throw inputError(p, at + ": missing, empty or unprintable name");
     }
     a.name = name.get<std::string>();
     const std::string an = "array '" + a.name + "'";
@@ -416,7 +477,8 @@ void ContainerReader::validate() {
 }
 
 void ContainerReader::requireKind(const std::string& kind, int supportedMajor) const {
-  if (kind_ != kind) throw inputError(path_, "is " + withArticle(kind_) + " file, expected " + kind);
+  if (kind_ != kind)
+    throw inputError(path_, "is " + withArticle(kind_) + " file, expected " + kind);
   const std::string v = versionText(kindVersion_.first, kindVersion_.second);
   if (kindVersion_.first > supportedMajor) {
     throw inputError(path_, kind + " " + v + " is newer than supported " +
@@ -444,8 +506,8 @@ const ArrayInfo& ContainerReader::info(const std::string& name) const {
 const ArrayInfo& ContainerReader::checkedInfo(const std::string& name, DType dtype) const {
   const ArrayInfo& a = info(name);
   if (a.dtype != dtype) {
-    throw inputError(path_, "array '" + name + "' is " + dtypeName(a.dtype) + ", expected " +
-                                dtypeName(dtype));
+    throw inputError(
+        path_, "array '" + name + "' is " + dtypeName(a.dtype) + ", expected " + dtypeName(dtype));
   }
   return a;
 }

@@ -32,21 +32,30 @@ constexpr uint64_t kContainerAlignment = 64;
 
 enum class DType { kU8, kU16, kU32, kU64, kI32, kI64, kF32, kF64 };
 
-const char* dtypeName(DType t);     // "u8", ..., "f64"
-std::size_t dtypeSize(DType t);     // bytes per element
+const char* dtypeName(DType t);  // "u8", ..., "f64"
+std::size_t dtypeSize(DType t);  // bytes per element
 bool parseDType(const std::string& name, DType& out);
 
 template <class T>
 constexpr DType dtypeOf() {
-  if constexpr (std::is_same_v<T, uint8_t>) return DType::kU8;
-  else if constexpr (std::is_same_v<T, uint16_t>) return DType::kU16;
-  else if constexpr (std::is_same_v<T, uint32_t>) return DType::kU32;
-  else if constexpr (std::is_same_v<T, uint64_t>) return DType::kU64;
-  else if constexpr (std::is_same_v<T, int32_t>) return DType::kI32;
-  else if constexpr (std::is_same_v<T, int64_t>) return DType::kI64;
-  else if constexpr (std::is_same_v<T, float>) return DType::kF32;
-  else if constexpr (std::is_same_v<T, double>) return DType::kF64;
-  else static_assert(!sizeof(T), "no container dtype for this element type");
+  if constexpr (std::is_same_v<T, uint8_t>)
+    return DType::kU8;
+  else if constexpr (std::is_same_v<T, uint16_t>)
+    return DType::kU16;
+  else if constexpr (std::is_same_v<T, uint32_t>)
+    return DType::kU32;
+  else if constexpr (std::is_same_v<T, uint64_t>)
+    return DType::kU64;
+  else if constexpr (std::is_same_v<T, int32_t>)
+    return DType::kI32;
+  else if constexpr (std::is_same_v<T, int64_t>)
+    return DType::kI64;
+  else if constexpr (std::is_same_v<T, float>)
+    return DType::kF32;
+  else if constexpr (std::is_same_v<T, double>)
+    return DType::kF64;
+  else
+    static_assert(!sizeof(T), "no container dtype for this element type");
 }
 
 struct ArrayInfo {
@@ -81,8 +90,8 @@ class ContainerWriter {
     addRaw(name, dtypeOf<T>(), std::move(shape), values.data(), values.size() * sizeof(T));
   }
   // Untyped form of addArray: `nbytes` bytes at `data`, already little-endian.
-  void addRaw(const std::string& name, DType dtype, std::vector<uint64_t> shape,
-              const void* data, std::size_t nbytes);
+  void addRaw(const std::string& name, DType dtype, std::vector<uint64_t> shape, const void* data,
+              std::size_t nbytes);
 
   // Serialises the whole file to memory (used by write(); handy for tests).
   std::vector<uint8_t> serialize() const;

@@ -31,7 +31,9 @@ std::string stringField(const nlohmann::json& obj, const char* key, const std::s
 }
 
 // Value as a user would type it after the option: strings bare, everything else as JSON.
-std::string optionValue(const nlohmann::json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+std::string optionValue(const nlohmann::json& v) {
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
 
 std::string optionName(const std::string& key) {
   return key.rfind("--", 0) == 0 ? key : "--" + key;
@@ -120,8 +122,10 @@ std::string shellQuote(const std::string& word) {
   if (safe) return word;
   std::string out = "'";
   for (char c : word) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
+    if (c == '\'')
+      out += "'\\''";
+    else
+      out += c;
   }
   return out + "'";
 }
@@ -144,8 +148,10 @@ Provenance makeProvenance(const std::string& tool, int argc, const char* const* 
     if (i) p.commandLine += ' ';
     p.commandLine += shellQuote(argv[i] ? argv[i] : "");
   }
-  if (parameters.is_object()) p.parameters = parameters;
-  else if (!parameters.is_null()) p.parameters = {{"value", parameters}};
+  if (parameters.is_object())
+    p.parameters = parameters;
+  else if (!parameters.is_null())
+    p.parameters = {{"value", parameters}};
   return p;
 }
 

@@ -44,7 +44,8 @@ std::vector<uint8_t> readBytes(const std::string& path) {
 
 void writeBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
   std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
 }
 
 // Expects `f` to throw rad::Error whose message starts with `where + ": "` and contains `part`.
@@ -108,7 +109,8 @@ void roundTripDtype(const std::string& path, DType expected) {
   const std::vector<std::vector<uint64_t>> shapes = {
       {}, {values.size()}, {1, values.size()}, {values.size(), 1, 1}};
   ContainerWriter w("test", 1, 0);
-  for (std::size_t i = 0; i < shapes.size(); ++i) w.addArray("a" + std::to_string(i), values, shapes[i]);
+  for (std::size_t i = 0; i < shapes.size(); ++i)
+    w.addArray("a" + std::to_string(i), values, shapes[i]);
   w.addArray("empty", std::vector<T>{});
   w.addArray("empty2d", std::vector<T>{}, {0, 7});
   w.write(path);
@@ -443,8 +445,10 @@ TEST_F(ContainerTest, FutureVersionsAreRefused) {
   ContainerWriter w("linkhier", 2, 0);
   w.write(path);
   const ContainerReader r = ContainerReader::open(path);
-  expectError([&] { r.requireKind("linkhier", 1); }, path, "linkhier 2.0 is newer than supported 1.x");
-  expectError([&] { r.requireKind("linkhier", 3); }, path, "linkhier 2.0 is older than supported 3.x");
+  expectError([&] { r.requireKind("linkhier", 1); }, path,
+              "linkhier 2.0 is newer than supported 1.x");
+  expectError([&] { r.requireKind("linkhier", 3); }, path,
+              "linkhier 2.0 is older than supported 3.x");
   EXPECT_NO_THROW(r.requireKind("linkhier", 2));
   ContainerWriter(std::string("linkhier"), 1, 9).write(path);
   EXPECT_NO_THROW(ContainerReader::open(path).requireKind("linkhier", 1));
@@ -456,7 +460,8 @@ TEST_F(ContainerTest, WrongKindAndArrayErrors) {
   w.addArray<float>("times", {0.f, 1.f});
   w.write(path);
   const ContainerReader r = ContainerReader::open(path);
-  expectError([&] { r.requireKind("linkhier", 1); }, path, "is an intervals file, expected linkhier");
+  expectError([&] { r.requireKind("linkhier", 1); }, path,
+              "is an intervals file, expected linkhier");
   EXPECT_NO_THROW(r.requireKind("intervals", 1));
   expectError([&] { r.array<uint32_t>("times"); }, path, "array 'times' is f32, expected u32");
   expectError([&] { r.array<double>("times"); }, path, "array 'times' is f32, expected f64");
@@ -489,7 +494,12 @@ TEST_F(ContainerTest, InconsistentHeadersAreRejected) {
   const std::pair<std::string, std::string> cases[] = {
       {"not json", "header is not valid JSON"},
       {"[1,2]", "header is not a JSON object"},
-      {R"({"kind_version":[1,0],"metadata":{},"arrays":[]})", "missing or empty \"kind\""},
+      {R"({"kind":"k","kind_version":[1,0],"arrays":[],"metadata":{"a":)" +
+           std::string(100000, '[') + std::string(100000, ']') + "}}",
+       "header nests deeper than 200 levels"},
+      {R"({"kind":"k\nx","kind_version":[1,0],"metadata":{},"arrays":[]})", "unprintable"},
+      {R"({"kind_version":[1,0],"metadata":{},"arrays":[]})",
+       "missing, empty or unprintable \"kind\""},
       {R"({"kind":"k","kind_version":[1],"metadata":{},"arrays":[]})", "kind_version"},
       {R"({"kind":"k","kind_version":[-1,0],"metadata":{},"arrays":[]})", "kind_version"},
       {R"({"kind":"k","kind_version":[1,0],"metadata":[],"arrays":[]})", "metadata"},
@@ -497,7 +507,8 @@ TEST_F(ContainerTest, InconsistentHeadersAreRejected) {
       {R"({"kind":"k","kind_version":[1,0],"metadata":{},"arrays":[],"provenance":{"tool":1}})",
        "provenance: \"tool\" is not a string"},
       {ok + "3]}", "array #0 is not an object"},
-      {arr(R"("dtype":"u32","shape":[2],"offset":0,"nbytes":8)"), "missing or empty name"},
+      {arr(R"("dtype":"u32","shape":[2],"offset":0,"nbytes":8)"),
+       "missing, empty or unprintable name"},
       {arr(R"("name":"a","dtype":"f16","shape":[2],"offset":0,"nbytes":8)"), "unknown dtype"},
       {arr(base + R"(,"shape":[2],"offset":0,"nbytes":12)"), "12 bytes do not match u32 shape [2]"},
       {arr(base + R"(,"shape":[-2],"offset":0,"nbytes":8)"), "bad shape"},
@@ -518,6 +529,12 @@ TEST_F(ContainerTest, InconsistentHeadersAreRejected) {
            R"("name":"b","dtype":"u8","hash":"x","shape":[2],"offset":0,"nbytes":2}]})",
        "array 'b' overlaps the previous array"},
   };
+  // Brackets inside strings (escaped quotes included) do not count as nesting.
+  EXPECT_NO_THROW(ContainerReader::fromBytes(
+      craft(R"({"kind":"k","kind_version":[1,0],"arrays":[],"metadata":{"s":"\"[)" +
+                std::string(1000, '[') + "\"}}",
+            {}),
+      "h.rc"));
   for (const auto& [header, message] : cases) {
     SCOPED_TRACE(header);
     expectError([&] { ContainerReader::fromBytes(craft(header, data), "h.rc"); }, "h.rc", message);
@@ -546,7 +563,9 @@ TEST_F(ContainerTest, RandomCorruptionNeverCrashes) {
           for (int k = 0, n = 1 + static_cast<int>(pick(8)); k < n; ++k)
             bad[pick(bad.size())] ^= static_cast<uint8_t>(1 + pick(255));
           break;
-        case 1: bad.resize(pick(bad.size())); break;
+        case 1:
+          bad.resize(pick(bad.size()));
+          break;
         case 2:
           for (int k = 0, n = 1 + static_cast<int>(pick(200)); k < n; ++k)
             bad.push_back(static_cast<uint8_t>(rng()));
@@ -556,7 +575,10 @@ TEST_F(ContainerTest, RandomCorruptionNeverCrashes) {
           std::memcpy(&bad[16], &v, 8);
           break;
         }
-        case 4: bad.assign(pick(300), 0); for (auto& c : bad) c = static_cast<uint8_t>(rng()); break;
+        case 4:
+          bad.assign(pick(300), 0);
+          for (auto& c : bad) c = static_cast<uint8_t>(rng());
+          break;
       }
     } else {
       // JSON mutations with a recomputed checksum, to exercise the header validation.
@@ -564,10 +586,18 @@ TEST_F(ContainerTest, RandomCorruptionNeverCrashes) {
       for (int k = 0, n = 1 + static_cast<int>(pick(4)); k < n; ++k) {
         const std::size_t at = pick(h.size());
         switch (pick(4)) {
-          case 0: h[at] = kJsonish[pick(sizeof kJsonish - 1)]; break;
-          case 1: h.erase(at, 1 + pick(20)); break;
-          case 2: h.insert(at, 1, kJsonish[pick(sizeof kJsonish - 1)]); break;
-          case 3: h[at] = static_cast<char>(rng()); break;
+          case 0:
+            h[at] = kJsonish[pick(sizeof kJsonish - 1)];
+            break;
+          case 1:
+            h.erase(at, 1 + pick(20));
+            break;
+          case 2:
+            h.insert(at, 1, kJsonish[pick(sizeof kJsonish - 1)]);
+            break;
+          case 3:
+            h[at] = static_cast<char>(rng());
+            break;
         }
       }
       bad = craft(h, data);
