@@ -1,0 +1,89 @@
+#include "formats/atomic_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+#include "libcommon/error.h"
+
+namespace rad {
+
+namespace {
+
+// Distinguishes two AtomicFiles for the same path in one process (e.g. two threads).
+std::atomic<unsigned> gTempCounter{0};
+
+std::string directoryOf(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  if (slash == 0) return "/";
+  return path.substr(0, slash);
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+  const auto slash = path_.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "" : path_.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? path_ : path_.substr(slash + 1);
+  // Keep the extension last; a leading-dot name such as ".hidden" has no extension.
+  const auto dot = name.find_last_of('.');
+  const bool hasExt = dot != std::string::npos && dot > 0;
+  const std::string stem = hasExt ? name.substr(0, dot) : name;
+  const std::string ext = hasExt ? name.substr(dot) : "";
+  tempPath_ = dir + "." + stem + ".tmp." + std::to_string(::getpid()) + "." +
+              std::to_string(gTempCounter.fetch_add(1)) + ext;
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_) ::unlink(tempPath_.c_str());  // ENOENT is fine: nothing was written
+}
+
+void AtomicFile::commit() {
+  if (committed_) return;
+  // Flush the data before the rename makes it visible, so a crash cannot leave a complete
+  // name with incomplete content.
+  int fd = ::open(tempPath_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    throw outputError(path_,
+                      "cannot open temporary file " + tempPath_ + ": " + std::strerror(errno));
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    throw outputError(path_, std::string("cannot sync: ") + std::strerror(err));
+  }
+  ::close(fd);
+  if (::rename(tempPath_.c_str(), path_.c_str()) != 0) {
+    throw outputError(
+        path_, std::string("cannot rename temporary file into place: ") + std::strerror(errno));
+  }
+  committed_ = true;
+  // Make the rename itself durable; failure here is not worth failing the stage for.
+  int dirFd = ::open(directoryOf(path_).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dirFd >= 0) {
+    ::fsync(dirFd);
+    ::close(dirFd);
+  }
+}
+
+bool writeAll(int fd, const void* data, std::size_t size) {
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, p, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+}  // namespace rad

@@ -1,0 +1,221 @@
+#include "formats/provenance.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <set>
+#include <sstream>
+
+#include "formats/checksum.h"
+#include "formats/container.h"
+#include "libcommon/error.h"
+
+namespace rad {
+
+namespace {
+
+const nlohmann::json& field(const nlohmann::json& obj, const char* key) {
+  static const nlohmann::json kNull;
+  const auto it = obj.find(key);
+  return it == obj.end() ? kNull : *it;
+}
+
+std::string stringField(const nlohmann::json& obj, const char* key, const std::string& where) {
+  const auto& v = field(obj, key);
+  if (v.is_null()) return "";  // absent: older writers, or a hand-made test file
+  if (!v.is_string()) throw inputError(where, std::string("\"") + key + "\" is not a string");
+  return v.get<std::string>();
+}
+
+// Value as a user would type it after the option: strings bare, everything else as JSON.
+std::string optionValue(const nlohmann::json& v) {
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+std::string optionName(const std::string& key) {
+  return key.rfind("--", 0) == 0 ? key : "--" + key;
+}
+
+void appendText(const Provenance& p, std::set<std::string>& printed, std::ostringstream& out,
+                int depth) {
+  // Histories are trees (rad-movies reads global.rlh and intervals.rti, both made from the same
+  // scene); print each distinct one once. Depth bounds malicious nesting.
+  if (depth > 64) return;
+  for (const auto& in : p.inputs) {
+    if (!in.history.is_object()) continue;
+    const std::string key = in.history.dump();
+    if (!printed.insert(key).second) continue;
+    try {
+      appendText(Provenance::fromJson(in.history, in.path), printed, out, depth + 1);
+    } catch (const Error&) {
+      out << "(unreadable history of " << in.path << ")\n";
+    }
+  }
+  out << (p.tool.empty() ? "(unknown tool)" : p.tool);
+  if (!p.version.empty()) out << " " << p.version;
+  if (!p.gitRevision.empty()) out << " (git " << p.gitRevision << ")";
+  out << ": " << p.commandLine << "\n";
+  if (!p.parameters.empty()) out << "    parameters " << p.parameters.dump() << "\n";
+  for (const auto& in : p.inputs) out << "    input " << in.path << " " << in.hash << "\n";
+}
+
+}  // namespace
+
+nlohmann::json Provenance::toJson() const {
+  nlohmann::json inputsJson = nlohmann::json::array();
+  for (const auto& in : inputs) {
+    inputsJson.push_back({{"path", in.path}, {"hash", in.hash}, {"history", in.history}});
+  }
+  return {{"tool", tool},
+          {"version", version},
+          {"git_revision", gitRevision},
+          {"command_line", commandLine},
+          {"parameters", parameters.is_null() ? nlohmann::json::object() : parameters},
+          {"inputs", inputsJson}};
+}
+
+Provenance Provenance::fromJson(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_object()) throw inputError(where, "not a JSON object");
+  Provenance p;
+  p.tool = stringField(j, "tool", where);
+  p.version = stringField(j, "version", where);
+  p.gitRevision = stringField(j, "git_revision", where);
+  p.commandLine = stringField(j, "command_line", where);
+  const auto& params = field(j, "parameters");
+  if (!params.is_null() && !params.is_object()) {
+    throw inputError(where, "\"parameters\" is not an object");
+  }
+  if (params.is_object()) p.parameters = params;
+  const auto& inputs = field(j, "inputs");
+  if (!inputs.is_null() && !inputs.is_array()) throw inputError(where, "\"inputs\" is not a list");
+  if (inputs.is_array()) {
+    for (const auto& in : inputs) {
+      if (!in.is_object()) throw inputError(where, "an input is not an object");
+      InputRecord r;
+      r.path = stringField(in, "path", where);
+      r.hash = stringField(in, "hash", where);
+      r.history = field(in, "history");
+      if (!r.history.is_null() && !r.history.is_object()) {
+        throw inputError(where, "history of input " + r.path + " is not an object");
+      }
+      p.inputs.push_back(std::move(r));
+    }
+  }
+  return p;
+}
+
+std::string Provenance::toText() const {
+  std::set<std::string> printed;
+  std::ostringstream out;
+  appendText(*this, printed, out, 0);
+  return out.str();
+}
+
+std::string shellQuote(const std::string& word) {
+  if (word.empty()) return "''";
+  const bool safe = word.find_first_not_of(
+                        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                        "@%+=:,./_-") == std::string::npos;
+  if (safe) return word;
+  std::string out = "'";
+  for (char c : word) {
+    if (c == '\'')
+      out += "'\\''";
+    else
+      out += c;
+  }
+  return out + "'";
+}
+
+Provenance makeProvenance(const std::string& tool, int argc, const char* const* argv,
+                          const nlohmann::json& parameters) {
+  Provenance p;
+  p.tool = tool;
+#ifdef RAD_VERSION
+  p.version = RAD_VERSION;
+#else
+  p.version = "unknown";
+#endif
+#ifdef RAD_GIT_REVISION
+  p.gitRevision = RAD_GIT_REVISION;
+#else
+  p.gitRevision = "unknown";
+#endif
+  for (int i = 0; i < argc; ++i) {
+    if (i) p.commandLine += ' ';
+    p.commandLine += shellQuote(argv[i] ? argv[i] : "");
+  }
+  if (parameters.is_object())
+    p.parameters = parameters;
+  else if (!parameters.is_null())
+    p.parameters = {{"value", parameters}};
+  return p;
+}
+
+std::string hashFile(const std::string& path) {
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw inputError(path, std::string("cannot open: ") + std::strerror(errno));
+  struct stat st;
+  if (::fstat(fd, &st) != 0 || S_ISDIR(st.st_mode)) {
+    ::close(fd);
+    throw inputError(path, "not a regular file");
+  }
+  std::vector<unsigned char> buf(1 << 20);
+  uint64_t h = kFnv1a64Offset;
+  for (;;) {
+    const ssize_t n = ::read(fd, buf.data(), buf.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      ::close(fd);
+      throw inputError(path, std::string("cannot read: ") + std::strerror(err));
+    }
+    if (n == 0) break;
+    h = fnv1a64(buf.data(), static_cast<std::size_t>(n), h);
+  }
+  ::close(fd);
+  return formatFnv1a64(h);
+}
+
+void addInput(Provenance& provenance, const std::string& path) {
+  if (ContainerReader::looksLikeContainer(path)) {
+    addInput(provenance, ContainerReader::open(path));
+    return;
+  }
+  provenance.inputs.push_back({path, hashFile(path), nullptr});
+}
+
+void addInput(Provenance& provenance, const ContainerReader& input) {
+  InputRecord r{input.path(), input.fileHash(), nullptr};
+  const auto& prov = input.header().find("provenance");
+  if (prov != input.header().end() && prov->is_object()) r.history = *prov;
+  provenance.inputs.push_back(std::move(r));
+}
+
+std::vector<std::string> parameterMismatch(const nlohmann::json& built,
+                                           const nlohmann::json& expected,
+                                           const std::vector<std::string>& keys) {
+  std::vector<std::string> out;
+  auto lookup = [](const nlohmann::json& obj, const std::string& key) -> const nlohmann::json* {
+    if (!obj.is_object()) return nullptr;
+    const auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+  };
+  for (const auto& key : keys) {
+    const nlohmann::json* b = lookup(built, key);
+    const nlohmann::json* e = lookup(expected, key);
+    const bool hasB = b != nullptr, hasE = e != nullptr;
+    if (!hasB && !hasE) continue;
+    if (hasB && hasE && *b == *e) continue;
+    const std::string name = optionName(key);
+    std::string msg = hasB ? "built with " + name + " " + optionValue(*b) : "built without " + name;
+    msg += hasE ? "; this run expects " + optionValue(*e) : "; this run does not set it";
+    out.push_back(msg);
+  }
+  return out;
+}
+
+}  // namespace rad
