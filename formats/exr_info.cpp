@@ -48,10 +48,14 @@ nlohmann::json attributeValue(const Imf::Attribute& a) {
 
 const char* pixelTypeName(Imf::PixelType t) {
   switch (t) {
-    case Imf::UINT: return "uint";
-    case Imf::HALF: return "half";
-    case Imf::FLOAT: return "float";
-    default: return "unknown";
+    case Imf::UINT:
+      return "uint";
+    case Imf::HALF:
+      return "half";
+    case Imf::FLOAT:
+      return "float";
+    default:
+      return "unknown";
   }
 }
 
@@ -75,7 +79,8 @@ nlohmann::json readExrInfo(const std::string& path) {
       }
       part["channels"] = channels;
       nlohmann::json attrs = nlohmann::json::object();
-      for (auto it = h.begin(); it != h.end(); ++it) attrs[it.name()] = attributeValue(it.attribute());
+      for (auto it = h.begin(); it != h.end(); ++it)
+        attrs[it.name()] = attributeValue(it.attribute());
       part["attributes"] = attrs;
       parts.push_back(part);
     }

@@ -11,7 +11,8 @@ FileKind detectFileKind(const std::string& path) {
   char b[16] = {};
   in.read(b, sizeof b);
   std::streamsize n = in.gcount();
-  if (n >= 8 && std::memcmp(b, "RADCONT", 7) == 0) return FileKind::kContainer;
+  // The container magic (formats/container.md).
+  if (n >= 8 && std::memcmp(b, "\x89RAD\r\n\x1a\n", 8) == 0) return FileKind::kContainer;
   if (n >= 4 && std::memcmp(b, "\x76\x2f\x31\x01", 4) == 0) return FileKind::kOpenExr;
   if (n >= 4 && std::memcmp(b, "glTF", 4) == 0) return FileKind::kGltfBinary;
   if (n >= 8 && std::memcmp(b, "\x89PNG\r\n\x1a\n", 8) == 0) return FileKind::kPng;
@@ -26,13 +27,20 @@ FileKind detectFileKind(const std::string& path) {
 
 const char* fileKindName(FileKind kind) {
   switch (kind) {
-    case FileKind::kMissing: return "missing";
-    case FileKind::kUnknown: return "unknown";
-    case FileKind::kContainer: return "rad container";
-    case FileKind::kOpenExr: return "OpenEXR";
-    case FileKind::kGltfJson: return "glTF";
-    case FileKind::kGltfBinary: return "glTF binary";
-    case FileKind::kPng: return "PNG";
+    case FileKind::kMissing:
+      return "missing";
+    case FileKind::kUnknown:
+      return "unknown";
+    case FileKind::kContainer:
+      return "rad container";
+    case FileKind::kOpenExr:
+      return "OpenEXR";
+    case FileKind::kGltfJson:
+      return "glTF";
+    case FileKind::kGltfBinary:
+      return "glTF binary";
+    case FileKind::kPng:
+      return "PNG";
   }
   return "unknown";
 }

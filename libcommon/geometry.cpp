@@ -16,7 +16,9 @@ glm::dvec3 Polygon::normal() const {
   return len > 0.0 ? a / len : glm::dvec3(0.0);
 }
 
-double Polygon::area() const { return glm::length(vectorArea()); }
+double Polygon::area() const {
+  return glm::length(vectorArea());
+}
 
 glm::dvec3 Polygon::centroid() const {
   // Fan triangulation from v0; each triangle's centroid weighted by its (signed) area.

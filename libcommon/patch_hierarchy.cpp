@@ -16,13 +16,18 @@ int PatchId::level() const {
 }
 
 PatchId PatchId::child(int k) const {
-  if (level() >= kMaxLevel) throw Error(ExitCode::kInternal, "", "patch " + toString() + ": too deep");
+  if (level() >= kMaxLevel)
+    throw Error(ExitCode::kInternal, "", "patch " + toString() + ": too deep");
   return {top, (path << 2) | uint32_t(k & 3)};
 }
 
-PatchId PatchId::parent() const { return {top, path >> 2}; }
+PatchId PatchId::parent() const {
+  return {top, path >> 2};
+}
 
-int PatchId::childIndex() const { return int(path & 3u); }
+int PatchId::childIndex() const {
+  return int(path & 3u);
+}
 
 std::string PatchId::toString() const {
   std::ostringstream os;
@@ -60,7 +65,8 @@ std::array<Polygon, 4> subdividePolygon(const Polygon& p) {
 glm::dvec3 polygonPointAt(const Polygon& p, glm::dvec2 uv) {
   double u = uv.x, v = uv.y;
   if (p.count == 4) {
-    return (1 - u) * (1 - v) * p.v[0] + u * (1 - v) * p.v[1] + u * v * p.v[2] + (1 - u) * v * p.v[3];
+    return (1 - u) * (1 - v) * p.v[0] + u * (1 - v) * p.v[1] + u * v * p.v[2] +
+           (1 - u) * v * p.v[3];
   }
   return p.v[0] + u * (p.v[1] - p.v[0]) + v * (p.v[2] - p.v[0]);
 }

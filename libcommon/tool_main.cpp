@@ -88,7 +88,9 @@ std::pair<int, int> parseImageSize(const std::string& spec, const std::string& f
   return {int(w), int(h)};
 }
 
-bool stderrIsTerminal() { return isatty(STDERR_FILENO) != 0; }
+bool stderrIsTerminal() {
+  return isatty(STDERR_FILENO) != 0;
+}
 
 Progress::Progress(std::string label, long total)
     : label_(std::move(label)), total_(total), active_(stderrIsTerminal() && total > 0) {}
@@ -110,6 +112,8 @@ void Progress::done() {
   active_ = false;
 }
 
-Progress::~Progress() { done(); }
+Progress::~Progress() {
+  done();
+}
 
 }  // namespace rad

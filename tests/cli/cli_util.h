@@ -42,7 +42,9 @@ inline CommandResult runCommand(const std::string& command) {
   return r;
 }
 
-inline std::string tool(const std::string& name) { return std::string(RAD_BIN_DIR) + "/" + name; }
+inline std::string tool(const std::string& name) {
+  return std::string(RAD_BIN_DIR) + "/" + name;
+}
 
 // Every rad-* executable that was built.
 inline std::vector<std::string> builtTools() {

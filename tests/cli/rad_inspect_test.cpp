@@ -1,0 +1,161 @@
+// rad-inspect on every kind of file it knows, and --check on damaged containers
+// (issue 2 "Done when").
+#include <filesystem>
+#include <fstream>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "formats/container.h"
+#include "formats/provenance.h"
+#include "tests/cli/cli_util.h"
+
+namespace rad::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kScene = std::string(RAD_SOURCE_DIR) + "/pipelines/scenes/cornell-moving.gltf";
+
+fs::path tempDir() {
+  fs::path d = fs::temp_directory_path() / ("rad_inspect_test_" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+std::string writeSampleContainer(const fs::path& dir) {
+  ContainerWriter w("sample", 1, 0);
+  w.setProvenance(makeProvenance("rad-test", 0, nullptr, {{"eps", 0.01}}));
+  w.metadata()["note"] = "written by rad_inspect_test";
+  w.addArray<float>("radiosity", {0.5f, 1.5f, 2.5f, 3.5f, 4.5f, 5.5f}, {2, 3});
+  w.addArray<uint32_t>("ids", {7, 8, 9});
+  std::string path = (dir / "sample.rad").string();
+  w.write(path);
+  return path;
+}
+
+TEST(RadInspect, BundledSceneJsonReportsWhatTheToolchainSees) {
+  CommandResult r = runCommand(tool("rad-inspect") + " --json " + kScene);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GE(j["emitters"].size(), 1u);
+  EXPECT_GT(j["emitters"][0]["power_w"][0].get<double>(), 0.0);
+  EXPECT_GE(j["dynamic_nodes"].size(), 1u);
+  EXPECT_EQ(j["cameras"].size(), 1u);
+  EXPECT_TRUE(j["cameras"][0]["animated"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["time_range"][0].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(j["time_range"][1].get<double>(), 4.0);
+  EXPECT_EQ(j["patches"].get<int>(), 16);  // 6 room quads + 5 + 5 box faces, all merged
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+}
+
+TEST(RadInspect, EveryExternalSceneExitsZeroOrOneNeverOnASignal) {
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(std::string(RAD_TEST_DATA) + "/external")) {
+    std::string ext = e.path().extension().string();
+    if (ext != ".gltf" && ext != ".glb") continue;
+    ++files;
+    CommandResult r = runCommand(tool("rad-inspect") + " " + e.path().string());
+    EXPECT_TRUE(r.exitCode == 0 || r.exitCode == 1) << e.path() << ": " << r.exitCode << r.err;
+  }
+  EXPECT_GE(files, 7);
+}
+
+TEST(RadInspect, SceneWithoutCameraOrEmitterIsAWarning) {
+  CommandResult r = runCommand(tool("rad-inspect") + " " + RAD_TEST_DATA +
+                               "/external/khronos_BoxAnimated/BoxAnimated.glb");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("warning        no camera"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("warning        no emitter"), std::string::npos) << r.out;
+}
+
+TEST(RadInspect, ContainerTextJsonArrayAndCheck) {
+  fs::path dir = tempDir();
+  std::string path = writeSampleContainer(dir);
+  CommandResult text = runCommand(tool("rad-inspect") + " " + path);
+  ASSERT_EQ(text.exitCode, 0) << text.err;
+  EXPECT_NE(text.out.find("radiosity"), std::string::npos);
+  EXPECT_NE(text.out.find("rad-test"), std::string::npos) << "provenance shows the tool";
+
+  CommandResult json = runCommand(tool("rad-inspect") + " --json " + path);
+  ASSERT_EQ(json.exitCode, 0);
+  nlohmann::json j = nlohmann::json::parse(json.out);
+  EXPECT_EQ(j["kind"], "sample");
+  EXPECT_EQ(j["provenance"]["parameters"]["eps"], 0.01);
+  EXPECT_EQ(j["arrays"][0]["stats"]["max"], 5.5);
+
+  CommandResult arr = runCommand(tool("rad-inspect") + " --array radiosity " + path);
+  ASSERT_EQ(arr.exitCode, 0);
+  EXPECT_EQ(arr.out, "0.5 1.5 2.5\n3.5 4.5 5.5\n");
+
+  CommandResult check = runCommand(tool("rad-inspect") + " --check " + path);
+  EXPECT_EQ(check.exitCode, 0);
+  EXPECT_EQ(check.out, path + ": ok\n");
+  fs::remove_all(dir);
+}
+
+TEST(RadInspect, TruncatedOrFlippedContainerIsOneLineAndExit1) {
+  fs::path dir = tempDir();
+  std::string path = writeSampleContainer(dir);
+  std::string bytes = readWholeFile(path);
+  std::string cut = (dir / "cut.rad").string();
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() - 1);
+  CommandResult r = runCommand(tool("rad-inspect") + " --check " + cut);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("rad-inspect: " + cut + ": ", 0), 0u) << r.err;
+
+  // One flipped byte anywhere in the preamble and the JSON header.
+  for (size_t at : {size_t(3), size_t(9), size_t(20), size_t(40), size_t(60), size_t(100)}) {
+    std::string flipped = bytes;
+    flipped[at] = char(flipped[at] ^ 0x10);
+    std::string p = (dir / ("flip" + std::to_string(at) + ".rad")).string();
+    std::ofstream(p, std::ios::binary) << flipped;
+    CommandResult f = runCommand(tool("rad-inspect") + " --check " + p);
+    EXPECT_EQ(f.exitCode, 1) << "byte " << at;
+    EXPECT_EQ(countLines(f.err), 1) << f.err;
+    EXPECT_EQ(f.err.rfind("rad-inspect: " + p + ": ", 0), 0u) << f.err;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(RadInspect, ExrPartsAndAttributes) {
+  fs::path dir = tempDir();
+  std::string path = (dir / "small.exr").string();
+  {
+    Imf::Header h(4, 2);
+    h.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    h.insert("rad.note", Imf::StringAttribute("hello"));
+    Imf::OutputFile out(path.c_str(), h);
+    std::vector<float> px(8, 1.0f);
+    Imf::FrameBuffer fb;
+    fb.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(px.data()), sizeof(float),
+                              4 * sizeof(float)));
+    out.setFrameBuffer(fb);
+    out.writePixels(2);
+  }
+  CommandResult r = runCommand(tool("rad-inspect") + " --json " + path);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["parts"][0]["width"], 4);
+  EXPECT_EQ(j["parts"][0]["attributes"]["rad.note"], "hello");
+  fs::remove_all(dir);
+}
+
+TEST(RadInspect, UnknownFileIsAnError) {
+  fs::path dir = tempDir();
+  std::string p = (dir / "notes.txt").string();
+  std::ofstream(p) << "hello";
+  CommandResult r = runCommand(tool("rad-inspect") + " " + p);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(r.err.rfind("rad-inspect: " + p + ": not a file", 0), 0u) << r.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rad::test

@@ -1,0 +1,209 @@
+// rad-inspect: shows what is inside any file of the toolchain (DESIGN.md §6 "rad-inspect"),
+// like Radiance's getinfo: a container's header, provenance and arrays; what the toolchain
+// sees in a glTF scene; an OpenEXR file's parts and attributes.
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+
+#include "formats/container.h"
+#include "formats/exr_info.h"
+#include "formats/file_kind.h"
+#include "formats/gltf_scene.h"
+#include "formats/inspect_kinds.h"
+#include "libcommon/scene_summary.h"
+#include "libcommon/tool_main.h"
+
+namespace {
+
+constexpr const char* kTool = "rad-inspect";
+
+struct Options {
+  std::vector<std::string> files;
+  bool json = false;
+  bool check = false;
+  std::string array;  // dump one array of a container
+};
+
+// count, min, max and non-finite count of one array, whatever its dtype.
+template <class T>
+nlohmann::json statsOf(const rad::ContainerReader& r, const rad::ArrayInfo& a) {
+  std::vector<T> v = r.array<T>(a.name);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  uint64_t nonFinite = 0;
+  for (const T& x : v) {
+    double d = double(x);
+    if (!std::isfinite(d)) {
+      ++nonFinite;
+      continue;
+    }
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+  }
+  nlohmann::json s = {{"count", v.size()}, {"non_finite", nonFinite}};
+  if (lo <= hi) s["min"] = lo, s["max"] = hi;
+  return s;
+}
+
+nlohmann::json arrayStats(const rad::ContainerReader& r, const rad::ArrayInfo& a) {
+  switch (a.dtype) {
+    case rad::DType::kU8:
+      return statsOf<uint8_t>(r, a);
+    case rad::DType::kU16:
+      return statsOf<uint16_t>(r, a);
+    case rad::DType::kU32:
+      return statsOf<uint32_t>(r, a);
+    case rad::DType::kU64:
+      return statsOf<uint64_t>(r, a);
+    case rad::DType::kI32:
+      return statsOf<int32_t>(r, a);
+    case rad::DType::kI64:
+      return statsOf<int64_t>(r, a);
+    case rad::DType::kF32:
+      return statsOf<float>(r, a);
+    case rad::DType::kF64:
+      return statsOf<double>(r, a);
+  }
+  return {};
+}
+
+template <class T>
+nlohmann::json valuesOf(const rad::ContainerReader& r, const std::string& name) {
+  return r.array<T>(name);
+}
+
+nlohmann::json arrayValues(const rad::ContainerReader& r, const rad::ArrayInfo& a) {
+  switch (a.dtype) {
+    case rad::DType::kU8:
+      return valuesOf<uint8_t>(r, a.name);
+    case rad::DType::kU16:
+      return valuesOf<uint16_t>(r, a.name);
+    case rad::DType::kU32:
+      return valuesOf<uint32_t>(r, a.name);
+    case rad::DType::kU64:
+      return valuesOf<uint64_t>(r, a.name);
+    case rad::DType::kI32:
+      return valuesOf<int32_t>(r, a.name);
+    case rad::DType::kI64:
+      return valuesOf<int64_t>(r, a.name);
+    case rad::DType::kF32:
+      return valuesOf<float>(r, a.name);
+    case rad::DType::kF64:
+      return valuesOf<double>(r, a.name);
+  }
+  return {};
+}
+
+nlohmann::json inspectContainer(const std::string& path, const Options& o, std::string& text) {
+  rad::ContainerReader r = rad::ContainerReader::open(path);
+  if (!o.array.empty()) {
+    const rad::ArrayInfo& a = r.info(o.array);
+    nlohmann::json values = arrayValues(r, a);
+    // Rows of the last dimension, one per line, so the output pipes into awk or gnuplot.
+    size_t row = a.shape.size() > 1 ? size_t(a.shape.back()) : 1;
+    std::ostringstream os;
+    for (size_t i = 0; i < values.size(); ++i) {
+      os << values[i].dump() << ((i + 1) % row == 0 ? "\n" : " ");
+    }
+    text = os.str();
+    return {{"path", path}, {"array", a.name}, {"shape", a.shape}, {"values", values}};
+  }
+  nlohmann::json j;
+  j["path"] = path;
+  j["type"] = "container";
+  j["kind"] = r.kind();
+  j["kind_version"] = {r.kindVersion().first, r.kindVersion().second};
+  j["provenance"] = r.provenance().toJson();
+  j["metadata"] = r.metadata();
+  nlohmann::json arrays = nlohmann::json::array();
+  std::ostringstream os;
+  os << r.summary();
+  os << "provenance:\n" << r.provenance().toText();
+  os << "array summaries:\n";
+  for (const rad::ArrayInfo& a : r.arrays()) {
+    nlohmann::json s = arrayStats(r, a);
+    arrays.push_back(
+        {{"name", a.name}, {"dtype", rad::dtypeName(a.dtype)}, {"shape", a.shape}, {"stats", s}});
+    os << "  " << a.name << ": " << s.dump() << "\n";
+  }
+  j["arrays"] = arrays;
+  // What the stage that wrote it knows about its content (movies, links, ...).
+  nlohmann::json content = rad::summarizeContainerContent(r);
+  if (!content.is_null()) {
+    j["content"] = content;
+    os << "content:\n" << rad::contentSummaryText(content);
+  }
+  text = os.str();
+  return j;
+}
+
+nlohmann::json inspectOne(const std::string& path, const Options& o, std::string& text) {
+  rad::FileKind kind = rad::detectFileKind(path);
+  switch (kind) {
+    case rad::FileKind::kMissing:
+      throw rad::inputError(path, std::filesystem::is_directory(path)
+                                      ? "is a directory"
+                                      : "cannot open (missing or unreadable)");
+    case rad::FileKind::kContainer:
+      return inspectContainer(path, o, text);
+    case rad::FileKind::kGltfJson:
+    case rad::FileKind::kGltfBinary: {
+      rad::Scene scene = rad::readGltfScene(path);
+      nlohmann::json s = rad::summarizeScene(scene);
+      s["type"] = "gltf";
+      text = rad::sceneSummaryText(s);
+      return s;
+    }
+    case rad::FileKind::kOpenExr: {
+      nlohmann::json info = rad::readExrInfo(path);
+      info["path"] = path;
+      info["type"] = "openexr";
+      std::ostringstream os;
+      os << path << ": OpenEXR, " << info["parts"].size() << " part(s)\n";
+      for (const auto& p : info["parts"]) {
+        os << "  part '" << p["name"].get<std::string>() << "' " << p["width"] << "x" << p["height"]
+           << " channels " << p["channels"].dump() << "\n";
+        for (const auto& [k, v] : p["attributes"].items())
+          os << "    " << k << " = " << v.dump() << "\n";
+      }
+      text = os.str();
+      return info;
+    }
+    default:
+      throw rad::inputError(
+          path, std::string("not a file rad-inspect knows (") + rad::fileKindName(kind) + ")");
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Shows what is inside a rad file (container, glTF scene, OpenEXR)."};
+  Options o;
+  rad::setUpApp(app, kTool, "rad-inspect out/global.rlh --array radiosity");
+  app.add_option("FILE", o.files, "files to inspect")->required();
+  app.add_flag("--json", o.json, "print JSON on stdout instead of text");
+  app.add_flag("--check", o.check, "validate only: print 'FILE: ok' or the error");
+  app.add_option("--array", o.array, "dump one array of a container file");
+  if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
+
+  int worst = 0;
+  nlohmann::json all = nlohmann::json::array();
+  for (const std::string& path : o.files) {
+    int rc = rad::runTool(kTool, [&]() {
+      std::string text;
+      nlohmann::json j = inspectOne(path, o, text);
+      if (o.check) {
+        std::cout << path << ": ok\n";
+      } else if (o.json) {
+        all.push_back(j);
+      } else {
+        std::cout << text;
+      }
+      return 0;
+    });
+    worst = std::max(worst, rc);
+  }
+  if (o.json && !o.check) std::cout << (all.size() == 1 ? all[0] : all).dump(1) << "\n";
+  return worst;
+}
