@@ -1,29 +1,106 @@
-# The production pipeline (DESIGN.md §1, §7): make -f pipelines/animation.mk [VAR=value ...]
+# The production pipeline (DESIGN.md §1, §7):
 #
-#   scene.gltf ─► rad-global ─► global.rlh ──┐
+#   make -f pipelines/animation.mk [SCENE=...] [FRAMES=0-95] [SIZE=352x240] [GLOBAL_FLAGS=...] ...
+#
+#   scene.gltf ─► rad-global ────► global.rlh ──────┐
 #        └──────► rad-intervals ─► intervals.rti ─► rad-movies ─► movies/ ─► rad-compose ─► frames/ ─► movie.mp4
 #
-# Stages whose tools are not built yet are reported, not faked.
+# Each stage's parameters are written to a stamp file (OUT/*.params) that changes only when
+# they change, so Make re-runs exactly the stages a change affects: GLOBAL_FLAGS re-runs
+# global → movies → compose; INTERVALS_FLAGS re-runs intervals → movies → compose;
+# MOVIES_FLAGS re-runs movies → compose; COMPOSE_FLAGS re-runs compose only.
+# Every tool writes atomically, and directory outputs are marked done by a stamp written
+# after the tool succeeded, so a killed stage leaves nothing Make would take as up to date.
+# `make -j` is safe: global and intervals run side by side.
 
 SCENE ?= pipelines/scenes/cornell-moving.gltf
 OUT   ?= out/$(basename $(notdir $(SCENE)))
 BIN   ?= build/bin
 
-.PHONY: all clean
+FRAMES ?= 0-95
+FPS    ?= 24
+SIZE   ?= 352x240
+
+GLOBAL_FLAGS    ?=
+INTERVALS_FLAGS ?=
+MOVIES_FLAGS    ?=
+COMPOSE_FLAGS   ?=
+
+GLOBAL_ARGS    = --frames $(FRAMES) --fps $(FPS) $(GLOBAL_FLAGS)
+INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) $(INTERVALS_FLAGS)
+MOVIES_ARGS    = $(MOVIES_FLAGS)
+COMPOSE_ARGS   = --frames $(FRAMES) $(COMPOSE_FLAGS)
+
+STAGES = rad-global rad-intervals rad-movies rad-compose
+MISSING = $(foreach t,$(STAGES),$(if $(wildcard $(BIN)/$(t)),,$(t)))
+
+.PHONY: all frames clean FORCE
 .DELETE_ON_ERROR:
 
-all: $(OUT)/scene.json
-	@for t in rad-global rad-intervals rad-movies rad-compose; do \
-	  test -x $(BIN)/$$t || echo "animation.mk: $$t is not built yet; frames and movie.mp4 need it" >&2; \
-	done
+ifeq ($(MISSING),)
+all: $(OUT)/movie.mp4 $(OUT)/contact-sheet.png
+	@echo "animation.mk: frames in $(OUT)/frames, $(OUT)/movie.mp4, $(OUT)/contact-sheet.png" >&2
+else
+# Run what exists and say what is still missing.
+all: $(OUT)/scene.json $(if $(filter rad-global,$(MISSING)),,$(OUT)/global.rlh) \
+     $(if $(filter rad-intervals,$(MISSING)),,$(OUT)/intervals.rti)
+	@echo "animation.mk: not built yet: $(MISSING); frames and movie.mp4 need them" >&2
+endif
 
-$(OUT):
-	mkdir -p $@
+frames: $(OUT)/frames/.done
+
+# A stamp's content is the stage's parameters; it is rewritten only when they change.
+define update-params
+	@mkdir -p $(@D)
+	@printf '%s\n' '$(1)' > $@.new
+	@if cmp -s $@.new $@; then rm -f $@.new; else mv -f $@.new $@; fi
+endef
+
+$(OUT)/global.params: FORCE
+	$(call update-params,$(GLOBAL_ARGS))
+$(OUT)/intervals.params: FORCE
+	$(call update-params,$(INTERVALS_ARGS))
+$(OUT)/movies.params: FORCE
+	$(call update-params,$(MOVIES_ARGS))
+$(OUT)/compose.params: FORCE
+	$(call update-params,$(COMPOSE_ARGS))
 
 # What the toolchain sees in the scene (patches, emitters, dynamic nodes, camera, time range).
-$(OUT)/scene.json: $(SCENE) $(BIN)/rad-inspect | $(OUT)
-	$(BIN)/rad-inspect --json $(SCENE) > $@.tmp && mv $@.tmp $@
-	@$(BIN)/rad-inspect $(SCENE) >&2
+$(OUT)/scene.json: $(SCENE) $(BIN)/rad-inspect
+	@mkdir -p $(@D)
+	$(BIN)/rad-inspect --json $(SCENE) > $@.tmp && mv -f $@.tmp $@
+
+$(OUT)/global.rlh: $(SCENE) $(OUT)/global.params $(BIN)/rad-global
+	$(BIN)/rad-global $(SCENE) -o $@ $(GLOBAL_ARGS) --report $(OUT)/global-report.json
+
+$(OUT)/intervals.rti: $(SCENE) $(OUT)/intervals.params $(BIN)/rad-intervals
+	$(BIN)/rad-intervals $(SCENE) -o $@ $(INTERVALS_ARGS) --report $(OUT)/intervals-report.json
+
+$(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
+	@rm -f $@
+	$(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti -o $(OUT)/movies $(MOVIES_ARGS) \
+	  --report $(OUT)/movies-report.json
+	@touch $@
+
+$(OUT)/frames/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
+                     $(BIN)/rad-compose
+	@rm -f $@
+	$(BIN)/rad-compose $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies -o $(OUT)/frames \
+	  $(COMPOSE_ARGS)
+	@touch $@
+
+$(OUT)/movie.mp4: $(OUT)/frames/.done
+	ffmpeg -loglevel error -y -framerate $(FPS) -start_number $(firstword $(subst -, ,$(FRAMES))) \
+	  -i $(OUT)/frames/%04d.png -c:v libx264 -pix_fmt yuv420p -crf 18 -f mp4 $@.tmp
+	mv -f $@.tmp $@
+
+# Every 12th frame, 4 across.
+$(OUT)/contact-sheet.png: $(OUT)/frames/.done
+	ffmpeg -loglevel error -y -start_number $(firstword $(subst -, ,$(FRAMES))) -i $(OUT)/frames/%04d.png \
+	  -vf "select=not(mod(n\,12)),tile=4x2:padding=4:color=white" -frames:v 1 -update 1 -f image2 $@.tmp
+	mv -f $@.tmp $@
 
 clean:
 	rm -rf $(OUT)
+
+FORCE:
