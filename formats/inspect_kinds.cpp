@@ -2,11 +2,15 @@
 
 #include <sstream>
 
+#include "formats/link_hierarchy.h"
+#include "formats/texture_intervals.h"
+
 namespace rad {
 
 nlohmann::json summarizeContainerContent(const ContainerReader& reader) {
-  // Kinds register here as their stages land (linkhier, intervals).
-  (void)reader;
+  // Each kind's summary lives with its format.
+  if (reader.kind() == kLinkHierarchyKind) return summarizeLinkHierarchy(reader);
+  if (reader.kind() == kTextureIntervalsKind) return summarizeTextureIntervals(reader);
   return nullptr;
 }
 

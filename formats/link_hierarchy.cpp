@@ -1,0 +1,173 @@
+#include "formats/link_hierarchy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace rad {
+
+namespace {
+
+std::vector<float> flatten(const std::vector<glm::vec3>& v) {
+  std::vector<float> out(v.size() * 3);
+  for (size_t i = 0; i < v.size(); ++i)
+    for (int c = 0; c < 3; ++c) out[i * 3 + c] = v[i][c];
+  return out;
+}
+
+std::vector<glm::vec3> unflatten(const std::vector<float>& f) {
+  std::vector<glm::vec3> out(f.size() / 3);
+  for (size_t i = 0; i < out.size(); ++i) out[i] = {f[i * 3], f[i * 3 + 1], f[i * 3 + 2]};
+  return out;
+}
+
+}  // namespace
+
+void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
+                        const Provenance& provenance, const nlohmann::json& metadata) {
+  s.validate(path);
+  ContainerWriter w(kLinkHierarchyKind, kLinkHierarchyMajor, kLinkHierarchyMinor);
+  w.setProvenance(provenance);
+  w.metadata() = metadata.is_object() ? metadata : nlohmann::json::object();
+  size_t N = size_t(s.hierarchy.size()), K = s.keyTimes.size();
+  w.metadata()["key_count"] = K;
+  w.metadata()["node_count"] = N;
+  w.metadata()["link_count"] = s.links.size();
+  w.metadata()["top_count"] = s.hierarchy.topCount();
+
+  w.addArray("key_times", s.keyTimes);
+  std::vector<uint64_t> ids(N);
+  std::vector<int32_t> parent(N);
+  for (size_t i = 0; i < N; ++i) {
+    ids[i] = s.hierarchy.node(int(i)).id.packed();
+    parent[i] = s.hierarchy.node(int(i)).parent;
+  }
+  w.addArray("node_ids", ids);
+  w.addArray("node_parent", parent);
+  w.addArray("node_radiosity", flatten(s.nodeRadiosity), {N, K, 3});
+  w.addArray("leaf_row", s.leafRow);
+  size_t L = s.leafVertexGoodIrradiance.size() / std::max<size_t>(1, K * 4);
+  w.addArray("leaf_vertex_good_irradiance", flatten(s.leafVertexGoodIrradiance), {L, K, 4, 3});
+  size_t M = s.links.size();
+  std::vector<uint32_t> cols(M * 6);
+  std::vector<uint8_t> flags(M);
+  for (size_t i = 0; i < M; ++i) {
+    const GlobalLink& l = s.links[i];
+    uint32_t row[6] = {l.receiver, l.shooter, l.firstKey, l.lastKey, l.sampleOffset, l.sampleCount};
+    std::copy(row, row + 6, cols.begin() + i * 6);
+    flags[i] = l.flags;
+  }
+  w.addArray("links", cols, {M, 6});
+  w.addArray("link_flags", flags);
+  w.addArray("link_sample_keys", s.linkSampleKeys);
+  w.addArray("link_sample_values", s.linkSampleValues);
+  std::vector<uint32_t> pairs;
+  for (auto& p : s.badPairs) {
+    pairs.push_back(p.first);
+    pairs.push_back(p.second);
+  }
+  w.addArray("bad_pairs", pairs, {s.badPairs.size(), 2});
+  w.write(path);
+}
+
+GlobalSolution readLinkHierarchy(const ContainerReader& r, const Scene& scene) {
+  const std::string& where = r.path();
+  r.requireKind(kLinkHierarchyKind, kLinkHierarchyMajor);
+  GlobalSolution s;
+  s.keyTimes = r.array<double>("key_times");
+  size_t K = s.keyTimes.size();
+  s.hierarchy = PatchHierarchy(scene.inputPolygons());
+  std::vector<uint64_t> ids = r.array<uint64_t>("node_ids");
+  size_t tops = size_t(s.hierarchy.topCount());
+  if (ids.size() < tops || r.metadata().value("top_count", -1) != int64_t(tops))
+    throw inputError(where, "was computed for a scene with " +
+                                std::to_string(r.metadata().value("top_count", -1)) +
+                                " top-level patches; this scene has " + std::to_string(tops));
+  for (size_t i = 0; i < tops; ++i)
+    if (ids[i] != PatchId{uint32_t(i), 1}.packed())
+      throw inputError(
+          where, "node " + std::to_string(i) + " is not top-level patch " + std::to_string(i));
+  for (size_t i = tops; i < ids.size();) {
+    PatchId id = PatchId::fromPacked(ids[i]);
+    if (id.top >= tops || id.level() < 1 || id.level() > PatchId::kMaxLevel || id.childIndex() != 0)
+      throw inputError(where, "node " + std::to_string(i) + " has an invalid id");
+    int parent = s.hierarchy.find(id.parent());
+    if (parent < 0 || !s.hierarchy.isLeaf(parent) || i + 4 > ids.size())
+      throw inputError(where, "node ids are not in subdivision order at node " + std::to_string(i));
+    int first = s.hierarchy.subdivide(parent);
+    for (int k = 0; k < 4; ++k)
+      if (size_t(first + k) != i + k || s.hierarchy.node(first + k).id.packed() != ids[i + k])
+        throw inputError(where,
+                         "node ids are not in subdivision order at node " + std::to_string(i));
+    i += 4;
+  }
+  size_t N = ids.size();
+  std::vector<float> b = r.array<float>("node_radiosity");
+  if (b.size() != N * K * 3) throw inputError(where, "node_radiosity has the wrong size");
+  s.nodeRadiosity = unflatten(b);
+  s.leafRow = r.array<int32_t>("leaf_row");
+  s.leafVertexGoodIrradiance = unflatten(r.array<float>("leaf_vertex_good_irradiance"));
+  std::vector<uint32_t> cols = r.array<uint32_t>("links");
+  std::vector<uint8_t> flags = r.array<uint8_t>("link_flags");
+  if (cols.size() != flags.size() * 6)
+    throw inputError(where, "links and link_flags differ in size");
+  s.links.resize(flags.size());
+  for (size_t i = 0; i < flags.size(); ++i) {
+    const uint32_t* c = &cols[i * 6];
+    s.links[i] = {c[0], c[1], c[2], c[3], c[4], c[5], flags[i]};
+  }
+  s.linkSampleKeys = r.array<uint32_t>("link_sample_keys");
+  s.linkSampleValues = r.array<float>("link_sample_values");
+  std::vector<uint32_t> pairs = r.array<uint32_t>("bad_pairs");
+  if (pairs.size() % 2) throw inputError(where, "bad_pairs has an odd size");
+  for (size_t i = 0; i < pairs.size(); i += 2) s.badPairs.emplace_back(pairs[i], pairs[i + 1]);
+  s.validate(where);
+  return s;
+}
+
+GlobalSolution readLinkHierarchy(const std::string& path, const Scene& scene) {
+  return readLinkHierarchy(ContainerReader::open(path), scene);
+}
+
+nlohmann::json summarizeLinkHierarchy(const ContainerReader& r) {
+  nlohmann::json j;
+  std::vector<double> keys = r.array<double>("key_times");
+  j["key_times"] =
+      keys.empty()
+          ? nlohmann::json(nullptr)
+          : nlohmann::json{{"count", keys.size()}, {"first", keys.front()}, {"last", keys.back()}};
+  std::vector<uint64_t> ids = r.array<uint64_t>("node_ids");
+  std::map<int, int> perLevel;
+  for (uint64_t id : ids) perLevel[PatchId::fromPacked(id).level()]++;
+  nlohmann::json levels = nlohmann::json::object();
+  for (auto& [l, n] : perLevel) levels[std::to_string(l)] = n;
+  j["nodes"] = {{"total", ids.size()}, {"per_level", levels}};
+  std::vector<uint8_t> flags = r.array<uint8_t>("link_flags");
+  std::vector<uint32_t> cols = r.array<uint32_t>("links");
+  size_t bad = 0, vis = 0, refined = 0, constant = 0;
+  for (size_t i = 0; i < flags.size(); ++i) {
+    bad += (flags[i] & kLinkBad) != 0;
+    vis += (flags[i] & kLinkVisibilityEvent) != 0;
+    refined += (flags[i] & kLinkRefined) != 0;
+    if (i * 6 + 5 < cols.size()) constant += cols[i * 6 + 5] == 1;
+  }
+  j["links"] = {{"total", flags.size()},      {"bad", bad},
+                {"good", flags.size() - bad}, {"refined", refined},
+                {"visibility_events", vis},   {"single_sample", constant}};
+  j["bad_pairs"] = r.info("bad_pairs").count() / 2;
+  std::vector<float> b = r.array<float>("node_radiosity");
+  size_t nonFinite = 0, negative = 0;
+  float maxB = 0.0f;
+  for (float x : b) {
+    if (!std::isfinite(x))
+      ++nonFinite;
+    else {
+      if (x < 0) ++negative;
+      maxB = std::max(maxB, x);
+    }
+  }
+  j["radiosity"] = {{"max", maxB}, {"non_finite", nonFinite}, {"negative", negative}};
+  return j;
+}
+
+}  // namespace rad

@@ -1,0 +1,33 @@
+// global.rlh: the space-time link hierarchy rad-global writes (container kind "linkhier").
+// Arrays and metadata: formats/link_hierarchy.md.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "formats/container.h"
+#include "libcommon/global_solution.h"
+#include "libcommon/scene.h"
+
+namespace rad {
+
+constexpr const char* kLinkHierarchyKind = "linkhier";
+constexpr int kLinkHierarchyMajor = 1;
+constexpr int kLinkHierarchyMinor = 0;
+
+// Writes `solution` atomically. `metadata` (an object) is stored as the kind's metadata; the
+// writer adds key_count, node_count, link_count, top_count.
+void writeLinkHierarchy(const std::string& path, const GlobalSolution& solution,
+                        const Provenance& provenance, const nlohmann::json& metadata);
+
+// Reads and validates a linkhier container against the scene it was computed for: the
+// top-level patches are rebuilt from scene.inputPolygons() and must agree in number; node ids
+// must form the hierarchy in subdivision order. Errors are rad::inputError(path, ...).
+GlobalSolution readLinkHierarchy(const ContainerReader& reader, const Scene& scene);
+GlobalSolution readLinkHierarchy(const std::string& path, const Scene& scene);
+
+// rad-inspect's content summary of a linkhier container (no scene needed).
+nlohmann::json summarizeLinkHierarchy(const ContainerReader& reader);
+
+}  // namespace rad

@@ -1,0 +1,180 @@
+#include "formats/texture_movie.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputPart.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
+#include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfStringAttribute.h>
+
+#include "formats/atomic_file.h"
+#include "libcommon/error.h"
+
+namespace rad {
+
+void TextureMovie::textureAt(double t, std::vector<float>& out) const {
+  size_t n = size_t(width) * height * 3;
+  out.resize(n);
+  if (keys.size() == 1 || t <= keyTimes.front()) {
+    std::copy(keys.front().begin(), keys.front().end(), out.begin());
+    return;
+  }
+  if (t >= keyTimes.back()) {
+    std::copy(keys.back().begin(), keys.back().end(), out.begin());
+    return;
+  }
+  size_t k1 = size_t(std::upper_bound(keyTimes.begin(), keyTimes.end(), t) - keyTimes.begin());
+  size_t k0 = k1 - 1;
+  float w = float((t - keyTimes[k0]) / (keyTimes[k1] - keyTimes[k0]));
+  const float* a = keys[k0].data();
+  const float* b = keys[k1].data();
+  for (size_t i = 0; i < n; ++i) out[i] = (1.0f - w) * a[i] + w * b[i];
+}
+
+std::string textureMoviePath(const std::string& dir, uint32_t id) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/%06u.exr", id);
+  return dir + name;
+}
+
+void writeTextureMovie(const std::string& path, const TextureMovie& m) {
+  if (m.keys.empty() || m.keys.size() != m.keyTimes.size() || m.keys.size() != m.keyFrames.size())
+    throw Error(ExitCode::kInternal, path, "texture movie keys, times and frames differ");
+  size_t n = size_t(m.width) * m.height * 3;
+  std::vector<Imf::Header> headers;
+  for (size_t k = 0; k < m.keys.size(); ++k) {
+    if (m.keys[k].size() != n)
+      throw Error(ExitCode::kInternal, path, "texture movie key has the wrong size");
+    Imf::Header h(m.width, m.height);
+    h.compression() = Imf::ZIP_COMPRESSION;
+    h.lineOrder() = Imf::INCREASING_Y;
+    for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    char name[32];
+    std::snprintf(name, sizeof name, "key%04zu", k);
+    h.setName(name);
+    h.setType(Imf::SCANLINEIMAGE);
+    h.insert("rad.format",
+             Imf::StringAttribute("texture-movie " + std::to_string(kTextureMovieMajor) + "." +
+                                  std::to_string(kTextureMovieMinor)));
+    h.insert("rad.movie", Imf::IntAttribute(int(m.movie)));
+    h.insert("rad.patch", Imf::StringAttribute(m.patch.toString()));
+    h.insert("rad.patchPacked", Imf::StringAttribute(std::to_string(m.patch.packed())));
+    h.insert("rad.level", Imf::IntAttribute(m.patch.level()));
+    h.insert("rad.firstFrame", Imf::IntAttribute(m.firstFrame));
+    h.insert("rad.lastFrame", Imf::IntAttribute(m.lastFrame));
+    h.insert("rad.keyCount", Imf::IntAttribute(int(m.keys.size())));
+    h.insert("rad.keyIndex", Imf::IntAttribute(int(k)));
+    h.insert("rad.keyFrame", Imf::IntAttribute(m.keyFrames[k]));
+    h.insert("rad.keyTime", Imf::DoubleAttribute(m.keyTimes[k]));
+    h.insert("rad.units", Imf::StringAttribute("irradiance W/m^2"));
+    if (k == 0 && !m.provenanceJson.empty())
+      h.insert("rad.provenance", Imf::StringAttribute(m.provenanceJson));
+    headers.push_back(h);
+  }
+  AtomicFile file(path);
+  try {
+    Imf::MultiPartOutputFile out(file.tempPath().c_str(), headers.data(), int(headers.size()));
+    for (size_t k = 0; k < m.keys.size(); ++k) {
+      Imf::OutputPart part(out, int(k));
+      Imf::FrameBuffer fb;
+      const size_t xs = 3 * sizeof(float), ys = size_t(m.width) * xs;
+      char* base = (char*)m.keys[k].data();
+      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+      part.setFrameBuffer(fb);
+      part.writePixels(m.height);
+    }
+  } catch (const std::exception& e) {
+    throw outputError(path, e.what());
+  }
+  file.commit();
+}
+
+namespace {
+
+template <class A>
+const A& attr(const Imf::Header& h, const char* name, const std::string& path) {
+  const A* a = h.findTypedAttribute<A>(name);
+  if (!a) throw inputError(path, std::string("not a texture movie: no attribute ") + name);
+  return *a;
+}
+
+}  // namespace
+
+TextureMovie readTextureMovie(const std::string& path) {
+  TextureMovie m;
+  try {
+    Imf::MultiPartInputFile in(path.c_str());
+    int parts = in.parts();
+    if (parts < 1) throw inputError(path, "no parts");
+    for (int k = 0; k < parts; ++k) {
+      const Imf::Header& h = in.header(k);
+      const std::string fmt = attr<Imf::StringAttribute>(h, "rad.format", path).value();
+      if (fmt.rfind("texture-movie ", 0) != 0) throw inputError(path, "not a texture movie");
+      int major = std::atoi(fmt.c_str() + 14);
+      if (major != kTextureMovieMajor)
+        throw inputError(path, "texture-movie version " + fmt.substr(14) + ", expected " +
+                                   std::to_string(kTextureMovieMajor) + ".x");
+      const Imath::Box2i dw = h.dataWindow();
+      int w = dw.max.x - dw.min.x + 1, hh = dw.max.y - dw.min.y + 1;
+      if (dw.min.x != 0 || dw.min.y != 0 || w < 1 || hh < 1 || w > 16384 || hh > 16384)
+        throw inputError(path, "part " + std::to_string(k) + ": invalid data window");
+      if (attr<Imf::IntAttribute>(h, "rad.keyCount", path).value() != parts ||
+          attr<Imf::IntAttribute>(h, "rad.keyIndex", path).value() != k)
+        throw inputError(path, "part " + std::to_string(k) + ": key index/count disagree");
+      for (const char* c : {"R", "G", "B"})
+        if (!h.channels().findChannel(c) || h.channels().findChannel(c)->type != Imf::FLOAT)
+          throw inputError(path,
+                           std::string("part ") + std::to_string(k) + ": no FLOAT channel " + c);
+      if (k == 0) {
+        m.width = w;
+        m.height = hh;
+        m.movie = uint32_t(attr<Imf::IntAttribute>(h, "rad.movie", path).value());
+        m.patch = PatchId::fromPacked(
+            std::stoull(attr<Imf::StringAttribute>(h, "rad.patchPacked", path).value()));
+        m.firstFrame = attr<Imf::IntAttribute>(h, "rad.firstFrame", path).value();
+        m.lastFrame = attr<Imf::IntAttribute>(h, "rad.lastFrame", path).value();
+        if (auto* p = h.findTypedAttribute<Imf::StringAttribute>("rad.provenance"))
+          m.provenanceJson = p->value();
+      } else if (w != m.width || hh != m.height) {
+        throw inputError(path, "parts differ in size");
+      }
+      m.keyFrames.push_back(attr<Imf::IntAttribute>(h, "rad.keyFrame", path).value());
+      m.keyTimes.push_back(attr<Imf::DoubleAttribute>(h, "rad.keyTime", path).value());
+      if (k > 0 && !(m.keyTimes[k] > m.keyTimes[k - 1]))
+        throw inputError(path, "key times are not increasing");
+      std::vector<float> px(size_t(w) * hh * 3);
+      Imf::InputPart part(in, k);
+      Imf::FrameBuffer fb;
+      const size_t xs = 3 * sizeof(float), ys = size_t(w) * xs;
+      char* base = (char*)px.data();
+      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+      part.setFrameBuffer(fb);
+      part.readPixels(0, hh - 1);
+      for (float v : px)
+        if (!std::isfinite(v))
+          throw inputError(path, "non-finite irradiance in part " + std::to_string(k));
+      m.keys.push_back(std::move(px));
+    }
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw inputError(path, e.what());
+  }
+  if (m.firstFrame > m.lastFrame) throw inputError(path, "first frame after last frame");
+  return m;
+}
+
+}  // namespace rad

@@ -1,0 +1,46 @@
+// movies/MMMMMM.exr: one texture movie (paper §3.1, §4.3): the irradiance over one patch node
+// at the movie's key times, as a multi-part OpenEXR file, one part per key time (FLOAT R, G, B;
+// W/m^2). Readable with exrheader and oiiotool --info -v. Spec: formats/texture_movie.md.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "formats/provenance.h"
+#include "libcommon/patch_hierarchy.h"
+
+namespace rad {
+
+constexpr int kTextureMovieMajor = 1;
+constexpr int kTextureMovieMinor = 0;
+
+struct TextureMovie {
+  uint32_t movie = 0;  // id in intervals.rti
+  PatchId patch;
+  int firstFrame = 0, lastFrame = 0;
+  int width = 1, height = 1;     // texel (i, j) centre at node (u,v) = ((i+.5)/w, (j+.5)/h);
+                                 // row j = 0 is v = 0 (stored as the EXR's first scanline)
+  std::vector<int> keyFrames;    // frames of the key textures, increasing, within the movie
+  std::vector<double> keyTimes;  // their times, seconds
+  // keys[k]: width * height * 3 floats (RGB irradiance), row-major from j = 0. A movie whose
+  // texture does not change over its interval has exactly one key ("constant").
+  std::vector<std::vector<float>> keys;
+  std::string provenanceJson;  // Provenance::toJson().dump() of the tool that baked it
+
+  bool constant() const { return keys.size() == 1; }
+  // Irradiance texture at time t: linear between the two key textures around t (held before
+  // the first and after the last). out gets width * height * 3 floats.
+  void textureAt(double t, std::vector<float>& out) const;
+};
+
+// Path of movie `id` in `dir`: dir/000042.exr.
+std::string textureMoviePath(const std::string& dir, uint32_t id);
+
+// Atomic write (temporary + rename). Throws rad::outputError(path, ...).
+void writeTextureMovie(const std::string& path, const TextureMovie& movie);
+// Reads and validates (part count, sizes, attributes, finite values). Throws
+// rad::inputError(path, ...), never crashes on a truncated or corrupted file.
+TextureMovie readTextureMovie(const std::string& path);
+
+}  // namespace rad
