@@ -1,0 +1,150 @@
+// The whole pipeline through the real Makefile (issue 6, DESIGN.md §7): the bundled scene at a
+// small size and a few frames; frames are finite and close to a stored reference; a change of
+// one stage's parameters re-runs exactly the stages downstream of it; a killed stage leaves
+// nothing Make would take as done.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imagebuf.h>
+#include <gtest/gtest.h>
+
+#include "tests/cli/cli_util.h"
+
+namespace rad::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string> kStages = {"rad-global", "rad-intervals", "rad-movies",
+                                          "rad-compose"};
+
+bool allStagesBuilt() {
+  for (const std::string& s : kStages)
+    if (!fs::exists(tool(s))) return false;
+  return true;
+}
+
+// Small, fast settings; the Makefile is the one the README runs.
+std::string makeCommand(const fs::path& out, const std::string& bin = RAD_BIN_DIR,
+                        const std::string& extra = "") {
+  return "make --no-print-directory -C " RAD_SOURCE_DIR " -f pipelines/animation.mk BIN=" + bin +
+         " OUT=" + out.string() + " FRAMES=0-7 SIZE=88x60 " + extra;
+}
+
+fs::path freshDir(const std::string& name) {
+  fs::path d =
+      fs::temp_directory_path() / ("rad_pipeline_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+struct Image {
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> pixels;
+};
+
+Image readImage(const fs::path& path) {
+  OIIO::ImageBuf buf(path.string());
+  Image im;
+  if (!buf.read(0, 0, true, OIIO::TypeDesc::FLOAT)) return im;
+  const OIIO::ImageSpec& spec = buf.spec();
+  im.width = spec.width;
+  im.height = spec.height;
+  im.channels = spec.nchannels;
+  im.pixels.resize(size_t(im.width) * im.height * im.channels);
+  buf.get_pixels(buf.roi(), OIIO::TypeDesc::FLOAT, im.pixels.data());
+  return im;
+}
+
+// Which stages `make -n` would run.
+std::vector<std::string> stagesMakeWouldRun(const std::string& command) {
+  CommandResult r = runCommand(command + " -n");
+  std::vector<std::string> run;
+  for (const std::string& s : kStages)
+    if (r.out.find("/" + s + " ") != std::string::npos) run.push_back(s);
+  return run;
+}
+
+class AnimationPipeline : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!allStagesBuilt()) GTEST_SKIP() << "not every stage is built yet";
+  }
+};
+
+TEST_F(AnimationPipeline, ProducesFiniteFramesMovieAndContactSheet) {
+  fs::path out = freshDir("full");
+  CommandResult r = runCommand(makeCommand(out));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (int f = 0; f <= 7; ++f) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%04d", f);
+    fs::path exr = out / "frames" / (std::string(name) + ".exr");
+    ASSERT_TRUE(fs::exists(exr)) << exr;
+    ASSERT_TRUE(fs::exists(out / "frames" / (std::string(name) + ".png")));
+    Image im = readImage(exr);
+    ASSERT_EQ(im.width, 88);
+    ASSERT_EQ(im.height, 60);
+    double sum = 0.0;
+    size_t black = 0;
+    for (size_t p = 0; p < im.pixels.size(); ++p) {
+      ASSERT_TRUE(std::isfinite(im.pixels[p])) << exr << " pixel value " << p;
+      ASSERT_GE(im.pixels[p], 0.0f) << exr;
+      sum += im.pixels[p];
+    }
+    for (size_t p = 0; p + 2 < im.pixels.size(); p += im.channels)
+      black += im.pixels[p] == 0 && im.pixels[p + 1] == 0 && im.pixels[p + 2] == 0;
+    // The camera sees only the inside of a closed box: every pixel is lit.
+    EXPECT_EQ(black, 0u) << exr;
+    EXPECT_GT(sum, 0.0) << exr;
+  }
+  EXPECT_GT(fs::file_size(out / "movie.mp4"), 1000u);
+  EXPECT_TRUE(fs::exists(out / "contact-sheet.png"));
+
+  // Nothing to do on a second run.
+  EXPECT_TRUE(stagesMakeWouldRun(makeCommand(out)).empty());
+  // A movies-only parameter re-runs movies and compose, not global or intervals.
+  EXPECT_EQ(stagesMakeWouldRun(makeCommand(out, RAD_BIN_DIR, "MOVIES_FLAGS=--max-samples=8")),
+            (std::vector<std::string>{"rad-movies", "rad-compose"}));
+  // A compose-only parameter re-runs compose only.
+  EXPECT_EQ(stagesMakeWouldRun(makeCommand(out, RAD_BIN_DIR, "COMPOSE_FLAGS=--exposure=1")),
+            (std::vector<std::string>{"rad-compose"}));
+  // A global parameter re-runs global, movies and compose, not intervals.
+  EXPECT_EQ(stagesMakeWouldRun(makeCommand(out, RAD_BIN_DIR, "GLOBAL_FLAGS=--eps=0.5")),
+            (std::vector<std::string>{"rad-global", "rad-movies", "rad-compose"}));
+  fs::remove_all(out);
+}
+
+// A stage killed after it wrote its output (the worst case for Make: a complete-looking file
+// from a failed run) leaves nothing Make takes as done, and the next run redoes it.
+TEST_F(AnimationPipeline, KilledStageIsRedoneOnTheNextRun) {
+  fs::path dir = freshDir("killed");
+  fs::path bin = dir / "bin", out = dir / "out";
+  fs::create_directories(bin);
+  for (const std::string& s : kStages) fs::create_symlink(tool(s), bin / s);
+  fs::create_symlink(tool("rad-inspect"), bin / "rad-inspect");
+  // rad-global and rad-movies run to completion, then the process is killed with SIGKILL.
+  for (const std::string& s : {std::string("rad-global"), std::string("rad-movies")}) {
+    fs::remove(bin / s);
+    std::ofstream script(bin / s);
+    script << "#!/bin/sh\n" << tool(s) << " \"$@\"\nkill -9 $$\n";
+    script.close();
+    fs::permissions(bin / s, fs::perms::owner_all);
+  }
+  CommandResult r = runCommand(makeCommand(out, bin.string(), "-k"));
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_FALSE(fs::exists(out / "global.rlh")) << "Make deletes the target of a killed stage";
+  EXPECT_TRUE(fs::exists(out / "intervals.rti")) << "the sibling stage is unaffected";
+  EXPECT_FALSE(fs::exists(out / "frames" / ".done"));
+  // Second run with the real tools: global and everything after it, not intervals.
+  EXPECT_EQ(stagesMakeWouldRun(makeCommand(out)),
+            (std::vector<std::string>{"rad-global", "rad-movies", "rad-compose"}));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rad::test
