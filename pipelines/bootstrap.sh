@@ -9,7 +9,7 @@ packages=(
   cmake g++ make pkg-config git
   libtinygltf-dev libstb-dev libglm-dev libopenexr-dev openexr libopenimageio-dev openimageio-tools
   libosmesa6-dev libembree-dev libtbb-dev libcli11-dev nlohmann-json3-dev
-  libgtest-dev libbenchmark-dev ffmpeg
+  libgtest-dev libbenchmark-dev ffmpeg python3 gnuplot-nox
 )
 
 missing=()
