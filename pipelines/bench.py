@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""Reproduces the paper's §6 tables with this toolchain (issue 7; DESIGN.md §8).
+
+Every configuration runs the whole pipeline twice with the same binaries, one after the
+other on this machine:
+
+  coherent    the default: space-time links reused between key times (rad-global), texture
+              movies as long as visibility allows, static blockers once per movie (rad-movies);
+  scratch     the per-frame static two-pass method the paper compares against:
+              rad-global --no-coherence, rad-intervals --max-length 1 (every movie one frame),
+              rad-movies --no-coherence (every blocker re-rendered for every frame).
+
+Wall time and peak resident memory are measured per stage from the child processes
+(os.wait4), so no external timer is needed. Speed-up = scratch time / coherent time, measured
+as a ratio in one run. The coherent and scratch frames are compared with rad-diff.
+
+usage: bench.py [--frames N] [--size WxH] [--out DIR] [--bin DIR] [--only NAME,...]
+"""
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+TABLE2 = ["table-static-static", "table-static-pan", "table-static-follow",
+          "table-dynamic-static", "table-dynamic-pan", "table-dynamic-follow"]
+TABLE3 = ["cubes-%d" % n for n in (1, 2, 4, 8, 16, 32)]
+TABLE5 = ["cubic"]
+
+
+def run(cmd, log):
+    """Runs cmd; returns (seconds, peak RSS in MiB). Raises on failure."""
+    t0 = time.monotonic()
+    with open(log, "ab") as f:
+        f.write(("$ " + " ".join(cmd) + "\n").encode())
+        f.flush()
+        p = subprocess.Popen(cmd, stdout=f, stderr=f)
+        _, status, usage = os.wait4(p.pid, 0)
+    dt = time.monotonic() - t0
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise RuntimeError("%s failed (see %s)" % (os.path.basename(cmd[0]), log))
+    return dt, usage.ru_maxrss / 1024.0
+
+
+def pipeline(bin_dir, scene, out, frames, size, scratch, log):
+    os.makedirs(out, exist_ok=True)
+    fr = "0-%d" % (frames - 1)
+    g, i, m, c = (os.path.join(bin_dir, t) for t in
+                  ("rad-global", "rad-intervals", "rad-movies", "rad-compose"))
+    no_coh = ["--no-coherence"] if scratch else []
+    stages = {}
+    stages["global"] = run([g, scene, "-o", out + "/global.rlh", "--frames", fr, "--fps", "24",
+                            "--report", out + "/global-report.json"] + no_coh, log)
+    stages["intervals"] = run([i, scene, "-o", out + "/intervals.rti", "--frames", fr, "--fps",
+                               "24", "--size", size, "--report", out + "/intervals-report.json"]
+                              + (["--max-length", "1"] if scratch else []), log)
+    stages["movies"] = run([m, scene, out + "/global.rlh", out + "/intervals.rti", "-o",
+                            out + "/movies", "--report", out + "/movies-report.json"] + no_coh, log)
+    stages["compose"] = run([c, scene, out + "/global.rlh", out + "/intervals.rti",
+                             out + "/movies", "-o", out + "/frames", "--frames", fr, "--no-png"],
+                            log)
+    total = sum(s[0] for s in stages.values())
+    peak = max(s[1] for s in stages.values())
+    return {"stages": stages, "total": total, "peak_mib": peak}
+
+
+def link_stats(report_path):
+    """Links recomputed per key time from rad-global's report (min, max, mean, % of total)."""
+    try:
+        with open(report_path) as f:
+            r = json.load(f)
+    except (OSError, ValueError):
+        return None
+    keys = r.get("keys") or r.get("key_times") or []
+    rec = [k.get("links_recomputed") for k in keys if isinstance(k, dict)]
+    tot = [k.get("links_total") for k in keys if isinstance(k, dict)]
+    rec = [x for x in rec[1:] if x is not None]  # the first key computes everything
+    tot = [x for x in tot[1:] if x]
+    if not rec or not tot:
+        return None
+    return {"min": min(rec), "max": max(rec), "mean": sum(rec) / len(rec),
+            "percent": 100.0 * sum(rec) / max(1, sum(tot))}
+
+
+def frame_difference(bin_dir, a, b):
+    diff = os.path.join(bin_dir, "rad-diff")
+    if not os.path.exists(diff):
+        return None
+    p = subprocess.run([diff, a, b, "--json"], capture_output=True, text=True)
+    if p.returncode != 0:
+        return None
+    try:
+        return json.loads(p.stdout)
+    except ValueError:
+        return None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    ap.add_argument("--frames", type=int, default=400)
+    ap.add_argument("--size", default="352x240")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--only", default="")
+    a = ap.parse_args()
+    scenes_dir = os.path.join(a.out, "scenes")
+    wanted = [s for s in a.only.split(",") if s] or TABLE2 + TABLE3 + TABLE5
+    subprocess.run([sys.executable, os.path.join(HERE, "scenes", "make_paper_scenes.py"),
+                    scenes_dir] + wanted, check=True, stdout=subprocess.DEVNULL)
+    log = os.path.join(a.out, "bench.log")
+    rows = []
+    for name in wanted:
+        scene = os.path.join(scenes_dir, name + ".gltf")
+        row = {"scene": name}
+        for mode in ("coherent", "scratch"):
+            out = os.path.join(a.out, name, mode)
+            print("bench: %s %s (%d frames, %s)" % (name, mode, a.frames, a.size),
+                  file=sys.stderr, flush=True)
+            row[mode] = pipeline(a.bin, scene, out, a.frames, a.size, mode == "scratch", log)
+        row["links"] = link_stats(os.path.join(a.out, name, "coherent", "global-report.json"))
+        row["difference"] = frame_difference(a.bin, os.path.join(a.out, name, "coherent", "frames"),
+                                             os.path.join(a.out, name, "scratch", "frames"))
+        rows.append(row)
+        print_tables(rows, a.frames, a.size, sys.stderr)
+    write_csv(rows, a.frames, os.path.join(a.out, "tables.csv"))
+    with open(os.path.join(a.out, "tables.json"), "w") as f:
+        json.dump(rows, f, indent=1)
+    print_tables(rows, a.frames, a.size, sys.stdout)
+
+
+def fmt_row(r, frames):
+    c, s = r["coherent"], r["scratch"]
+    return (r["scene"], c["total"], c["total"] / frames, s["total"], s["total"] / frames,
+            s["total"] / c["total"] if c["total"] > 0 else float("nan"), c["peak_mib"],
+            s["peak_mib"])
+
+
+def print_tables(rows, frames, size, out):
+    head = "%-22s %10s %9s %10s %9s %8s %9s %9s" % (
+        "scene", "coh. s", "s/frame", "scratch s", "s/frame", "speed-up", "coh. MiB", "scr. MiB")
+    for title, names in (("Table 2: table and chairs", TABLE2),
+                         ("Tables 3-4: moving cubes", TABLE3), ("Table 5: cubic", TABLE5)):
+        sel = [r for r in rows if r["scene"] in names]
+        if not sel:
+            continue
+        print("\n%s (%d frames, %s, this machine)" % (title, frames, size), file=out)
+        print(head, file=out)
+        for r in sel:
+            print("%-22s %10.2f %9.4f %10.2f %9.4f %8.2f %9.1f %9.1f" % fmt_row(r, frames), file=out)
+        if names is TABLE3:
+            print("%-22s %8s %8s %10s %8s" % ("links updated/key", "min", "max", "average", "%"),
+                  file=out)
+            for r in sel:
+                l = r.get("links")
+                if l:
+                    print("%-22s %8d %8d %10.1f %8.2f" % (r["scene"], l["min"], l["max"],
+                                                          l["mean"], l["percent"]), file=out)
+        diffs = [(r["scene"], r["difference"]) for r in sel if r.get("difference")]
+        for name, d in diffs:
+            print("%-22s coherent vs scratch: %s" % (name, json.dumps(d.get("summary", d))[:160]),
+                  file=out)
+    out.flush()
+
+
+def write_csv(rows, frames, path):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["scene", "frames", "coherent_s", "coherent_s_per_frame", "scratch_s",
+                    "scratch_s_per_frame", "speedup", "coherent_peak_mib", "scratch_peak_mib",
+                    "links_min", "links_max", "links_mean", "links_percent"]
+                   + ["coherent_%s_s" % s for s in ("global", "intervals", "movies", "compose")]
+                   + ["scratch_%s_s" % s for s in ("global", "intervals", "movies", "compose")])
+        for r in rows:
+            l = r.get("links") or {}
+            w.writerow(list(fmt_row(r, frames)[:1]) + [frames] + list(fmt_row(r, frames)[1:])
+                       + [l.get("min"), l.get("max"), l.get("mean"), l.get("percent")]
+                       + [r["coherent"]["stages"][s][0] for s in
+                          ("global", "intervals", "movies", "compose")]
+                       + [r["scratch"]["stages"][s][0] for s in
+                          ("global", "intervals", "movies", "compose")])
+
+
+if __name__ == "__main__":
+    main()
