@@ -1,0 +1,27 @@
+// Item buffers as OpenEXR files (DESIGN.md §5 `itembuffers/NNNN.exr`): what rad-intervals
+// saw at one frame, for inspection with rad-inspect, exrheader or oiiotool.
+//
+// One scanline part, data window (0,0)-(width-1,height-1), row 0 = top of the image (EXR's
+// INCREASING_Y, same as camera_projection.h), ZIP compression:
+//   channel "id" UINT:  item id (rad-intervals: dense patch node index + 1; 0 = nothing)
+//   channel "Z"  FLOAT: eye-space depth in metres (+inf where id is 0)
+// Attributes: rad.format "item-buffer 1.0", rad.frame (int), rad.time (double, seconds),
+// rad.provenance (the writer's provenance JSON) when given.
+#pragma once
+
+#include <string>
+
+#include "libcommon/item_buffer.h"
+
+namespace rad {
+
+constexpr int kItemBufferExrMajor = 1;
+constexpr int kItemBufferExrMinor = 0;
+
+// Written atomically (AtomicFile). Throws rad::outputError(path, ...) on failure.
+void writeItemBufferExr(const std::string& path, const ItemBuffer& buffer, int frame, double time,
+                        const std::string& provenanceJson = "");
+// Throws rad::inputError(path, ...) when the file is not an item buffer.
+ItemBuffer readItemBufferExr(const std::string& path);
+
+}  // namespace rad

@@ -1,0 +1,501 @@
+#include "libcommon/texture_intervals_builder.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "formats/gltf_scene.h"
+#include "formats/item_buffer_exr.h"
+#include "formats/provenance.h"
+#include "formats/texture_intervals.h"
+#include "libcommon/error.h"
+#include "libcommon/projected_area.h"
+
+namespace rad {
+namespace {
+
+constexpr ImageSize kSize{176, 120};
+
+// Synthetic scenes built directly in the scene model: fronto-parallel rectangles and one
+// camera at the origin looking down -Z, both optionally animated (LINEAR translation).
+struct TestScene {
+  Scene scene;
+  int camera = -1;
+
+  TestScene() {
+    scene.path = "test.gltf";
+    scene.materials.push_back(Material{});
+    Node cam;
+    cam.name = "camera";
+    cam.camera = 0;
+    Camera lens;
+    lens.name = "lens";
+    lens.yfov = 0.8;
+    lens.znear = 0.05;
+    scene.cameras.push_back(lens);
+    camera = addNode(cam);
+  }
+  int addNode(const Node& n) {
+    scene.nodes.push_back(n);
+    return int(scene.nodes.size()) - 1;
+  }
+  // Rectangle [x0, x1] x [y0, y1] in the plane z (local frame), facing +Z (the camera).
+  int addRect(const std::string& name, double x0, double y0, double x1, double y1, double z) {
+    Mesh m;
+    m.name = name;
+    glm::dvec3 a(x0, y0, z), b(x1, y0, z), c(x1, y1, z), d(x0, y1, z);
+    MeshTriangle t1, t2;
+    t1.p = {a, b, c};
+    t2.p = {a, c, d};
+    t1.material = t2.material = 0;
+    m.triangles = {t1, t2};
+    scene.meshes.push_back(m);
+    Node n;
+    n.name = name;
+    n.mesh = int(scene.meshes.size()) - 1;
+    return addNode(n);
+  }
+  // Linear translation from `from` at t = 0 to `to` at t = t1.
+  void move(int node, glm::dvec3 from, glm::dvec3 to, double t1) {
+    AnimationChannel ch;
+    ch.node = node;
+    ch.path = AnimationPath::kTranslation;
+    ch.interpolation = Interpolation::kLinear;
+    ch.times = {0.0, t1};
+    ch.values = {from.x, from.y, from.z, to.x, to.y, to.z};
+    scene.channels.push_back(ch);
+    scene.nodes[node].translation = from;
+  }
+};
+
+std::vector<int> frameRange(int a, int b) {
+  std::vector<int> f;
+  for (int i = a; i <= b; ++i) f.push_back(i);
+  return f;
+}
+
+int topOfNode(const PatchHierarchy& h, int sceneNode) {
+  for (int t = 0; t < h.topCount(); ++t)
+    if (h.top(t).node == sceneNode) return t;
+  return -1;
+}
+
+std::vector<MovieExtent> moviesOfTop(const std::vector<MovieExtent>& all, int top) {
+  std::vector<MovieExtent> out;
+  for (const MovieExtent& m : all)
+    if (int(m.patch.top) == top) out.push_back(m);
+  return out;
+}
+
+TEST(TextureSize, PowerOfTwoClampedWithHysteresis) {
+  TextureIntervalsOptions o;
+  EXPECT_EQ(textureSideFor(30.0 * 30.0, 0, o), 32);
+  EXPECT_EQ(textureSideFor(33.0 * 33.0, 0, o), 64);
+  EXPECT_EQ(textureSideFor(1.0, 0, o), 4);            // min size
+  EXPECT_EQ(textureSideFor(1e6 * 1e6, 0, o), 256);    // max size
+  EXPECT_EQ(textureSideFor(47.0 * 47.0, 32, o), 32);  // within (32/3, 48]: kept
+  EXPECT_EQ(textureSideFor(49.0 * 49.0, 32, o), 64);
+  EXPECT_EQ(textureSideFor(11.0 * 11.0, 32, o), 32);
+  EXPECT_EQ(textureSideFor(10.0 * 10.0, 32, o), 16);
+  o.texelDensity = 4.0;  // two texels per pixel along each side
+  EXPECT_EQ(textureSideFor(30.0 * 30.0, 0, o), 64);
+  o.resizeTolerance = 0.0;
+  o.texelDensity = 1.0;
+  EXPECT_EQ(textureSideFor(33.0 * 33.0, 32, o), 64);
+  EXPECT_EQ(textureSideFor(16.5 * 16.5, 32, o), 32);
+  EXPECT_EQ(textureSideFor(16.0 * 16.0, 32, o), 16);
+}
+
+TEST(TextureIntervalsOptions, RejectsBadValuesNamingTheFlag) {
+  TextureIntervalsOptions o;
+  o.minVisibleFraction = 1.5;
+  try {
+    o.validate();
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::kUsage);
+    EXPECT_NE(std::string(e.what()).find("--min-visible-fraction"), std::string::npos);
+  }
+  o = {};
+  o.maxSize = 2;
+  EXPECT_THROW(o.validate(), Error);
+}
+
+// A rectangle to the right of the view comes in as the camera pans right: its first movie
+// starts at the first frame where one pixel centre is inside its image.
+TEST(TextureIntervalsBuilder, PatchEnteringTheFrustumOpensAtTheExactFrame) {
+  TestScene s;
+  int rect = s.addRect("rect", 6.1, -1.0, 8.1, 1.0, -5.0);
+  s.move(s.camera, {0, 0, 0}, {10, 0, 0}, 2.0);  // 5 m/s; 48 frames at 24 fps
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  // Expected: first frame whose left edge projects left of the last column's centre.
+  int expected = -1;
+  for (int f = 0; f <= 48 && expected < 0; ++f) {
+    CameraView v = s.scene.cameraAt(s.camera, f / 24.0);
+    double x = projectToPixel(v, kSize, {6.1, 0.0, -5.0}).pixel.x;
+    ASSERT_GT(std::abs(x - (kSize.width - 0.5)), 0.05) << "ambiguous frame " << f;
+    if (x < kSize.width - 0.5) expected = f;
+  }
+  ASSERT_GT(expected, 5);
+  TextureIntervalsBuilder b(s.scene, s.camera, o);
+  for (int f : frameRange(0, 48)) b.addFrame(f);
+  std::vector<MovieExtent> all = b.finish();
+  std::vector<MovieExtent> mine = moviesOfTop(all, topOfNode(b.hierarchy(), rect));
+  ASSERT_FALSE(mine.empty());
+  int first = mine.front().firstFrame;
+  for (const MovieExtent& m : mine) first = std::min(first, m.firstFrame);
+  EXPECT_EQ(first, expected);
+  // Entering with a small visible fraction, it starts below the top level and goes up.
+  EXPECT_GT(mine.front().patch.level(), 0);
+  EXPECT_EQ(mine.back().patch.level(), 0);
+  EXPECT_EQ(mine.back().end, MovieEnd::kWindow);
+  for (size_t i = 0; i + 1 < mine.size(); ++i) EXPECT_EQ(mine[i].end, MovieEnd::kLevelChange) << i;
+}
+
+// A wide occluder slides across in front of a small rectangle: the rectangle's movie closes
+// as hidden the frame before it is fully covered and a new one opens when it reappears.
+TEST(TextureIntervalsBuilder, OccluderPassingInFrontClosesAsHidden) {
+  TestScene s;
+  int back = s.addRect("back", -1.0, -1.0, 1.0, 1.0, -10.0);
+  int occluder = s.addRect("occluder", -2.0, -3.0, 2.0, 3.0, -5.0);
+  // Centre x(f) = -10 + 0.3 f. The occluder (4 m wide at z = -5) hides the back rectangle
+  // ([-0.5, 0.5] at z = -5 in projection) for x in [-1.5, 1.5]: frames 29..38.
+  s.move(occluder, {-10, 0, 0}, {20, 0, 0}, 100.0 / 24.0);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 0;  // no level changes: only visibility events
+  std::vector<MovieExtent> all = buildTextureIntervals(s.scene, s.camera, frameRange(0, 60), o);
+  PatchHierarchy h(s.scene.inputPolygons());
+  std::vector<MovieExtent> mine = moviesOfTop(all, topOfNode(h, back));
+  ASSERT_EQ(mine.size(), 2u);
+  EXPECT_EQ(mine[0].firstFrame, 0);
+  EXPECT_EQ(mine[0].lastFrame, 28);
+  EXPECT_EQ(mine[0].end, MovieEnd::kHidden);
+  EXPECT_EQ(mine[1].firstFrame, 39);
+  EXPECT_EQ(mine[1].lastFrame, 60);
+  EXPECT_EQ(mine[1].end, MovieEnd::kWindow);
+  // The occluder itself leaves the frustum to the right before frame 60.
+  std::vector<MovieExtent> occ = moviesOfTop(all, topOfNode(h, occluder));
+  ASSERT_FALSE(occ.empty());
+  EXPECT_EQ(occ.back().end, MovieEnd::kLeftFrustum);
+  EXPECT_LT(occ.back().lastFrame, 60);
+}
+
+// The camera moves from 8 m to 4 m in front of a rectangle that starts at about 30 x 30
+// pixels: the ideal side doubles (30.3 -> 60.6), crossing 32 x 1.5 = 48, so its 32 x 32 movie
+// closes as resized and a 64 x 64 one follows, at the first frame past the threshold.
+TEST(TextureIntervalsBuilder, ZoomThatDoublesResolutionResizes) {
+  TestScene s;
+  double focal = kSize.height / 2.0 / std::tan(0.8 / 2.0);
+  double half = 15.15 * 8.0 / focal;  // 30.3 pixels wide at 8 m
+  int rect = s.addRect("rect", -half, -half, half, half, -8.0);
+  s.move(s.camera, {0, 0, 0}, {0, 0, -4}, 2.0);  // 48 frames
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 0;
+  int expected = -1;
+  for (int f = 0; f <= 48 && expected < 0; ++f) {
+    CameraView v = s.scene.cameraAt(s.camera, f / 24.0);
+    Polygon p;
+    p.count = 4;
+    p.v = {glm::dvec3(-half, -half, -8), glm::dvec3(half, -half, -8), glm::dvec3(half, half, -8),
+           glm::dvec3(-half, half, -8)};
+    double n = std::sqrt(projectedAreaPixels(v, kSize, p));
+    ASSERT_GT(std::abs(n - 48.0), 0.1) << "ambiguous frame " << f;
+    if (n > 48.0) expected = f;
+  }
+  ASSERT_GT(expected, 0);
+  std::vector<MovieExtent> all = buildTextureIntervals(s.scene, s.camera, frameRange(0, 48), o);
+  PatchHierarchy h(s.scene.inputPolygons());
+  std::vector<MovieExtent> mine = moviesOfTop(all, topOfNode(h, rect));
+  ASSERT_EQ(mine.size(), 2u);
+  EXPECT_EQ(mine[0].width, 32);
+  EXPECT_EQ(mine[0].height, 32);
+  EXPECT_EQ(mine[0].end, MovieEnd::kResize);
+  EXPECT_EQ(mine[0].lastFrame, expected - 1);
+  EXPECT_EQ(mine[1].firstFrame, expected);
+  EXPECT_EQ(mine[1].width, 64);
+  EXPECT_EQ(mine[1].end, MovieEnd::kWindow);
+}
+
+// A rectangle mostly (60 %) outside the frustum has a visible fraction below theta: it is
+// represented by its children inside the frustum; the children wholly outside get nothing.
+TEST(TextureIntervalsBuilder, PatchHalfOutsideTheFrustumIsRepresentedByChildren) {
+  TestScene s;
+  // Image half-width at z = -5: 5 tan(0.4) x aspect.
+  double edge = 5.0 * std::tan(0.4) * kSize.aspect();
+  double w = 2.0;
+  int rect = s.addRect("rect", edge - 0.4 * w, -1.0, edge + 0.6 * w, 1.0, -5.0);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 1;
+  TextureIntervalsBuilder b(s.scene, s.camera, o);
+  int top = topOfNode(b.hierarchy(), rect);
+  std::vector<int> chosen;
+  b.addFrame(0, [&](const IntervalFrame& f) { chosen = *f.chosen; });
+  std::vector<MovieExtent> all = b.finish();
+  ASSERT_EQ(chosen.size(), 2u);
+  for (int i : chosen) {
+    EXPECT_EQ(b.hierarchy().node(i).parent, top);
+    EXPECT_EQ(b.hierarchy().node(i).id.level(), 1);
+  }
+  ASSERT_EQ(all.size(), 2u);
+  // The same rectangle fully inside the view is represented by itself.
+  TestScene inside;
+  int r2 = inside.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);
+  TextureIntervalsBuilder b2(inside.scene, inside.camera, o);
+  b2.addFrame(0, [&](const IntervalFrame& f) { chosen = *f.chosen; });
+  ASSERT_EQ(chosen.size(), 1u);
+  EXPECT_EQ(chosen[0], topOfNode(b2.hierarchy(), r2));
+}
+
+TEST(TextureIntervalsBuilder, MaxLengthSplitsMovies) {
+  TestScene s;
+  int rect = s.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLength = 10;
+  std::vector<MovieExtent> all = buildTextureIntervals(s.scene, s.camera, frameRange(3, 27), o);
+  PatchHierarchy h(s.scene.inputPolygons());
+  std::vector<MovieExtent> mine = moviesOfTop(all, topOfNode(h, rect));
+  ASSERT_EQ(mine.size(), 3u);
+  EXPECT_EQ(mine[0].firstFrame, 3);
+  EXPECT_EQ(mine[0].lastFrame, 12);
+  EXPECT_EQ(mine[0].end, MovieEnd::kMaxLength);
+  EXPECT_EQ(mine[1].firstFrame, 13);
+  EXPECT_EQ(mine[1].lastFrame, 22);
+  EXPECT_EQ(mine[2].firstFrame, 23);
+  EXPECT_EQ(mine[2].lastFrame, 27);
+  EXPECT_EQ(mine[2].end, MovieEnd::kWindow);
+}
+
+std::string cornellPath() {
+  return RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
+}
+
+// The invariant rad-compose relies on: at every frame every visible pixel is covered by
+// exactly one open movie, whose node is an ancestor-or-self of the pixel's leaf.
+TEST(TextureIntervalsBuilder, EveryVisiblePixelOfCornellIsCoveredByExactlyOneMovie) {
+  Scene scene = readGltfScene(cornellPath());
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  TextureIntervalsBuilder b(scene, scene.cameraNode(""), o);
+  const PatchHierarchy& h = b.hierarchy();
+  std::vector<std::pair<int, uint64_t>> uses;  // (frame, packed patch) of every chosen node
+  long pixels = 0;
+  for (int frame : frameRange(0, 23)) {
+    b.addFrame(frame, [&](const IntervalFrame& f) {
+      std::vector<char> isChosen(h.size(), 0);
+      for (int i : *f.chosen) isChosen[i] = 1;
+      for (uint32_t id : f.itemBuffer->id) {
+        if (id == kNoItem) continue;
+        int covering = 0;
+        for (int n = TextureIntervalsBuilder::nodeOfItem(id); n >= 0; n = h.node(n).parent)
+          covering += isChosen[n];
+        ASSERT_EQ(covering, 1) << "frame " << f.frame << " leaf " << id - 1;
+        ++pixels;
+      }
+      for (size_t c = 0; c < f.chosen->size(); ++c) {
+        uses.push_back({f.frame, h.node((*f.chosen)[c]).id.packed()});
+        ASSERT_GE((*f.chosenMovie)[c], 0);
+      }
+    });
+  }
+  EXPECT_GT(pixels, 24L * kSize.pixelCount() / 2);
+  std::vector<MovieExtent> all = b.finish();
+  // Each chosen (frame, node) lies in exactly one movie of that node; movies overlap nowhere.
+  for (auto [frame, packed] : uses) {
+    int n = 0;
+    for (const MovieExtent& m : all)
+      n += m.patch.packed() == packed && m.firstFrame <= frame && frame <= m.lastFrame;
+    ASSERT_EQ(n, 1) << "frame " << frame << " patch " << PatchId::fromPacked(packed).toString();
+  }
+  size_t frames = 0;
+  for (const MovieExtent& m : all) frames += size_t(m.lastFrame - m.firstFrame + 1);
+  EXPECT_EQ(frames, uses.size());
+  // Id order: (firstFrame, patch).
+  for (size_t i = 1; i < all.size(); ++i) {
+    bool ordered = all[i - 1].firstFrame < all[i].firstFrame ||
+                   (all[i - 1].firstFrame == all[i].firstFrame &&
+                    all[i - 1].patch.packed() < all[i].patch.packed());
+    EXPECT_TRUE(ordered) << i;
+  }
+}
+
+TEST(TextureIntervalsBuilder, BitIdenticalAcrossRuns) {
+  Scene scene = readGltfScene(cornellPath());
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  std::vector<MovieExtent> a =
+      buildTextureIntervals(scene, scene.cameraNode(""), frameRange(0, 23), o);
+  std::vector<MovieExtent> b =
+      buildTextureIntervals(scene, scene.cameraNode(""), frameRange(0, 23), o);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b);
+  // And the files: same bytes.
+  auto write = [&](const std::vector<MovieExtent>& ms, const std::string& path) {
+    TextureIntervals iv;
+    iv.firstFrame = 0;
+    iv.lastFrame = 23;
+    iv.imageWidth = kSize.width;
+    iv.imageHeight = kSize.height;
+    for (size_t i = 0; i < ms.size(); ++i) {
+      TextureInterval m;
+      m.movie = uint32_t(i);
+      m.patch = ms[i].patch;
+      m.firstFrame = ms[i].firstFrame;
+      m.lastFrame = ms[i].lastFrame;
+      m.width = ms[i].width;
+      m.height = ms[i].height;
+      m.reason = CloseReason(int(ms[i].end));
+      iv.movies.push_back(m);
+    }
+    const char* argv[] = {"rad-intervals", "cornell-moving.gltf"};
+    writeTextureIntervals(path, iv, makeProvenance("rad-intervals", 2, argv, {}), {});
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  std::string dir = testing::TempDir();
+  std::string fa = write(a, dir + "/rad_iv_a.rti"), fb = write(b, dir + "/rad_iv_b.rti");
+  EXPECT_GT(fa.size(), 100u);
+  EXPECT_EQ(fa, fb);
+  EXPECT_EQ(readTextureIntervals(dir + "/rad_iv_a.rti").movies.size(), a.size());
+}
+
+// Embree with one-sided triangles (the item buffer culls back faces).
+struct EmbreeCaster {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<glm::dvec3> normals;
+  std::vector<uint32_t> ids;
+
+  explicit EmbreeCaster(const std::vector<ItemTriangle>& triangles) {
+    device = rtcNewDevice(nullptr);
+    scene = rtcNewScene(device);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), triangles.size() * 3));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
+    for (size_t i = 0; i < triangles.size(); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        for (int c = 0; c < 3; ++c) vb[9 * i + 3 * k + c] = float(triangles[i].p[k][c]);
+        ib[3 * i + k] = unsigned(3 * i + k);
+      }
+      const auto& p = triangles[i].p;
+      normals.push_back(glm::cross(p[1] - p[0], p[2] - p[0]));
+      ids.push_back(triangles[i].id);
+    }
+    rtcSetGeometryUserData(g, &normals);
+    rtcSetGeometryIntersectFilterFunction(g, &EmbreeCaster::frontFacesOnly);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(scene);
+  }
+  ~EmbreeCaster() {
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+  }
+  static void frontFacesOnly(const RTCFilterFunctionNArguments* args) {
+    const auto& n = *static_cast<const std::vector<glm::dvec3>*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+      if (args->valid[i] == 0) continue;
+      unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+      glm::dvec3 dir(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                     RTCRayN_dir_z(args->ray, args->N, i));
+      if (glm::dot(n[prim], dir) >= 0.0) args->valid[i] = 0;
+    }
+  }
+  uint32_t cast(const Ray& r) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh{};
+    rh.ray.org_x = float(r.origin.x);
+    rh.ray.org_y = float(r.origin.y);
+    rh.ray.org_z = float(r.origin.z);
+    rh.ray.dir_x = float(r.direction.x);
+    rh.ray.dir_y = float(r.direction.y);
+    rh.ray.dir_z = float(r.direction.z);
+    rh.ray.tnear = float(r.tNear);
+    rh.ray.tfar = std::isinf(r.tFar) ? std::numeric_limits<float>::infinity() : float(r.tFar);
+    rh.ray.mask = ~0u;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return kNoItem;
+    return ids[rh.hit.primID];
+  }
+};
+
+// The item buffer's leaf ids agree with Embree primary rays through the pixel centres, away
+// from leaf edges (3 x 3 neighbourhood of one id), at several frames of the moving scene.
+TEST(TextureIntervalsBuilder, ItemBufferIdsAgreeWithEmbreeRayCasts) {
+  Scene scene = readGltfScene(cornellPath());
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  int camera = scene.cameraNode("");
+  TextureIntervalsBuilder b(scene, camera, o);
+  const PatchHierarchy& h = b.hierarchy();
+  int checked = 0, framesChecked = 0;
+  for (int frame : {0, 11, 23, 47, 95}) {
+    b.addFrame(frame, [&](const IntervalFrame& f) {
+      std::vector<ItemTriangle> world;
+      for (int i = 0; i < h.size(); ++i) {
+        if (!h.isLeaf(i)) continue;
+        Polygon p = h.node(i).local.transformed(scene.worldTransform(h.topOf(i).node, f.time));
+        for (int k = 1; k + 1 < p.count; ++k)
+          world.push_back({{p.v[0], p.v[k], p.v[k + 1]}, uint32_t(i + 1)});
+      }
+      EmbreeCaster caster(world);
+      CameraView view = scene.cameraAt(camera, f.time);
+      const ItemBuffer& ib = *f.itemBuffer;
+      for (int row = 1; row + 1 < ib.height; row += 3)
+        for (int col = 1; col + 1 < ib.width; col += 3) {
+          uint32_t id = ib.idAt(col, row);
+          bool uniform = true;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) uniform &= ib.idAt(col + dx, row + dy) == id;
+          if (!uniform) continue;
+          ASSERT_EQ(caster.cast(pixelCentreRay(view, kSize, col, row)), id)
+              << "frame " << f.frame << " pixel " << col << "," << row;
+          ++checked;
+        }
+      ++framesChecked;
+    });
+  }
+  EXPECT_EQ(framesChecked, 5);
+  EXPECT_GT(checked, 5 * 1000);
+}
+
+TEST(ItemBufferExr, RoundTripKeepsIdsAndDepth) {
+  ItemBuffer b;
+  b.width = 7;
+  b.height = 5;
+  for (int i = 0; i < 35; ++i) {
+    b.id.push_back(i % 4 == 0 ? kNoItem : uint32_t(i * 1000003u));
+    b.depth.push_back(i % 4 == 0 ? std::numeric_limits<float>::infinity() : 0.5f + i);
+  }
+  std::string path = testing::TempDir() + "/rad_ib_test.exr";
+  writeItemBufferExr(path, b, 12, 0.5, "{}");
+  ItemBuffer r = readItemBufferExr(path);
+  EXPECT_EQ(r.width, 7);
+  EXPECT_EQ(r.height, 5);
+  EXPECT_EQ(r.id, b.id);
+  EXPECT_EQ(r.depth, b.depth);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << "not an exr";
+  EXPECT_THROW(readItemBufferExr(path), Error);
+}
+
+}  // namespace
+}  // namespace rad
