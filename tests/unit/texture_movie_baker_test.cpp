@@ -1,0 +1,310 @@
+// Texture-movie baking (libcommon/texture_movie_baker.h): unoccluded irradiance against the
+// exact form factor, shadows, coherence (static blockers once, exact OR merge) against the
+// per-key baseline, constant movies, determinism and the memory budget.
+#include "libcommon/texture_movie_baker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "libcommon/error.h"
+#include "libcommon/form_factor.h"
+
+namespace rad {
+namespace {
+
+constexpr double kFps = 24.0;
+
+int addQuadNode(Scene& s, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d, int material) {
+  Mesh m;
+  MeshTriangle t1, t2;
+  t1.p = {a, b, c};
+  t2.p = {a, c, d};
+  t1.material = t2.material = material;
+  m.triangles = {t1, t2};
+  s.meshes.push_back(m);
+  Node n;
+  n.mesh = int(s.meshes.size()) - 1;
+  s.nodes.push_back(n);
+  return int(s.nodes.size()) - 1;
+}
+
+void translate(Scene& s, int node, glm::dvec3 from, glm::dvec3 to, double t0, double t1) {
+  AnimationChannel ch;
+  ch.node = node;
+  ch.path = AnimationPath::kTranslation;
+  ch.interpolation = Interpolation::kLinear;
+  ch.times = {t0, t1};
+  ch.values = {from.x, from.y, from.z, to.x, to.y, to.z};
+  s.channels.push_back(ch);
+}
+
+int topOfNode(const GlobalSolution& g, int node) {
+  for (int i = 0; i < g.hierarchy.topCount(); ++i)
+    if (g.hierarchy.top(i).node == node) return i;
+  return -1;
+}
+
+struct TestScene {
+  Scene scene;
+  GlobalSolution solution;
+  int floorNode = -1, lightNode = -1, wallNode = -1, moverNode = -1;
+  int floorTop = -1, lightTop = -1;
+  glm::dvec3 lightB{10.0, 20.0, 5.0};
+  glm::dvec3 good{0.25, 0.5, 1.0};
+};
+
+// Floor [-1,1]^2 at z = 0 (up), a square light [-.5,.5]^2 at z = 2 (down), optionally a static
+// half-plane occluder x < 0 at z = 1 and a small occluder moving across the shaft at z = 1.2.
+TestScene makeScene(bool wall, bool mover) {
+  TestScene t;
+  Scene& s = t.scene;
+  Material white;
+  white.reflectance = glm::dvec3(0.5);
+  Material lamp;
+  lamp.emission = glm::dvec3(1.0);
+  s.materials = {white, lamp};
+  t.floorNode = addQuadNode(s, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, 0);
+  t.lightNode = addQuadNode(s, {-.5, -.5, 2}, {-.5, .5, 2}, {.5, .5, 2}, {.5, -.5, 2}, 1);
+  if (wall) t.wallNode = addQuadNode(s, {-3, -3, 1}, {0, -3, 1}, {0, 3, 1}, {-3, 3, 1}, 0);
+  if (mover) {
+    t.moverNode = addQuadNode(s, {-.2, -.2, 0}, {.2, -.2, 0}, {.2, .2, 0}, {-.2, .2, 0}, 0);
+    translate(s, t.moverNode, {-1.5, 0.1, 1.2}, {1.5, -0.1, 1.2}, 0.0, 1.0);
+  }
+  GlobalSolution& g = t.solution;
+  g.keyTimes = {0.0};
+  g.hierarchy = PatchHierarchy(s.inputPolygons());
+  const int n = g.hierarchy.size();
+  t.floorTop = topOfNode(g, t.floorNode);
+  t.lightTop = topOfNode(g, t.lightNode);
+  g.nodeRadiosity.assign(size_t(n), glm::vec3(0.0f));
+  g.nodeRadiosity[size_t(t.lightTop)] = glm::vec3(t.lightB);
+  for (int i = 0; i < n; ++i) g.leafRow.push_back(i);
+  g.leafVertexGoodIrradiance.assign(size_t(n) * 4, glm::vec3(0.0f));
+  for (int c = 0; c < 4; ++c)
+    g.leafVertexGoodIrradiance[size_t(t.floorTop) * 4 + c] = glm::vec3(t.good);
+  g.badPairs = {{uint32_t(t.floorTop), uint32_t(t.lightTop)}};
+  g.validate("test");
+  return t;
+}
+
+MovieRequest request(const TestScene& t, int w, int h, int f0 = 0, int f1 = 24) {
+  MovieRequest r;
+  r.movie = 3;
+  r.patch = PatchId{uint32_t(t.floorTop), 1u};
+  r.firstFrame = f0;
+  r.lastFrame = f1;
+  r.width = w;
+  r.height = h;
+  return r;
+}
+
+TEST(TextureMovieBaker, KeyFramesEveryStepAndTheLast) {
+  EXPECT_EQ(movieKeyFrames(0, 24, 6), (std::vector<int>{0, 6, 12, 18, 24}));
+  EXPECT_EQ(movieKeyFrames(3, 10, 6), (std::vector<int>{3, 9, 10}));
+  EXPECT_EQ(movieKeyFrames(5, 5, 6), (std::vector<int>{5}));
+}
+
+TEST(TextureMovieBaker, UnoccludedIrradianceIsGoodPlusRadiosityTimesFormFactor) {
+  TestScene t = makeScene(false, false);
+  ASSERT_EQ(t.solution.hierarchy.topCount(), 2) << "quads merged";
+  TextureMovieBaker baker(t.scene, t.solution, kFps, {});
+  const int w = 12, h = 9;
+  BakedMovie m = baker.bake(request(t, w, h));
+  ASSERT_EQ(m.keys.size(), 1u) << "static scene, constant solution: one key";
+  EXPECT_EQ(m.keyFrames, std::vector<int>{0});
+  Polygon light = t.solution.hierarchy.top(t.lightTop).local;
+  const Polygon& floor = t.solution.hierarchy.top(t.floorTop).local;
+  double worst = 0.0;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      glm::dvec3 x = polygonPointAt(floor, {(i + 0.5) / w, (j + 0.5) / h});
+      double f = pointToPolygonFormFactor(x, {0, 0, 1}, light);
+      ASSERT_GT(f, 0.01);
+      for (int c = 0; c < 3; ++c) {
+        double expected = t.good[c] + t.lightB[c] * f;
+        double got = m.keys[0][(size_t(j) * w + i) * 3 + size_t(c)];
+        worst = std::max(worst, std::abs(got - expected) / expected);
+      }
+    }
+  EXPECT_LT(worst, 1e-6);
+  const TextureMovieBakerStats& s = baker.stats();
+  EXPECT_EQ(s.badPairs, 1);
+  EXPECT_EQ(s.staticPairs, 1);
+  EXPECT_EQ(s.passes, 0) << "no blocker in the shaft: nothing to render";
+}
+
+TEST(TextureMovieBaker, HalfPlaneShadowGivesUmbraAndAnalyticPenumbra) {
+  TestScene t = makeScene(true, false);
+  TextureMovieBaker baker(t.scene, t.solution, kFps, {});
+  const int w = 32, h = 4;
+  BakedMovie m = baker.bake(request(t, w, h, 0, 0));
+  ASSERT_EQ(m.keys.size(), 1u);
+  Polygon light = t.solution.hierarchy.top(t.lightTop).local;
+  const Polygon& floor = t.solution.hierarchy.top(t.floorTop).local;
+  const int n = int(baker.stats().samples);
+  EXPECT_GE(n, 16);
+  for (int i = 0; i < w; ++i) {
+    glm::dvec3 x = polygonPointAt(floor, {(i + 0.5) / w, 0.5 / h});
+    double f = pointToPolygonFormFactor(x, {0, 0, 1}, light);
+    double got = m.keys[0][size_t(i) * 3 + 1];
+    double transmittance = (got - t.good.y) / (t.lightB.y * f);
+    double expected = std::clamp(0.5 + x.x, 0.0, 1.0);
+    EXPECT_NEAR(transmittance, expected, 1.0 / n + 1e-5) << "texel " << i << " x " << x.x;
+    if (x.x < -0.5) {
+      EXPECT_NEAR(got, t.good.y, 1e-6) << "umbra: only the good layer";
+    }
+  }
+}
+
+double maxRelativeDifference(const BakedMovie& a, const BakedMovie& b, int f0, int f1) {
+  // Compare the textures at every frame (the two may store different key sets).
+  auto at = [](const BakedMovie& m, double t) {
+    std::vector<double> out(m.keys[0].size());
+    size_t k1 =
+        size_t(std::upper_bound(m.keyTimes.begin(), m.keyTimes.end(), t) - m.keyTimes.begin());
+    if (k1 == 0 || m.keys.size() == 1) k1 = 1;
+    if (k1 >= m.keys.size()) {
+      for (size_t i = 0; i < out.size(); ++i) out[i] = m.keys.back()[i];
+      return out;
+    }
+    size_t k0 = k1 - 1;
+    double w = (t - m.keyTimes[k0]) / (m.keyTimes[k1] - m.keyTimes[k0]);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = (1 - w) * m.keys[k0][i] + w * m.keys[k1][i];
+    return out;
+  };
+  double worst = 0.0;
+  for (int f = f0; f <= f1; ++f) {
+    std::vector<double> x = at(a, f / kFps), y = at(b, f / kFps);
+    for (size_t i = 0; i < x.size(); ++i)
+      worst = std::max(worst, std::abs(x[i] - y[i]) / std::max(std::abs(y[i]), 1e-30));
+  }
+  return worst;
+}
+
+TEST(TextureMovieBaker, CoherentEqualsTheBaselineAndSavesRenders) {
+  TestScene t = makeScene(true, true);
+  TextureMovieBakerOptions coherentOptions, baselineOptions;
+  baselineOptions.coherence = false;
+  TextureMovieBaker coherent(t.scene, t.solution, kFps, coherentOptions);
+  TextureMovieBaker baseline(t.scene, t.solution, kFps, baselineOptions);
+  MovieRequest r = request(t, 20, 16, 0, 24);
+  BakedMovie a = coherent.bake(r), b = baseline.bake(r);
+  ASSERT_EQ(a.keys.size(), 5u) << "a moving occluder: every key stored";
+  ASSERT_EQ(b.keys.size(), 5u);
+  for (size_t k = 0; k < a.keys.size(); ++k)
+    EXPECT_EQ(0, std::memcmp(a.keys[k].data(), b.keys[k].data(), a.keys[k].size() * 4))
+        << "key " << k << " differs between coherent and baseline";
+  EXPECT_LE(maxRelativeDifference(a, b, 0, 24), 1e-6);
+  // The mover's shadow moves: keys differ.
+  EXPECT_NE(a.keys.front(), a.keys[2]);
+  const TextureMovieBakerStats& sa = coherent.stats();
+  const TextureMovieBakerStats& sb = baseline.stats();
+  EXPECT_EQ(sa.staticBlockers, 1);
+  EXPECT_EQ(sa.dynamicBlockers, 1);
+  EXPECT_EQ(sa.passesSavedByCoherence, 4);
+  EXPECT_EQ(sb.passesSavedByCoherence, 0);
+  EXPECT_EQ(sb.passes, 5);
+  EXPECT_LE(sa.passes, 1 + 5);
+}
+
+TEST(TextureMovieBaker, ApproximateMergesDifferFromExactOnlyWhereLayersOverlap) {
+  TestScene t = makeScene(true, true);
+  MovieRequest r = request(t, 20, 16, 0, 24);
+  TextureMovieBakerOptions o;
+  BakedMovie exact = TextureMovieBaker(t.scene, t.solution, kFps, o).bake(r);
+  for (MergeMode mode : {MergeMode::kMax, MergeMode::kSum, MergeMode::kIndependent}) {
+    o.merge = mode;
+    BakedMovie approx = TextureMovieBaker(t.scene, t.solution, kFps, o).bake(r);
+    ASSERT_EQ(approx.keys.size(), exact.keys.size());
+    // Texels no dynamic shadow touches agree exactly; somewhere the merge shows.
+    double worst = maxRelativeDifference(approx, exact, 0, 24);
+    EXPECT_GT(worst, 1e-3) << mergeModeName(mode);
+    EXPECT_LT(worst, 1.0 + 1e-9) << mergeModeName(mode);
+  }
+}
+
+TEST(TextureMovieBaker, StaticShadowsMakeAConstantMovieUnlessCoherenceIsOff) {
+  TestScene t = makeScene(true, false);
+  MovieRequest r = request(t, 8, 8, 0, 30);
+  TextureMovieBaker coherent(t.scene, t.solution, kFps, {});
+  BakedMovie a = coherent.bake(r);
+  EXPECT_EQ(a.keys.size(), 1u);
+  EXPECT_EQ(coherent.stats().constantMovies, 1);
+  EXPECT_EQ(coherent.stats().passes, 1) << "the static wall, rendered once";
+  TextureMovieBakerOptions o;
+  o.coherence = false;
+  TextureMovieBaker baseline(t.scene, t.solution, kFps, o);
+  BakedMovie b = baseline.bake(r);
+  EXPECT_EQ(b.keys.size(), 6u);  // 0, 6, ..., 30
+  EXPECT_EQ(baseline.stats().passes, 6);
+  EXPECT_LE(maxRelativeDifference(a, b, 0, 30), 1e-6);
+}
+
+TEST(TextureMovieBaker, BitIdenticalAcrossRuns) {
+  TestScene t = makeScene(true, true);
+  MovieRequest r = request(t, 17, 11, 2, 20);
+  BakedMovie a = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
+  BakedMovie b = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
+  ASSERT_EQ(a.keys.size(), b.keys.size());
+  EXPECT_EQ(a.keyFrames, b.keyFrames);
+  for (size_t k = 0; k < a.keys.size(); ++k)
+    EXPECT_EQ(0, std::memcmp(a.keys[k].data(), b.keys[k].data(), a.keys[k].size() * 4));
+}
+
+TEST(TextureMovieBaker, ChildPatchTexelsAreTheTopsTexelsAtTheSamePoints) {
+  // Child 0 of the floor at 4x4 has its texel centres exactly on the top's 8x8 texels (0..3).
+  TestScene t = makeScene(true, false);
+  TextureMovieBaker baker(t.scene, t.solution, kFps, {});
+  BakedMovie top = baker.bake(request(t, 8, 8, 0, 0));
+  MovieRequest child = request(t, 4, 4, 0, 0);
+  child.patch = child.patch.child(0);
+  BakedMovie sub = baker.bake(child);
+  double worst = 0.0;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i)
+      for (int c = 0; c < 3; ++c) {
+        double a = sub.keys[0][(size_t(j) * 4 + i) * 3 + c];
+        double b = top.keys[0][(size_t(j) * 8 + i) * 3 + c];
+        worst = std::max(worst, std::abs(a - b) / b);
+      }
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(TextureMovieBaker, MemoryBudgetRaisesTheKeyStepAndRefusesWhatCannotFit) {
+  TestScene t = makeScene(false, true);
+  TextureMovieBakerOptions o;
+  o.maxTextureMemoryMiB = 64.0 * 64 * 36 * 3 / 1048576.0;  // about 3 keys of 64x64
+  TextureMovieBaker baker(t.scene, t.solution, kFps, o);
+  BakedMovie m = baker.bake(request(t, 64, 64, 0, 48));
+  EXPECT_GT(m.keyStep, 6);
+  EXPECT_LE(m.keys.size(), 3u);
+  EXPECT_EQ(baker.stats().keyStepRaised, 1);
+  o.maxTextureMemoryMiB = 0.01;
+  TextureMovieBaker tiny(t.scene, t.solution, kFps, o);
+  EXPECT_THROW(tiny.bake(request(t, 64, 64, 0, 48)), Error);
+}
+
+TEST(TextureMovieBaker, BadRequestsAreInputErrors) {
+  TestScene t = makeScene(false, false);
+  TextureMovieBaker baker(t.scene, t.solution, kFps, {});
+  MovieRequest r = request(t, 4, 4);
+  r.patch.top = 99;
+  try {
+    baker.bake(r);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::kBadInput);
+    EXPECT_NE(std::string(e.what()).find("movie 3"), std::string::npos) << e.what();
+  }
+  r = request(t, 0, 4);
+  EXPECT_THROW(baker.bake(r), Error);
+  TextureMovieBakerOptions o;
+  o.maxSamples = 65;
+  EXPECT_THROW(TextureMovieBaker(t.scene, t.solution, kFps, o), Error);
+}
+
+}  // namespace
+}  // namespace rad

@@ -1,0 +1,229 @@
+// Transmittance by projective shadows into sample masks (libcommon/transmittance.h): the
+// projection, the sample pattern, occlusion against hand-computed visible fractions and the
+// exact OR merge.
+#include "libcommon/transmittance.h"
+
+#include <algorithm>
+#include <bitset>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "libcommon/error.h"
+#include "libcommon/patch_hierarchy.h"
+
+namespace rad {
+namespace {
+
+Polygon quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
+  Polygon p;
+  p.count = 4;
+  p.v = {a, b, c, d};
+  return p;
+}
+
+// Receiver [-1,1]^2 at z = 0 facing +z; u along +x, v along +y.
+Polygon floorReceiver() {
+  return quad({-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0});
+}
+// Square light [-.5,.5]^2 at z = 2 facing -z.
+Polygon ceilingLight() {
+  return quad({-0.5, -0.5, 2}, {-0.5, 0.5, 2}, {0.5, 0.5, 2}, {0.5, -0.5, 2});
+}
+
+std::vector<glm::dvec3> lightSamples(int n, uint32_t seed = 7) {
+  std::vector<glm::dvec3> s;
+  for (glm::dvec2 a : multiJitteredPoints(n, seed))
+    s.push_back(samplePointOnPolygon(ceilingLight(), a));
+  return s;
+}
+
+std::vector<BlockerTriangle> quadTriangles(const Polygon& p) {
+  return {{p.v[0], p.v[1], p.v[2]}, {p.v[0], p.v[2], p.v[3]}};
+}
+
+glm::dvec2 uvOf(const glm::dmat4& m, const glm::dvec3& y) {
+  glm::dvec4 c = m * glm::dvec4(y, 1.0);
+  return {0.5 * (c.x / c.w + 1.0), 0.5 * (c.y / c.w + 1.0)};
+}
+
+TEST(Transmittance, ProjectionMapsThePlaneOntoTheTextureSquare) {
+  // A non-parallelogram quad, a triangle and a parallelogram: corners land on their (u,v).
+  Polygon trapezoid = quad({0, 0, 0}, {3, 0, 0}, {2, 1, 0}, {0.5, 1.5, 0});
+  Polygon tri;
+  tri.count = 3;
+  tri.v = {glm::dvec3(0, 0, 1), glm::dvec3(2, 0, 1), glm::dvec3(0, 3, 1)};
+  const glm::dvec3 eye(0.3, 0.4, 5.0);
+  const glm::dvec2 quadUv[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const glm::dvec2 triUv[3] = {{0, 0}, {1, 0}, {0, 1}};
+  glm::dmat4 m = projectiveShadowMatrix(trapezoid, eye);
+  for (int k = 0; k < 4; ++k) {
+    glm::dvec2 uv = uvOf(m, trapezoid.v[k]);
+    EXPECT_NEAR(uv.x, quadUv[k].x, 1e-12);
+    EXPECT_NEAR(uv.y, quadUv[k].y, 1e-12);
+  }
+  m = projectiveShadowMatrix(tri, eye);
+  for (int k = 0; k < 3; ++k) {
+    glm::dvec2 uv = uvOf(m, tri.v[k]);
+    EXPECT_NEAR(uv.x, triUv[k].x, 1e-12);
+    EXPECT_NEAR(uv.y, triUv[k].y, 1e-12);
+  }
+  // Triangles and parallelograms: the homography is the texture map everywhere, and a point
+  // above the plane maps to where the ray from the eye through it meets the plane.
+  Polygon para = quad({0, 0, 0}, {2, 0.5, 0}, {2.5, 2, 0}, {0.5, 1.5, 0});
+  m = projectiveShadowMatrix(para, eye);
+  for (glm::dvec2 uv : {glm::dvec2(0.25, 0.7), glm::dvec2(0.9, 0.1), glm::dvec2(1.3, -0.2)}) {
+    glm::dvec3 x = polygonPointAt(para, uv);
+    glm::dvec3 y = eye + 0.6 * (x - eye);  // 40 % of the way down from the eye
+    glm::dvec2 got = uvOf(m, y);
+    EXPECT_NEAR(got.x, uv.x, 1e-12);
+    EXPECT_NEAR(got.y, uv.y, 1e-12);
+    EXPECT_NEAR(receiverPlaneUv(para, x).x, uv.x, 1e-12);
+  }
+}
+
+TEST(Transmittance, SampleCountFollowsTheFormFactorAndIsASquare) {
+  EXPECT_EQ(transmittanceSampleCount(0.0, 256, 4, 64), 4);
+  EXPECT_EQ(transmittanceSampleCount(1.0, 256, 4, 64), 64);
+  EXPECT_EQ(transmittanceSampleCount(0.1, 256, 4, 64), 36);  // 25.6 -> 26 -> 6x6
+  EXPECT_EQ(transmittanceSampleCount(0.5, 256, 4, 32), 25);  // largest square <= 32
+  EXPECT_EQ(transmittanceSampleCount(1e-9, 256, 1, 64), 1);
+}
+
+TEST(Transmittance, MultiJitteredPointsAreNRooksInBothAxes) {
+  for (int n : {4, 16, 64}) {
+    std::vector<glm::dvec2> p = multiJitteredPoints(n, 12345);
+    ASSERT_EQ(int(p.size()), n);
+    std::vector<int> xs(n, 0), ys(n, 0), cells(n, 0);
+    int m = int(std::lround(std::sqrt(n)));
+    for (glm::dvec2 q : p) {
+      ASSERT_GE(q.x, 0.0);
+      ASSERT_LT(q.x, 1.0);
+      ASSERT_GE(q.y, 0.0);
+      ASSERT_LT(q.y, 1.0);
+      xs[int(q.x * n)]++;
+      ys[int(q.y * n)]++;
+      cells[int(q.y * m) * m + int(q.x * m)]++;
+    }
+    for (int i = 0; i < n; ++i) {
+      EXPECT_EQ(xs[i], 1) << n;
+      EXPECT_EQ(ys[i], 1) << n;
+      EXPECT_EQ(cells[i], 1) << n;
+    }
+    EXPECT_EQ(multiJitteredPoints(n, 12345), p) << "deterministic";
+    EXPECT_NE(multiJitteredPoints(n, 99), p) << "seeded";
+  }
+}
+
+TEST(Transmittance, MergeOperatorsOnHalfOccludedLayers) {
+  EXPECT_DOUBLE_EQ(mergeTransmittance(MergeMode::kMax, 0.5, 0.5), 0.5);
+  EXPECT_DOUBLE_EQ(mergeTransmittance(MergeMode::kSum, 0.5, 0.5), 0.0);
+  EXPECT_DOUBLE_EQ(mergeTransmittance(MergeMode::kIndependent, 0.5, 0.5), 0.25);
+  EXPECT_DOUBLE_EQ(mergeTransmittance(MergeMode::kSum, 1.0, 0.3), 0.3);
+  EXPECT_EQ(parseMergeMode("independent"), MergeMode::kIndependent);
+  EXPECT_THROW(parseMergeMode("mean"), Error);
+  EXPECT_DOUBLE_EQ(transmittanceFromMask(0b0101, 0b1111), 0.5);
+  EXPECT_DOUBLE_EQ(transmittanceFromMask(0b1111, 0), 1.0);
+}
+
+TEST(Transmittance, NoBlockersLeaveEverythingLit) {
+  TransmittanceRenderer r;
+  std::vector<SampleMask> mask;
+  r.render(floorReceiver(), 8, 8, lightSamples(16), {}, mask);
+  ASSERT_EQ(mask.size(), 64u);
+  for (SampleMask m : mask) EXPECT_EQ(m, 0u);
+  EXPECT_EQ(r.passes(), 0);
+}
+
+// A half-plane occluder x < 0 at z = 1 between the light (z = 2, x in [-.5,.5]) and the floor:
+// the ray from floor point (px, *, 0) to light point (sx, *, 2) crosses z = 1 at (px + sx) / 2,
+// so it is blocked when sx < -px and the visible fraction is clamp(0.5 + px, 0, 1).
+TEST(Transmittance, HalfPlaneOccluderMatchesTheAnalyticVisibleFraction) {
+  const int n = 64, w = 32, h = 8;
+  TransmittanceRenderer r;
+  std::vector<SampleMask> mask;
+  Polygon occluder = quad({-10, -10, 1}, {0, -10, 1}, {0, 10, 1}, {-10, 10, 1});
+  std::vector<glm::dvec3> samples = lightSamples(n);
+  SampleMask valid = frontSampleMask(floorReceiver(), samples);
+  EXPECT_EQ(valid, ~SampleMask(0));
+  r.render(floorReceiver(), w, h, samples, quadTriangles(occluder), mask);
+  EXPECT_EQ(r.passes(), 1);
+  EXPECT_EQ(r.samplePasses(), n);
+  int penumbra = 0;
+  double worst = 0.0;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      double px = -1.0 + 2.0 * (i + 0.5) / w;
+      double t = transmittanceFromMask(mask[size_t(j) * w + i], valid);
+      double expected = std::clamp(0.5 + px, 0.0, 1.0);
+      if (px < -0.5) {
+        EXPECT_EQ(t, 0.0) << "umbra texel " << i;
+      } else if (px > 0.5) {
+        EXPECT_EQ(t, 1.0) << "lit texel " << i;
+      } else {
+        ++penumbra;
+        worst = std::max(worst, std::abs(t - expected));
+        EXPECT_LE(std::abs(t - expected), 1.0 / n + 1e-9) << "penumbra texel " << i;
+      }
+    }
+  EXPECT_EQ(penumbra, 16 * h);
+  RecordProperty("penumbra_max_error", std::to_string(worst));
+}
+
+TEST(Transmittance, BlockersBehindThePlaneOrBeyondTheSampleCastNothing) {
+  TransmittanceRenderer r;
+  std::vector<SampleMask> mask;
+  // Under the floor, above the light, and lying in the receiver's own plane next to it.
+  std::vector<BlockerTriangle> tris;
+  for (const Polygon& p : {quad({-3, -3, -0.5}, {3, -3, -0.5}, {3, 3, -0.5}, {-3, 3, -0.5}),
+                           quad({-3, -3, 2.5}, {3, -3, 2.5}, {3, 3, 2.5}, {-3, 3, 2.5}),
+                           quad({1, -1, 0}, {3, -1, 0}, {3, 1, 0}, {1, 1, 0})}) {
+    auto t = quadTriangles(p);
+    tris.insert(tris.end(), t.begin(), t.end());
+  }
+  r.render(floorReceiver(), 16, 16, lightSamples(16), tris, mask);
+  for (SampleMask m : mask) EXPECT_EQ(m, 0u);
+  // A small square right under the light's centre shadows the middle for every sample.
+  Polygon chip =
+      quad({-0.05, -0.05, 1.9}, {0.05, -0.05, 1.9}, {0.05, 0.05, 1.9}, {-0.05, 0.05, 1.9});
+  r.render(floorReceiver(), 16, 16, lightSamples(16), quadTriangles(chip), mask);
+  int touched = 0;
+  for (SampleMask m : mask) touched += m != 0;
+  EXPECT_GT(touched, 0);
+  EXPECT_LT(touched, 256);
+}
+
+TEST(Transmittance, StaticAndDynamicMasksOrToTheMaskOfAllBlockers) {
+  TransmittanceRenderer r;
+  const int w = 24, h = 20;
+  std::vector<glm::dvec3> samples = lightSamples(64, 3);
+  // Two overlapping sets of slanted triangles between light and floor.
+  std::vector<BlockerTriangle> a, b;
+  for (int i = 0; i < 6; ++i) {
+    double x = -0.8 + 0.3 * i, z = 0.4 + 0.2 * (i % 4);
+    a.push_back({glm::dvec3(x, -0.7, z), glm::dvec3(x + 0.35, -0.2, z + 0.3),
+                 glm::dvec3(x - 0.1, 0.5, z + 0.1)});
+    b.push_back({glm::dvec3(-x, 0.8, z + 0.2), glm::dvec3(-x + 0.2, -0.1, z),
+                 glm::dvec3(-x - 0.3, 0.1, z + 0.5)});
+  }
+  std::vector<BlockerTriangle> all = a;
+  all.insert(all.end(), b.begin(), b.end());
+  std::vector<SampleMask> ma, mb, mall;
+  r.render(floorReceiver(), w, h, samples, a, ma);
+  r.render(floorReceiver(), w, h, samples, b, mb);
+  r.render(floorReceiver(), w, h, samples, all, mall);
+  int differing = 0, partial = 0;
+  for (size_t x = 0; x < mall.size(); ++x) {
+    differing += (ma[x] | mb[x]) != mall[x];
+    partial += mall[x] != 0 && mall[x] != ~SampleMask(0);
+  }
+  EXPECT_EQ(differing, 0);
+  EXPECT_GT(partial, 20) << "the test needs penumbrae to mean anything";
+  // Deterministic: the same render twice is bit-identical.
+  std::vector<SampleMask> again;
+  r.render(floorReceiver(), w, h, samples, all, again);
+  EXPECT_EQ(again, mall);
+}
+
+}  // namespace
+}  // namespace rad
