@@ -1,0 +1,146 @@
+// Frame images: OpenEXR (linear radiance) and PNG (sRGB). Spec in frame_image.h.
+#include "formats/frame_image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include <Imath/half.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfDoubleAttribute.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenImageIO/imageio.h>
+
+#include "formats/atomic_file.h"
+#include "libcommon/error.h"
+
+namespace rad {
+
+std::string framePath(const std::string& dir, int frame, const std::string& ext) {
+  char name[32];
+  std::snprintf(name, sizeof name, "/%04d", frame);
+  return dir + name + ext;
+}
+
+void writeFrameExr(const std::string& path, const ComposedFrame& frame, const FrameImageInfo& info,
+                   bool half) {
+  const int w = frame.size.width, h = frame.size.height;
+  if (w < 1 || h < 1 || frame.rgb.size() != size_t(w) * h * 3)
+    throw Error(ExitCode::kInternal, path, "frame has the wrong size");
+  Imf::Header header(w, h);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  header.lineOrder() = Imf::INCREASING_Y;
+  const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
+  for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(type));
+  header.insert("rad.format", Imf::StringAttribute("frame " + std::to_string(kFrameImageMajor) +
+                                                   "." + std::to_string(kFrameImageMinor)));
+  header.insert("rad.frame", Imf::IntAttribute(info.frame));
+  header.insert("rad.time", Imf::DoubleAttribute(frame.time));
+  header.insert("rad.units", Imf::StringAttribute("radiance W/(m^2 sr)"));
+  header.insert("rad.exposureEV", Imf::DoubleAttribute(info.exposureEV));
+  header.insert("rad.coveredPixels", Imf::IntAttribute(int(frame.coveredPixels)));
+  header.insert("rad.moviePixels", Imf::IntAttribute(int(frame.moviePixels)));
+  header.insert("rad.fallbackPixels", Imf::IntAttribute(int(frame.fallbackPixels)));
+  if (!info.provenanceJson.empty())
+    header.insert("rad.provenance", Imf::StringAttribute(info.provenanceJson));
+
+  std::vector<Imath::half> halves;
+  const char* base = reinterpret_cast<const char*>(frame.rgb.data());
+  size_t elem = sizeof(float);
+  if (half) {
+    // Half overflows at 65504: clamp rather than write inf (DESIGN.md §5).
+    halves.resize(frame.rgb.size());
+    for (size_t i = 0; i < frame.rgb.size(); ++i)
+      halves[i] = Imath::half(std::min(frame.rgb[i], 65504.0f));
+    base = reinterpret_cast<const char*>(halves.data());
+    elem = sizeof(Imath::half);
+  }
+  AtomicFile file(path);
+  try {
+    Imf::OutputFile out(file.tempPath().c_str(), header);
+    Imf::FrameBuffer fb;
+    const size_t xs = 3 * elem, ys = size_t(w) * xs;
+    fb.insert("R", Imf::Slice(type, const_cast<char*>(base), xs, ys));
+    fb.insert("G", Imf::Slice(type, const_cast<char*>(base + elem), xs, ys));
+    fb.insert("B", Imf::Slice(type, const_cast<char*>(base + 2 * elem), xs, ys));
+    out.setFrameBuffer(fb);
+    out.writePixels(h);
+  } catch (const std::exception& e) {
+    throw outputError(path, e.what());
+  }
+  file.commit();
+}
+
+void writeFramePng(const std::string& path, const ComposedFrame& frame,
+                   const FrameImageInfo& info) {
+  const int w = frame.size.width, h = frame.size.height;
+  if (w < 1 || h < 1 || frame.rgb.size() != size_t(w) * h * 3)
+    throw Error(ExitCode::kInternal, path, "frame has the wrong size");
+  std::vector<uint8_t> pixels = toSrgb8(frame.rgb, info.exposureEV);
+  AtomicFile file(path);
+  auto out = OIIO::ImageOutput::create(file.tempPath());
+  if (!out) throw outputError(path, "no PNG writer: " + OIIO::geterror());
+  OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  std::ostringstream description;
+  description << "rad frame " << info.frame << ", exposure " << info.exposureEV << " EV";
+  if (!info.provenanceJson.empty()) description << "; provenance " << info.provenanceJson;
+  spec.attribute("ImageDescription", description.str());
+  spec.attribute("Software", "rad-compose");
+  if (!out->open(file.tempPath(), spec)) throw outputError(path, out->geterror());
+  bool ok = out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
+  ok = out->close() && ok;
+  if (!ok) throw outputError(path, out->geterror());
+  file.commit();
+}
+
+FrameExr readFrameExr(const std::string& path) {
+  FrameExr f;
+  try {
+    Imf::InputFile in(path.c_str());
+    const Imf::Header& h = in.header();
+    const Imath::Box2i dw = h.dataWindow();
+    f.width = dw.max.x - dw.min.x + 1;
+    f.height = dw.max.y - dw.min.y + 1;
+    if (dw.min.x != 0 || dw.min.y != 0 || f.width < 1 || f.height < 1 || f.width > 65536 ||
+        f.height > 65536)
+      throw inputError(path, "invalid data window");
+    for (const char* c : {"R", "G", "B"})
+      if (!h.channels().findChannel(c)) throw inputError(path, std::string("no channel ") + c);
+    f.half = h.channels().findChannel("R")->type == Imf::HALF;
+    for (auto it = h.begin(); it != h.end(); ++it) {
+      const Imf::Attribute& a = it.attribute();
+      if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&a))
+        f.attributes[it.name()] = s->value();
+      else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&a))
+        f.attributes[it.name()] = std::to_string(i->value());
+      else if (auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&a)) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.17g", d->value());
+        f.attributes[it.name()] = buf;
+      }
+    }
+    f.rgb.resize(size_t(f.width) * f.height * 3);
+    Imf::FrameBuffer fb;
+    const size_t xs = 3 * sizeof(float), ys = size_t(f.width) * xs;
+    char* base = reinterpret_cast<char*>(f.rgb.data());
+    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw inputError(path, e.what());
+  }
+  return f;
+}
+
+}  // namespace rad

@@ -1,0 +1,50 @@
+// frames/NNNN.exr and frames/NNNN.png: rad-compose's final frames (DESIGN.md §5).
+//
+// EXR: one scanline part, channels R, G, B of linear exitant radiance W/(m^2 sr), FLOAT (or
+// HALF with --half; values above 65504 are clamped there), ZIP compressed, row 0 = top.
+// String/int/double attributes: rad.format "frame 1.0", rad.frame, rad.time, rad.units,
+// rad.exposureEV (what the PNG used), rad.coveredPixels, rad.moviePixels, rad.fallbackPixels and
+// rad.provenance (Provenance::toJson().dump()). Readable with exrheader / oiiotool / rad-inspect.
+//
+// PNG: 8-bit sRGB of the radiance scaled by 2^exposureEV (frame_composer.h toSrgb8), written
+// with OpenImageIO; the provenance goes into its "ImageDescription" text chunk.
+//
+// Both writes are atomic (formats/atomic_file.h) and deterministic (no time stamps).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "libcommon/frame_composer.h"
+
+namespace rad {
+
+constexpr int kFrameImageMajor = 1;
+constexpr int kFrameImageMinor = 0;
+
+struct FrameImageInfo {
+  int frame = 0;
+  double exposureEV = 0.0;
+  std::string provenanceJson;
+};
+
+// Throws rad::outputError(path, ...) when it cannot be written.
+void writeFrameExr(const std::string& path, const ComposedFrame& frame, const FrameImageInfo& info,
+                   bool half);
+void writeFramePng(const std::string& path, const ComposedFrame& frame, const FrameImageInfo& info);
+
+// What a frame EXR holds (for tests and tools): pixels as float RGB, row 0 = top, and its
+// string, int and double attributes printed as strings. Throws rad::inputError(path, ...).
+struct FrameExr {
+  int width = 0, height = 0;
+  bool half = false;
+  std::vector<float> rgb;
+  std::map<std::string, std::string> attributes;
+};
+FrameExr readFrameExr(const std::string& path);
+
+// Path of frame f in dir with extension ext (".exr", ".png"): dir/0012.exr.
+std::string framePath(const std::string& dir, int frame, const std::string& ext);
+
+}  // namespace rad

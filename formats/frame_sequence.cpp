@@ -1,0 +1,211 @@
+// rad-compose's frame loop with lazily loaded, evicted texture movies (paper §5: the movie
+// files are the disk cache; only the movies of the current frame are in memory).
+#include "formats/frame_sequence.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "formats/checksum.h"
+#include "formats/exr_info.h"
+#include "formats/frame_image.h"
+#include "formats/texture_movie.h"
+#include "libcommon/error.h"
+
+namespace rad {
+namespace {
+
+// The movies in memory: read on first use, dropped once the frames have passed their last.
+class MovieCache {
+ public:
+  MovieCache(const TextureIntervals& intervals, std::string dir)
+      : intervals_(intervals), dir_(std::move(dir)) {}
+
+  // Loads (once) and returns the movie of interval `index`.
+  TextureMovie& get(size_t index) {
+    auto it = loaded_.find(index);
+    if (it != loaded_.end()) return *it->second;
+    const TextureInterval& iv = intervals_.movies[index];
+    std::string path = textureMoviePath(dir_, iv.movie);
+    auto movie = std::make_unique<TextureMovie>(readTextureMovie(path));
+    auto differs = [&](const std::string& what, const std::string& got,
+                       const std::string& expected) {
+      throw inputError(path, what + " " + got + " differs from the intervals' " + expected +
+                                 " (movie " + std::to_string(iv.movie) + ")");
+    };
+    if (movie->patch != iv.patch) differs("patch", movie->patch.toString(), iv.patch.toString());
+    if (movie->firstFrame != iv.firstFrame || movie->lastFrame != iv.lastFrame)
+      differs("frames", std::to_string(movie->firstFrame) + "-" + std::to_string(movie->lastFrame),
+              std::to_string(iv.firstFrame) + "-" + std::to_string(iv.lastFrame));
+    if (movie->width != iv.width || movie->height != iv.height)
+      differs("texture size", std::to_string(movie->width) + "x" + std::to_string(movie->height),
+              std::to_string(iv.width) + "x" + std::to_string(iv.height));
+    ++read_;
+    TextureMovie& ref = *movie;
+    loaded_.emplace(index, std::move(movie));
+    peak_ = std::max(peak_, int(loaded_.size()));
+    return ref;
+  }
+
+  // Drops every movie whose last frame is before `frame`.
+  void evictBefore(int frame) {
+    for (auto it = loaded_.begin(); it != loaded_.end();) {
+      if (intervals_.movies[it->first].lastFrame < frame)
+        it = loaded_.erase(it);
+      else
+        ++it;
+    }
+  }
+
+  long long read() const { return read_; }
+  int peak() const { return peak_; }
+
+ private:
+  const TextureIntervals& intervals_;
+  std::string dir_;
+  std::map<size_t, std::unique_ptr<TextureMovie>> loaded_;
+  long long read_ = 0;
+  int peak_ = 0;
+};
+
+}  // namespace
+
+nlohmann::json ComposeSequenceReport::toJson() const {
+  nlohmann::json fs = nlohmann::json::array();
+  long long fallback = 0;
+  for (const ComposeFrameStats& f : frames) {
+    fs.push_back({{"frame", f.frame},
+                  {"time", f.time},
+                  {"seconds", f.seconds},
+                  {"movies", f.movies},
+                  {"covered_pixels", f.coveredPixels},
+                  {"movie_pixels", f.moviePixels},
+                  {"fallback_pixels", f.fallbackPixels}});
+    fallback += f.fallbackPixels;
+  }
+  return {{"exposure_ev", exposureEV},
+          {"seconds", seconds},
+          {"seconds_per_frame", frames.empty() ? 0.0 : seconds / double(frames.size())},
+          {"movies_read", moviesRead},
+          {"peak_loaded_movies", peakLoadedMovies},
+          {"fallback_pixels", fallback},
+          {"frames", fs}};
+}
+
+ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& solution,
+                                      const TextureIntervals& intervals,
+                                      const ComposeSequenceOptions& options,
+                                      const Provenance& provenance,
+                                      const std::function<void(const std::string&)>& warn,
+                                      const std::function<void()>& progress) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  std::vector<int> frames = options.frames;
+  std::sort(frames.begin(), frames.end());
+  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  for (int f : frames)
+    if (f < intervals.firstFrame || f > intervals.lastFrame)
+      throw Error(ExitCode::kUsage, "--frames",
+                  "frame " + std::to_string(f) + " is outside the intervals' window " +
+                      std::to_string(intervals.firstFrame) + "-" +
+                      std::to_string(intervals.lastFrame));
+  if (!(options.fps > 0.0)) throw Error(ExitCode::kUsage, "--fps", "must be positive");
+
+  std::error_code ec;
+  std::filesystem::create_directories(options.framesDir, ec);
+  if (ec || !std::filesystem::is_directory(options.framesDir))
+    throw outputError(options.framesDir,
+                      "cannot create output directory" + (ec ? ": " + ec.message() : ""));
+
+  ComposeSequenceReport report;
+  report.exposureEV = options.autoExposure ? autoExposureEV(scene, solution) : options.exposureEV;
+  FrameImageInfo info;
+  info.exposureEV = report.exposureEV;
+  info.provenanceJson = provenance.toJson().dump();
+
+  FrameComposer composer(scene, solution, options.size, options.cameraNode);
+  MovieCache cache(intervals, options.moviesDir);
+  ComposedFrame frame;
+  std::vector<std::vector<float>> textures;  // per active movie, reused
+  std::vector<MovieTexture> active;
+  for (int f : frames) {
+    const auto frameStart = Clock::now();
+    cache.evictBefore(f);
+    const double t = f / options.fps;
+    active.clear();
+    size_t used = 0;
+    for (size_t i = 0; i < intervals.movies.size(); ++i) {
+      const TextureInterval& iv = intervals.movies[i];
+      if (iv.firstFrame > f || iv.lastFrame < f) continue;
+      TextureMovie& movie = cache.get(i);
+      MovieTexture mt;
+      mt.patch = movie.patch;
+      mt.width = movie.width;
+      mt.height = movie.height;
+      if (movie.constant()) {
+        mt.irradiance = movie.keys.front().data();
+      } else {
+        if (textures.size() <= used) textures.resize(used + 1);
+        movie.textureAt(t, textures[used]);
+        mt.irradiance = textures[used].data();
+        ++used;
+      }
+      active.push_back(mt);
+    }
+    composer.compose(t, active, frame);
+    info.frame = f;
+    writeFrameExr(framePath(options.framesDir, f, ".exr"), frame, info, options.half);
+    if (options.png) writeFramePng(framePath(options.framesDir, f, ".png"), frame, info);
+    if (frame.fallbackPixels > 0 && warn)
+      warn("frame " + std::to_string(f) + ": " + std::to_string(frame.fallbackPixels) +
+           " pixels fell back to the global solution");
+
+    ComposeFrameStats s;
+    s.frame = f;
+    s.time = t;
+    s.movies = int(active.size());
+    s.coveredPixels = frame.coveredPixels;
+    s.moviePixels = frame.moviePixels;
+    s.fallbackPixels = frame.fallbackPixels;
+    s.seconds = std::chrono::duration<double>(Clock::now() - frameStart).count();
+    report.frames.push_back(s);
+    if (progress) progress();
+  }
+  report.moviesRead = cache.read();
+  report.peakLoadedMovies = cache.peak();
+  report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return report;
+}
+
+}  // namespace rad
+
+namespace rad {
+
+void addMoviesInput(Provenance& provenance, const TextureIntervals& intervals,
+                    const std::string& moviesDir, const std::vector<int>& frames) {
+  if (frames.empty()) return;
+  const auto [lo, hi] = std::minmax_element(frames.begin(), frames.end());
+  uint64_t h = kFnv1a64Offset;
+  InputRecord record;
+  record.path = moviesDir;
+  for (const TextureInterval& iv : intervals.movies) {
+    if (iv.lastFrame < *lo || iv.firstFrame > *hi) continue;
+    std::string path = textureMoviePath(moviesDir, iv.movie);
+    std::string fileHash = hashFile(path);
+    h = fnv1a64(fileHash.data(), fileHash.size(), h);
+    if (record.history.is_null()) {
+      nlohmann::json info = readExrInfo(path);
+      const nlohmann::json& attrs = info["parts"][0]["attributes"];
+      if (attrs.contains("rad.provenance") && attrs["rad.provenance"].is_string())
+        record.history =
+            nlohmann::json::parse(attrs["rad.provenance"].get<std::string>(), nullptr, false);
+      if (record.history.is_discarded()) record.history = nullptr;
+    }
+  }
+  record.hash = formatFnv1a64(h);
+  provenance.inputs.push_back(std::move(record));
+}
+
+}  // namespace rad

@@ -1,0 +1,253 @@
+// FrameComposer (paper §3.1 last step): L = Le + rho/pi H from movies, B/pi fallback, pixel
+// agreement with the item buffer, texture orientation, sRGB encoding and auto exposure.
+#include "libcommon/frame_composer.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "tests/unit/compose_fixture.h"
+
+namespace rad {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr ImageSize kSize{64, 48};
+
+class FrameComposerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    std::string dir = ::testing::TempDir() + "/frame_composer_test";
+    scene = new Scene(readGltfScene(test::writeComposeScene(dir)));
+  }
+  static void TearDownTestSuite() { delete scene; }
+  static Scene* scene;
+
+  // Item buffer of the same scene, straight from ItemBufferRenderer.
+  static ItemBuffer itemBuffer() {
+    std::vector<ItemTriangle> tris;
+    auto tops = scene->inputPolygons();
+    for (size_t i = 0; i < tops.size(); ++i) {
+      const Polygon& p = tops[i].local;
+      for (int k = 1; k + 1 < p.count; ++k)
+        tris.push_back({{p.v[0], p.v[k], p.v[k + 1]}, uint32_t(i + 1)});
+    }
+    return renderItemBuffer(tris, scene->cameraAt(scene->cameraNode(""), 0.0), kSize);
+  }
+  static glm::dvec3 pixel(const ComposedFrame& f, size_t p) {
+    return {f.rgb[3 * p], f.rgb[3 * p + 1], f.rgb[3 * p + 2]};
+  }
+};
+Scene* FrameComposerTest::scene = nullptr;
+
+void expectRel(const glm::dvec3& got, const glm::dvec3& want, double rel, const std::string& at) {
+  for (int a = 0; a < 3; ++a)
+    EXPECT_NEAR(got[a], want[a], rel * std::abs(want[a]) + 1e-30) << at << " channel " << a;
+}
+
+TEST_F(FrameComposerTest, SceneIsWhatTheTestsAssume) {
+  auto tops = scene->inputPolygons();
+  ASSERT_EQ(tops.size(), 2u);
+  EXPECT_EQ(tops[test::kWallTop].local.count, 4);
+  EXPECT_EQ(scene->materials[tops[test::kLampTop].material].emission, test::kLampEmission);
+  EXPECT_EQ(scene->materials[tops[test::kWallTop].material].reflectance, glm::dvec3(0.5));
+}
+
+TEST_F(FrameComposerTest, ConstantMovieGivesRhoOverPiTimesH) {
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  const glm::dvec3 H(2.0, 4.0, 8.0);
+  std::vector<float> tex;
+  for (int i = 0; i < 5 * 3; ++i) tex.insert(tex.end(), {float(H.x), float(H.y), float(H.z)});
+  // Wall: constant H; lamp: constant H too (L = Le + rho/pi H).
+  std::vector<MovieTexture> movies = {{PatchId{test::kWallTop, 1}, 5, 3, tex.data()},
+                                      {PatchId{test::kLampTop, 1}, 5, 3, tex.data()}};
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  ComposedFrame f = composer.compose(0.0, movies);
+  ItemBuffer ib = itemBuffer();
+  ASSERT_EQ(f.rgb.size(), size_t(kSize.pixelCount()) * 3);
+  long long covered = 0, wall = 0, lamp = 0;
+  for (size_t p = 0; p < ib.id.size(); ++p) {
+    std::string at = "pixel " + std::to_string(p);
+    if (ib.id[p] == kNoItem) {
+      EXPECT_EQ(pixel(f, p), glm::dvec3(0.0)) << at;
+      EXPECT_EQ(f.source[p], PixelSource::kBackground) << at;
+      continue;
+    }
+    ++covered;
+    EXPECT_EQ(f.source[p], PixelSource::kMovie) << at;
+    if (ib.id[p] == test::kWallTop + 1) {
+      ++wall;
+      expectRel(pixel(f, p), 0.5 / kPi * H, 1e-5, at);
+    } else {
+      ++lamp;
+      expectRel(pixel(f, p), test::kLampEmission + 0.5 / kPi * H, 1e-5, at);
+    }
+  }
+  EXPECT_GT(wall, 300);
+  EXPECT_GT(lamp, 20);
+  EXPECT_EQ(f.coveredPixels, covered);
+  EXPECT_EQ(f.moviePixels, covered);
+  EXPECT_EQ(f.fallbackPixels, 0);
+}
+
+TEST_F(FrameComposerTest, EmitterWithZeroIrradianceShowsLe) {
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  std::vector<float> zero(3, 0.0f);
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  ComposedFrame f = composer.compose(0.0, {{PatchId{test::kLampTop, 1}, 1, 1, zero.data()}});
+  ItemBuffer ib = itemBuffer();
+  int lamp = 0;
+  for (size_t p = 0; p < ib.id.size(); ++p)
+    if (ib.id[p] == test::kLampTop + 1) {
+      ++lamp;
+      expectRel(pixel(f, p), test::kLampEmission, 1e-6, "pixel " + std::to_string(p));
+    }
+  EXPECT_GT(lamp, 20);
+}
+
+TEST_F(FrameComposerTest, NoMovieFallsBackToBOverPiAndCountsEveryCoveredPixel) {
+  // Radiosity linear in time between keys 0 s and 1 s; composed at 0.25 s.
+  auto B = [](int node, int key) {
+    return node == test::kLampTop ? glm::dvec3(kPi * test::kLampEmission) * (1.0 + key)
+                                  : glm::dvec3(1.0, 2.0, 3.0) * (1.0 + 3.0 * key);
+  };
+  GlobalSolution g = test::makeSolution(*scene, {0.0, 1.0}, false, B);
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  ComposedFrame f = composer.compose(0.25, {});
+  ItemBuffer ib = itemBuffer();
+  long long covered = 0;
+  for (size_t p = 0; p < ib.id.size(); ++p) {
+    if (ib.id[p] == kNoItem) {
+      EXPECT_EQ(pixel(f, p), glm::dvec3(0.0));
+      continue;
+    }
+    ++covered;
+    int top = int(ib.id[p]) - 1;
+    glm::dvec3 want = (0.75 * B(top, 0) + 0.25 * B(top, 1)) / kPi;
+    expectRel(pixel(f, p), want, 1e-6, "pixel " + std::to_string(p));
+    EXPECT_EQ(f.source[p], PixelSource::kFallback);
+  }
+  EXPECT_GT(covered, 300);
+  EXPECT_EQ(f.fallbackPixels, covered);
+  EXPECT_EQ(f.coveredPixels, covered);
+  EXPECT_EQ(f.moviePixels, 0);
+}
+
+// Where a pixel lies in the wall's (u,v), from its centre ray.
+glm::dvec2 wallUvAt(const Scene& scene, int col, int row) {
+  CameraView view = scene.cameraAt(scene.cameraNode(""), 0.0);
+  Ray r = pixelCentreRay(view, kSize, col, row);
+  double s = (-5.0 - r.origin.z) / r.direction.z;
+  return polygonUvAt(scene.inputPolygons()[test::kWallTop].local, r.origin + s * r.direction);
+}
+
+TEST_F(FrameComposerTest, FallbackUsesTheUnionLeafUnderThePixel) {
+  // Wall split into 4 children (nodes 2..5) with distinct radiosity.
+  auto B = [](int node, int) { return glm::dvec3(10.0 * node + 1.0); };
+  GlobalSolution g = test::makeSolution(*scene, {0.0}, true, B);
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  ComposedFrame f = composer.compose(0.0, {});
+  ItemBuffer ib = itemBuffer();
+  int checked = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      glm::dvec2 uv = wallUvAt(*scene, col, row);
+      if (std::abs(uv.x - 0.5) < 0.02 || std::abs(uv.y - 0.5) < 0.02) continue;  // seams
+      int child = uv.y < 0.5 ? (uv.x < 0.5 ? 0 : 1) : (uv.x < 0.5 ? 3 : 2);
+      expectRel(pixel(f, p), B(2 + child, 0) / kPi, 1e-6, "pixel " + std::to_string(p));
+      ++checked;
+    }
+  EXPECT_GT(checked, 300);
+}
+
+TEST_F(FrameComposerTest, MovieTexelsMapToTheirPatchPoints) {
+  // H = 100 u on a 16x1 texture: texel i centre at u = (i+.5)/16, bilinear between centres
+  // reproduces the linear function exactly; row j = 0 is v = 0, so a 1x16 texture in v checks
+  // the other axis.
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  std::vector<float> ramp;
+  for (int i = 0; i < 16; ++i) {
+    float h = float(100.0 * (i + 0.5) / 16);
+    ramp.insert(ramp.end(), {h, h, h});
+  }
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  for (int axis = 0; axis < 2; ++axis) {
+    MovieTexture mt{PatchId{test::kWallTop, 1}, axis == 0 ? 16 : 1, axis == 0 ? 1 : 16,
+                    ramp.data()};
+    ComposedFrame f = composer.compose(0.0, {mt});
+    ItemBuffer ib = itemBuffer();
+    int checked = 0;
+    for (int row = 0; row < kSize.height; ++row)
+      for (int col = 0; col < kSize.width; ++col) {
+        size_t p = size_t(row) * kSize.width + col;
+        if (ib.id[p] != test::kWallTop + 1) continue;
+        double u = wallUvAt(*scene, col, row)[axis];
+        if (u < 0.5 / 16 || u > 1 - 0.5 / 16) continue;  // clamped border texels
+        double want = 0.5 / kPi * 100.0 * u;
+        EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want) << col << "," << row << " axis " << axis;
+        ++checked;
+      }
+    EXPECT_GT(checked, 250);
+  }
+}
+
+TEST_F(FrameComposerTest, SubPatchMovieCoversItsQuarterAndTheRestFallsBack) {
+  auto B = [](int, int) { return glm::dvec3(kPi); };  // fallback L = 1
+  GlobalSolution g = test::makeSolution(*scene, {0.0}, false, B);
+  std::vector<float> h(3, float(4.0 * kPi));             // movie L = 0.5/pi * 4 pi = 2
+  PatchId child2 = PatchId{test::kWallTop, 1}.child(2);  // (u,v) in [.5,1]^2
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  ComposedFrame f = composer.compose(0.0, {{child2, 1, 1, h.data()}});
+  ItemBuffer ib = itemBuffer();
+  int movie = 0, fallback = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      glm::dvec2 uv = wallUvAt(*scene, col, row);
+      if (std::abs(uv.x - 0.5) < 0.02 || std::abs(uv.y - 0.5) < 0.02) continue;
+      bool inChild = uv.x > 0.5 && uv.y > 0.5;
+      EXPECT_NEAR(pixel(f, p).x, inChild ? 2.0 : 1.0, 1e-5) << col << "," << row;
+      (inChild ? movie : fallback)++;
+    }
+  EXPECT_GT(movie, 50);
+  EXPECT_GT(fallback, 150);
+  EXPECT_EQ(f.moviePixels + f.fallbackPixels, f.coveredPixels);
+}
+
+TEST_F(FrameComposerTest, DeterministicAcrossCalls) {
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, true, [](int n, int) { return glm::dvec3(0.1 * n + 0.3); });
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  ComposedFrame a = composer.compose(0.0, {}), b = composer.compose(0.0, {});
+  EXPECT_EQ(a.rgb, b.rgb);
+}
+
+TEST(Srgb, EncodeAndExposure) {
+  EXPECT_DOUBLE_EQ(srgbEncode(0.0), 0.0);
+  EXPECT_DOUBLE_EQ(srgbEncode(1.0), 1.0);
+  EXPECT_NEAR(srgbEncode(0.5), 0.735356983, 1e-8);
+  EXPECT_NEAR(srgbEncode(0.002), 0.02584, 1e-8);
+  EXPECT_DOUBLE_EQ(srgbEncode(7.0), 1.0);
+  std::vector<float> rgb = {0.25f, 0.5f, 2.0f, -1.0f, 0.0f, 0.125f};
+  std::vector<uint8_t> b = toSrgb8(rgb, 1.0);  // x2
+  std::vector<uint8_t> want = {188, 255, 255, 0, 0, 137};
+  EXPECT_EQ(b, want);
+}
+
+TEST_F(FrameComposerTest, AutoExposureIgnoresEmittersAndDependsOnlyOnTheSolution) {
+  // Wall leaves B/pi luminance 0.25; lamp (emitter) much brighter, ignored.
+  auto B = [](int node, int) {
+    return node == test::kLampTop ? glm::dvec3(1000.0) : glm::dvec3(0.25 * kPi);
+  };
+  GlobalSolution g = test::makeSolution(*scene, {0.0}, false, B);
+  EXPECT_NEAR(autoExposureEV(*scene, g), 2.0, 1e-6);  // 0.25 * 2^2 = 1 (B stored as float)
+}
+
+}  // namespace
+}  // namespace rad

@@ -1,0 +1,154 @@
+// rad-compose: final frames from the texture movies (paper §3.1 last step; DESIGN.md §6
+// "rad-compose"). Reads the scene, the global solution, the intervals and the movies; writes
+// FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The work is in
+// libcommon/frame_composer.h and formats/frame_sequence.h.
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+#include <optional>
+
+#include "formats/atomic_file.h"
+#include "formats/container.h"
+#include "formats/frame_sequence.h"
+#include "formats/gltf_scene.h"
+#include "formats/link_hierarchy.h"
+#include "formats/provenance.h"
+#include "formats/texture_intervals.h"
+#include "libcommon/tool_main.h"
+
+namespace {
+
+constexpr const char* kTool = "rad-compose";
+
+struct Options {
+  std::string scene, global, intervals, movies;
+  std::string output;
+  std::string frames;  // empty: the intervals' window
+  std::optional<double> fps;
+  std::string size;  // empty: the intervals' image size
+  std::string camera;
+  std::optional<double> exposure;
+  bool autoExposure = false;
+  bool half = false;
+  bool noPng = false;
+  std::string report;
+};
+
+void writeReport(const std::string& path, const nlohmann::json& report) {
+  rad::AtomicFile file(path);
+  std::string text = report.dump(1) + "\n";
+  FILE* f = std::fopen(file.tempPath().c_str(), "wb");
+  if (!f) throw rad::outputError(path, "cannot write");
+  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  ok = std::fclose(f) == 0 && ok;
+  if (!ok) throw rad::outputError(path, "write failed");
+  file.commit();
+}
+
+int run(const Options& o, int argc, char** argv) {
+  rad::Scene scene = rad::readGltfScene(o.scene);
+  rad::ContainerReader globalReader = rad::ContainerReader::open(o.global);
+  rad::GlobalSolution solution = rad::readLinkHierarchy(globalReader, scene);
+  rad::ContainerReader intervalsReader = rad::ContainerReader::open(o.intervals);
+  rad::TextureIntervals intervals = rad::readTextureIntervals(intervalsReader);
+
+  rad::ComposeSequenceOptions c;
+  c.moviesDir = o.movies;
+  c.framesDir = o.output;
+  if (o.frames.empty()) {
+    for (int f = intervals.firstFrame; f <= intervals.lastFrame; ++f) c.frames.push_back(f);
+  } else {
+    c.frames = rad::parseFrameRange(o.frames);
+  }
+  c.fps = o.fps.value_or(intervals.fps);
+  if (!(c.fps > 0.0)) throw rad::Error(rad::ExitCode::kUsage, "", "--fps must be positive");
+  if (o.size.empty()) {
+    c.size = {intervals.imageWidth, intervals.imageHeight};
+  } else {
+    auto [w, h] = rad::parseImageSize(o.size);
+    c.size = {w, h};
+  }
+  if (c.size.width < 1 || c.size.height < 1)
+    throw rad::inputError(o.intervals, "no image size; pass --size");
+  c.cameraNode = scene.cameraNode(o.camera);
+  if (c.cameraNode < 0)
+    throw rad::inputError(o.scene,
+                          o.camera.empty() ? "no camera" : "no camera named '" + o.camera + "'");
+  c.autoExposure = o.autoExposure;
+  c.exposureEV = o.exposure.value_or(0.0);
+  c.half = o.half;
+  c.png = !o.noPng;
+
+  nlohmann::json parameters = {
+      {"output", o.output},
+      {"frames", std::to_string(c.frames.front()) + "-" + std::to_string(c.frames.back())},
+      {"fps", c.fps},
+      {"size", std::to_string(c.size.width) + "x" + std::to_string(c.size.height)},
+      {"camera", scene.nodes[c.cameraNode].name},
+      {"exposure", c.exposureEV},
+      {"auto-exposure", c.autoExposure},
+      {"half", c.half},
+      {"no-png", o.noPng}};
+  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
+  rad::addInput(provenance, o.scene);
+  rad::addInput(provenance, globalReader);
+  rad::addInput(provenance, intervalsReader);
+  rad::addMoviesInput(provenance, intervals, o.movies, c.frames);
+
+  rad::Progress progress(kTool, long(c.frames.size()));
+  auto warn = [&](const std::string& message) {
+    if (rad::stderrIsTerminal()) std::fprintf(stderr, "\r\033[K");
+    std::cerr << kTool << ": " << message << "\n";
+  };
+  rad::ComposeSequenceReport report = rad::composeSequence(
+      scene, solution, intervals, c, provenance, warn, [&]() { progress.advance(); });
+  progress.done();
+  if (o.autoExposure)
+    std::cerr << kTool << ": auto exposure " << report.exposureEV << " EV for all frames\n";
+  if (!o.report.empty()) {
+    nlohmann::json j = report.toJson();
+    j["provenance"] = provenance.toJson();
+    writeReport(o.report, j);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Composes the final frames: each visible patch textured with its texture movie's\n"
+      "irradiance H at the frame's time, L = Le + rho/pi H (paper §3.1); pixels no movie\n"
+      "covers fall back to the global solution (counted in a warning). Writes FRAMES_DIR/\n"
+      "NNNN.exr (linear radiance, W/(m^2 sr)) and NNNN.png (sRGB, exposure applied)."};
+  Options o;
+  rad::setUpApp(app, kTool,
+                "rad-compose scene.gltf out/global.rlh out/intervals.rti out/movies -o out/frames "
+                "--frames 0-95 --auto-exposure");
+  app.add_option("SCENE", o.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
+  app.add_option("GLOBAL", o.global, "global solution from rad-global (global.rlh)")->required();
+  app.add_option("INTERVALS", o.intervals, "texture-movie extents from rad-intervals (.rti)")
+      ->required();
+  app.add_option("MOVIES_DIR", o.movies, "texture movies from rad-movies (MMMMMM.exr)")->required();
+  app.add_option("-o,--output", o.output, "output directory for NNNN.exr / NNNN.png (created)")
+      ->required();
+  app.add_option("--frames", o.frames,
+                 "frames to compose, FIRST-LAST[xSTEP] (default: all of "
+                 "the intervals' window)");
+  app.add_option("--fps", o.fps, "frames per second, frame f at f/fps (default: the intervals')");
+  app.add_option("--size", o.size, "image size WIDTHxHEIGHT (default: the intervals')");
+  app.add_option("--camera", o.camera, "camera node or camera name (default: the first camera)");
+  auto* exposure = app.add_option("--exposure", o.exposure,
+                                  "PNG exposure in EV: PNG = sRGB(L * 2^EV) "
+                                  "(default 0)");
+  app.add_flag("--auto-exposure", o.autoExposure,
+               "one exposure for the whole sequence: the 99th area percentile of the global "
+               "solution's non-emitter radiance maps to white")
+      ->excludes(exposure);
+  app.add_flag("--half", o.half, "write HALF instead of FLOAT EXR channels");
+  app.add_flag("--no-png", o.noPng, "write only the EXR frames");
+  app.add_option("--report", o.report, "write per-frame times and fallback pixel counts as JSON");
+  if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
+  return rad::runTool(kTool, [&]() { return run(o, argc, argv); });
+}
