@@ -49,6 +49,7 @@ TEST(ToolsCli, MissingInputIsOneLineNamingTheFile) {
     if (t == "rad-inspect") rest = "";
     if (t == "rad-movies") rest = " g.rlh i.rti -o /tmp/rad_cli_unused";
     if (t == "rad-compose") rest = " g.rlh i.rti movies -o /tmp/rad_cli_unused";
+    if (t == "rad-diff") rest = " /tmp/rad_cli_unused.exr";
     CommandResult r = runCommand(tool(t) + " /nonexistent/scene.gltf" + rest);
     EXPECT_EQ(r.exitCode, 1) << t << ": " << r.err;
     EXPECT_EQ(countLines(r.err), 1) << t << ": " << r.err;
