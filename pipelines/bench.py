@@ -47,23 +47,30 @@ def run(cmd, log):
     return dt, usage.ru_maxrss / 1024.0
 
 
-def pipeline(bin_dir, scene, out, frames, size, scratch, log):
+SCRATCH_FLAGS = {"global": ["--no-coherence"], "intervals": ["--max-length", "1"],
+                 "movies": ["--no-coherence"], "compose": []}
+
+
+def pipeline(bin_dir, scene, out, frames, size, flags, log):
+    """Runs the four stages into out/; flags: stage name -> extra arguments. Returns per-stage
+    (seconds, peak MiB), total seconds and overall peak MiB."""
     os.makedirs(out, exist_ok=True)
-    fr = "0-%d" % (frames - 1)
+    fr = frames if isinstance(frames, str) else "0-%d" % (frames - 1)
     g, i, m, c = (os.path.join(bin_dir, t) for t in
                   ("rad-global", "rad-intervals", "rad-movies", "rad-compose"))
-    no_coh = ["--no-coherence"] if scratch else []
+    f = lambda k: list(flags.get(k, []))
     stages = {}
     stages["global"] = run([g, scene, "-o", out + "/global.rlh", "--frames", fr, "--fps", "24",
-                            "--report", out + "/global-report.json"] + no_coh, log)
+                            "--report", out + "/global-report.json"] + f("global"), log)
     stages["intervals"] = run([i, scene, "-o", out + "/intervals.rti", "--frames", fr, "--fps",
                                "24", "--size", size, "--report", out + "/intervals-report.json"]
-                              + (["--max-length", "1"] if scratch else []), log)
+                              + f("intervals"), log)
     stages["movies"] = run([m, scene, out + "/global.rlh", out + "/intervals.rti", "-o",
-                            out + "/movies", "--report", out + "/movies-report.json"] + no_coh, log)
+                            out + "/movies", "--report", out + "/movies-report.json"] + f("movies"),
+                           log)
     stages["compose"] = run([c, scene, out + "/global.rlh", out + "/intervals.rti",
-                             out + "/movies", "-o", out + "/frames", "--frames", fr, "--no-png"],
-                            log)
+                             out + "/movies", "-o", out + "/frames", "--frames", fr, "--no-png"]
+                            + f("compose"), log)
     total = sum(s[0] for s in stages.values())
     peak = max(s[1] for s in stages.values())
     return {"stages": stages, "total": total, "peak_mib": peak}
@@ -121,7 +128,8 @@ def main():
             out = os.path.join(a.out, name, mode)
             print("bench: %s %s (%d frames, %s)" % (name, mode, a.frames, a.size),
                   file=sys.stderr, flush=True)
-            row[mode] = pipeline(a.bin, scene, out, a.frames, a.size, mode == "scratch", log)
+            row[mode] = pipeline(a.bin, scene, out, a.frames, a.size,
+                                 SCRATCH_FLAGS if mode == "scratch" else {}, log)
         row["links"] = link_stats(os.path.join(a.out, name, "coherent", "global-report.json"))
         row["difference"] = frame_difference(a.bin, os.path.join(a.out, name, "coherent", "frames"),
                                              os.path.join(a.out, name, "scratch", "frames"))
@@ -162,7 +170,7 @@ def print_tables(rows, frames, size, out):
                                                           l["mean"], l["percent"]), file=out)
         diffs = [(r["scene"], r["difference"]) for r in sel if r.get("difference")]
         for name, d in diffs:
-            print("%-22s coherent vs scratch: %s" % (name, json.dumps(d.get("summary", d))[:160]),
+            print("%-22s coherent vs scratch: %s" % (name, json.dumps(d.get("difference", d))[:200]),
                   file=out)
     out.flush()
 
