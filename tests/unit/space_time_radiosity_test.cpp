@@ -56,6 +56,18 @@ TEST(SpaceTimeRadiosity, CoherenceMatchesIndependentSolves) {
   std::cout << "coherent vs independent: max |dB| " << worst << " of max B " << maxB << "; reused "
             << reused << ", recomputed " << recomputed << "\n";
   EXPECT_LT(worst, 0.02 * maxB);
+  // And per top-level patch, relative to its own radiosity.
+  double worstRel = 0;
+  for (int t = 0; t < coherent.hierarchy.topCount(); ++t)
+    for (size_t k = 0; k < keys.size(); ++k) {
+      glm::dvec3 a = coherent.radiosityAtKey(t, int(k)), b = plain.radiosityAtKey(t, int(k));
+      for (int c = 0; c < 3; ++c)
+        worstRel = std::max(worstRel, std::abs(a[c] - b[c]) / std::max(1e-12, std::abs(b[c])));
+    }
+  std::cout << "per-top relative difference " << worstRel << "\n";
+  // Measured 6.5% on the dimmest face (16 rays: a partly visible link's V has a standard
+  // deviation up to 1/8, and reused links keep the previous key's seed).
+  EXPECT_LT(worstRel, 0.1);
   // Key 0 is solved identically by both.
   for (int t = 0; t < coherent.hierarchy.topCount(); ++t)
     EXPECT_EQ(coherent.radiosityAtKey(t, 0), plain.radiosityAtKey(t, 0));
