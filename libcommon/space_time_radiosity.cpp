@@ -1,0 +1,318 @@
+// Space-time hierarchical radiosity: key-time solves, coherence, merge (see the header).
+#include "libcommon/space_time_radiosity.h"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <unordered_map>
+
+#include "libcommon/error.h"
+
+namespace rad {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// What the merge needs of one key-time solve.
+struct KeyRecord {
+  struct Link {
+    uint32_t receiver, shooter;
+    float fv, visibility;
+    bool refined;
+  };
+  std::vector<Link> links;
+  std::vector<char> split;
+  std::vector<glm::vec3> radiosity;  // per node of the union hierarchy at that time (push-down)
+};
+
+// Radiosity of every node, nodes outside the key's tree taking their parent's value.
+std::vector<glm::dvec3> pushedDown(const KeySolution& s, const PatchHierarchy& h) {
+  std::vector<glm::dvec3> b(s.radiosity.begin(), s.radiosity.end());
+  b.resize(size_t(h.size()), glm::dvec3(0.0));
+  for (int i = 0; i < h.size(); ++i)
+    if (size_t(i) >= s.split.size() || !s.inTree(i, h)) b[size_t(i)] = b[size_t(h.node(i).parent)];
+  return b;
+}
+
+}  // namespace
+
+BadLinkRule parseBadLinkRule(const std::string& s) {
+  if (s == "lights") return BadLinkRule::kLights;
+  if (s == "partial") return BadLinkRule::kPartial;
+  if (s == "all") return BadLinkRule::kAll;
+  if (s == "none") return BadLinkRule::kNone;
+  throw Error(ExitCode::kUsage, "--bad-links",
+              "expected lights, partial, all or none, got '" + s + "'");
+}
+
+const char* badLinkRuleName(BadLinkRule r) {
+  switch (r) {
+    case BadLinkRule::kLights:
+      return "lights";
+    case BadLinkRule::kPartial:
+      return "partial";
+    case BadLinkRule::kAll:
+      return "all";
+    case BadLinkRule::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const Scene& scene,
+                        double t0, double t1) {
+  // Per mesh node: static over [t0, t1]? Dynamic ones contribute their swept bounds.
+  std::unordered_map<int, bool> dynamic;
+  std::vector<std::array<glm::dvec3, 2>> swept;
+  for (int node : scene.meshNodes()) {
+    bool d = scene.isDynamic(node, t0, t1);
+    dynamic[node] = d;
+    if (d) swept.push_back(scene.sweptBounds(node, t0, t1));
+  }
+  auto isStatic = [&](int top) {
+    int node = h.top(top).node;
+    auto it = dynamic.find(node);
+    return node < 0 || it == dynamic.end() || !it->second;
+  };
+  LinkCache cache;
+  cache.reserve(prev.links.size());
+  for (const SolverLink& l : prev.links) {
+    const PatchNode& r = h.node(l.receiver);
+    const PatchNode& s = h.node(l.shooter);
+    if (!isStatic(int(r.id.top)) || !isStatic(int(s.id.top))) continue;
+    bool hit = false;
+    for (const auto& box : swept)
+      if (shaftMeetsBox(prev.world[size_t(l.receiver)], prev.world[size_t(l.shooter)], box[0],
+                        box[1])) {
+        hit = true;
+        break;
+      }
+    if (hit) continue;
+    CachedLink c;
+    c.formFactor = l.formFactor;
+    c.visibility = l.visibility;
+    c.estimate = l.estimate;
+    c.accurate = l.accurate;
+    c.refined = l.refined;
+    cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
+  }
+  return cache;
+}
+
+GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
+                              const SpaceTimeOptions& opt, SpaceTimeReport* report) {
+  SpaceTimeReport localReport;
+  SpaceTimeReport& rep = report ? *report : localReport;
+  const size_t K = keyTimes.size();
+  if (K == 0) throw Error(ExitCode::kUsage, "", "no key times");
+  auto tSetup = std::chrono::steady_clock::now();
+  PatchHierarchy h(scene.inputPolygons());
+  if (h.topCount() == 0) throw inputError(scene.path, "has no polygons");
+  const int T = h.topCount();
+  std::vector<SurfaceProperties> surfaces = surfacePropertiesOf(scene, h);
+  SceneVisibility vis(scene, h, keyTimes.front(), keyTimes.back());
+  rep.secondsSetup = secondsSince(tSetup);
+
+  std::vector<KeyRecord> records(K);
+  KeySolution prev;
+  for (size_t k = 0; k < K; ++k) {
+    double t = keyTimes[k];
+    vis.setTime(t);
+    KeySolveInput in;
+    in.topToWorld = topTransforms(scene, h, t);
+    in.visibility = &vis.visibility();
+    in.keyIndex = uint32_t(k);
+    KeyTimeReport kr;
+    kr.time = t;
+    LinkCache cache;
+    std::vector<glm::dvec3> warm;
+    if (opt.coherence && k > 0) {
+      auto tc = std::chrono::steady_clock::now();
+      cache = reusableLinks(prev, h, scene, keyTimes[k - 1], t);
+      warm = pushedDown(prev, h);
+      in.reuse = &cache;
+      in.initialRadiosity = &warm;
+      kr.secondsCoherence = secondsSince(tc);
+    }
+    KeySolution s = solveKeyTime(h, surfaces, in, opt.radiosity);
+    kr.links = s.links.size();
+    kr.recomputed = s.linksComputed;
+    kr.reused = s.linksReused;
+    kr.iterations = s.iterations;
+    kr.refineRounds = s.refineRounds;
+    kr.secondsLinks = s.secondsLinks;
+    kr.secondsSolve = s.secondsSolve;
+    for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
+    rep.keys.push_back(kr);
+
+    KeyRecord& rec = records[k];
+    rec.links.reserve(s.links.size());
+    for (const SolverLink& l : s.links)
+      rec.links.push_back({uint32_t(l.receiver), uint32_t(l.shooter), float(l.fv()),
+                           float(l.visibility), l.refined});
+    rec.split = s.split;
+    std::vector<glm::dvec3> b = pushedDown(s, h);
+    rec.radiosity.assign(b.begin(), b.end());
+    prev = std::move(s);
+  }
+
+  // ---- merge into the union hierarchy
+  auto tMerge = std::chrono::steady_clock::now();
+  const size_t N = size_t(h.size());
+  GlobalSolution g;
+  g.keyTimes = keyTimes;
+  // Radiosity per node and key; nodes created after key k take their ancestor's value there.
+  g.nodeRadiosity.assign(N * K, glm::vec3(0.0f));
+  for (size_t k = 0; k < K; ++k) {
+    const KeyRecord& rec = records[k];
+    for (size_t i = 0; i < N; ++i) {
+      glm::vec3 b = i < rec.radiosity.size()
+                        ? rec.radiosity[i]
+                        : g.nodeRadiosity[size_t(h.node(int(i)).parent) * K + k];
+      g.nodeRadiosity[i * K + k] = b;
+    }
+  }
+
+  // Bad pairs (paper §3.1): by shooter top (and partial visibility), over all key times.
+  std::vector<char> badPair(size_t(T) * size_t(T), 0);
+  for (const KeyRecord& rec : records)
+    for (const KeyRecord::Link& l : rec.links) {
+      uint32_t rt = h.node(int(l.receiver)).id.top, st = h.node(int(l.shooter)).id.top;
+      char& bad = badPair[size_t(rt) * size_t(T) + st];
+      switch (opt.badLinks) {
+        case BadLinkRule::kNone:
+          break;
+        case BadLinkRule::kAll:
+          bad = 1;
+          break;
+        case BadLinkRule::kLights:
+          bad |= surfaces[st].isEmitter();
+          break;
+        case BadLinkRule::kPartial:
+          bad |= surfaces[st].isEmitter() ||
+                 (!l.refined && l.visibility > opt.partialThreshold && l.visibility < 1.0f);
+          break;
+      }
+    }
+  for (uint32_t r = 0; r < uint32_t(T); ++r)
+    for (uint32_t s = 0; s < uint32_t(T); ++s)
+      if (badPair[size_t(r) * size_t(T) + s]) g.badPairs.emplace_back(r, s);
+
+  // Links: one row per activity interval (maximal run of consecutive keys, same refined flag).
+  struct Sample {
+    uint32_t key;
+    float fv, visibility;
+    bool refined;
+  };
+  std::unordered_map<uint64_t, std::vector<Sample>> perLink;
+  for (size_t k = 0; k < K; ++k)
+    for (const KeyRecord::Link& l : records[k].links)
+      perLink[(uint64_t(l.receiver) << 32) | l.shooter].push_back(
+          {uint32_t(k), l.fv, l.visibility, l.refined});
+  std::vector<uint64_t> linkKeys;
+  linkKeys.reserve(perLink.size());
+  for (const auto& [key, v] : perLink) linkKeys.push_back(key);
+  std::sort(linkKeys.begin(), linkKeys.end());
+  for (uint64_t key : linkKeys) {
+    const std::vector<Sample>& v = perLink[key];  // ascending keys (filled in key order)
+    uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
+    bool bad = badPair[size_t(h.node(int(rcv)).id.top) * size_t(T) + h.node(int(sh)).id.top];
+    for (size_t a = 0; a < v.size();) {
+      size_t b = a + 1;
+      while (b < v.size() && v[b].key == v[b - 1].key + 1 && v[b].refined == v[a].refined) ++b;
+      GlobalLink gl;
+      gl.receiver = rcv;
+      gl.shooter = sh;
+      gl.firstKey = v[a].key;
+      gl.lastKey = v[b - 1].key;
+      gl.sampleOffset = uint32_t(g.linkSampleKeys.size());
+      bool constant = true, visChanged = false;
+      for (size_t j = a + 1; j < b; ++j) {
+        constant &= v[j].fv == v[a].fv;
+        visChanged |= v[j].visibility != v[a].visibility;
+      }
+      for (size_t j = a; j < (constant ? a + 1 : b); ++j) {
+        g.linkSampleKeys.push_back(v[j].key);
+        g.linkSampleValues.push_back(v[j].fv);
+      }
+      gl.sampleCount = uint32_t(g.linkSampleKeys.size()) - gl.sampleOffset;
+      gl.flags = uint8_t((bad ? kLinkBad : 0) | (visChanged ? kLinkVisibilityEvent : 0) |
+                         (v[a].refined ? kLinkRefined : 0));
+      g.links.push_back(gl);
+      a = b;
+    }
+  }
+
+  // Good-link irradiance at the union leaves' vertices (Gouraud: averaged over the leaves of
+  // the same top-level patch that share the vertex, in exact dyadic top-level (u,v)).
+  g.leafRow.assign(N, -1);
+  std::vector<int> leaves;
+  for (size_t i = 0; i < N; ++i)
+    if (h.isLeaf(int(i))) {
+      g.leafRow[i] = int32_t(leaves.size());
+      leaves.push_back(int(i));
+    }
+  const size_t L = leaves.size();
+  std::vector<std::array<int, 4>> leafVertex(L);  // vertex index per corner
+  std::vector<int> vertexCount;
+  {
+    std::vector<std::map<std::pair<double, double>, int>> perTop(static_cast<size_t>(T));
+    for (size_t li = 0; li < L; ++li) {
+      const PatchNode& n = h.node(leaves[li]);
+      bool tri = n.local.count == 3;
+      const glm::dvec2 corners[4] = {
+          {0, 0}, {1, 0}, tri ? glm::dvec2(0, 1) : glm::dvec2(1, 1), {0, 1}};
+      for (int c = 0; c < 4; ++c) {
+        if (tri && c == 3) {
+          leafVertex[li][3] = leafVertex[li][0];
+          continue;
+        }
+        glm::dvec2 uv = topUvFromNodeUv(n.id, corners[c], tri);
+        auto [it, fresh] =
+            perTop[n.id.top].emplace(std::make_pair(uv.x, uv.y), int(vertexCount.size()));
+        if (fresh) vertexCount.push_back(0);
+        leafVertex[li][size_t(c)] = it->second;
+        vertexCount[size_t(it->second)]++;
+      }
+    }
+  }
+  g.leafVertexGoodIrradiance.assign(L * K * 4, glm::vec3(0.0f));
+  std::vector<glm::dvec3> nodeH(N), leafH(L), vertexSum(vertexCount.size());
+  for (size_t k = 0; k < K; ++k) {
+    std::fill(nodeH.begin(), nodeH.end(), glm::dvec3(0.0));
+    for (const KeyRecord::Link& l : records[k].links) {
+      if (l.refined) continue;
+      if (badPair[size_t(h.node(int(l.receiver)).id.top) * size_t(T) +
+                  h.node(int(l.shooter)).id.top])
+        continue;
+      nodeH[l.receiver] += double(l.fv) * glm::dvec3(records[k].radiosity[l.shooter]);
+    }
+    std::fill(vertexSum.begin(), vertexSum.end(), glm::dvec3(0.0));
+    for (size_t li = 0; li < L; ++li) {
+      glm::dvec3 H(0.0);
+      for (int a = leaves[li]; a >= 0; a = h.node(a).parent) H += nodeH[size_t(a)];
+      leafH[li] = H;
+      const PatchNode& n = h.node(leaves[li]);
+      for (int c = 0; c < (n.local.count == 3 ? 3 : 4); ++c)
+        vertexSum[size_t(leafVertex[li][size_t(c)])] += H;
+    }
+    for (size_t li = 0; li < L; ++li)
+      for (int c = 0; c < 4; ++c) {
+        int v = leafVertex[li][size_t(c)];
+        g.leafVertexGoodIrradiance[(li * K + k) * 4 + size_t(c)] =
+            glm::vec3(vertexSum[size_t(v)] / double(vertexCount[size_t(v)]));
+      }
+  }
+  g.hierarchy = std::move(h);
+  g.validate("rad-global");
+  rep.secondsMerge = secondsSince(tMerge);
+  rep.unionNodes = N;
+  rep.linkRows = g.links.size();
+  rep.badPairs = g.badPairs.size();
+  return g;
+}
+
+}  // namespace rad
