@@ -82,7 +82,9 @@ int run(const Options& o, int argc, char** argv) {
 
   nlohmann::json parameters = {
       {"output", o.output},
-      {"frames", std::to_string(c.frames.front()) + "-" + std::to_string(c.frames.back())},
+      {"frames", o.frames.empty()
+                     ? std::to_string(c.frames.front()) + "-" + std::to_string(c.frames.back())
+                     : o.frames},
       {"fps", c.fps},
       {"size", std::to_string(c.size.width) + "x" + std::to_string(c.size.height)},
       {"camera", scene.nodes[c.cameraNode].name},
