@@ -107,7 +107,9 @@ class RadCompose : public ::testing::Test {
             {{tops[i].local.v[0], tops[i].local.v[k], tops[i].local.v[k + 1]}, uint32_t(i + 1)});
     items = renderItemBuffer(tris, scene.cameraAt(scene.cameraNode(""), 0.0), kSize);
   }
-  void TearDown() override { fs::remove_all(dir); }
+  void TearDown() override {
+    if (!std::getenv("RAD_KEEP_TEST_DIR")) fs::remove_all(dir);
+  }
 
   std::string command(const std::string& out, const std::string& extra = "") const {
     return tool("rad-compose") + " " + scenePath + " " + (dir / "global.rlh").string() + " " +

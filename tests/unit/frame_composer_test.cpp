@@ -228,6 +228,48 @@ TEST_F(FrameComposerTest, DeterministicAcrossCalls) {
   EXPECT_EQ(a.rgb, b.rgb);
 }
 
+TEST_F(FrameComposerTest, BaseColourTextureModulatesMovieAndFallback) {
+  // The wall gets a 1x2 base colour texture (row 0 at glTF v = 0, the top of the wall) with
+  // baseColorFactor 0.5: rho(x) = 0.5 tex(x); Material::reflectance holds 0.5 mean(tex).
+  Scene s = *scene;
+  Texture tex;
+  tex.width = 1;
+  tex.height = 2;
+  tex.rgb = {0.2f, 0.4f, 0.6f, 0.8f, 0.8f, 0.8f};
+  tex.mean = glm::dvec3(0.5, 0.6, 0.7);
+  s.textures.push_back(tex);
+  int wallMaterial = s.inputPolygons()[test::kWallTop].material;
+  s.materials[wallMaterial].baseColorTexture = 0;
+  s.materials[wallMaterial].reflectance = 0.5 * tex.mean;
+  for (Mesh& mesh : s.meshes)
+    for (MeshTriangle& t : mesh.triangles)
+      for (int k = 0; k < 3; ++k) t.uv[k] = {(t.p[k].x + 1) / 2, (1 - t.p[k].y) / 2};
+  const glm::dvec3 B(0.3, 0.6, 0.9), H(2.0, 3.0, 4.0);
+  GlobalSolution g = test::makeSolution(s, {0.0}, false, [&](int, int) { return B; });
+  std::vector<float> h = {float(H.x), float(H.y), float(H.z)};
+  FrameComposer composer(s, g, kSize, s.cameraNode(""));
+  ComposedFrame withMovie = composer.compose(0.0, {{PatchId{test::kWallTop, 1}, 1, 1, h.data()}});
+  ComposedFrame fallback = composer.compose(0.0, {});
+  ItemBuffer ib = itemBuffer();
+  CameraView view = s.cameraAt(s.cameraNode(""), 0.0);
+  int checked = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      Ray r = pixelCentreRay(view, kSize, col, row);
+      double y = r.origin.y + (-5.0 - r.origin.z) / r.direction.z * r.direction.y;
+      double v = (1 - y) / 2;
+      if (v < 0.3 || v > 0.7) continue;  // bilinear REPEAT wraps outside [.25, .75]
+      double w = 2 * v - 0.5;
+      glm::dvec3 c = (1 - w) * glm::dvec3(0.2, 0.4, 0.6) + w * glm::dvec3(0.8);
+      expectRel(pixel(withMovie, p), 0.5 * c / kPi * H, 1e-5, "movie " + std::to_string(p));
+      expectRel(pixel(fallback, p), c / tex.mean * B / kPi, 1e-5, "fallback " + std::to_string(p));
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
+}
+
 TEST(Srgb, EncodeAndExposure) {
   EXPECT_DOUBLE_EQ(srgbEncode(0.0), 0.0);
   EXPECT_DOUBLE_EQ(srgbEncode(1.0), 1.0);
