@@ -228,6 +228,96 @@ TEST_F(FrameComposerTest, DeterministicAcrossCalls) {
   EXPECT_EQ(a.rgb, b.rgb);
 }
 
+TEST_F(FrameComposerTest, BaseColourTextureModulatesMovieAndFallback) {
+  // The wall gets a 1x2 base colour texture (row 0 at glTF v = 0, the top of the wall) with
+  // baseColorFactor 0.5: rho(x) = 0.5 tex(x); Material::reflectance holds 0.5 mean(tex).
+  Scene s = *scene;
+  Texture tex;
+  tex.width = 1;
+  tex.height = 2;
+  tex.rgb = {0.2f, 0.4f, 0.6f, 0.8f, 0.8f, 0.8f};
+  tex.mean = glm::dvec3(0.5, 0.6, 0.7);
+  s.textures.push_back(tex);
+  int wallMaterial = s.inputPolygons()[test::kWallTop].material;
+  s.materials[wallMaterial].baseColorTexture = 0;
+  s.materials[wallMaterial].reflectance = 0.5 * tex.mean;
+  for (Mesh& mesh : s.meshes)
+    for (MeshTriangle& t : mesh.triangles)
+      for (int k = 0; k < 3; ++k) t.uv[k] = {(t.p[k].x + 1) / 2, (1 - t.p[k].y) / 2};
+  const glm::dvec3 B(0.3, 0.6, 0.9), H(2.0, 3.0, 4.0);
+  GlobalSolution g = test::makeSolution(s, {0.0}, false, [&](int, int) { return B; });
+  std::vector<float> h = {float(H.x), float(H.y), float(H.z)};
+  FrameComposer composer(s, g, kSize, s.cameraNode(""));
+  ComposedFrame withMovie = composer.compose(0.0, {{PatchId{test::kWallTop, 1}, 1, 1, h.data()}});
+  ComposedFrame fallback = composer.compose(0.0, {});
+  ItemBuffer ib = itemBuffer();
+  CameraView view = s.cameraAt(s.cameraNode(""), 0.0);
+  int checked = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      Ray r = pixelCentreRay(view, kSize, col, row);
+      double y = r.origin.y + (-5.0 - r.origin.z) / r.direction.z * r.direction.y;
+      double v = (1 - y) / 2;
+      if (v < 0.3 || v > 0.7) continue;  // bilinear REPEAT wraps outside [.25, .75]
+      double w = 2 * v - 0.5;
+      glm::dvec3 c = (1 - w) * glm::dvec3(0.2, 0.4, 0.6) + w * glm::dvec3(0.8);
+      expectRel(pixel(withMovie, p), 0.5 * c / kPi * H, 1e-5, "movie " + std::to_string(p));
+      expectRel(pixel(fallback, p), c / tex.mean * B / kPi, 1e-5, "fallback " + std::to_string(p));
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
+}
+
+TEST_F(FrameComposerTest, MovingPatchCarriesItsTextureAlong) {
+  // The wall node slides down 1 m over [0, 1] s; at t = 0.5 it is 0.5 m lower. A ramp H = 100 v
+  // (1x16 texture) must follow the surface: value by the pixel's *local* (u,v).
+  Scene s = *scene;
+  int wallNode = s.inputPolygons()[test::kWallTop].node;
+  AnimationChannel ch;
+  ch.node = wallNode;
+  ch.path = AnimationPath::kTranslation;
+  ch.interpolation = Interpolation::kLinear;
+  ch.times = {0.0, 1.0};
+  ch.values = {0, 0, 0, 0, -1, 0};
+  s.channels.push_back(ch);
+  GlobalSolution g = test::makeSolution(s, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  std::vector<float> ramp;
+  for (int j = 0; j < 16; ++j) {
+    float h = float(100.0 * (j + 0.5) / 16);
+    ramp.insert(ramp.end(), {h, h, h});
+  }
+  FrameComposer composer(s, g, kSize, s.cameraNode(""));
+  ComposedFrame f = composer.compose(0.5, {{PatchId{test::kWallTop, 1}, 1, 16, ramp.data()}});
+  CameraView view = s.cameraAt(s.cameraNode(""), 0.5);
+  const Polygon local = s.inputPolygons()[test::kWallTop].local;
+  int inside = 0, outside = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      Ray r = pixelCentreRay(view, kSize, col, row);
+      glm::dvec3 world = r.origin + (-5.0 - r.origin.z) / r.direction.z * r.direction;
+      glm::dvec3 localPoint = world - glm::dvec3(0, -0.5, 0);
+      if (std::abs(localPoint.x) > 1.1 || std::abs(localPoint.y) > 1.1) {
+        if (world.x < 1.2) {  // not the lamp
+          EXPECT_EQ(pixel(f, p), glm::dvec3(0.0)) << col << "," << row;
+          ++outside;
+        }
+        continue;
+      }
+      glm::dvec2 uv = polygonUvAt(local, localPoint);
+      if (uv.x < 0.05 || uv.x > 0.95 || uv.y < 0.5 / 16 + 0.01 || uv.y > 1 - 0.5 / 16 - 0.01)
+        continue;
+      EXPECT_EQ(f.source[p], PixelSource::kMovie) << col << "," << row;
+      double want = 0.5 / kPi * 100.0 * uv.y;
+      EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want) << col << "," << row;
+      ++inside;
+    }
+  EXPECT_GT(inside, 250);
+  EXPECT_GT(outside, 500);
+}
+
 TEST(Srgb, EncodeAndExposure) {
   EXPECT_DOUBLE_EQ(srgbEncode(0.0), 0.0);
   EXPECT_DOUBLE_EQ(srgbEncode(1.0), 1.0);

@@ -82,7 +82,9 @@ int run(const Options& o, int argc, char** argv) {
 
   nlohmann::json parameters = {
       {"output", o.output},
-      {"frames", std::to_string(c.frames.front()) + "-" + std::to_string(c.frames.back())},
+      {"frames", o.frames.empty()
+                     ? std::to_string(c.frames.front()) + "-" + std::to_string(c.frames.back())
+                     : o.frames},
       {"fps", c.fps},
       {"size", std::to_string(c.size.width) + "x" + std::to_string(c.size.height)},
       {"camera", scene.nodes[c.cameraNode].name},
@@ -95,6 +97,20 @@ int run(const Options& o, int argc, char** argv) {
   rad::addInput(provenance, globalReader);
   rad::addInput(provenance, intervalsReader);
   rad::addMoviesInput(provenance, intervals, o.movies, c.frames);
+
+  // The movies were sized and timed for the intervals' image, fps and camera: say so when this
+  // run differs (still allowed: a quick preview at another size is legitimate).
+  if (c.size != rad::ImageSize{intervals.imageWidth, intervals.imageHeight})
+    std::cerr << kTool << ": warning: composing at " << c.size.width << "x" << c.size.height << "; "
+              << o.intervals << " sized the movies for " << intervals.imageWidth << "x"
+              << intervals.imageHeight << "\n";
+  if (c.fps != intervals.fps)
+    std::cerr << kTool << ": warning: --fps " << c.fps << "; " << o.intervals << " was built with "
+              << intervals.fps << " fps\n";
+  const nlohmann::json& built = intervalsReader.provenance().parameters;
+  if (!o.camera.empty() && built.contains("camera"))
+    for (const std::string& m : rad::parameterMismatch(built, {{"camera", o.camera}}, {"camera"}))
+      std::cerr << kTool << ": warning: " << o.intervals << ": " << m << "\n";
 
   rad::Progress progress(kTool, long(c.frames.size()));
   auto warn = [&](const std::string& message) {

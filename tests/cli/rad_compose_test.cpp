@@ -1,0 +1,280 @@
+// rad-compose as a user runs it: a synthetic scene, global solution, intervals and movies
+// written with the real writers; frames checked for radiance, fallback warnings, PNG encoding,
+// provenance, determinism and atomic failure.
+#include <filesystem>
+#include <regex>
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "formats/frame_image.h"
+#include "formats/link_hierarchy.h"
+#include "formats/provenance.h"
+#include "formats/texture_intervals.h"
+#include "formats/texture_movie.h"
+#include "libcommon/frame_composer.h"
+#include "libcommon/item_buffer.h"
+#include "tests/cli/cli_util.h"
+#include "tests/unit/compose_fixture.h"
+
+namespace rad::test {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = 3.14159265358979323846;
+constexpr ImageSize kSize{64, 48};
+constexpr double kFps = 4.0;
+const glm::dvec3 kWallH0(2.0, 4.0, 8.0);  // movie 0 (frames 0-1), constant
+const glm::dvec3 kWallKey0(1.0, 1.0, 1.0), kWallKey1(3.0, 5.0, 7.0);  // movie 2 keys at 2, 3
+const glm::dvec3 kWallB(0.7, 0.8, 0.9);  // global solution radiosity of the wall
+const glm::dvec3 kLampB = kPi * kLampEmission + glm::dvec3(0.1);
+
+TextureMovie constantMovie(uint32_t id, PatchId patch, int first, int last, glm::dvec3 h) {
+  TextureMovie m;
+  m.movie = id;
+  m.patch = patch;
+  m.firstFrame = first;
+  m.lastFrame = last;
+  m.width = 3;
+  m.height = 2;
+  m.keyFrames = {first};
+  m.keyTimes = {first / kFps};
+  m.keys.emplace_back();
+  for (int i = 0; i < 6; ++i)
+    m.keys[0].insert(m.keys[0].end(), {float(h.x), float(h.y), float(h.z)});
+  m.provenanceJson =
+      makeProvenance("rad-movies", 0, nullptr, {{"max-samples", 64}}).toJson().dump();
+  return m;
+}
+
+class RadCompose : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() /
+          ("rad_compose_test_" + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir / "movies");
+    scenePath = writeComposeScene(dir.string());
+    scene = readGltfScene(scenePath);
+    GlobalSolution g = makeSolution(
+        scene, {0.0, 1.0}, false, [](int node, int) { return node == kLampTop ? kLampB : kWallB; });
+    Provenance p = makeProvenance("rad-global", 0, nullptr, {{"eps", 0.01}});
+    writeLinkHierarchy((dir / "global.rlh").string(), g, p, nlohmann::json::object());
+
+    TextureIntervals iv;
+    iv.firstFrame = 0;
+    iv.lastFrame = 3;
+    iv.fps = kFps;
+    iv.imageWidth = kSize.width;
+    iv.imageHeight = kSize.height;
+    auto add = [&](uint32_t id, int top, int first, int last) {
+      TextureInterval t;
+      t.movie = id;
+      t.patch = PatchId{uint32_t(top), 1};
+      t.firstFrame = first;
+      t.lastFrame = last;
+      t.width = 3;
+      t.height = 2;
+      iv.movies.push_back(t);
+    };
+    add(0, kWallTop, 0, 1);
+    add(1, kLampTop, 0, 1);
+    add(2, kWallTop, 2, 3);  // the lamp has no movie at frames 2-3: fallback
+    writeTextureIntervals((dir / "intervals.rti").string(), iv,
+                          makeProvenance("rad-intervals", 0, nullptr, {}),
+                          nlohmann::json::object());
+
+    writeTextureMovie(textureMoviePath((dir / "movies").string(), 0),
+                      constantMovie(0, {kWallTop, 1}, 0, 1, kWallH0));
+    writeTextureMovie(textureMoviePath((dir / "movies").string(), 1),
+                      constantMovie(1, {kLampTop, 1}, 0, 1, glm::dvec3(0.0)));
+    TextureMovie m2 = constantMovie(2, {kWallTop, 1}, 2, 3, kWallKey0);
+    m2.keyFrames = {2, 3};
+    m2.keyTimes = {2 / kFps, 3 / kFps};
+    m2.keys.push_back({});
+    for (int i = 0; i < 6; ++i)
+      m2.keys[1].insert(m2.keys[1].end(),
+                        {float(kWallKey1.x), float(kWallKey1.y), float(kWallKey1.z)});
+    writeTextureMovie(textureMoviePath((dir / "movies").string(), 2), m2);
+
+    std::vector<ItemTriangle> tris;
+    auto tops = scene.inputPolygons();
+    for (size_t i = 0; i < tops.size(); ++i)
+      for (int k = 1; k + 1 < tops[i].local.count; ++k)
+        tris.push_back(
+            {{tops[i].local.v[0], tops[i].local.v[k], tops[i].local.v[k + 1]}, uint32_t(i + 1)});
+    items = renderItemBuffer(tris, scene.cameraAt(scene.cameraNode(""), 0.0), kSize);
+  }
+  void TearDown() override {
+    if (!std::getenv("RAD_KEEP_TEST_DIR")) fs::remove_all(dir);
+  }
+
+  std::string command(const std::string& out, const std::string& extra = "") const {
+    return tool("rad-compose") + " " + scenePath + " " + (dir / "global.rlh").string() + " " +
+           (dir / "intervals.rti").string() + " " + (dir / "movies").string() + " -o " + out + " " +
+           extra;
+  }
+  long long count(uint32_t id) const { return std::count(items.id.begin(), items.id.end(), id); }
+
+  fs::path dir;
+  std::string scenePath;
+  Scene scene;
+  ItemBuffer items;
+};
+
+glm::dvec3 px(const FrameExr& f, size_t p) {
+  return {f.rgb[3 * p], f.rgb[3 * p + 1], f.rgb[3 * p + 2]};
+}
+void expectRel(const glm::dvec3& got, const glm::dvec3& want, double rel, const std::string& at) {
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], want[a], rel * std::abs(want[a])) << at;
+}
+
+TEST_F(RadCompose, FramesHaveRadianceFallbackWarningsAndProvenance) {
+  std::string out = (dir / "frames").string();
+  CommandResult r = runCommand(command(out, "--report " + (dir / "report.json").string()));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const long long wallPixels = count(kWallTop + 1), lampPixels = count(kLampTop + 1);
+  ASSERT_GT(wallPixels, 300);
+  ASSERT_GT(lampPixels, 20);
+  // One warning per fallback frame, counting exactly the lamp's pixels.
+  std::string w2 = "rad-compose: frame 2: " + std::to_string(lampPixels) +
+                   " pixels fell back to the global solution\n";
+  std::string w3 = "rad-compose: frame 3: " + std::to_string(lampPixels) +
+                   " pixels fell back to the global solution\n";
+  EXPECT_EQ(r.err, w2 + w3);
+
+  for (int f = 0; f < 4; ++f) {
+    FrameExr e = readFrameExr(framePath(out, f, ".exr"));
+    ASSERT_EQ(e.width, kSize.width);
+    ASSERT_EQ(e.height, kSize.height);
+    EXPECT_FALSE(e.half);
+    EXPECT_EQ(e.attributes["rad.frame"], std::to_string(f));
+    EXPECT_EQ(e.attributes["rad.fallbackPixels"], std::to_string(f >= 2 ? lampPixels : 0));
+    EXPECT_DOUBLE_EQ(std::stod(e.attributes["rad.time"]), f / kFps);
+    // Movie 2 is linear between its keys at frames 2 and 3.
+    glm::dvec3 H = f < 2 ? kWallH0 : (f == 2 ? kWallKey0 : kWallKey1);
+    for (size_t p = 0; p < items.id.size(); ++p) {
+      std::string at = "frame " + std::to_string(f) + " pixel " + std::to_string(p);
+      if (items.id[p] == kNoItem)
+        EXPECT_EQ(px(e, p), glm::dvec3(0.0)) << at;
+      else if (items.id[p] == kWallTop + 1)
+        expectRel(px(e, p), 0.5 / kPi * H, 1e-5, at);
+      else
+        expectRel(px(e, p), f < 2 ? kLampEmission : kLampB / kPi, 1e-5, at);
+    }
+    nlohmann::json prov = nlohmann::json::parse(e.attributes["rad.provenance"]);
+    EXPECT_EQ(prov["tool"], "rad-compose");
+    ASSERT_EQ(prov["inputs"].size(), 4u);
+    EXPECT_EQ(prov["inputs"][1]["history"]["tool"], "rad-global");
+    EXPECT_EQ(prov["inputs"][2]["history"]["tool"], "rad-intervals");
+    EXPECT_EQ(prov["inputs"][3]["history"]["tool"], "rad-movies");
+    EXPECT_EQ(prov["parameters"]["fps"], kFps);
+    EXPECT_EQ(prov["parameters"]["size"], "64x48");
+  }
+  nlohmann::json rep = nlohmann::json::parse(readWholeFile((dir / "report.json").string()));
+  ASSERT_EQ(rep["frames"].size(), 4u);
+  EXPECT_EQ(rep["fallback_pixels"], 2 * lampPixels);
+  EXPECT_EQ(rep["frames"][3]["fallback_pixels"], lampPixels);
+  EXPECT_EQ(rep["movies_read"], 3);
+  EXPECT_EQ(rep["peak_loaded_movies"], 2);  // movies 0 and 1 evicted before movie 2 loads
+  EXPECT_GE(rep["frames"][0]["seconds"].get<double>(), 0.0);
+}
+
+TEST_F(RadCompose, PngIsSrgbOfExposureScaledRadiance) {
+  std::string out = (dir / "frames").string();
+  CommandResult r = runCommand(command(out, "--frames 1 --exposure -1.5"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_FALSE(fs::exists(framePath(out, 0, ".exr")));
+  FrameExr e = readFrameExr(framePath(out, 1, ".exr"));
+  EXPECT_DOUBLE_EQ(std::stod(e.attributes["rad.exposureEV"]), -1.5);
+  auto in = OIIO::ImageInput::open(framePath(out, 1, ".png"));
+  ASSERT_TRUE(in);
+  const OIIO::ImageSpec& spec = in->spec();
+  ASSERT_EQ(spec.width, kSize.width);
+  ASSERT_EQ(spec.nchannels, 3);
+  std::vector<uint8_t> png(size_t(kSize.pixelCount()) * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, png.data()));
+  EXPECT_EQ(png, toSrgb8(e.rgb, -1.5));
+  // A wall pixel by hand: L = 0.5/pi * 8 (blue) at 2^-1.5.
+  size_t wall =
+      std::find(items.id.begin(), items.id.end(), uint32_t(kWallTop + 1)) - items.id.begin();
+  double blue = 0.5 / kPi * kWallH0.z * std::exp2(-1.5);
+  EXPECT_EQ(png[3 * wall + 2],
+            uint8_t(std::lround(255 * (1.055 * std::pow(blue, 1 / 2.4) - 0.055))));
+}
+
+TEST_F(RadCompose, AutoExposureIsOneValueForTheSequence) {
+  std::string out = (dir / "frames").string();
+  CommandResult r = runCommand(command(out, "--auto-exposure --no-png"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("auto exposure"), std::string::npos) << r.err;
+  // Only the wall reflects: luminance of kWallB / pi maps to 1.
+  double want = -std::log2(luminance(kWallB / kPi));
+  for (int f = 0; f < 4; ++f) {
+    FrameExr e = readFrameExr(framePath(out, f, ".exr"));
+    EXPECT_NEAR(std::stod(e.attributes["rad.exposureEV"]), want, 1e-6);
+    EXPECT_FALSE(fs::exists(framePath(out, f, ".png")));
+  }
+  EXPECT_NE(runCommand(command(out, "--auto-exposure --exposure 1")).exitCode, 0);
+}
+
+TEST_F(RadCompose, HalfFrames) {
+  std::string out = (dir / "frames").string();
+  ASSERT_EQ(runCommand(command(out, "--frames 0 --half --no-png")).exitCode, 0);
+  FrameExr e = readFrameExr(framePath(out, 0, ".exr"));
+  EXPECT_TRUE(e.half);
+  for (size_t p = 0; p < items.id.size(); ++p)
+    if (items.id[p] == kWallTop + 1) expectRel(px(e, p), 0.5 / kPi * kWallH0, 1e-3, "half");
+}
+
+TEST_F(RadCompose, BitIdenticalAcrossRuns) {
+  std::string out = (dir / "frames").string();
+  ASSERT_EQ(runCommand(command(out)).exitCode, 0);
+  std::map<std::string, std::string> first;
+  for (const auto& e : fs::directory_iterator(out))
+    first[e.path().filename().string()] = readWholeFile(e.path().string());
+  EXPECT_EQ(first.size(), 8u);  // 4 EXR + 4 PNG, no temporaries
+  fs::remove_all(out);
+  ASSERT_EQ(runCommand(command(out)).exitCode, 0);
+  for (const auto& [name, bytes] : first)
+    EXPECT_TRUE(readWholeFile((fs::path(out) / name).string()) == bytes) << name;
+}
+
+TEST_F(RadCompose, UnwritableOutputIsOneLineExit3) {
+  writeBytes((dir / "plain").string(), "not a directory");
+  std::string out = (dir / "plain" / "frames").string();
+  CommandResult r = runCommand(command(out));
+  EXPECT_EQ(r.exitCode, 3) << r.err;
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("rad-compose: " + out + ": ", 0), 0u) << r.err;
+}
+
+TEST_F(RadCompose, BadMovieMidSequenceLeavesNoPartialFrame) {
+  // Movie 2 claims another patch than the intervals give it: fails when frame 2 loads it.
+  TextureMovie bad = constantMovie(2, PatchId{kWallTop, 1}.child(1), 2, 3, kWallKey0);
+  writeTextureMovie(textureMoviePath((dir / "movies").string(), 2), bad);
+  std::string out = (dir / "frames").string();
+  CommandResult r = runCommand(command(out));
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("000002.exr: patch 0/1 differs"), std::string::npos) << r.err;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"0000.exr", "0000.png", "0001.exr", "0001.png"}));
+}
+
+TEST_F(RadCompose, MissingMovieAndFramesOutsideTheWindow) {
+  fs::remove(textureMoviePath((dir / "movies").string(), 1));
+  CommandResult r = runCommand(command((dir / "frames").string()));
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("000001.exr"), std::string::npos) << r.err;
+  r = runCommand(command((dir / "frames2").string(), "--frames 2-9"));
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("outside the intervals' window 0-3"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace rad::test
