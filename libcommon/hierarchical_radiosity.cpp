@@ -105,9 +105,9 @@ bool mutuallyFacing(const Polygon& p, const Polygon& q) {
   return someVertexInFront(p, q) && someVertexInFront(q, p);
 }
 
-uint64_t linkSeed(PatchId receiver, PatchId shooter, uint32_t keyIndex) {
+uint64_t linkSeed(PatchId receiver, PatchId shooter) {
   return splitMix64(splitMix64(splitMix64(receiver.packed()) ^ shooter.packed()) +
-                    0x9E3779B97F4A7C15ull * (uint64_t(keyIndex) + 1));
+                    0x9E3779B97F4A7C15ull);
 }
 
 glm::dvec3 KeySolution::absorbedPower(const PatchHierarchy& h,
@@ -199,11 +199,10 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       double est = std::max(formFactorEstimate(P, Q), formFactorEstimate(Q, P) * aq / ap);
       l.estimate = std::min(1.0, est);
       l.formFactor = l.estimate;
-      l.visibility =
-          input.visibility
-              ? (input.visibility->visibility(P, Q, opt.rays, linkSeed(r.id, q.id, input.keyIndex),
-                                              r.id.top, q.id.top))
-              : 1.0;
+      l.visibility = input.visibility
+                         ? (input.visibility->visibility(P, Q, opt.rays, linkSeed(r.id, q.id),
+                                                         r.id.top, q.id.top))
+                         : 1.0;
     });
     evaluated = end;
   };

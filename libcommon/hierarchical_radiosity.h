@@ -12,7 +12,7 @@
 //    cheap estimate (formFactorEstimate, both directions), V the link's visibility. Refined
 //    links are kept (flag refined) but not gathered;
 //  * leaf links get the accurate unoccluded F (polygonToPolygonFormFactor) and V from k
-//    stratified shadow-ray pairs (VisibilityScene), seeded from (receiver id, shooter id, key);
+//    stratified shadow-ray pairs (VisibilityScene), seeded from (receiver id, shooter id);
 //  * gather + push-pull (HSA'91 §5), Gauss-Seidel over the top-level patches, until the
 //    relative change of B is below tol * (1 - rho_max) (the stop rule of the furnace
 //    reference: a change below tol alone leaves an error of tol / (1 - rho));
@@ -90,7 +90,7 @@ using LinkCache = std::unordered_map<std::pair<uint64_t, uint64_t>, CachedLink, 
 struct KeySolveInput {
   std::vector<glm::dmat4> topToWorld;           // per top-level patch: its node's world transform
   const VisibilityScene* visibility = nullptr;  // null: every link fully visible
-  uint32_t keyIndex = 0;                        // part of the visibility seeds
+  uint32_t keyIndex = 0;                        // for reports only (seeds ignore it)
   const LinkCache* reuse = nullptr;             // coherence: values to take over
   // Warm start: radiosity per dense node (nodes beyond its size start at B_e).
   const std::vector<glm::dvec3>* initialRadiosity = nullptr;
@@ -135,8 +135,10 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order);
 // strictly in front of the other's plane.
 bool mutuallyFacing(const Polygon& p, const Polygon& q);
 
-// Seed of the shadow rays of link (receiver <- shooter) at a key index.
-uint64_t linkSeed(PatchId receiver, PatchId shooter, uint32_t keyIndex);
+// Seed of the shadow rays of link (receiver <- shooter). It does not depend on the key time:
+// a link whose ends and blockers did not move gets bit-identical visibility whether it is
+// reused (coherent) or recomputed (--no-coherence), and its shadow does not shimmer in time.
+uint64_t linkSeed(PatchId receiver, PatchId shooter);
 
 // The scene's triangles for visibility: mesh nodes static over [t0, t1] in the static BVH in
 // world space, each dynamic mesh node an instance whose transform setTime() updates. Every
