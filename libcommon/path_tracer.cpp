@@ -4,6 +4,7 @@
 #include "libcommon/path_tracer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -96,6 +97,11 @@ struct PathTracer::Impl {
     glm::dvec3 reflectance{0.0};
     glm::dvec3 emission{0.0};
     bool doubleSided = false;
+    // Reflectance texture (glTF baseColorTexture): rho(x) = factor x texel(uv(x)), bilinear,
+    // repeat-wrapped; texture == nullptr means constant reflectance.
+    const Texture* texture = nullptr;
+    glm::dvec3 factor{0.0};
+    std::array<glm::dvec2, 4> uv{};
     int frontEmitter = -1;  // index into emitters of the side facing the front normal
     int backEmitter = -1;   // of the back side (doubleSided emitters only)
   };
@@ -112,6 +118,7 @@ struct PathTracer::Impl {
   std::vector<InputPolygon> inputs;      // Scene::inputPolygons(), in local frames
   std::vector<Surface> surfaces;         // ray-castable polygons (reversed copies left out)
   std::vector<std::uint32_t> polygonOf;  // Embree triangle -> surface index
+  std::vector<std::uint8_t> fanIndex;    // Embree triangle -> k of its fan triangle (0, k, k+1)
   std::vector<Emitter> emitters;         // every emitting side (reversed copies included)
   std::vector<double> emitterCdf;        // cumulative probabilities
   double sceneSize = 1.0;                // largest coordinate magnitude (ray offsets)
@@ -140,6 +147,7 @@ struct PathTracer::Impl {
     surfaces.clear();
     emitters.clear();
     polygonOf.clear();
+    fanIndex.clear();
     sceneSize = 0.0;
     std::vector<glm::dmat4> worldFromLocal(scene.nodes.size());
     std::vector<bool> known(scene.nodes.size(), false);
@@ -170,7 +178,20 @@ struct PathTracer::Impl {
         if (!surfaces.empty()) surfaces.back().backEmitter = emitter;
         continue;
       }
-      surfaces.push_back({world, n, m.reflectance, m.emission, m.doubleSided, emitter, -1});
+      Surface surface{world, n, m.reflectance, m.emission, m.doubleSided};
+      surface.frontEmitter = emitter;
+      if (m.baseColorTexture >= 0 && m.baseColorTexture < int(scene.textures.size())) {
+        const Texture& tex = scene.textures[size_t(m.baseColorTexture)];
+        if (tex.width > 0 && tex.height > 0 &&
+            tex.rgb.size() == size_t(tex.width) * size_t(tex.height) * 3) {
+          surface.texture = &tex;
+          surface.uv = in.uv;
+          // Material::reflectance is factor x mean(texture); undo the mean.
+          for (int c = 0; c < 3; ++c)
+            surface.factor[c] = tex.mean[c] > 0.0 ? m.reflectance[c] / tex.mean[c] : 0.0;
+        }
+      }
+      surfaces.push_back(surface);
     }
     emitterCdf.clear();
     double sum = 0.0;
@@ -211,6 +232,7 @@ struct PathTracer::Impl {
             ib[3 * tri + c] = unsigned(3 * tri + c);
           }
           polygonOf.push_back(std::uint32_t(s));
+          fanIndex.push_back(std::uint8_t(k));
         }
       }
       rtcSetGeometryUserData(g, polygonOf.data());
@@ -225,8 +247,15 @@ struct PathTracer::Impl {
   }
 
   // Nearest hit on [tNear, tFar]: surface index and distance, or kNoPolygon.
-  std::uint32_t intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tNear,
-                          double tFar, std::uint32_t ignore, double& tHit) const {
+  struct Hit {
+    std::uint32_t surface = kNoPolygon;
+    double t = 0.0;
+    int fan = 1;              // triangle (0, fan, fan + 1) of the polygon
+    double u = 0.0, v = 0.0;  // Embree barycentrics: p = (1-u-v) v0 + u v_fan + v v_fan+1
+  };
+
+  Hit intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tNear, double tFar,
+                std::uint32_t ignore) const {
     FilterContext fc;
     rtcInitIntersectContext(&fc.context);
     fc.ignore = ignore;
@@ -246,9 +275,40 @@ struct PathTracer::Impl {
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(bvh, &fc.context, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return kNoPolygon;
-    tHit = double(rh.ray.tfar);
-    return polygonOf[rh.hit.primID];
+    Hit hit;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return hit;
+    hit.surface = polygonOf[rh.hit.primID];
+    hit.fan = fanIndex[rh.hit.primID];
+    hit.t = double(rh.ray.tfar);
+    hit.u = double(rh.hit.u);
+    hit.v = double(rh.hit.v);
+    return hit;
+  }
+
+  // Reflectance at a hit: constant, or factor x bilinear texel lookup (glTF: uv (0, 0) is the
+  // top-left corner of the image, texel centres at half-integers, REPEAT wrap).
+  glm::dvec3 reflectanceAt(const Surface& s, const Hit& h) const {
+    if (!s.texture) return s.reflectance;
+    const glm::dvec2 uv =
+        (1.0 - h.u - h.v) * s.uv[0] + h.u * s.uv[size_t(h.fan)] + h.v * s.uv[size_t(h.fan + 1)];
+    const Texture& tex = *s.texture;
+    const double x = uv.x * tex.width - 0.5, y = uv.y * tex.height - 0.5;
+    if (!std::isfinite(x) || !std::isfinite(y)) return s.reflectance;
+    const double x0 = std::floor(x), y0 = std::floor(y);
+    const double fx = x - x0, fy = y - y0;
+    auto wrap = [](double i, int n) {
+      const long long m = (long long)std::fmod(i, double(n));
+      return int(m < 0 ? m + n : m);
+    };
+    const int xa = wrap(x0, tex.width), xb = wrap(x0 + 1, tex.width);
+    const int ya = wrap(y0, tex.height), yb = wrap(y0 + 1, tex.height);
+    auto texel = [&](int tx, int ty) {
+      const size_t i = (size_t(ty) * size_t(tex.width) + size_t(tx)) * 3;
+      return glm::dvec3(tex.rgb[i], tex.rgb[i + 1], tex.rgb[i + 2]);
+    };
+    const glm::dvec3 value = (1 - fy) * ((1 - fx) * texel(xa, ya) + fx * texel(xb, ya)) +
+                             fy * ((1 - fx) * texel(xa, yb) + fx * texel(xb, yb));
+    return glm::clamp(s.factor * value, glm::dvec3(0.0), glm::dvec3(1.0));
   }
 
   bool occluded(const glm::dvec3& origin, const glm::dvec3& dir, double tFar,
@@ -322,9 +382,10 @@ struct PathTracer::Impl {
     std::uint32_t from = kNoPolygon;
     double pdfBsdf = 0.0;  // solid-angle density of the continuation that reached this hit
     for (int bounce = 0;; ++bounce) {
-      double t = 0.0;
-      const std::uint32_t hit = intersect(origin, dir, tNear, tFar, from, t);
-      if (hit == kNoPolygon) break;
+      const Hit h = intersect(origin, dir, tNear, tFar, from);
+      if (h.surface == kNoPolygon) break;
+      const std::uint32_t hit = h.surface;
+      const double t = h.t;
       const Surface& s = surfaces[hit];
       glm::dvec3 n = s.normal;
       int emitter = s.frontEmitter;
@@ -342,15 +403,16 @@ struct PathTracer::Impl {
         L += throughput * emitters[size_t(emitter)].radiance * weight;
       }
       if (bounce >= o.maxDepth) break;
-      if (maxComponent(s.reflectance) <= 0.0) break;
+      const glm::dvec3 rho = reflectanceAt(s, h);
+      if (maxComponent(rho) <= 0.0) break;
       const glm::dvec3 x = origin + t * dir;
       // Reflected direct light: BRDF rho / pi times the NEE estimate.
-      L += throughput * s.reflectance * (1.0 / kPi) * directLight(x, n, hit, rng);
+      L += throughput * rho * (1.0 / kPi) * directLight(x, n, hit, rng);
       // Continue with a cosine-distributed direction: BRDF x cos / pdf = rho.
       const double u1 = rng.next(), u2 = rng.next(), uRoulette = rng.next();
-      throughput *= s.reflectance;
+      throughput *= rho;
       if (bounce + 1 >= o.rouletteDepth) {
-        const double q = std::min(0.95, maxComponent(s.reflectance));
+        const double q = std::min(0.95, maxComponent(rho));
         if (uRoulette >= q) break;
         throughput /= q;
       }

@@ -6,8 +6,10 @@
 // scene (one world-space triangle BVH rebuilt per frame time), not VisibilityScene.
 //
 // Light transport (Kajiya 1986, "The rendering equation"; Pharr, Jakob, Humphreys, PBRT 3rd
-// ed. §14.5): every surface is Lambertian with reflectance rho (BRDF rho / pi); emitters have
-// constant exitant radiance L_e. Conventions are those of form_factor.h: polygons are one-sided
+// ed. §14.5): every surface is Lambertian with reflectance rho (BRDF rho / pi) — where the
+// material has a baseColorTexture, rho = baseColorFactor x the texel under the hit (bilinear,
+// REPEAT), not the texture's mean the radiosity pass uses; emitters have constant exitant
+// radiance L_e. Conventions are those of form_factor.h: polygons are one-sided
 // (CCW about the front normal), the back of a single-sided polygon is black and absorbing, an
 // emitter emits from its front only; a doubleSided material reflects and emits on both sides
 // (Scene::inputPolygons adds its reversed copy).

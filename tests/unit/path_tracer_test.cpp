@@ -23,6 +23,7 @@ constexpr double kPi = 3.14159265358979323846;
 struct TestPolygon {
   std::vector<glm::dvec3> v;  // CCW about the front normal
   int material = 0;
+  std::vector<glm::dvec2> uv = {};  // per vertex, or empty
 };
 
 // One static mesh node per polygon (fan triangulation keeps the orientation); optional camera.
@@ -36,6 +37,7 @@ Scene sceneOf(const std::vector<TestPolygon>& polygons, const std::vector<Materi
       MeshTriangle t;
       t.p = {p.v[0], p.v[k], p.v[k + 1]};
       t.material = p.material;
+      if (!p.uv.empty()) t.uv = {p.uv[0], p.uv[k], p.uv[k + 1]};
       mesh.triangles.push_back(t);
     }
     Node node;
@@ -275,6 +277,37 @@ TEST(PathTracer, EmitterFacingAwayOrBlockedGivesNoLight) {
   Ray r = sl.probe(1.0);
   r.origin = sl.p + 0.01 * -r.direction;  // start below the blocker
   EXPECT_EQ(t2.estimateRadiance(r, 200, 3, PathTracerOptions()).mean, glm::dvec3(0.0));
+}
+
+// A textured receiver: reflectance = baseColorFactor x texel at the hit's uv (bilinear,
+// texel centres at half-integers), not the material's mean.
+TEST(PathTracer, TexturedReceiverUsesTheTexelUnderTheHit) {
+  SquareLight sl;
+  Texture tex;
+  tex.width = 2;
+  tex.height = 1;
+  tex.rgb = {0.9f, 0.2f, 0.4f, 0.1f, 0.8f, 0.6f};
+  tex.mean = glm::dvec3(0.5, 0.5, 0.5);
+  const glm::dvec3 factor(1.0, 0.5, 0.75);
+  Material textured = material(factor * tex.mean, glm::dvec3(0.0));
+  textured.baseColorTexture = 0;
+  TestPolygon receiver{sl.receiverFacingUp(), 1, {{0, 0}, {0.5, 0}, {0.5, 1}, {0, 1}}};
+  Scene scene = sceneOf({{sl.emitterFacingDown(), 0}, receiver},
+                        {material(glm::dvec3(0.0), sl.le), textured});
+  scene.textures.push_back(tex);
+  PathTracer tracer(scene, 0.0);
+  Polygon emitter;
+  emitter.count = 4;
+  for (int k = 0; k < 4; ++k) emitter.v[size_t(k)] = sl.emitterFacingDown()[size_t(k)];
+  const double F = pointToPolygonFormFactor(sl.p, {0, 0, 1}, emitter);
+  // The receiver's centre has uv (0.25, 0.5): the centre of texel 0.
+  const glm::dvec3 rho = factor * glm::dvec3(0.9, 0.2, 0.4);
+  const glm::dvec3 expected = rho * sl.le * F;
+  RadianceEstimate e = tracer.estimateRadiance(sl.probe(1.0), 20000, 13, PathTracerOptions());
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_LT(e.standardError[c], 0.01 * expected[c]);
+    EXPECT_NEAR(e.mean[c], expected[c], 4.0 * e.standardError[c]) << c;
+  }
 }
 
 // A doubleSided receiver lit from below through its back: it reflects like its front.
