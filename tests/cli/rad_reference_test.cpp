@@ -14,6 +14,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Removes this process's scratch directory when the test program ends.
+struct TempRootCleanup {
+  ~TempRootCleanup() {
+    std::error_code ec;
+    fs::remove_all(fs::temp_directory_path() / ("rad_reference_test_" + std::to_string(::getpid())),
+                   ec);
+  }
+} cleanupAtExit;
+
 const std::string kScene = std::string(RAD_SOURCE_DIR) + "/pipelines/scenes/cornell-moving.gltf";
 
 fs::path freshDir(const std::string& name) {
