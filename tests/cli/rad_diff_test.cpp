@@ -13,6 +13,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Removes this process's scratch directory when the test program ends.
+struct TempRootCleanup {
+  ~TempRootCleanup() {
+    std::error_code ec;
+    fs::remove_all(fs::temp_directory_path() / ("rad_diff_test_" + std::to_string(::getpid())), ec);
+  }
+} cleanupAtExit;
+
 fs::path freshDir(const std::string& name) {
   fs::path d = fs::temp_directory_path() / ("rad_diff_test_" + std::to_string(::getpid())) / name;
   fs::remove_all(d);
