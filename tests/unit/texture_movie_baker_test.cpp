@@ -243,6 +243,61 @@ TEST(TextureMovieBaker, StaticShadowsMakeAConstantMovieUnlessCoherenceIsOff) {
   EXPECT_LE(maxRelativeDifference(a, b, 0, 30), 1e-6);
 }
 
+TEST(TextureMovieBaker, MovingLightOrReceiverRendersEveryBlockerPerKey) {
+  for (bool moveLight : {true, false}) {
+    TestScene t = makeScene(true, false);
+    if (moveLight)
+      translate(t.scene, t.lightNode, {-0.3, 0, 0}, {0.3, 0, 0.2}, 0.0, 1.0);
+    else
+      translate(t.scene, t.floorNode, {0, 0, 0}, {0.2, 0.1, -0.3}, 0.0, 1.0);
+    TextureMovieBakerOptions o;
+    TextureMovieBaker coherent(t.scene, t.solution, kFps, o);
+    o.coherence = false;
+    TextureMovieBaker baseline(t.scene, t.solution, kFps, o);
+    MovieRequest r = request(t, 16, 12, 0, 24);
+    BakedMovie a = coherent.bake(r), b = baseline.bake(r);
+    ASSERT_EQ(a.keys.size(), 5u) << moveLight;
+    EXPECT_NE(a.keys.front(), a.keys.back()) << "the shadow moves";
+    EXPECT_EQ(coherent.stats().dynamicPairs, 1);
+    EXPECT_EQ(coherent.stats().passesSavedByCoherence, 0);
+    EXPECT_EQ(coherent.stats().passes, 5);
+    EXPECT_LE(maxRelativeDifference(a, b, 0, 24), 1e-6);
+  }
+}
+
+TEST(TextureMovieBaker, SceneScaleFromMillimetresToTenKilometresGivesTheSameIrradiance) {
+  // F and T are scale invariant: scaling every node by k leaves H unchanged (DESIGN.md §9).
+  TestScene ref = makeScene(true, false);
+  BakedMovie a =
+      TextureMovieBaker(ref.scene, ref.solution, kFps, {}).bake(request(ref, 16, 16, 0, 0));
+  for (double k : {1e-3, 1e4}) {
+    TestScene t = makeScene(true, false);
+    for (Node& n : t.scene.nodes) n.scale = glm::dvec3(k);
+    for (Node& n : t.scene.nodes) n.translation = glm::dvec3(k * 3.0, -k, 2.0 * k);
+    BakedMovie b = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(request(t, 16, 16, 0, 0));
+    int off = 0;
+    double worst = 0.0;
+    for (size_t i = 0; i < a.keys[0].size(); ++i) {
+      double d = std::abs(a.keys[0][i] - b.keys[0][i]) / a.keys[0][i];
+      ASSERT_TRUE(std::isfinite(b.keys[0][i]));
+      off += d > 1e-4;
+      worst = std::max(worst, d);
+    }
+    // A texel centre exactly on a shadow edge may flip one sample at float precision.
+    EXPECT_LE(off, 3) << "scale " << k << " worst " << worst;
+  }
+}
+
+TEST(TextureMovieBaker, OneTexelMovie) {
+  TestScene t = makeScene(true, true);
+  BakedMovie m = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(request(t, 1, 1, 0, 24));
+  ASSERT_FALSE(m.keys.empty());
+  for (const auto& k : m.keys) {
+    ASSERT_EQ(k.size(), 3u);
+    for (float v : k) EXPECT_TRUE(std::isfinite(v) && v >= 0.0f);
+  }
+}
+
 TEST(TextureMovieBaker, BitIdenticalAcrossRuns) {
   TestScene t = makeScene(true, true);
   MovieRequest r = request(t, 17, 11, 2, 20);

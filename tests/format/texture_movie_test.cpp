@@ -1,0 +1,180 @@
+// movies/MMMMMM.exr (formats/texture_movie.md): round trip of keys, times and attributes;
+// constant movies; interpolation between keys; truncated, corrupted, non-movie and
+// future-version files give one-line errors naming the file, never a crash.
+#include "formats/texture_movie.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "libcommon/error.h"
+
+namespace fs = std::filesystem;
+
+namespace rad {
+namespace {
+
+class TextureMovieFormat : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(::testing::TempDir()) /
+           ("rad_texture_movie_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string dir() const { return dir_.string(); }
+  fs::path dir_;
+};
+
+TextureMovie sampleMovie(int keys) {
+  TextureMovie m;
+  m.movie = 42;
+  m.patch = PatchId{7, 1}.child(2).child(1);
+  m.firstFrame = 10;
+  m.lastFrame = 10 + 6 * (keys - 1);
+  m.width = 5;
+  m.height = 3;
+  for (int k = 0; k < keys; ++k) {
+    m.keyFrames.push_back(10 + 6 * k);
+    m.keyTimes.push_back((10 + 6 * k) / 24.0);
+    std::vector<float> px(size_t(m.width) * m.height * 3);
+    for (size_t i = 0; i < px.size(); ++i) px[i] = float(k * 1000 + i) * 0.5f + 1e-7f * float(i);
+    m.keys.push_back(px);
+  }
+  m.provenanceJson = R"({"tool":"rad-movies","version":"0.1.0"})";
+  return m;
+}
+
+std::string errorOf(const std::string& path) {
+  try {
+    readTextureMovie(path);
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::kBadInput);
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(TextureMovieFormat, RoundTripKeepsEverythingBitExact) {
+  TextureMovie m = sampleMovie(4);
+  std::string path = textureMoviePath(dir(), m.movie);
+  EXPECT_EQ(fs::path(path).filename(), "000042.exr");
+  writeTextureMovie(path, m);
+  TextureMovie r = readTextureMovie(path);
+  EXPECT_EQ(r.movie, m.movie);
+  EXPECT_EQ(r.patch, m.patch);
+  EXPECT_EQ(r.patch.level(), 2);
+  EXPECT_EQ(r.firstFrame, m.firstFrame);
+  EXPECT_EQ(r.lastFrame, m.lastFrame);
+  EXPECT_EQ(r.width, m.width);
+  EXPECT_EQ(r.height, m.height);
+  EXPECT_EQ(r.keyFrames, m.keyFrames);
+  EXPECT_EQ(r.keyTimes, m.keyTimes);
+  EXPECT_EQ(r.keys, m.keys);
+  EXPECT_EQ(r.provenanceJson, m.provenanceJson);
+  EXPECT_FALSE(r.constant());
+  // Parts are named and carry the attributes the spec lists.
+  Imf::MultiPartInputFile in(path.c_str());
+  ASSERT_EQ(in.parts(), 4);
+  EXPECT_EQ(in.header(0).name(), "key0000");
+  EXPECT_EQ(in.header(3).name(), "key0003");
+  EXPECT_EQ(in.header(1).findTypedAttribute<Imf::StringAttribute>("rad.patch")->value(), "7/2.1");
+  EXPECT_EQ(in.header(0).findTypedAttribute<Imf::StringAttribute>("rad.format")->value(),
+            "texture-movie 1.0");
+}
+
+TEST_F(TextureMovieFormat, ConstantMovieAndInterpolation) {
+  TextureMovie c = sampleMovie(1);
+  writeTextureMovie(dir() + "/c.exr", c);
+  TextureMovie r = readTextureMovie(dir() + "/c.exr");
+  EXPECT_TRUE(r.constant());
+  std::vector<float> out;
+  r.textureAt(100.0, out);
+  EXPECT_EQ(out, c.keys[0]);
+  TextureMovie m = sampleMovie(3);
+  std::vector<float> mid;
+  m.textureAt(0.5 * (m.keyTimes[1] + m.keyTimes[2]), mid);
+  for (size_t i = 0; i < mid.size(); ++i)
+    EXPECT_FLOAT_EQ(mid[i], 0.5f * (m.keys[1][i] + m.keys[2][i]));
+  m.textureAt(-1.0, out);
+  EXPECT_EQ(out, m.keys[0]);
+}
+
+TEST_F(TextureMovieFormat, TruncatedFilesGiveOneLineErrors) {
+  TextureMovie m = sampleMovie(3);
+  std::string path = dir() + "/m.exr";
+  writeTextureMovie(path, m);
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_GT(bytes.size(), 200u);
+  for (size_t cut : {size_t(0), size_t(3), size_t(40), bytes.size() / 2, bytes.size() - 1}) {
+    std::string t = dir() + "/cut" + std::to_string(cut) + ".exr";
+    std::ofstream(t, std::ios::binary).write(bytes.data(), std::streamsize(cut));
+    std::string e = errorOf(t);
+    EXPECT_FALSE(e.empty()) << "cut at " << cut;
+    EXPECT_EQ(e.rfind(t + ": ", 0), 0u) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+  // Corrupted bytes in the pixel data: an error or a valid movie, never a crash.
+  for (size_t at = bytes.size() / 3; at < bytes.size(); at += bytes.size() / 7) {
+    std::vector<char> bad = bytes;
+    bad[at] = char(bad[at] ^ 0x5a);
+    std::string t = dir() + "/bad.exr";
+    std::ofstream(t, std::ios::binary | std::ios::trunc)
+        .write(bad.data(), std::streamsize(bad.size()));
+    try {
+      readTextureMovie(t);
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    }
+  }
+}
+
+TEST_F(TextureMovieFormat, NotAMovieAndFutureVersionsAreRefusedByName) {
+  std::string missing = dir() + "/missing.exr";
+  EXPECT_EQ(errorOf(missing).rfind(missing + ": ", 0), 0u);
+  std::string text = dir() + "/text.exr";
+  std::ofstream(text) << "hello";
+  EXPECT_EQ(errorOf(text).rfind(text + ": ", 0), 0u);
+  TextureMovie m = sampleMovie(2);
+  std::string path = dir() + "/m.exr";
+  writeTextureMovie(path, m);
+  // Rewrite the version string in place ("texture-movie 1.0" -> "texture-movie 9.0").
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  size_t pos = 0;
+  int replaced = 0;
+  while ((pos = bytes.find("texture-movie 1.", pos)) != std::string::npos) {
+    bytes[pos + 14] = '9';
+    ++replaced;
+  }
+  ASSERT_EQ(replaced, 2);
+  std::string future = dir() + "/future.exr";
+  std::ofstream(future, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+  std::string e = errorOf(future);
+  EXPECT_NE(e.find("texture-movie version 9.0, expected 1.x"), std::string::npos) << e;
+}
+
+TEST_F(TextureMovieFormat, WriterRefusesInconsistentMovies) {
+  TextureMovie m = sampleMovie(2);
+  m.keyTimes.pop_back();
+  EXPECT_THROW(writeTextureMovie(dir() + "/x.exr", m), Error);
+  EXPECT_FALSE(fs::exists(dir() + "/x.exr"));
+  m = sampleMovie(2);
+  m.keys[1].pop_back();
+  EXPECT_THROW(writeTextureMovie(dir() + "/y.exr", m), Error);
+  EXPECT_FALSE(fs::exists(dir() + "/y.exr"));
+}
+
+}  // namespace
+}  // namespace rad
