@@ -65,7 +65,8 @@ struct TextureIntervalsBuilder::Impl {
 
   // Per-frame state.
   std::vector<long> visible;
-  std::vector<double> area, inFrustum;
+  std::vector<double> area, inFrustum;  // -1 = not computed this frame
+  std::vector<glm::dmat4> clipFromObject, guardFromObject;
   std::vector<int> chosen, chosenMovie;
   // Open movie per dense node (-1 = none): index into movies.
   std::vector<int> openMovie;
@@ -119,8 +120,28 @@ struct TextureIntervalsBuilder::Impl {
     openMovie.assign(hierarchy.size(), -1);
   }
 
+  // Whole-patch projected area (header: clipped at the near and far planes only).
+  double wholeArea(int i) {
+    if (area[i] < 0.0) {
+      const Polygon& p = hierarchy.node(i).local;
+      area[i] = kGuardBand * kGuardBand *
+                projectedAreaPixels(guardFromObject[nodeObject[i]], options.imageSize, p.v.data(),
+                                    p.count);
+    }
+    return area[i];
+  }
+  double areaInFrustum(int i) {
+    if (inFrustum[i] < 0.0) {
+      const Polygon& p = hierarchy.node(i).local;
+      inFrustum[i] = projectedAreaPixels(clipFromObject[nodeObject[i]], options.imageSize,
+                                         p.v.data(), p.count);
+    }
+    return inFrustum[i];
+  }
+
   void choose(int i) {
     if (visible[i] == 0) return;
+    wholeArea(i);
     bool enough = area[i] > 0.0 && double(visible[i]) >= options.minVisibleFraction * area[i];
     if (enough || hierarchy.isLeaf(i)) {
       chosen.push_back(i);
@@ -186,24 +207,19 @@ struct TextureIntervalsBuilder::Impl {
     for (int i = hierarchy.size() - 1; i >= hierarchy.topCount(); --i)
       visible[hierarchy.node(i).parent] += visible[i];
 
-    // Projected areas per node: in the frustum, and of the whole patch (guard band).
+    // Projected areas, computed only where needed (nodes with visible pixels, closing movies):
+    // a frame then costs O(visible nodes), not O(all nodes).
     glm::dmat4 clip = clipFromWorld(view, options.imageSize);
     glm::dmat4 guard(1.0);
     guard[0][0] = guard[1][1] = 1.0 / kGuardBand;
-    std::vector<glm::dmat4> clipFromObject(meshNodes.size()), guardFromObject(meshNodes.size());
+    clipFromObject.resize(meshNodes.size());
+    guardFromObject.resize(meshNodes.size());
     for (size_t o = 0; o < meshNodes.size(); ++o) {
       clipFromObject[o] = clip * transforms[o];
       guardFromObject[o] = guard * clipFromObject[o];
     }
-    for (int i = 0; i < hierarchy.size(); ++i) {
-      const Polygon& p = hierarchy.node(i).local;
-      int o = nodeObject[i];
-      inFrustum[i] = projectedAreaPixels(clipFromObject[o], options.imageSize, p.v.data(), p.count);
-      area[i] = inFrustum[i] > 0.0 ? kGuardBand * kGuardBand *
-                                         projectedAreaPixels(guardFromObject[o], options.imageSize,
-                                                             p.v.data(), p.count)
-                                   : 0.0;
-    }
+    std::fill(area.begin(), area.end(), -1.0);
+    std::fill(inFrustum.begin(), inFrustum.end(), -1.0);
 
     // Representation of each top-level patch.
     chosen.clear();
@@ -222,7 +238,7 @@ struct TextureIntervalsBuilder::Impl {
       MovieExtent& m = movies[openMovie[node]];
       if (relativeChosen(node, isChosen))
         m.end = MovieEnd::kLevelChange;
-      else if (inFrustum[node] <= 0.0)
+      else if (areaInFrustum(node) <= 0.0)
         m.end = MovieEnd::kLeftFrustum;
       else
         m.end = MovieEnd::kHidden;

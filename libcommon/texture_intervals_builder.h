@@ -89,7 +89,9 @@ struct IntervalFrame {
   double itemBufferSeconds = 0.0;  // render + readback
   const ItemBuffer* itemBuffer = nullptr;
   // Per dense node index: visible pixels, projected area of the whole patch (pixels, see
-  // above) and the part of it inside the frustum.
+  // above) and the part of it inside the frustum. The areas are computed only where the
+  // algorithm needs them (nodes with visible pixels; the frustum area of nodes whose movie
+  // closed) and are -1 elsewhere.
   const std::vector<long>* visiblePixels = nullptr;
   const std::vector<double>* projectedArea = nullptr;
   const std::vector<double>* areaInFrustum = nullptr;

@@ -278,6 +278,37 @@ TEST(TextureIntervalsBuilder, MaxLengthSplitsMovies) {
   EXPECT_EQ(mine[2].end, MovieEnd::kWindow);
 }
 
+TEST(TextureIntervalsBuilder, EdgeCasesGiveNoMoviesOrValidOnes) {
+  // A scene with nothing but the camera.
+  TestScene empty;
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  EXPECT_TRUE(buildTextureIntervals(empty.scene, empty.camera, {0}, o).empty());
+  // One frame, 1 x 1 textures, a frame far from zero (time precision).
+  TestScene s;
+  s.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);
+  o.minSize = o.maxSize = 1;
+  std::vector<MovieExtent> one = buildTextureIntervals(s.scene, s.camera, {100000}, o);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].firstFrame, 100000);
+  EXPECT_EQ(one[0].lastFrame, 100000);
+  EXPECT_EQ(one[0].width, 1);
+  EXPECT_EQ(one[0].end, MovieEnd::kWindow);
+  // Seen from behind (one-sided patch): visible nowhere, so no movie.
+  TestScene behind;
+  behind.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);
+  behind.scene.nodes[behind.camera].translation = {0, 0, -10};
+  behind.scene.nodes[behind.camera].rotation = glm::dquat(0.0, 0.0, 1.0, 0.0);  // turn around
+  ASSERT_TRUE(
+      projectToPixel(behind.scene.cameraAt(behind.camera, 0.0), kSize, {0, 0, -5}).inFrustum);
+  EXPECT_TRUE(buildTextureIntervals(behind.scene, behind.camera, {0}, o).empty());
+  // Frames must increase; a node that is not a camera is refused.
+  TextureIntervalsBuilder b(s.scene, s.camera, o);
+  b.addFrame(3);
+  EXPECT_THROW(b.addFrame(3), Error);
+  EXPECT_THROW(TextureIntervalsBuilder(s.scene, 1, o), Error);
+}
+
 std::string cornellPath() {
   return RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
 }
