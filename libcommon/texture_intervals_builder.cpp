@@ -35,6 +35,8 @@ void TextureIntervalsOptions::validate() const {
   if (minSize < 1) throw bad("--min-size", "must be >= 1");
   if (maxSize < minSize || maxSize > 16384)
     throw bad("--max-size", "must be in [--min-size, 16384]");
+  if (!(levelHysteresis >= 0.0 && levelHysteresis <= 1.0))
+    throw bad("--level-hysteresis", "must be in [0, 1]");
   if (!(resizeTolerance >= 0.0) || !std::isfinite(resizeTolerance))
     throw bad("--resize-tolerance", "must be >= 0");
   if (maxLength < 0) throw bad("--max-length", "must be >= 0 (0 = unlimited)");
@@ -70,7 +72,8 @@ struct TextureIntervalsBuilder::Impl {
   std::vector<int> chosen, chosenMovie;
   // Open movie per dense node (-1 = none): index into movies.
   std::vector<int> openMovie;
-  std::vector<int> openList;  // dense nodes with an open movie, ascending
+  std::vector<int> openList;    // dense nodes with an open movie, ascending
+  std::vector<char> openBelow;  // per node: a descendant had an open movie last frame
   std::vector<MovieExtent> movies;
   int lastFrame = 0;
   int frames = 0;
@@ -118,6 +121,7 @@ struct TextureIntervalsBuilder::Impl {
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
     openMovie.assign(hierarchy.size(), -1);
+    openBelow.assign(hierarchy.size(), 0);
   }
 
   // Whole-patch projected area (header: clipped at the near and far planes only).
@@ -142,7 +146,14 @@ struct TextureIntervalsBuilder::Impl {
   void choose(int i) {
     if (visible[i] == 0) return;
     wholeArea(i);
-    bool enough = area[i] > 0.0 && double(visible[i]) >= options.minVisibleFraction * area[i];
+    // Level hysteresis: a node represented by itself last frame keeps it down to theta - h; a
+    // node represented by descendants last frame needs theta + h to take over again.
+    double theta = options.minVisibleFraction;
+    if (openMovie[i] >= 0)
+      theta -= options.levelHysteresis;
+    else if (openBelow[i])
+      theta += options.levelHysteresis;
+    bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
     if (enough || hierarchy.isLeaf(i)) {
       chosen.push_back(i);
       return;
@@ -222,6 +233,11 @@ struct TextureIntervalsBuilder::Impl {
     std::fill(inFrustum.begin(), inFrustum.end(), -1.0);
 
     // Representation of each top-level patch.
+    std::fill(openBelow.begin(), openBelow.end(), 0);
+    for (int node : openList)
+      for (int p = hierarchy.node(node).parent; p >= 0 && !openBelow[p];
+           p = hierarchy.node(p).parent)
+        openBelow[p] = 1;
     chosen.clear();
     for (int top = 0; top < hierarchy.topCount(); ++top) choose(top);
     std::sort(chosen.begin(), chosen.end());

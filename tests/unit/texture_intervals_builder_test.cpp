@@ -258,6 +258,45 @@ TEST(TextureIntervalsBuilder, PatchHalfOutsideTheFrustumIsRepresentedByChildren)
   EXPECT_EQ(chosen[0], topOfNode(b2.hierarchy(), r2));
 }
 
+// A rectangle straddling the right image edge while the camera sways: its visible fraction
+// swings between 0.6 and 0.4 around theta = 0.5. The paper's rule switches level at every
+// swing; with a level hysteresis of 0.15 it keeps its first (top-level) movie throughout.
+TEST(TextureIntervalsBuilder, LevelHysteresisKeepsTheLevelNearTheta) {
+  TestScene s;
+  double edge = 5.0 * std::tan(0.4) * kSize.aspect();
+  double w = 2.0;
+  int rect = s.addRect("rect", edge - 0.5 * w, -1.0, edge + 0.5 * w, 1.0, -5.0);
+  AnimationChannel ch;
+  ch.node = s.camera;
+  ch.path = AnimationPath::kTranslation;
+  ch.interpolation = Interpolation::kStep;
+  for (int k = 0; k < 5; ++k) {
+    ch.times.push_back(k * 6 / 24.0);
+    double c = (k % 2 == 0 ? 0.1 : -0.1) * w;  // fraction 0.5 + c / w
+    ch.values.insert(ch.values.end(), {c, 0.0, 0.0});
+  }
+  s.scene.channels.push_back(ch);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 1;
+  PatchHierarchy h(s.scene.inputPolygons());
+  int top = topOfNode(h, rect);
+  auto levelChanges = [&](double hysteresis) {
+    o.levelHysteresis = hysteresis;
+    std::vector<MovieExtent> all = buildTextureIntervals(s.scene, s.camera, frameRange(0, 29), o);
+    int n = 0;
+    for (const MovieExtent& m : moviesOfTop(all, top)) n += m.end == MovieEnd::kLevelChange;
+    return std::make_pair(n, moviesOfTop(all, top));
+  };
+  EXPECT_GE(levelChanges(0.0).first, 4);
+  auto [changes, movies] = levelChanges(0.15);
+  EXPECT_EQ(changes, 0);
+  ASSERT_EQ(movies.size(), 1u);
+  EXPECT_EQ(movies[0].patch.level(), 0);
+  EXPECT_EQ(movies[0].firstFrame, 0);
+  EXPECT_EQ(movies[0].lastFrame, 29);
+}
+
 TEST(TextureIntervalsBuilder, MaxLengthSplitsMovies) {
   TestScene s;
   int rect = s.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);

@@ -49,6 +49,7 @@ nlohmann::json parametersOf(const Options& o, const std::string& frames) {
           {"item-buffers", o.itemBuffers},
           {"max-level", b.maxLevel},
           {"min-visible-fraction", b.minVisibleFraction},
+          {"level-hysteresis", b.levelHysteresis},
           {"texel-density", b.texelDensity},
           {"min-size", b.minSize},
           {"max-size", b.maxSize},
@@ -189,6 +190,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--min-visible-fraction", o.build.minVisibleFraction,
                  "theta: below this visible fraction a patch is represented by its children")
+      ->capture_default_str();
+  app.add_option("--level-hysteresis", o.build.levelHysteresis,
+                 "keep a patch's level while its visible fraction stays within this of theta")
       ->capture_default_str();
   app.add_option("--texel-density", o.build.texelDensity, "texels per covered pixel")
       ->capture_default_str();
