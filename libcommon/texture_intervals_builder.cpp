@@ -17,6 +17,9 @@ namespace {
 // crosses the eye plane edge-on cannot have an unbounded area.
 constexpr double kGuardBand = 64.0;
 
+// Largest subdivision the builder makes (~300 MB of patch and item-buffer geometry).
+constexpr long kMaxNodes = 1L << 21;
+
 }  // namespace
 
 void TextureIntervalsOptions::validate() const {
@@ -88,6 +91,14 @@ struct TextureIntervalsBuilder::Impl {
         scene.nodes[cameraNode].camera < 0)
       throw inputError(scene.path, "node " + std::to_string(cameraNode) + " is not a camera");
     hierarchy = PatchHierarchy(scene.inputPolygons());
+    // Nodes of the full subdivision: tops x (4^(L+1) - 1) / 3.
+    double nodes = hierarchy.topCount() * (std::pow(4.0, options.maxLevel + 1) - 1.0) / 3.0;
+    if (nodes > double(kMaxNodes))
+      throw Error(ExitCode::kUsage, "",
+                  "--max-level " + std::to_string(options.maxLevel) + ": " +
+                      std::to_string(hierarchy.topCount()) + " top-level patches would make " +
+                      std::to_string((long long)nodes) + " patch nodes (at most " +
+                      std::to_string(kMaxNodes) + "); use a smaller --max-level");
     // Regular subdivision down to maxLevel: level by level, so dense indices grow with depth
     // and every child comes after its parent.
     std::vector<int> level(hierarchy.topCount());
