@@ -17,8 +17,9 @@ namespace {
 // crosses the eye plane edge-on cannot have an unbounded area.
 constexpr double kGuardBand = 64.0;
 
-// Largest subdivision the builder makes (~300 MB of patch and item-buffer geometry).
-constexpr long kMaxNodes = 1L << 21;
+// Largest subdivision the builder makes: ~480 bytes per node (patch hierarchy, GL and item
+// geometry), so at most ~250 MB.
+constexpr long kMaxNodes = 1L << 19;
 
 }  // namespace
 
