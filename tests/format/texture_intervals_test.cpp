@@ -120,12 +120,10 @@ TEST(TextureIntervalsFormat, InconsistentContentIsRejected) {
                     {"fps", 24.0},
                     {"image_width", 8},
                     {"image_height", 8}};
-    size_t n = patch.size();
     w.addArray("movie_patch", patch);
     w.addArray("movie_frames", frames, {frames.size() / 2, 2});
     w.addArray("movie_size", size, {size.size() / 2, 2});
     w.addArray("movie_close_reason", reason);
-    (void)n;
     w.write(path);
   };
   uint64_t p = PatchId{1, 1}.packed();
