@@ -658,3 +658,22 @@ TEST(ItemBufferExr, RoundTripKeepsIdsAndDepth) {
 
 }  // namespace
 }  // namespace rad
+
+namespace rad {
+namespace {
+
+// DESIGN.md §9 scene scale: the Cornell box in millimetres under a 0.001 root scale gives the
+// same movies as the same box in metres.
+TEST(TextureIntervalsBuilder, SameMoviesAtMillimetreScale) {
+  Scene m = readGltfScene(RAD_TEST_DATA "/external/cornell_box/cornell_box.gltf");
+  Scene mm = readGltfScene(RAD_TEST_DATA "/external/cornell_box/cornell_box_mm_rootscale.gltf");
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  std::vector<MovieExtent> a = buildTextureIntervals(m, m.cameraNode(""), {0, 1, 2}, o);
+  std::vector<MovieExtent> b = buildTextureIntervals(mm, mm.cameraNode(""), {0, 1, 2}, o);
+  ASSERT_FALSE(a.empty());
+  EXPECT_TRUE(a == b);
+}
+
+}  // namespace
+}  // namespace rad
