@@ -17,6 +17,10 @@ namespace {
 // crosses the eye plane edge-on cannot have an unbounded area.
 constexpr double kGuardBand = 64.0;
 
+// Largest subdivision the builder makes: ~480 bytes per node (patch hierarchy, GL and item
+// geometry), so at most ~250 MB.
+constexpr long kMaxNodes = 1L << 19;
+
 }  // namespace
 
 void TextureIntervalsOptions::validate() const {
@@ -35,6 +39,8 @@ void TextureIntervalsOptions::validate() const {
   if (minSize < 1) throw bad("--min-size", "must be >= 1");
   if (maxSize < minSize || maxSize > 16384)
     throw bad("--max-size", "must be in [--min-size, 16384]");
+  if (!(levelHysteresis >= 0.0 && levelHysteresis <= 1.0))
+    throw bad("--level-hysteresis", "must be in [0, 1]");
   if (!(resizeTolerance >= 0.0) || !std::isfinite(resizeTolerance))
     throw bad("--resize-tolerance", "must be >= 0");
   if (maxLength < 0) throw bad("--max-length", "must be >= 0 (0 = unlimited)");
@@ -65,11 +71,13 @@ struct TextureIntervalsBuilder::Impl {
 
   // Per-frame state.
   std::vector<long> visible;
-  std::vector<double> area, inFrustum;
+  std::vector<double> area, inFrustum;  // -1 = not computed this frame
+  std::vector<glm::dmat4> clipFromObject, guardFromObject;
   std::vector<int> chosen, chosenMovie;
   // Open movie per dense node (-1 = none): index into movies.
   std::vector<int> openMovie;
-  std::vector<int> openList;  // dense nodes with an open movie, ascending
+  std::vector<int> openList;    // dense nodes with an open movie, ascending
+  std::vector<char> openBelow;  // per node: a descendant had an open movie last frame
   std::vector<MovieExtent> movies;
   int lastFrame = 0;
   int frames = 0;
@@ -84,6 +92,14 @@ struct TextureIntervalsBuilder::Impl {
         scene.nodes[cameraNode].camera < 0)
       throw inputError(scene.path, "node " + std::to_string(cameraNode) + " is not a camera");
     hierarchy = PatchHierarchy(scene.inputPolygons());
+    // Nodes of the full subdivision: tops x (4^(L+1) - 1) / 3.
+    double nodes = hierarchy.topCount() * (std::pow(4.0, options.maxLevel + 1) - 1.0) / 3.0;
+    if (nodes > double(kMaxNodes))
+      throw Error(ExitCode::kUsage, "",
+                  "--max-level " + std::to_string(options.maxLevel) + ": " +
+                      std::to_string(hierarchy.topCount()) + " top-level patches would make " +
+                      std::to_string((long long)nodes) + " patch nodes (at most " +
+                      std::to_string(kMaxNodes) + "); use a smaller --max-level");
     // Regular subdivision down to maxLevel: level by level, so dense indices grow with depth
     // and every child comes after its parent.
     std::vector<int> level(hierarchy.topCount());
@@ -117,11 +133,39 @@ struct TextureIntervalsBuilder::Impl {
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
     openMovie.assign(hierarchy.size(), -1);
+    openBelow.assign(hierarchy.size(), 0);
+  }
+
+  // Whole-patch projected area (header: clipped at the near and far planes only).
+  double wholeArea(int i) {
+    if (area[i] < 0.0) {
+      const Polygon& p = hierarchy.node(i).local;
+      area[i] = kGuardBand * kGuardBand *
+                projectedAreaPixels(guardFromObject[nodeObject[i]], options.imageSize, p.v.data(),
+                                    p.count);
+    }
+    return area[i];
+  }
+  double areaInFrustum(int i) {
+    if (inFrustum[i] < 0.0) {
+      const Polygon& p = hierarchy.node(i).local;
+      inFrustum[i] = projectedAreaPixels(clipFromObject[nodeObject[i]], options.imageSize,
+                                         p.v.data(), p.count);
+    }
+    return inFrustum[i];
   }
 
   void choose(int i) {
     if (visible[i] == 0) return;
-    bool enough = area[i] > 0.0 && double(visible[i]) >= options.minVisibleFraction * area[i];
+    wholeArea(i);
+    // Level hysteresis: a node represented by itself last frame keeps it down to theta - h; a
+    // node represented by descendants last frame needs theta + h to take over again.
+    double theta = options.minVisibleFraction;
+    if (openMovie[i] >= 0)
+      theta -= options.levelHysteresis;
+    else if (openBelow[i])
+      theta += options.levelHysteresis;
+    bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
     if (enough || hierarchy.isLeaf(i)) {
       chosen.push_back(i);
       return;
@@ -186,26 +230,26 @@ struct TextureIntervalsBuilder::Impl {
     for (int i = hierarchy.size() - 1; i >= hierarchy.topCount(); --i)
       visible[hierarchy.node(i).parent] += visible[i];
 
-    // Projected areas per node: in the frustum, and of the whole patch (guard band).
+    // Projected areas, computed only where needed (nodes with visible pixels, closing movies):
+    // a frame then costs O(visible nodes), not O(all nodes).
     glm::dmat4 clip = clipFromWorld(view, options.imageSize);
     glm::dmat4 guard(1.0);
     guard[0][0] = guard[1][1] = 1.0 / kGuardBand;
-    std::vector<glm::dmat4> clipFromObject(meshNodes.size()), guardFromObject(meshNodes.size());
+    clipFromObject.resize(meshNodes.size());
+    guardFromObject.resize(meshNodes.size());
     for (size_t o = 0; o < meshNodes.size(); ++o) {
       clipFromObject[o] = clip * transforms[o];
       guardFromObject[o] = guard * clipFromObject[o];
     }
-    for (int i = 0; i < hierarchy.size(); ++i) {
-      const Polygon& p = hierarchy.node(i).local;
-      int o = nodeObject[i];
-      inFrustum[i] = projectedAreaPixels(clipFromObject[o], options.imageSize, p.v.data(), p.count);
-      area[i] = inFrustum[i] > 0.0 ? kGuardBand * kGuardBand *
-                                         projectedAreaPixels(guardFromObject[o], options.imageSize,
-                                                             p.v.data(), p.count)
-                                   : 0.0;
-    }
+    std::fill(area.begin(), area.end(), -1.0);
+    std::fill(inFrustum.begin(), inFrustum.end(), -1.0);
 
     // Representation of each top-level patch.
+    std::fill(openBelow.begin(), openBelow.end(), 0);
+    for (int node : openList)
+      for (int p = hierarchy.node(node).parent; p >= 0 && !openBelow[p];
+           p = hierarchy.node(p).parent)
+        openBelow[p] = 1;
     chosen.clear();
     for (int top = 0; top < hierarchy.topCount(); ++top) choose(top);
     std::sort(chosen.begin(), chosen.end());
@@ -222,7 +266,7 @@ struct TextureIntervalsBuilder::Impl {
       MovieExtent& m = movies[openMovie[node]];
       if (relativeChosen(node, isChosen))
         m.end = MovieEnd::kLevelChange;
-      else if (inFrustum[node] <= 0.0)
+      else if (areaInFrustum(node) <= 0.0)
         m.end = MovieEnd::kLeftFrustum;
       else
         m.end = MovieEnd::kHidden;

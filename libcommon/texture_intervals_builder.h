@@ -25,6 +25,12 @@
 //    another size, or has lasted maxLength frames; movies open at the end of the window close
 //    with kWindow.
 //
+// Level hysteresis (levelHysteresis = h, beyond the paper, default 0): a node represented by
+// itself in the previous frame stays so while its visible fraction is >= theta - h; a node
+// represented by its descendants in the previous frame goes back to one texture only when
+// its fraction is >= theta + h. Other nodes use theta. This keeps patches whose fraction
+// hovers around theta from switching level every frame.
+//
 // Size hysteresis: a movie of size s (a power of two) is right for ideal sizes n in (s/2, s].
 // It keeps s while n stays in (s / (2 (1 + tol)), s (1 + tol)], i.e. within a factor (1 + tol)
 // of the interval it was rounded from, so small zooms do not close movies every frame.
@@ -51,10 +57,12 @@ struct TextureIntervalsOptions {
   double fps = 24.0;                // frame f is at time f / fps
   int maxLevel = 2;                 // depth of the regular subdivision (0 = top-level only)
   double minVisibleFraction = 0.5;  // theta of §4.3
-  double texelDensity = 1.0;        // texels per covered pixel
-  int minSize = 4, maxSize = 256;   // texture side bounds (powers of two not required)
-  double resizeTolerance = 0.5;     // hysteresis factor (see above)
-  int maxLength = 0;                // frames per movie; 0 = unlimited
+  // Hysteresis on the level choice (0 = the paper's rule): see the header comment.
+  double levelHysteresis = 0.0;
+  double texelDensity = 1.0;       // texels per covered pixel
+  int minSize = 4, maxSize = 256;  // texture side bounds (powers of two not required)
+  double resizeTolerance = 0.5;    // hysteresis factor (see above)
+  int maxLength = 0;               // frames per movie; 0 = unlimited
 
   // Throws rad::Error(kUsage) naming the flag of the first invalid value.
   void validate() const;
@@ -89,7 +97,9 @@ struct IntervalFrame {
   double itemBufferSeconds = 0.0;  // render + readback
   const ItemBuffer* itemBuffer = nullptr;
   // Per dense node index: visible pixels, projected area of the whole patch (pixels, see
-  // above) and the part of it inside the frustum.
+  // above) and the part of it inside the frustum. The areas are computed only where the
+  // algorithm needs them (nodes with visible pixels; the frustum area of nodes whose movie
+  // closed) and are -1 elsewhere.
   const std::vector<long>* visiblePixels = nullptr;
   const std::vector<double>* projectedArea = nullptr;
   const std::vector<double>* areaInFrustum = nullptr;

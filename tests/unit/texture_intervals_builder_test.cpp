@@ -258,6 +258,45 @@ TEST(TextureIntervalsBuilder, PatchHalfOutsideTheFrustumIsRepresentedByChildren)
   EXPECT_EQ(chosen[0], topOfNode(b2.hierarchy(), r2));
 }
 
+// A rectangle straddling the right image edge while the camera sways: its visible fraction
+// swings between 0.6 and 0.4 around theta = 0.5. The paper's rule switches level at every
+// swing; with a level hysteresis of 0.15 it keeps its first (top-level) movie throughout.
+TEST(TextureIntervalsBuilder, LevelHysteresisKeepsTheLevelNearTheta) {
+  TestScene s;
+  double edge = 5.0 * std::tan(0.4) * kSize.aspect();
+  double w = 2.0;
+  int rect = s.addRect("rect", edge - 0.5 * w, -1.0, edge + 0.5 * w, 1.0, -5.0);
+  AnimationChannel ch;
+  ch.node = s.camera;
+  ch.path = AnimationPath::kTranslation;
+  ch.interpolation = Interpolation::kStep;
+  for (int k = 0; k < 5; ++k) {
+    ch.times.push_back(k * 6 / 24.0);
+    double c = (k % 2 == 0 ? 0.1 : -0.1) * w;  // fraction 0.5 + c / w
+    ch.values.insert(ch.values.end(), {c, 0.0, 0.0});
+  }
+  s.scene.channels.push_back(ch);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 1;
+  PatchHierarchy h(s.scene.inputPolygons());
+  int top = topOfNode(h, rect);
+  auto levelChanges = [&](double hysteresis) {
+    o.levelHysteresis = hysteresis;
+    std::vector<MovieExtent> all = buildTextureIntervals(s.scene, s.camera, frameRange(0, 29), o);
+    int n = 0;
+    for (const MovieExtent& m : moviesOfTop(all, top)) n += m.end == MovieEnd::kLevelChange;
+    return std::make_pair(n, moviesOfTop(all, top));
+  };
+  EXPECT_GE(levelChanges(0.0).first, 4);
+  auto [changes, movies] = levelChanges(0.15);
+  EXPECT_EQ(changes, 0);
+  ASSERT_EQ(movies.size(), 1u);
+  EXPECT_EQ(movies[0].patch.level(), 0);
+  EXPECT_EQ(movies[0].firstFrame, 0);
+  EXPECT_EQ(movies[0].lastFrame, 29);
+}
+
 TEST(TextureIntervalsBuilder, MaxLengthSplitsMovies) {
   TestScene s;
   int rect = s.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);
@@ -278,21 +317,54 @@ TEST(TextureIntervalsBuilder, MaxLengthSplitsMovies) {
   EXPECT_EQ(mine[2].end, MovieEnd::kWindow);
 }
 
+TEST(TextureIntervalsBuilder, EdgeCasesGiveNoMoviesOrValidOnes) {
+  // A scene with nothing but the camera.
+  TestScene empty;
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  EXPECT_TRUE(buildTextureIntervals(empty.scene, empty.camera, {0}, o).empty());
+  // One frame, 1 x 1 textures, a frame far from zero (time precision).
+  TestScene s;
+  s.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);
+  o.minSize = o.maxSize = 1;
+  std::vector<MovieExtent> one = buildTextureIntervals(s.scene, s.camera, {100000}, o);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].firstFrame, 100000);
+  EXPECT_EQ(one[0].lastFrame, 100000);
+  EXPECT_EQ(one[0].width, 1);
+  EXPECT_EQ(one[0].end, MovieEnd::kWindow);
+  // Seen from behind (one-sided patch): visible nowhere, so no movie.
+  TestScene behind;
+  behind.addRect("rect", -1.0, -1.0, 1.0, 1.0, -5.0);
+  behind.scene.nodes[behind.camera].translation = {0, 0, -10};
+  behind.scene.nodes[behind.camera].rotation = glm::dquat(0.0, 0.0, 1.0, 0.0);  // turn around
+  ASSERT_TRUE(
+      projectToPixel(behind.scene.cameraAt(behind.camera, 0.0), kSize, {0, 0, -5}).inFrustum);
+  EXPECT_TRUE(buildTextureIntervals(behind.scene, behind.camera, {0}, o).empty());
+  // Frames must increase; a node that is not a camera is refused.
+  TextureIntervalsBuilder b(s.scene, s.camera, o);
+  b.addFrame(3);
+  EXPECT_THROW(b.addFrame(3), Error);
+  EXPECT_THROW(TextureIntervalsBuilder(s.scene, 1, o), Error);
+}
+
 std::string cornellPath() {
   return RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
 }
 
-// The invariant rad-compose relies on: at every frame every visible pixel is covered by
-// exactly one open movie, whose node is an ancestor-or-self of the pixel's leaf.
-TEST(TextureIntervalsBuilder, EveryVisiblePixelOfCornellIsCoveredByExactlyOneMovie) {
-  Scene scene = readGltfScene(cornellPath());
-  TextureIntervalsOptions o;
-  o.imageSize = kSize;
-  TextureIntervalsBuilder b(scene, scene.cameraNode(""), o);
+// The invariants rad-compose and rad-movies rely on, checked frame by frame:
+//  * every visible pixel is covered by exactly one chosen node, an ancestor-or-self of its
+//    leaf, and each chosen (frame, node) lies in exactly one movie of that node;
+//  * movies are ordered by (firstFrame, patch), sizes are within [minSize, maxSize];
+//  * each close reason is what happened at the next frame.
+// Returns the number of visible pixels checked.
+long checkInvariants(const Scene& scene, int camera, const std::vector<int>& frames,
+                     const TextureIntervalsOptions& o) {
+  TextureIntervalsBuilder b(scene, camera, o);
   const PatchHierarchy& h = b.hierarchy();
-  std::vector<std::pair<int, uint64_t>> uses;  // (frame, packed patch) of every chosen node
+  std::set<std::pair<int, uint64_t>> uses;  // (frame, packed patch) of every chosen node
   long pixels = 0;
-  for (int frame : frameRange(0, 23)) {
+  for (int frame : frames) {
     b.addFrame(frame, [&](const IntervalFrame& f) {
       std::vector<char> isChosen(h.size(), 0);
       for (int i : *f.chosen) isChosen[i] = 1;
@@ -305,30 +377,117 @@ TEST(TextureIntervalsBuilder, EveryVisiblePixelOfCornellIsCoveredByExactlyOneMov
         ++pixels;
       }
       for (size_t c = 0; c < f.chosen->size(); ++c) {
-        uses.push_back({f.frame, h.node((*f.chosen)[c]).id.packed()});
+        int node = (*f.chosen)[c];
+        EXPECT_GT((*f.visiblePixels)[node], 0);
+        uses.insert({f.frame, h.node(node).id.packed()});
         ASSERT_GE((*f.chosenMovie)[c], 0);
       }
     });
   }
-  EXPECT_GT(pixels, 24L * kSize.pixelCount() / 2);
   std::vector<MovieExtent> all = b.finish();
-  // Each chosen (frame, node) lies in exactly one movie of that node; movies overlap nowhere.
   for (auto [frame, packed] : uses) {
     int n = 0;
     for (const MovieExtent& m : all)
       n += m.patch.packed() == packed && m.firstFrame <= frame && frame <= m.lastFrame;
-    ASSERT_EQ(n, 1) << "frame " << frame << " patch " << PatchId::fromPacked(packed).toString();
+    EXPECT_EQ(n, 1) << "frame " << frame << " patch " << PatchId::fromPacked(packed).toString();
   }
-  size_t frames = 0;
-  for (const MovieExtent& m : all) frames += size_t(m.lastFrame - m.firstFrame + 1);
-  EXPECT_EQ(frames, uses.size());
-  // Id order: (firstFrame, patch).
-  for (size_t i = 1; i < all.size(); ++i) {
-    bool ordered = all[i - 1].firstFrame < all[i].firstFrame ||
-                   (all[i - 1].firstFrame == all[i].firstFrame &&
-                    all[i - 1].patch.packed() < all[i].patch.packed());
-    EXPECT_TRUE(ordered) << i;
+  size_t used = 0;
+  // With a frame step, movies also span the skipped frames: count the processed ones.
+  for (const MovieExtent& m : all)
+    for (int f : frames) used += f >= m.firstFrame && f <= m.lastFrame;
+  EXPECT_EQ(used, uses.size());
+  // A node or any relative (ancestor or descendant) chosen at a frame.
+  auto relativeUsed = [&](const PatchId& p, int frame) {
+    for (auto it = uses.lower_bound({frame, 0}); it != uses.end() && it->first == frame; ++it) {
+      PatchId q = PatchId::fromPacked(it->second);
+      if (q.top != p.top || q == p) continue;
+      PatchId deep = q.level() > p.level() ? q : p, shallow = q.level() > p.level() ? p : q;
+      while (deep.level() > shallow.level()) deep = deep.parent();
+      if (deep == shallow) return true;
+    }
+    return false;
+  };
+  for (size_t i = 0; i < all.size(); ++i) {
+    const MovieExtent& m = all[i];
+    if (i > 0) {
+      bool ordered =
+          all[i - 1].firstFrame < m.firstFrame ||
+          (all[i - 1].firstFrame == m.firstFrame && all[i - 1].patch.packed() < m.patch.packed());
+      EXPECT_TRUE(ordered) << i;
+    }
+    EXPECT_EQ(m.width, m.height);
+    EXPECT_GE(m.width, o.minSize);
+    EXPECT_LE(m.width, o.maxSize);
+    if (o.maxLength > 0) {
+      EXPECT_LE(m.lastFrame - m.firstFrame + 1, o.maxLength);
+    }
+    auto after = std::upper_bound(frames.begin(), frames.end(), m.lastFrame);
+    int next = after == frames.end() ? m.lastFrame + 1 : *after;
+    bool nodeNext = uses.count({next, m.patch.packed()}) > 0;
+    switch (m.end) {
+      case MovieEnd::kWindow:
+        EXPECT_EQ(m.lastFrame, frames.back()) << i;
+        break;
+      case MovieEnd::kResize:
+      case MovieEnd::kMaxLength:
+        EXPECT_TRUE(nodeNext) << i;
+        break;
+      case MovieEnd::kLevelChange:
+        EXPECT_FALSE(nodeNext) << i;
+        EXPECT_TRUE(relativeUsed(m.patch, next)) << i;
+        break;
+      case MovieEnd::kHidden:
+      case MovieEnd::kLeftFrustum:
+        EXPECT_FALSE(nodeNext) << i;
+        EXPECT_FALSE(relativeUsed(m.patch, next)) << i;
+        break;
+    }
   }
+  return pixels;
+}
+
+TEST(TextureIntervalsBuilder, EveryVisiblePixelOfCornellIsCoveredByExactlyOneMovie) {
+  Scene scene = readGltfScene(cornellPath());
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  EXPECT_GT(checkInvariants(scene, scene.cameraNode(""), frameRange(0, 23), o),
+            24L * kSize.pixelCount() / 2);
+  // Other options: deeper, hysteresis on both level and size, limited length.
+  o.maxLevel = 3;
+  o.levelHysteresis = 0.15;
+  o.resizeTolerance = 0.0;
+  o.maxLength = 5;
+  o.minSize = 2;
+  o.maxSize = 64;
+  EXPECT_GT(checkInvariants(scene, scene.cameraNode(""), frameRange(40, 63), o), 0);
+}
+
+// Triangles (subdivided into 4 with an inverted centre child), occlusion, a pan and a step.
+TEST(TextureIntervalsBuilder, InvariantsHoldWithTrianglesOccludersAndSteps) {
+  TestScene s;
+  Mesh tri;
+  tri.name = "tri";
+  MeshTriangle t;
+  t.p = {glm::dvec3(-3, -2, -8), glm::dvec3(3, -2, -8), glm::dvec3(0, 3, -8)};
+  t.material = 0;
+  tri.triangles = {t};
+  s.scene.meshes.push_back(tri);
+  Node n;
+  n.name = "tri";
+  n.mesh = int(s.scene.meshes.size()) - 1;
+  s.addNode(n);
+  s.addRect("wall", -6, -4, 6, 4, -12);
+  int occluder = s.addRect("occluder", -0.7, -0.7, 0.7, 0.7, -4.0);
+  s.move(occluder, {-4, 0, 0}, {4, 0.5, 0}, 2.0);
+  s.move(s.camera, {-1, 0, 0}, {1.5, 0.3, 1}, 2.0);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 3;
+  EXPECT_GT(checkInvariants(s.scene, s.camera, frameRange(0, 47), o), 24L * kSize.pixelCount());
+  std::vector<int> stepped;
+  for (int f = 0; f <= 48; f += 3) stepped.push_back(f);
+  o.levelHysteresis = 0.1;
+  EXPECT_GT(checkInvariants(s.scene, s.camera, stepped, o), 0);
 }
 
 TEST(TextureIntervalsBuilder, BitIdenticalAcrossRuns) {
@@ -495,6 +654,25 @@ TEST(ItemBufferExr, RoundTripKeepsIdsAndDepth) {
   EXPECT_EQ(r.depth, b.depth);
   std::ofstream(path, std::ios::binary | std::ios::trunc) << "not an exr";
   EXPECT_THROW(readItemBufferExr(path), Error);
+}
+
+}  // namespace
+}  // namespace rad
+
+namespace rad {
+namespace {
+
+// DESIGN.md §9 scene scale: the Cornell box in millimetres under a 0.001 root scale gives the
+// same movies as the same box in metres.
+TEST(TextureIntervalsBuilder, SameMoviesAtMillimetreScale) {
+  Scene m = readGltfScene(RAD_TEST_DATA "/external/cornell_box/cornell_box.gltf");
+  Scene mm = readGltfScene(RAD_TEST_DATA "/external/cornell_box/cornell_box_mm_rootscale.gltf");
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  std::vector<MovieExtent> a = buildTextureIntervals(m, m.cameraNode(""), {0, 1, 2}, o);
+  std::vector<MovieExtent> b = buildTextureIntervals(mm, mm.cameraNode(""), {0, 1, 2}, o);
+  ASSERT_FALSE(a.empty());
+  EXPECT_TRUE(a == b);
 }
 
 }  // namespace

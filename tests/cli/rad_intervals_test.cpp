@@ -1,0 +1,84 @@
+// rad-intervals as a user runs it: output, report, item buffers, determinism, bad flags.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "formats/item_buffer_exr.h"
+#include "formats/texture_intervals.h"
+#include "tests/cli/cli_util.h"
+
+namespace rad::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kScene = RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
+
+fs::path freshDir(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("rad_cli_intervals_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+TEST(RadIntervalsCli, WritesIntervalsReportAndItemBuffers) {
+  fs::path d = freshDir("full");
+  CommandResult r = runCommand("cd " + d.string() + " && " + tool("rad-intervals") + " " + kScene +
+                               " -o i.rti --frames 0-11 --size 176x120 --item-buffers ib "
+                               "--report report.json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_NE(r.err.find("movies"), std::string::npos) << r.err;
+  TextureIntervals iv = readTextureIntervals((d / "i.rti").string());
+  EXPECT_EQ(iv.firstFrame, 0);
+  EXPECT_EQ(iv.lastFrame, 11);
+  EXPECT_EQ(iv.imageWidth, 176);
+  EXPECT_FALSE(iv.movies.empty());
+  nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "report.json").string()));
+  EXPECT_EQ(rep["frames"], 12);
+  EXPECT_EQ(rep["movies"], iv.movies.size());
+  EXPECT_GT(rep["item_buffer_ms_per_frame"].get<double>(), 0.0);
+  EXPECT_GT(rep["texels_per_frame"].get<double>(), 0.0);
+  for (int f = 0; f < 12; ++f) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%04d.exr", f);
+    ItemBuffer b = readItemBufferExr((d / "ib" / name).string());
+    EXPECT_EQ(b.width, 176);
+    EXPECT_EQ(b.height, 120);
+  }
+  // Nothing but the outputs (no temporaries left behind).
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(d)) entries += e.path().filename().string()[0] != '.';
+  EXPECT_EQ(entries, 3);
+}
+
+TEST(RadIntervalsCli, IdenticalRunsGiveIdenticalFiles) {
+  fs::path a = freshDir("a"), b = freshDir("b");
+  std::string args = " " + kScene + " -o i.rti --frames 0-23x2 --size 176x120 --max-length 5";
+  ASSERT_EQ(runCommand("cd " + a.string() + " && " + tool("rad-intervals") + args).exitCode, 0);
+  ASSERT_EQ(runCommand("cd " + b.string() + " && " + tool("rad-intervals") + args).exitCode, 0);
+  std::string fa = readWholeFile((a / "i.rti").string());
+  EXPECT_GT(fa.size(), 200u);
+  EXPECT_EQ(fa, readWholeFile((b / "i.rti").string()));
+}
+
+TEST(RadIntervalsCli, BadValuesAreUsageErrors) {
+  fs::path d = freshDir("bad");
+  for (std::string flags : {"--max-level -1", "--min-visible-fraction 2", "--size 0x5",
+                            "--frames 5-2", "--texel-density 0", "--max-level 8"}) {
+    CommandResult r = runCommand(tool("rad-intervals") + " " + kScene + " -o " +
+                                 (d / "x.rti").string() + " " + flags);
+    EXPECT_EQ(r.exitCode, 2) << flags << ": " << r.err;
+    EXPECT_EQ(countLines(r.err), 1) << flags << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("rad-intervals: ", 0), 0u) << r.err;
+  }
+  CommandResult r = runCommand(tool("rad-intervals") + " " + kScene + " -o " +
+                               (d / "x.rti").string() + " --camera nope");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("no camera named 'nope'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "x.rti"));
+}
+
+}  // namespace
+}  // namespace rad::test
