@@ -32,9 +32,9 @@ MOVIES_ARGS    = $(MOVIES_FLAGS)
 COMPOSE_ARGS   = --frames $(FRAMES) $(COMPOSE_FLAGS)
 
 STAGES = rad-global rad-intervals rad-movies rad-compose
-MISSING = $(foreach t,$(STAGES),$(if $(wildcard $(BIN)/$(t)),,$(t)))
+MISSING = $(strip $(foreach t,$(STAGES),$(if $(wildcard $(BIN)/$(t)),,$(t))))
 
-.PHONY: all frames clean FORCE
+.PHONY: all frames clean
 .DELETE_ON_ERROR:
 
 ifeq ($(MISSING),)
@@ -49,21 +49,18 @@ endif
 
 frames: $(OUT)/frames/.done
 
-# A stamp's content is the stage's parameters; it is rewritten only when they change.
-define update-params
-	@mkdir -p $(@D)
-	@printf '%s\n' '$(1)' > $@.new
-	@if cmp -s $@.new $@; then rm -f $@.new; else mv -f $@.new $@; fi
-endef
-
-$(OUT)/global.params: FORCE
-	$(call update-params,$(GLOBAL_ARGS))
-$(OUT)/intervals.params: FORCE
-	$(call update-params,$(INTERVALS_ARGS))
-$(OUT)/movies.params: FORCE
-	$(call update-params,$(MOVIES_ARGS))
-$(OUT)/compose.params: FORCE
-	$(call update-params,$(COMPOSE_ARGS))
+# A stamp's content is the stage's parameters; it is rewritten only when they change. It is
+# updated while the Makefile is read (not by a rule), so `make -n` already knows which stages
+# a change of parameters affects.
+update-params = $(shell mkdir -p $(OUT) && printf '%s\n' '$(2)' > $(OUT)/$(1).params.new && \
+  { cmp -s $(OUT)/$(1).params.new $(OUT)/$(1).params && rm -f $(OUT)/$(1).params.new || \
+    mv -f $(OUT)/$(1).params.new $(OUT)/$(1).params; })
+ifeq ($(filter clean,$(MAKECMDGOALS)),)
+$(call update-params,global,$(GLOBAL_ARGS))
+$(call update-params,intervals,$(INTERVALS_ARGS))
+$(call update-params,movies,$(MOVIES_ARGS))
+$(call update-params,compose,$(COMPOSE_ARGS))
+endif
 
 # What the toolchain sees in the scene (patches, emitters, dynamic nodes, camera, time range).
 $(OUT)/scene.json: $(SCENE) $(BIN)/rad-inspect
@@ -103,4 +100,3 @@ $(OUT)/contact-sheet.png: $(OUT)/frames/.done
 clean:
 	rm -rf $(OUT)
 
-FORCE:

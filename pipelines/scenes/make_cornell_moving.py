@@ -88,7 +88,7 @@ short_node = len(nodes)
 nodes.append({"name": "short_box", "mesh": short, "translation": [0.13, 0.0, 0.17]})
 
 camera_node = len(nodes)
-nodes.append({"name": "camera", "camera": 0, "translation": [0.278, 0.273, -0.1]})
+nodes.append({"name": "camera", "camera": 0, "translation": [0.278, 0.273, -0.8]})
 
 
 def quat_y(deg):

@@ -1,0 +1,27 @@
+# Measurement targets (issue 7; DESIGN.md §8). Both print their figures and write CSV.
+#
+#   make -f pipelines/bench.mk tables   [BENCH_FRAMES=400] [BENCH_SIZE=352x240] [BENCH_ONLY=cubes-1,cubes-32]
+#       the paper's Tables 2-5: every configuration coherent and from scratch (same binaries,
+#       one run), total and per-frame time, speed-up, peak memory, links updated per key;
+#       out/bench/tables.csv
+#   make -f pipelines/bench.mk tradeoff [TRADEOFF_FRAMES=0-11] [TRADEOFF_SIZE=176x120] [TRADEOFF_SPP=1024]
+#       each accuracy knob swept against a converged rad-reference render: time per frame vs
+#       RMSE, Pareto front; out/tradeoff/tradeoff.csv and tradeoff.png (gnuplot)
+
+BIN ?= build/bin
+BENCH_FRAMES ?= 400
+BENCH_SIZE ?= 352x240
+BENCH_ONLY ?=
+TRADEOFF_SCENE ?= pipelines/scenes/cornell-moving.gltf
+TRADEOFF_FRAMES ?= 0-11
+TRADEOFF_SIZE ?= 176x120
+TRADEOFF_SPP ?= 1024
+
+.PHONY: tables tradeoff
+tables:
+	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
+	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --out out/bench
+
+tradeoff:
+	python3 pipelines/tradeoff.py --bin $(BIN) --scene $(TRADEOFF_SCENE) --frames $(TRADEOFF_FRAMES) \
+	  --size $(TRADEOFF_SIZE) --spp $(TRADEOFF_SPP) --out out/tradeoff
