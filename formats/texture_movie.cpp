@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <map>
+#include <regex>
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfDoubleAttribute.h>
@@ -175,6 +178,50 @@ TextureMovie readTextureMovie(const std::string& path) {
   }
   if (m.firstFrame > m.lastFrame) throw inputError(path, "first frame after last frame");
   return m;
+}
+
+nlohmann::json summarizeTextureMovieDirectory(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw inputError(dir, "is not a directory");
+  std::vector<std::string> files;
+  static const std::regex name("[0-9]{6}\\.exr");
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (std::regex_match(e.path().filename().string(), name)) files.push_back(e.path().string());
+  if (ec) throw inputError(dir, ec.message());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw inputError(dir, "no texture movie (NNNNNN.exr) in it");
+  size_t keys = 0, constant = 0, bytes = 0;
+  double texels = 0, minH = 1e300, maxH = -1e300;
+  int first = 1 << 30, last = -(1 << 30);
+  std::map<int, int> levels;
+  for (const std::string& f : files) {
+    TextureMovie m = readTextureMovie(f);
+    keys += m.keys.size();
+    constant += m.constant();
+    bytes += size_t(fs::file_size(f, ec));
+    texels += double(m.width) * m.height * (m.lastFrame - m.firstFrame + 1);
+    first = std::min(first, m.firstFrame);
+    last = std::max(last, m.lastFrame);
+    levels[m.patch.level()]++;
+    for (const auto& k : m.keys)
+      for (float v : k) {
+        minH = std::min(minH, double(v));
+        maxH = std::max(maxH, double(v));
+      }
+  }
+  nlohmann::json lv = nlohmann::json::object();
+  for (auto& [l, n] : levels) lv[std::to_string(l)] = n;
+  return {{"type", "texture-movies"},
+          {"path", dir},
+          {"movies", files.size()},
+          {"keys", keys},
+          {"constant_movies", constant},
+          {"frames", {first, last}},
+          {"texel_frames", texels},
+          {"movies_per_level", lv},
+          {"bytes", bytes},
+          {"irradiance", {{"min", minH}, {"max", maxH}}}};
 }
 
 }  // namespace rad

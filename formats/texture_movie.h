@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "formats/provenance.h"
 #include "libcommon/patch_hierarchy.h"
 
@@ -42,5 +44,10 @@ void writeTextureMovie(const std::string& path, const TextureMovie& movie);
 // Reads and validates (part count, sizes, attributes, finite values). Throws
 // rad::inputError(path, ...), never crashes on a truncated or corrupted file.
 TextureMovie readTextureMovie(const std::string& path);
+
+// rad-inspect's summary of a movies folder: every NNNNNN.exr read and validated; counts of
+// movies, keys and constant movies, texels, frame range, levels, bytes on disk, irradiance
+// range. Throws the first movie's error (a corrupt movie is never summarised as fine).
+nlohmann::json summarizeTextureMovieDirectory(const std::string& dir);
 
 }  // namespace rad

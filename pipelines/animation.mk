@@ -73,15 +73,16 @@ $(OUT)/global.rlh: $(SCENE) $(OUT)/global.params $(BIN)/rad-global
 $(OUT)/intervals.rti: $(SCENE) $(OUT)/intervals.params $(BIN)/rad-intervals
 	$(BIN)/rad-intervals $(SCENE) -o $@ $(INTERVALS_ARGS) --report $(OUT)/intervals-report.json
 
+# The folder is emptied first: movies of an earlier run (another intervals.rti) must not linger.
 $(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
-	@rm -f $@
+	@rm -rf $(OUT)/movies
 	$(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti -o $(OUT)/movies $(MOVIES_ARGS) \
 	  --report $(OUT)/movies-report.json
 	@touch $@
 
 $(OUT)/frames/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
-	@rm -f $@
+	@rm -rf $(OUT)/frames
 	$(BIN)/rad-compose $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies -o $(OUT)/frames \
 	  $(COMPOSE_ARGS)
 	@touch $@

@@ -13,6 +13,7 @@
 
 #include "formats/container.h"
 #include "formats/provenance.h"
+#include "formats/texture_movie.h"
 #include "tests/cli/cli_util.h"
 
 namespace rad::test {
@@ -154,6 +155,46 @@ TEST(RadInspect, UnknownFileIsAnError) {
   CommandResult r = runCommand(tool("rad-inspect") + " " + p);
   EXPECT_EQ(r.exitCode, 1);
   EXPECT_EQ(r.err.rfind("rad-inspect: " + p + ": not a file", 0), 0u) << r.err;
+  fs::remove_all(dir);
+}
+
+TEST(RadInspect, MoviesFolderIsSummarisedAndACorruptMovieIsAnError) {
+  fs::path dir = tempDir() / "movies";
+  fs::create_directories(dir);
+  for (uint32_t id = 0; id < 2; ++id) {
+    TextureMovie m;
+    m.movie = id;
+    m.patch = PatchId{id, 1}.child(2);
+    m.firstFrame = 3 * id;
+    m.lastFrame = 3 * id + 4;
+    m.width = 4;
+    m.height = 2;
+    m.keyFrames = {m.firstFrame, m.lastFrame};
+    m.keyTimes = {m.firstFrame / 24.0, m.lastFrame / 24.0};
+    m.keys = {std::vector<float>(24, 1.0f), std::vector<float>(24, 3.0f + id)};
+    if (id == 1) {  // a constant movie
+      m.keys.pop_back();
+      m.keyFrames.pop_back();
+      m.keyTimes.pop_back();
+    }
+    writeTextureMovie(textureMoviePath(dir.string(), id), m);
+  }
+  CommandResult r = runCommand(tool("rad-inspect") + " --json " + dir.string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["movies"], 2);
+  EXPECT_EQ(j["keys"], 3);
+  EXPECT_EQ(j["constant_movies"], 1);
+  EXPECT_EQ(j["frames"], nlohmann::json({0, 7}));
+  EXPECT_EQ(j["movies_per_level"]["1"], 2);
+  EXPECT_DOUBLE_EQ(j["irradiance"]["max"].get<double>(), 3.0);
+  // Truncate one movie: one line naming it, exit 1.
+  std::string bad = textureMoviePath(dir.string(), 1);
+  fs::resize_file(bad, fs::file_size(bad) / 2);
+  r = runCommand(tool("rad-inspect") + " " + dir.string());
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
   fs::remove_all(dir);
 }
 

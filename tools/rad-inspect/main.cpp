@@ -11,6 +11,7 @@
 #include "formats/file_kind.h"
 #include "formats/gltf_scene.h"
 #include "formats/inspect_kinds.h"
+#include "formats/texture_movie.h"
 #include "libcommon/scene_summary.h"
 #include "libcommon/tool_main.h"
 
@@ -138,6 +139,15 @@ nlohmann::json inspectContainer(const std::string& path, const Options& o, std::
 }
 
 nlohmann::json inspectOne(const std::string& path, const Options& o, std::string& text) {
+  if (std::filesystem::is_directory(path)) {
+    nlohmann::json s = rad::summarizeTextureMovieDirectory(path);
+    std::ostringstream os;
+    os << path << ": texture movies\n";
+    for (const auto& [k, v] : s.items())
+      if (k != "type" && k != "path") os << "  " << k << ": " << v.dump() << "\n";
+    text = os.str();
+    return s;
+  }
   rad::FileKind kind = rad::detectFileKind(path);
   switch (kind) {
     case rad::FileKind::kMissing:
@@ -178,7 +188,8 @@ nlohmann::json inspectOne(const std::string& path, const Options& o, std::string
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Shows what is inside a rad file (container, glTF scene, OpenEXR)."};
+  CLI::App app{
+      "Shows what is inside a rad file (container, glTF scene, OpenEXR, texture-movie folder)."};
   Options o;
   rad::setUpApp(app, kTool, "rad-inspect out/global.rlh --array radiosity");
   app.add_option("FILE", o.files, "files to inspect")->required();
