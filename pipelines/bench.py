@@ -83,9 +83,9 @@ def link_stats(report_path):
             r = json.load(f)
     except (OSError, ValueError):
         return None
-    keys = r.get("keys") or r.get("key_times") or []
-    rec = [k.get("links_recomputed") for k in keys if isinstance(k, dict)]
-    tot = [k.get("links_total") for k in keys if isinstance(k, dict)]
+    keys = r.get("key_times") or []
+    rec = [k.get("recomputed") for k in keys if isinstance(k, dict)]
+    tot = [k.get("links") for k in keys if isinstance(k, dict)]
     rec = [x for x in rec[1:] if x is not None]  # the first key computes everything
     tot = [x for x in tot[1:] if x]
     if not rec or not tot:
