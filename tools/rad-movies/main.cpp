@@ -2,6 +2,8 @@
 // transmittance textures, §5 frame-to-frame coherence; DESIGN.md §6 "rad-movies"). One
 // multi-part OpenEXR per movie (formats/texture_movie.md), written atomically as each movie
 // finishes, so peak memory is one movie's keys whatever the animation's length.
+#include <sys/resource.h>
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -133,6 +135,9 @@ int run(const Options& o, int argc, char** argv) {
     report["seconds"]["read"] = secondsRead;
     report["seconds"]["write"] = secondsWrite;
     report["seconds"]["total"] = since(start);
+    struct rusage usage {};
+    getrusage(RUSAGE_SELF, &usage);
+    report["peak_memory_mb"] = double(usage.ru_maxrss) / 1024.0;  // Linux: kilobytes
     rad::AtomicFile file(o.report);
     {
       std::ofstream out(file.tempPath());
