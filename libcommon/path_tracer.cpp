@@ -497,7 +497,9 @@ FloatImage PathTracer::render(const CameraView& view, ImageSize size,
           const double jx = uniformOpen01(sampleSeed, 1000001);
           const double jy = uniformOpen01(sampleSeed, 1000002);
           glm::dvec2 pixel;
-          if (s < strata * strata) {
+          if (options.pixelCentres) {
+            pixel = glm::dvec2(col + 0.5, row + 0.5);
+          } else if (s < strata * strata) {
             pixel = glm::dvec2(col + (s % strata + jx) / strata, row + (s / strata + jy) / strata);
           } else {
             pixel = glm::dvec2(col + jx, row + jy);

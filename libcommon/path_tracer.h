@@ -51,6 +51,9 @@ struct PathTracerOptions {
   std::uint64_t seed = 0;
   // Mix the frame number into every pixel's seed (independent noise per frame).
   bool decorrelateFrames = false;
+  // Every sample through the pixel centre (no antialiasing): the image then point-samples the
+  // scene exactly as rad-compose does, so a comparison measures shading, not edge coverage.
+  bool pixelCentres = false;
 };
 
 // Mean and spread of a Monte Carlo estimate.

@@ -25,6 +25,7 @@ struct Options {
   int spp = 256, maxDepth = 64;
   std::uint64_t seed = 0;
   bool decorrelateFrames = false;
+  bool pixelCentres = false;
 };
 
 int run(const Options& o, int argc, char** argv) {
@@ -50,7 +51,8 @@ int run(const Options& o, int argc, char** argv) {
                                {"camera", o.camera},
                                {"max-depth", o.maxDepth},
                                {"seed", o.seed},
-                               {"decorrelate-frames", o.decorrelateFrames}};
+                               {"decorrelate-frames", o.decorrelateFrames},
+                               {"pixel-centres", o.pixelCentres}};
   rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
   rad::addInput(provenance, o.scene);
   const std::string provenanceJson = provenance.toJson().dump();
@@ -64,6 +66,7 @@ int run(const Options& o, int argc, char** argv) {
   options.maxDepth = o.maxDepth;
   options.seed = o.seed;
   options.decorrelateFrames = o.decorrelateFrames;
+  options.pixelCentres = o.pixelCentres;
 
   rad::PathTracer tracer(scene, frames.empty() ? 0.0 : frames.front() / o.fps);
   rad::Progress progress("rad-reference", long(frames.size()));
@@ -120,6 +123,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
   app.add_option("--seed", o.seed, "random seed")->capture_default_str();
+  app.add_flag("--pixel-centres", o.pixelCentres,
+               "every sample through the pixel centre (no antialiasing), as rad-compose samples");
   app.add_flag("--decorrelate-frames", o.decorrelateFrames,
                "independent noise per frame (default: the same per-pixel seeds every frame, so "
                "what does not change does not flicker)");
