@@ -1,6 +1,8 @@
 // Frame images: OpenEXR (linear radiance) and PNG (sRGB). Spec in frame_image.h.
 #include "formats/frame_image.h"
 
+#include "formats/exr_image.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -126,20 +128,12 @@ FrameExr readFrameExr(const std::string& path) {
         f.attributes[it.name()] = buf;
       }
     }
-    f.rgb.resize(size_t(f.width) * f.height * 3);
-    Imf::FrameBuffer fb;
-    const size_t xs = 3 * sizeof(float), ys = size_t(f.width) * xs;
-    char* base = reinterpret_cast<char*>(f.rgb.data());
-    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
-    in.setFrameBuffer(fb);
-    in.readPixels(dw.min.y, dw.max.y);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
     throw inputError(path, e.what());
   }
+  f.rgb = readExrImage(path, {"R", "G", "B"}).pixels;
   return f;
 }
 

@@ -24,6 +24,21 @@
 
 namespace rad {
 
+namespace {
+
+// R, G, B slices over interleaved float RGB texels, row-major from the data window's origin.
+Imf::FrameBuffer rgbFrameBuffer(float* rgb, int width) {
+  Imf::FrameBuffer fb;
+  const size_t xs = 3 * sizeof(float), ys = size_t(width) * xs;
+  char* base = reinterpret_cast<char*>(rgb);
+  fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+  fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+  fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+  return fb;
+}
+
+}  // namespace
+
 void TextureMovie::textureAt(double t, std::vector<float>& out) const {
   size_t n = size_t(width) * height * 3;
   out.resize(n);
@@ -88,13 +103,7 @@ void writeTextureMovie(const std::string& path, const TextureMovie& m) {
     Imf::MultiPartOutputFile out(file.tempPath().c_str(), headers.data(), int(headers.size()));
     for (size_t k = 0; k < m.keys.size(); ++k) {
       Imf::OutputPart part(out, int(k));
-      Imf::FrameBuffer fb;
-      const size_t xs = 3 * sizeof(float), ys = size_t(m.width) * xs;
-      char* base = (char*)m.keys[k].data();
-      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
-      part.setFrameBuffer(fb);
+      part.setFrameBuffer(rgbFrameBuffer(const_cast<float*>(m.keys[k].data()), m.width));
       part.writePixels(m.height);
     }
   } catch (const std::exception& e) {
@@ -158,13 +167,7 @@ TextureMovie readTextureMovie(const std::string& path) {
         throw inputError(path, "key times are not increasing");
       std::vector<float> px(size_t(w) * hh * 3);
       Imf::InputPart part(in, k);
-      Imf::FrameBuffer fb;
-      const size_t xs = 3 * sizeof(float), ys = size_t(w) * xs;
-      char* base = (char*)px.data();
-      fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-      fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-      fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
-      part.setFrameBuffer(fb);
+      part.setFrameBuffer(rgbFrameBuffer(px.data(), w));
       part.readPixels(0, hh - 1);
       for (float v : px)
         if (!std::isfinite(v))

@@ -16,46 +16,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The child maps of the quadtree in (u,v) (same as global_solution.cpp, which keeps them
-// private): child k's domain maps into its parent's as parent = o + a * u + b * v.
-struct ChildMap {
-  glm::dvec2 o, a, b;
-};
-
-ChildMap childMap(int k, bool triangle) {
-  if (!triangle) {
-    static const glm::dvec2 origin[4] = {{0, 0}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}};
-    return {origin[k], {0.5, 0}, {0, 0.5}};
-  }
-  switch (k) {
-    case 0:
-      return {{0, 0}, {0.5, 0}, {0, 0.5}};
-    case 1:
-      return {{0.5, 0}, {0.5, 0}, {0, 0.5}};
-    case 2:
-      return {{0, 0.5}, {0.5, 0}, {0, 0.5}};
-    default:
-      return {{0.5, 0.5}, {-0.5, 0}, {0, -0.5}};
-  }
-}
-
-int childContaining(glm::dvec2 uv, bool triangle) {
-  if (!triangle) return uv.y < 0.5 ? (uv.x < 0.5 ? 0 : 1) : (uv.x < 0.5 ? 3 : 2);
-  if (uv.x >= 0.5) return 1;
-  if (uv.y >= 0.5) return 2;
-  if (uv.x + uv.y <= 0.5) return 0;
-  return 3;
-}
-
-glm::dvec2 clampToDomain(glm::dvec2 uv, bool triangle) {
-  uv = glm::clamp(uv, glm::dvec2(0.0), glm::dvec2(1.0));
-  if (triangle && uv.x + uv.y > 1.0) {
-    double excess = 0.5 * (uv.x + uv.y - 1.0);
-    uv = glm::clamp(uv - excess, glm::dvec2(0.0), glm::dvec2(1.0));
-  }
-  return uv;
-}
-
 // Bilinear sample with texel centres at ((i+.5)/w, (j+.5)/h) and clamp-to-edge: what GL_LINEAR
 // with GL_CLAMP_TO_EDGE returns (in double, without GL's 8-bit weight quantisation).
 glm::dvec3 sampleClamped(const float* rgb, int w, int h, glm::dvec2 uv) {
@@ -222,7 +182,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
           double s = glm::dot(nrm, poly.v[0] - ray.origin) / denom;
           if (std::isfinite(s)) hit = ray.origin + s * ray.direction;
         }
-        glm::dvec2 topUv = clampToDomain(polygonUvAt(poly, hit), triangle);
+        glm::dvec2 topUv = clampToParameterDomain(polygonUvAt(poly, hit), triangle);
 
         // Base colour texture factor tex(x) / mean(tex) (Material::reflectance already holds
         // the mean), 1 without a texture.
@@ -252,11 +212,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
               foundUv = uv;
             }
             if (level >= deepest[top]) break;
-            int k = childContaining(uv, triangle);
-            ChildMap cm = childMap(k, triangle);
-            glm::dvec2 d = uv - cm.o;
-            uv = clampToDomain({d.x / cm.a.x, d.y / cm.b.y}, triangle);
-            node = node.child(k);
+            node = node.child(descendToChild(uv, triangle));
           }
         }
 

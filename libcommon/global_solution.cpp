@@ -42,7 +42,9 @@ int childContaining(glm::dvec2 uv, bool triangle) {
   return 3;
 }
 
-glm::dvec2 clampToDomain(glm::dvec2 uv, bool triangle) {
+}  // namespace
+
+glm::dvec2 clampToParameterDomain(glm::dvec2 uv, bool triangle) {
   uv = glm::clamp(uv, glm::dvec2(0.0), glm::dvec2(1.0));
   if (triangle && uv.x + uv.y > 1.0) {
     double excess = 0.5 * (uv.x + uv.y - 1.0);
@@ -51,7 +53,13 @@ glm::dvec2 clampToDomain(glm::dvec2 uv, bool triangle) {
   return uv;
 }
 
-}  // namespace
+int descendToChild(glm::dvec2& uv, bool triangle) {
+  int k = childContaining(uv, triangle);
+  ChildMap m = childMap(k, triangle);
+  glm::dvec2 d = uv - m.o;
+  uv = clampToParameterDomain({d.x / m.a.x, d.y / m.b.y}, triangle);
+  return k;
+}
 
 glm::dvec2 topUvFromNodeUv(PatchId node, glm::dvec2 uv, bool triangle) {
   for (int l = node.level(); l > 0; --l) {
@@ -76,15 +84,9 @@ glm::dvec2 nodeUvFromTopUv(PatchId node, glm::dvec2 uv, bool triangle) {
 
 int leafAtTopUv(const PatchHierarchy& h, int top, glm::dvec2 uv) {
   bool triangle = h.top(top).local.count == 3;
-  uv = clampToDomain(uv, triangle);
+  uv = clampToParameterDomain(uv, triangle);
   int i = top;
-  while (!h.isLeaf(i)) {
-    int k = childContaining(uv, triangle);
-    ChildMap m = childMap(k, triangle);
-    glm::dvec2 d = uv - m.o;
-    uv = clampToDomain({d.x / m.a.x, d.y / m.b.y}, triangle);
-    i = h.node(i).firstChild + k;
-  }
+  while (!h.isLeaf(i)) i = h.node(i).firstChild + descendToChild(uv, triangle);
   return i;
 }
 
@@ -118,7 +120,8 @@ glm::dvec3 GlobalSolution::goodIrradianceAtKey(int top, glm::dvec2 uv, int key) 
   int row = leafRow[leaf];
   if (row < 0) return glm::dvec3(0.0);
   bool triangle = hierarchy.node(leaf).local.count == 3;
-  glm::dvec2 l = clampToDomain(nodeUvFromTopUv(hierarchy.node(leaf).id, uv, triangle), triangle);
+  glm::dvec2 l =
+      clampToParameterDomain(nodeUvFromTopUv(hierarchy.node(leaf).id, uv, triangle), triangle);
   const glm::vec3* c = &leafVertexGoodIrradiance[(size_t(row) * keyCount() + key) * 4];
   if (triangle)
     return (1.0 - l.x - l.y) * glm::dvec3(c[0]) + l.x * glm::dvec3(c[1]) + l.y * glm::dvec3(c[2]);

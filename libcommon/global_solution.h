@@ -86,6 +86,11 @@ class GlobalSolution {
 // square, child 3 inverted).
 glm::dvec2 topUvFromNodeUv(PatchId node, glm::dvec2 nodeUv, bool triangle);
 glm::dvec2 nodeUvFromTopUv(PatchId node, glm::dvec2 topUv, bool triangle);
+// (u,v) clamped into a node's parameter domain ([0,1]^2, or the half square u+v <= 1).
+glm::dvec2 clampToParameterDomain(glm::dvec2 uv, bool triangle);
+// One step down the quadtree: the child (0..3) whose domain contains the node-local point uv,
+// with uv rewritten in that child's own (u,v) (clamped into its domain).
+int descendToChild(glm::dvec2& uv, bool triangle);
 // The deepest existing node of `hierarchy` under top-level patch `top` whose parameter domain
 // contains topUv (points outside the domain are clamped into it).
 int leafAtTopUv(const PatchHierarchy& hierarchy, int top, glm::dvec2 topUv);

@@ -1,5 +1,7 @@
 #include "libcommon/tool_main.h"
 
+#include <sys/resource.h>
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -86,6 +88,12 @@ std::pair<int, int> parseImageSize(const std::string& spec, const std::string& f
     throw Error(ExitCode::kUsage, "", flag + " " + spec + ": size must be 1..16384 per side");
   }
   return {int(w), int(h)};
+}
+
+double peakMemoryMb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
 }
 
 bool stderrIsTerminal() {

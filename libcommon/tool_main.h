@@ -36,6 +36,8 @@ std::vector<int> parseFrameRange(const std::string& spec, const std::string& fla
 // Parses "352x240".
 std::pair<int, int> parseImageSize(const std::string& spec, const std::string& flag = "--size");
 
+// Peak resident memory of this process so far, MiB (getrusage ru_maxrss), for --report.
+double peakMemoryMb();
 // True when stderr is a terminal (progress bars only then).
 bool stderrIsTerminal();
 

@@ -1,6 +1,5 @@
 // rad-global: the first pass (paper §3.1, §4.2; DESIGN.md §6 "rad-global"): space-time
 // hierarchical radiosity over the key times of a frame range, written as global.rlh.
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
@@ -34,12 +33,6 @@ struct Options {
   bool noCoherence = false;
   std::string report;
 };
-
-double peakMemoryMb() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
-}
 
 }  // namespace
 
@@ -200,14 +193,14 @@ int main(int argc, char** argv) {
                           {"merge", rep.secondsMerge},
                           {"write", secondsWrite},
                           {"total", secondsTotal}}},
-                        {"peak_memory_mb", peakMemoryMb()},
+                        {"peak_memory_mb", rad::peakMemoryMb()},
                         {"coherence", !o.noCoherence}};
     std::cerr << "  total: " << total << " links, " << recomputed << " recomputed, " << reused
               << " reused; " << rep.unionNodes << " union nodes, " << rep.linkRows << " link rows, "
               << rep.badPairs << " bad pairs\n"
               << "  seconds: links " << secondsLinks << ", solve " << secondsSolve << ", merge "
               << rep.secondsMerge << ", write " << secondsWrite << ", total " << secondsTotal
-              << "; peak memory " << std::setprecision(1) << peakMemoryMb() << " MB\n";
+              << "; peak memory " << std::setprecision(1) << rad::peakMemoryMb() << " MB\n";
     if (!o.report.empty()) {
       rad::AtomicFile f(o.report);
       {

@@ -2,8 +2,6 @@
 // transmittance textures, §5 frame-to-frame coherence; DESIGN.md §6 "rad-movies"). One
 // multi-part OpenEXR per movie (formats/texture_movie.md), written atomically as each movie
 // finishes, so peak memory is one movie's keys whatever the animation's length.
-#include <sys/resource.h>
-
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -135,9 +133,7 @@ int run(const Options& o, int argc, char** argv) {
     report["seconds"]["read"] = secondsRead;
     report["seconds"]["write"] = secondsWrite;
     report["seconds"]["total"] = since(start);
-    struct rusage usage {};
-    getrusage(RUSAGE_SELF, &usage);
-    report["peak_memory_mb"] = double(usage.ru_maxrss) / 1024.0;  // Linux: kilobytes
+    report["peak_memory_mb"] = rad::peakMemoryMb();
     rad::AtomicFile file(o.report);
     {
       std::ofstream out(file.tempPath());
