@@ -14,7 +14,12 @@ Wall time and peak resident memory are measured per stage from the child process
 (os.wait4), so no external timer is needed. Speed-up = scratch time / coherent time, measured
 as a ratio in one run. The coherent and scratch frames are compared with rad-diff.
 
-usage: bench.py [--frames N] [--size WxH] [--out DIR] [--bin DIR] [--only NAME,...]
+A finished run of one configuration and mode is kept in OUT/NAME/MODE/result.json with the
+frames, size, binaries' commit and pinned CPUs it was measured with; a later invocation with the
+same settings reuses it, so a long full run that is interrupted resumes where it stopped
+(--fresh measures everything again).
+
+usage: bench.py [--frames N] [--size WxH] [--out DIR] [--bin DIR] [--only NAME,...] [--fresh]
 """
 import argparse
 import csv
@@ -76,6 +81,43 @@ def pipeline(bin_dir, scene, out, frames, size, flags, log):
     return {"stages": stages, "total": total, "peak_mib": peak}
 
 
+def settings_of(bin_dir, frames, size):
+    """What a stored result must match to be reused: the run's shape, the binaries (commit of
+    the source tree and the rad-* modification times) and the CPUs this process may use."""
+    try:
+        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                                capture_output=True, text=True).stdout.strip()
+    except OSError:
+        commit = ""
+    stamps = {t: int(os.path.getmtime(os.path.join(bin_dir, t))) for t in
+              ("rad-global", "rad-intervals", "rad-movies", "rad-compose")}
+    return {"frames": frames, "size": size, "commit": commit, "binaries": stamps,
+            "cpus": sorted(os.sched_getaffinity(0))}
+
+
+def measured(bin_dir, scene, out, frames, size, flags, log, settings, fresh):
+    """pipeline(), or the stored result of an identical earlier run."""
+    path = os.path.join(out, "result.json")
+    if not fresh and os.path.exists(path):
+        try:
+            with open(path) as f:
+                kept = json.load(f)
+            same = {k: v for k, v in kept.get("settings", {}).items() if k != "commit"} == \
+                {k: v for k, v in settings.items() if k != "commit"}
+            if same and os.path.isdir(os.path.join(out, "frames")):
+                return kept["result"]
+        except (OSError, ValueError, KeyError):
+            pass
+    if os.path.exists(path):
+        os.remove(path)
+    result = pipeline(bin_dir, scene, out, frames, size, flags, log)
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump({"settings": settings, "result": result}, f, indent=1)
+    os.replace(tmp, path)  # atomic: a killed run leaves no half-written result
+    return result
+
+
 def link_stats(report_path):
     """Links recomputed per key time from rad-global's report (min, max, mean, % of total)."""
     try:
@@ -114,7 +156,10 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"))
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--only", default="")
+    ap.add_argument("--fresh", action="store_true", help="ignore results of earlier runs")
     a = ap.parse_args()
+    settings = settings_of(a.bin, a.frames, a.size)
+    print("bench: commit %s, CPUs %s" % (settings["commit"], settings["cpus"]), file=sys.stderr)
     scenes_dir = os.path.join(a.out, "scenes")
     wanted = [s for s in a.only.split(",") if s] or TABLE2 + TABLE3 + TABLE5
     subprocess.run([sys.executable, os.path.join(HERE, "scenes", "make_paper_scenes.py"),
@@ -128,8 +173,9 @@ def main():
             out = os.path.join(a.out, name, mode)
             print("bench: %s %s (%d frames, %s)" % (name, mode, a.frames, a.size),
                   file=sys.stderr, flush=True)
-            row[mode] = pipeline(a.bin, scene, out, a.frames, a.size,
-                                 SCRATCH_FLAGS if mode == "scratch" else {}, log)
+            row[mode] = measured(a.bin, scene, out, a.frames, a.size,
+                                 SCRATCH_FLAGS if mode == "scratch" else {}, log, settings,
+                                 a.fresh)
         row["links"] = link_stats(os.path.join(a.out, name, "coherent", "global-report.json"))
         row["difference"] = frame_difference(a.bin, os.path.join(a.out, name, "coherent", "frames"),
                                              os.path.join(a.out, name, "scratch", "frames"))
@@ -137,7 +183,7 @@ def main():
         print_tables(rows, a.frames, a.size, sys.stderr)
     write_csv(rows, a.frames, os.path.join(a.out, "tables.csv"))
     with open(os.path.join(a.out, "tables.json"), "w") as f:
-        json.dump(rows, f, indent=1)
+        json.dump({"settings": settings, "rows": rows}, f, indent=1)
     print_tables(rows, a.frames, a.size, sys.stdout)
 
 
