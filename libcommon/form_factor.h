@@ -94,6 +94,14 @@ AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const Polygon& from, const
 // look at d/s (see autoQuadratureOrder).
 double formFactorEstimate(const Polygon& from, const Polygon& to);
 
+// How much the point form factor F(dA -> to) varies over `from`: max - min over its vertices
+// and centroid. A link that gathers the shooter's mean radiosity through the mean form factor
+// errs by at most (spread over the receiver) x B x A_receiver on the receiving side and
+// (spread over the shooter) x (B variation) x A_shooter on the shooting side: the error
+// oracle of hierarchical radiosity (Lischinski, Tampieri, Greenberg 1993; Holzschuch and
+// Sillion 1998 bound the same quantity). Large near contact, ~0 in the far field.
+double formFactorSpread(const Polygon& from, const Polygon& to);
+
 // Helpers shared with the tests.
 std::vector<glm::dvec3> polygonVertices(const Polygon& poly);
 // Newell normal (unit; zero for a degenerate polygon) and area of a planar polygon.

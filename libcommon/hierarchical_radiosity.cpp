@@ -142,12 +142,7 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       s.world.push_back(n.local.transformed(input.topToWorld[n.id.top]));
       s.area.push_back(s.world.back().area());
       s.split.push_back(0);
-      glm::dvec3 b = surfaces[n.id.top].emission;
-      if (input.initialRadiosity && size_t(i) < input.initialRadiosity->size())
-        b = (*input.initialRadiosity)[size_t(i)];
-      else if (n.parent >= 0)
-        b = B[size_t(n.parent)];
-      B.push_back(b);
+      B.push_back(n.parent >= 0 ? B[size_t(n.parent)] : surfaces[n.id.top].emission);
     }
   };
   ensureNodes();
@@ -187,6 +182,7 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
           l.formFactor = it->second.formFactor;
           l.visibility = it->second.visibility;
           l.estimate = it->second.estimate;
+          l.spreadArea = it->second.spreadArea;
           l.accurate = it->second.accurate;
           l.reused = true;
           return;
@@ -199,6 +195,8 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       double est = std::max(formFactorEstimate(P, Q), formFactorEstimate(Q, P) * aq / ap);
       l.estimate = std::min(1.0, est);
       l.formFactor = l.estimate;
+      if (opt.oracle != RefinementOracle::kPower)
+        l.spreadArea = std::max(ap * formFactorSpread(P, Q), aq * formFactorSpread(Q, P));
       l.visibility = input.visibility
                          ? (input.visibility->visibility(P, Q, opt.rays, linkSeed(r.id, q.id),
                                                          r.id.top, q.id.top))
@@ -215,12 +213,6 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       if (s.area[size_t(n)] > opt.minArea && h.node(n).id.level() < PatchId::kMaxLevel) return n;
     return -1;
   };
-  auto sticky = [&](const SolverLink& l) {
-    if (!l.reused || !input.reuse) return false;
-    auto it = input.reuse->find({h.node(l.receiver).id.packed(), h.node(l.shooter).id.packed()});
-    return it != input.reuse->end() && it->second.refined;
-  };
-
   // Refines the links of `work` (and the links that makes) until the oracle is satisfied.
   auto refinePass = [&](std::vector<size_t> work) {
     size_t count = 0;
@@ -230,9 +222,12 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       for (size_t li : work) {
         if (s.links[li].refined) continue;
         SolverLink l = s.links[li];
-        bool want = sticky(l) || maxComponent(B[size_t(l.shooter)]) * double(l.estimate) *
-                                         double(l.visibility) * s.area[size_t(l.receiver)] >
-                                     epsAbs;
+        double bv = maxComponent(B[size_t(l.shooter)]) * l.visibility;
+        bool power = bv * l.estimate * s.area[size_t(l.receiver)] > epsAbs;
+        bool error = bv * l.spreadArea > epsAbs;
+        bool want = (opt.oracle == RefinementOracle::kPower   ? power
+                     : opt.oracle == RefinementOracle::kError ? error
+                                                              : power || error);
         if (!want) continue;
         int node = nodeToSplit(l);
         if (node < 0) continue;
@@ -240,13 +235,8 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
         int first = h.subdivide(node);
         ensureNodes();
         s.split[size_t(node)] = 1;
-        if (fresh)  // children enter this key's tree: start from the warm value or the parent's
-          for (int c = 0; c < 4; ++c) {
-            size_t ci = size_t(first + c);
-            B[ci] = (input.initialRadiosity && ci < input.initialRadiosity->size())
-                        ? (*input.initialRadiosity)[ci]
-                        : B[size_t(node)];
-          }
+        if (fresh)  // children enter this key's tree with their parent's radiosity
+          for (int c = 0; c < 4; ++c) B[size_t(first + c)] = B[size_t(node)];
         s.links[li].refined = true;
         for (int c = 0; c < 4; ++c) {
           SolverLink child;

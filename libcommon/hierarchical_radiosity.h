@@ -38,7 +38,15 @@
 
 namespace rad {
 
+// What the refinement oracle weighs (see the top of this file).
+enum class RefinementOracle {
+  kPower,  // HSA'91 "BF refinement": the power B_q F_pq V A_p the link carries
+  kError,  // the power it may carry wrongly: B_q V max(A_p dF_p, A_q dF_q), dF = formFactorSpread
+  kBoth,   // either one over eps
+};
+
 struct RadiosityOptions {
+  RefinementOracle oracle = RefinementOracle::kPower;
   double eps = 1e-3;           // refinement threshold relative to the largest emitted power
   double minArea = 0.0;        // m^2: a link whose larger patch is not larger than this stays
   bool refine = true;          // false: top-level links only (discrete system of the input patches)
@@ -67,6 +75,7 @@ struct SolverLink {
   double formFactor = 0;  // unoccluded F(receiver -> shooter); the estimate until `accurate`
   double visibility = 0;  // V in [0, 1]
   double estimate = 0;    // F~ of the oracle
+  double spreadArea = 0;  // max(A_p dF(p -> q), A_q dF(q -> p)) of the error oracle (m^2)
   bool refined = false;   // kept for the hierarchy, not gathered
   bool accurate = false;  // formFactor is the quadrature value
   bool reused = false;    // values taken from the previous key time (coherence)
@@ -74,11 +83,12 @@ struct SolverLink {
 };
 
 // Link values that a key-time solve may take over instead of recomputing (paper §4.2): keyed
-// by (receiver id, shooter id).
+// by (receiver id, shooter id). Only values are taken over, never decisions: the solve refines
+// and iterates exactly as without them, so a coherent key solve is bit-identical to an
+// independent one whenever the cached values are what recomputing would give.
 struct CachedLink {
-  double formFactor = 0, visibility = 0, estimate = 0;
+  double formFactor = 0, visibility = 0, estimate = 0, spreadArea = 0;
   bool accurate = false;
-  bool refined = false;  // refined at the previous key: refine again (the decision sticks)
 };
 struct LinkKeyHash {
   size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {
@@ -92,8 +102,6 @@ struct KeySolveInput {
   const VisibilityScene* visibility = nullptr;  // null: every link fully visible
   uint32_t keyIndex = 0;                        // for reports only (seeds ignore it)
   const LinkCache* reuse = nullptr;             // coherence: values to take over
-  // Warm start: radiosity per dense node (nodes beyond its size start at B_e).
-  const std::vector<glm::dvec3>* initialRadiosity = nullptr;
 };
 
 struct KeySolution {

@@ -95,8 +95,8 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     c.formFactor = l.formFactor;
     c.visibility = l.visibility;
     c.estimate = l.estimate;
+    c.spreadArea = l.spreadArea;
     c.accurate = l.accurate;
-    c.refined = l.refined;
     cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
   }
   return cache;
@@ -128,13 +128,10 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     KeyTimeReport kr;
     kr.time = t;
     LinkCache cache;
-    std::vector<glm::dvec3> warm;
     if (opt.coherence && k > 0) {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h, scene, keyTimes[k - 1], t);
-      warm = pushedDown(prev, h);
       in.reuse = &cache;
-      in.initialRadiosity = &warm;
       kr.secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h, surfaces, in, opt.radiosity);

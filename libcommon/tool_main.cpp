@@ -6,16 +6,29 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <regex>
 
+#include <tbb/global_control.h>
+
 namespace rad {
+
+namespace {
+int gThreads = 0;  // --threads; 0: every core this process may use (TBB's default)
+std::unique_ptr<tbb::global_control> gThreadLimit;
+}  // namespace
 
 void setUpApp(CLI::App& app, const std::string& tool, const std::string& example) {
   app.name(tool);
   app.set_version_flag("--version", std::string(tool) + " " RAD_VERSION " (" RAD_GIT_REVISION ")");
   app.footer(std::string("Example:\n  ") + example + "\n\n" + exitCodeHelp());
   app.get_formatter()->column_width(34);
+  // Results never depend on it (work is split by item, not by thread, and every sample seed
+  // comes from ids): it only bounds the cores used, e.g. for make -j or a shared machine.
+  app.add_option("--threads", gThreads, "worker threads; 0: all cores")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
 }
 
 int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** argv) {
@@ -31,6 +44,9 @@ int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** ar
     std::cerr << tool << ": " << e.what() << " (try --help)\n";
     return int(ExitCode::kUsage);
   }
+  if (gThreads > 0)
+    gThreadLimit = std::make_unique<tbb::global_control>(
+        tbb::global_control::max_allowed_parallelism, size_t(gThreads));
   return -1;
 }
 

@@ -18,7 +18,8 @@ inline const char* exitCodeHelp() {
          "            4 environment (no GL context, out of memory); 5 internal error.";
 }
 
-// Creates the CLI11 app with --version and the exit-code footer. `example` is one command line.
+// Creates the CLI11 app with --version, --threads and the exit-code footer. `example` is one
+// command line.
 void setUpApp(CLI::App& app, const std::string& tool, const std::string& example);
 
 // Parses the command line; returns -1 to go on, otherwise the exit code to return

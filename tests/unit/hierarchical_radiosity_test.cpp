@@ -3,6 +3,8 @@
 // two-squares system, energy balance with refinement, and the shaft test.
 #include "libcommon/hierarchical_radiosity.h"
 
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -196,39 +198,173 @@ TEST(HierarchicalRadiosity, TwoSquaresRefinedFormFactor) {
             << exact << ")\n";
 }
 
-// Closed box, small light, refinement on: absorbed = emitted power within 1% at rho = 0.5.
-// Constant-basis hierarchical radiosity does not conserve energy exactly (a link between
-// large patches uses the shooter's mean B, not its distribution); the brightness-weighted
-// oracle bounds each link's energy, not the sum of their errors. At rho = 0.9 the measured
-// excess is 13% (eps 1e-3), 11% (3e-4), 9% (1e-4): printed, not asserted.
+// The rectangle [u0, u1] x [v0, v1] of a parallelogram face, in its (v1 - v0, v3 - v0) frame:
+// same plane, same winding.
+Polygon subRectangle(const Polygon& f, double u0, double u1, double v0, double v1) {
+  glm::dvec3 du = f.v[1] - f.v[0], dv = f.v[3] - f.v[0];
+  Polygon p;
+  p.count = 4;
+  p.v = {f.v[0] + u0 * du + v0 * dv, f.v[0] + u1 * du + v0 * dv, f.v[0] + u1 * du + v1 * dv,
+         f.v[0] + u0 * du + v1 * dv};
+  return p;
+}
+
+// Closed box, small light flush with the ceiling, refinement on: absorbed = emitted power.
+// The enclosure is exactly closed (the ceiling is cut into a 3 x 3 grid whose centre cell is
+// the light), so every point sees exactly one hemisphere of patches and the only imbalance
+// left is hierarchical radiosity's own: a link gathers its shooter's mean radiosity through
+// the shooter's mean form factor. (An earlier version hung the light 1 mm below the ceiling
+// with visibility off: the floor then saw both the light and the ceiling behind it, an excess
+// of F(floor -> light) per bounce, amplified by 1 / (1 - rho) to 9-13 % at rho = 0.9.)
 TEST(HierarchicalRadiosity, EnergyBalanceWithRefinement) {
-  for (double rho : {0.5, 0.9}) {
-    // The unit cube with a small light 1 mm below the middle of the ceiling, facing down (a
-    // closed enclosure: the light's back emits nothing and blocks nothing here).
-    std::vector<Polygon> polys = geometry("unit_cube_6");
-    Polygon light;
-    light.count = 4;
-    double z = 1 - 1e-3;
-    light.v = {glm::dvec3(0.4, 0.4, z), glm::dvec3(0.4, 0.6, z), glm::dvec3(0.6, 0.6, z),
-               glm::dvec3(0.6, 0.4, z)};
-    polys.push_back(light);
-    PatchHierarchy h = hierarchyOf(polys);
-    std::vector<SurfaceProperties> surf(size_t(h.topCount()));
-    for (auto& s : surf) s.reflectance = glm::dvec3(rho);
-    surf[6].emission = glm::dvec3(1.0, 2.0, 3.0);
-    RadiosityOptions o;
-    o.eps = rho <= 0.5 ? 3e-4 : 1e-3;
-    o.minArea = 1e-3;
-    o.tol = 1e-6;
-    KeySolution s = solveKeyTime(h, surf, identityInput(h), o);
-    glm::dvec3 absorbed = s.absorbedPower(h, surf), emitted = s.emittedPower(h, surf);
-    if (rho <= 0.5) {
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(absorbed[c] / emitted[c], 1.0, 0.01) << rho;
+  for (RefinementOracle oracle : {RefinementOracle::kPower, RefinementOracle::kError})
+    for (double rho : {0.5, 0.9}) {
+      double previous = 1.0;  // |absorbed / emitted - 1| at the larger eps
+      for (double eps : {1e-3, 3e-4}) {
+        std::vector<Polygon> cube = geometry("unit_cube_6"), polys;
+        int ceiling = -1;
+        for (int i = 0; i < int(cube.size()); ++i) {
+          bool top = true;
+          for (int k = 0; k < cube[size_t(i)].count; ++k)
+            top &= cube[size_t(i)].v[size_t(k)].z == 1.0;
+          if (top)
+            ceiling = i;
+          else
+            polys.push_back(cube[size_t(i)]);
+        }
+        ASSERT_GE(ceiling, 0);
+        const double cut[4] = {0.0, 0.4, 0.6, 1.0};
+        int lightIndex = -1;
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) {
+            if (a == 1 && b == 1) lightIndex = int(polys.size());
+            polys.push_back(
+                subRectangle(cube[size_t(ceiling)], cut[a], cut[a + 1], cut[b], cut[b + 1]));
+          }
+        PatchHierarchy h = hierarchyOf(polys);
+        std::vector<SurfaceProperties> surf(size_t(h.topCount()));
+        for (auto& s : surf) s.reflectance = glm::dvec3(rho);
+        surf[size_t(lightIndex)].emission = glm::dvec3(1.0, 2.0, 3.0);
+        RadiosityOptions o;
+        o.eps = eps;
+        o.oracle = oracle;
+        o.minArea = 1e-3;
+        o.tol = 1e-7;
+        KeySolution s = solveKeyTime(h, surf, identityInput(h), o);
+        glm::dvec3 absorbed = s.absorbedPower(h, surf), emitted = s.emittedPower(h, surf);
+        double imbalance = std::abs(absorbed.x / emitted.x - 1.0);
+        std::cout << "closed box, " << (oracle == RefinementOracle::kPower ? "power" : "error")
+                  << " oracle, rho " << rho << ", eps " << eps << ": " << h.size() << " nodes, "
+                  << s.links.size() << " links, " << s.iterations << " sweeps, absorbed/emitted "
+                  << absorbed.x / emitted.x << "\n";
+        for (int c = 0; c < 3; ++c)  // the channels scale together: E is (1, 2, 3), rho grey
+          EXPECT_NEAR(absorbed[c] / emitted[c], absorbed.x / emitted.x, 1e-9);
+        // Measured (power / error oracle): rho 0.5: 2.0 / 1.7 % at eps 1e-3, 1.0 / 0.5 % at 3e-4;
+        // rho 0.9: 7.2 / 5.2 %, 4.8 / 3.8 %. The imbalance is amplified by 1 / (1 - rho) (at
+        // rho = 0.99 it is 20-47 %): tighten eps and minArea for bright, closed interiors.
+        EXPECT_LT(imbalance, rho <= 0.5 ? 0.025 : 0.08) << rho << " " << eps;
+        EXPECT_LT(imbalance, previous) << "a smaller eps balances better";
+        previous = imbalance;
+        EXPECT_GT(h.size(), 14 * 5);  // it did refine
+      }
     }
-    EXPECT_GT(h.size(), 6 * 5);
-    std::cout << "box rho " << rho << ": " << h.size() << " nodes, " << s.links.size() << " links, "
-              << s.iterations << " sweeps, " << s.refineRounds << " rounds, absorbed/emitted "
-              << absorbed.x / emitted.x << "\n";
+}
+
+// An axis-aligned box's six faces, facing out (inward = false) or in.
+std::vector<Polygon> boxFaces(glm::dvec3 lo, glm::dvec3 hi, bool inward) {
+  double x0 = lo.x, y0 = lo.y, z0 = lo.z, x1 = hi.x, y1 = hi.y, z1 = hi.z;
+  std::vector<std::array<glm::dvec3, 4>> q = {
+      {{{x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}}},   // -z
+      {{{x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}}},   // +z
+      {{{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}}},   // -y
+      {{{x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}}},   // +y
+      {{{x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}}},   // -x
+      {{{x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}}}};  // +x
+  std::vector<Polygon> out;
+  for (auto& f : q) {
+    Polygon p;
+    p.count = 4;
+    for (int i = 0; i < 4; ++i) p.v[size_t(i)] = f[size_t(inward ? 3 - i : i)];
+    out.push_back(p);
+  }
+  return out;
+}
+
+// Issue 3 item 9, extremes: a room scaled to 1 mm and to 10 km, emission 1e-6 and 1e6,
+// reflectance 0 and 0.999, a block standing on the floor (its bottom face touches the floor,
+// coplanar and facing it; its sides meet the floor along an edge), visibility by Embree.
+// Radiosity stays finite and non-negative, is linear in the emission and does not depend on
+// the scene's scale.
+TEST(HierarchicalRadiosity, ExtremesStayFiniteLinearAndScaleFree) {
+  auto solve = [](double scale, double emission, double rho, double* seconds) {
+    std::vector<Polygon> polys = boxFaces({0, 0, 0}, {1, 1, 1}, true);
+    for (const Polygon& p : boxFaces({0.3, 0.3, 0.0}, {0.6, 0.5, 0.4}, false)) polys.push_back(p);
+    int light = int(polys.size());
+    Polygon l;  // facing down, 1 mm below the ceiling
+    l.count = 4;
+    double z = 1 - 1e-3;
+    l.v = {glm::dvec3(0.4, 0.4, z), glm::dvec3(0.4, 0.6, z), glm::dvec3(0.6, 0.6, z),
+           glm::dvec3(0.6, 0.4, z)};
+    polys.push_back(l);
+    std::vector<VisibilityTriangle> tris;
+    for (Polygon& p : polys) {
+      for (auto& v : p.v) v *= scale;
+      tris.push_back({{p.v[0], p.v[1], p.v[2]}, uint32_t(tris.size() / 2)});
+      tris.push_back({{p.v[0], p.v[2], p.v[3]}, uint32_t(tris.size() / 2)});
+    }
+    PatchHierarchy h = hierarchyOf(polys);
+    VisibilityScene vis(tris);
+    KeySolveInput in = identityInput(h);
+    in.visibility = &vis;
+    std::vector<SurfaceProperties> surf(polys.size());
+    for (auto& sp : surf) sp.reflectance = glm::dvec3(rho);
+    surf[size_t(light)].emission = glm::dvec3(emission);
+    RadiosityOptions o;
+    o.eps = 2e-2;
+    o.minArea = 1e-3 * scale * scale;
+    o.tol = 1e-6;
+    auto t0 = std::chrono::steady_clock::now();
+    KeySolution s = solveKeyTime(h, surf, in, o);
+    *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::vector<double> top;
+    for (int i = 0; i < h.size(); ++i) {
+      if (!s.inTree(i, h)) continue;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_TRUE(std::isfinite(s.radiosity[size_t(i)][c])) << scale << " " << emission;
+        EXPECT_GE(s.radiosity[size_t(i)][c], 0.0) << scale << " " << emission;
+      }
+    }
+    // Mean irradiance per top-level patch (radiosity is 0 off the light at rho = 0).
+    top.assign(size_t(h.topCount()), 0.0);
+    for (int i = 0; i < h.size(); ++i)
+      if (s.inTree(i, h) && !s.split[size_t(i)])
+        top[h.node(i).id.top] += s.area[size_t(i)] * s.irradiance[size_t(i)].x;
+    for (int t = 0; t < h.topCount(); ++t) top[size_t(t)] /= s.area[size_t(t)] * emission;
+    return top;
+  };
+  for (double rho : {0.0, 0.999}) {
+    double sec = 0, worstEmission = 0, worstScale = 0;
+    std::vector<double> ref = solve(1.0, 1.0, rho, &sec);
+    EXPECT_GT(ref[0], 0.0);     // the floor is lit
+    EXPECT_LT(ref[6], ref[0]);  // under the block: its bottom face, touching the floor
+    for (double e : {1e-6, 1e6}) {
+      std::vector<double> b = solve(1.0, e, rho, &sec);
+      for (size_t t = 0; t < b.size(); ++t)
+        worstEmission = std::max(worstEmission, std::abs(b[t] - ref[t]) / std::max(ref[t], 1e-300));
+    }
+    for (double scale : {1e-3, 1e4}) {
+      std::vector<double> b = solve(scale, 1.0, rho, &sec);
+      for (size_t t = 0; t < b.size(); ++t)
+        worstScale = std::max(worstScale, std::abs(b[t] - ref[t]) / std::max(ref[t], 1e-300));
+    }
+    std::cout << "extremes rho " << rho << ": relative change with emission " << worstEmission
+              << ", with scale " << worstScale << " (last solve " << sec << " s)\n";
+    EXPECT_LT(worstEmission, 1e-9) << rho;
+    // Measured: identical to 1e-15 at rho = 0 and at 10 km. At 1 mm and rho = 0.999 the
+    // refinement takes other decisions (2413 instead of 2837 nodes: some test at the eps
+    // threshold comes out the other way in rounding) and 1 / (1 - rho) = 1000 amplifies what
+    // that moves to 2.3 %.
+    EXPECT_LT(worstScale, rho < 0.5 ? 1e-9 : 5e-2) << rho;
   }
 }
 

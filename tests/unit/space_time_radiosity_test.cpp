@@ -1,12 +1,15 @@
-// Space-time radiosity on the bundled moving Cornell box: coherence gives the same radiosity
-// as independent solves, a static scene recomputes no link after the first key time, and the
-// merged GlobalSolution is consistent (activity intervals, push-down, Gouraud vertices).
+// Space-time radiosity on the bundled moving Cornell box: coherence gives the same solution
+// as independent solves bit for bit, whatever the thread count; a static scene recomputes no link
+// after the first key time, and the merged GlobalSolution is consistent (activity intervals,
+// push-down, Gouraud vertices).
 #include "libcommon/space_time_radiosity.h"
 
 #include <cmath>
 #include <iostream>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include "formats/gltf_scene.h"
 
@@ -25,9 +28,34 @@ SpaceTimeOptions fastOptions() {
   return o;
 }
 
+// Everything the merged solution holds, compared bit for bit.
+void expectIdentical(const GlobalSolution& a, const GlobalSolution& b) {
+  ASSERT_EQ(a.hierarchy.size(), b.hierarchy.size());
+  for (int i = 0; i < a.hierarchy.size(); ++i)
+    ASSERT_EQ(a.hierarchy.node(i).id.packed(), b.hierarchy.node(i).id.packed()) << i;
+  EXPECT_TRUE(a.nodeRadiosity == b.nodeRadiosity);
+  EXPECT_TRUE(a.leafRow == b.leafRow);
+  EXPECT_TRUE(a.leafVertexGoodIrradiance == b.leafVertexGoodIrradiance);
+  ASSERT_EQ(a.links.size(), b.links.size());
+  for (size_t i = 0; i < a.links.size(); ++i) {
+    const GlobalLink &x = a.links[i], &y = b.links[i];
+    ASSERT_TRUE(x.receiver == y.receiver && x.shooter == y.shooter && x.firstKey == y.firstKey &&
+                x.lastKey == y.lastKey && x.sampleOffset == y.sampleOffset &&
+                x.sampleCount == y.sampleCount && x.flags == y.flags)
+        << "link row " << i;
+  }
+  EXPECT_TRUE(a.linkSampleKeys == b.linkSampleKeys);
+  EXPECT_TRUE(a.linkSampleValues == b.linkSampleValues);
+  EXPECT_TRUE(a.badPairs == b.badPairs);
+}
+
+// Paper §4.2 with exact reuse: a link is taken over only when recomputing it would give the
+// same values (static ends, no dynamic blocker's swept bound in its shaft, seeds from ids),
+// and the solve makes its refinement decisions afresh from them, so the coherent solution is
+// the independent one bit for bit (the issue asks for 1e-6 relative).
 TEST(SpaceTimeRadiosity, CoherenceMatchesIndependentSolves) {
   Scene scene = cornell();
-  std::vector<double> keys = {0.0, 4 / 24.0, 8 / 24.0};
+  std::vector<double> keys = {0.0, 4 / 24.0, 8 / 24.0, 12 / 24.0};
   SpaceTimeOptions o = fastOptions();
   SpaceTimeReport coherentReport, plainReport;
   GlobalSolution coherent = solveSpaceTime(scene, keys, o, &coherentReport);
@@ -39,38 +67,37 @@ TEST(SpaceTimeRadiosity, CoherenceMatchesIndependentSolves) {
     reused += coherentReport.keys[k].reused;
     recomputed += coherentReport.keys[k].recomputed;
     EXPECT_EQ(plainReport.keys[k].reused, 0u);
+    EXPECT_EQ(coherentReport.keys[k].links, plainReport.keys[k].links) << k;
   }
-  EXPECT_GT(reused, 0u);
+  EXPECT_GT(reused, recomputed);
   EXPECT_GT(recomputed, 0u);
-  // Top-level (mean) radiosity agrees: differences come only from the visibility estimates of
-  // partly visible links (other seeds) and from refinement decisions that stuck.
-  double worst = 0, maxB = 0;
-  for (int t = 0; t < coherent.hierarchy.topCount(); ++t)
-    for (size_t k = 0; k < keys.size(); ++k) {
-      glm::dvec3 a = coherent.radiosityAtKey(t, int(k)), b = plain.radiosityAtKey(t, int(k));
-      for (int c = 0; c < 3; ++c) {
-        worst = std::max(worst, std::abs(a[c] - b[c]));
-        maxB = std::max(maxB, std::abs(b[c]));
-      }
-    }
-  std::cout << "coherent vs independent: max |dB| " << worst << " of max B " << maxB << "; reused "
-            << reused << ", recomputed " << recomputed << "\n";
-  EXPECT_LT(worst, 0.02 * maxB);
-  // And per top-level patch, relative to its own radiosity.
-  double worstRel = 0;
-  for (int t = 0; t < coherent.hierarchy.topCount(); ++t)
-    for (size_t k = 0; k < keys.size(); ++k) {
-      glm::dvec3 a = coherent.radiosityAtKey(t, int(k)), b = plain.radiosityAtKey(t, int(k));
-      for (int c = 0; c < 3; ++c)
-        worstRel = std::max(worstRel, std::abs(a[c] - b[c]) / std::max(1e-12, std::abs(b[c])));
-    }
-  std::cout << "per-top relative difference " << worstRel << "\n";
-  // Measured 6.5% on the dimmest face (16 rays: a partly visible link's V has a standard
-  // deviation up to 1/8, and reused links keep the previous key's seed).
-  EXPECT_LT(worstRel, 0.1);
-  // Key 0 is solved identically by both.
-  for (int t = 0; t < coherent.hierarchy.topCount(); ++t)
-    EXPECT_EQ(coherent.radiosityAtKey(t, 0), plain.radiosityAtKey(t, 0));
+  std::cout << "coherent: " << reused << " links reused, " << recomputed << " recomputed\n";
+  expectIdentical(coherent, plain);
+}
+
+// The error oracle refines differently but keeps the same exactness.
+TEST(SpaceTimeRadiosity, CoherenceMatchesIndependentSolvesWithErrorOracle) {
+  Scene scene = cornell();
+  std::vector<double> keys = {0.0, 6 / 24.0};
+  SpaceTimeOptions o = fastOptions();
+  o.radiosity.oracle = RefinementOracle::kError;
+  GlobalSolution coherent = solveSpaceTime(scene, keys, o);
+  o.coherence = false;
+  expectIdentical(coherent, solveSpaceTime(scene, keys, o));
+}
+
+// Same solution with 1 and 4 worker threads (links are evaluated in parallel; every seed
+// comes from patch ids and every sum runs in a fixed order).
+TEST(SpaceTimeRadiosity, ThreadCountDoesNotChangeTheSolution) {
+  Scene scene = cornell();
+  std::vector<double> keys = {0.0, 6 / 24.0};
+  GlobalSolution one, four;
+  tbb::task_arena(1).execute([&] { one = solveSpaceTime(scene, keys, fastOptions()); });
+  {
+    tbb::global_control allowFour(tbb::global_control::max_allowed_parallelism, 4);
+    tbb::task_arena(4).execute([&] { four = solveSpaceTime(scene, keys, fastOptions()); });
+  }
+  expectIdentical(one, four);
 }
 
 TEST(SpaceTimeRadiosity, StaticSceneRecomputesNothingAfterFirstKey) {

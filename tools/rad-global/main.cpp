@@ -25,6 +25,7 @@ struct Options {
   double fps = 24.0;
   int keyStep = 4;
   double eps = 1e-3;
+  std::string oracle = "power";
   double minArea = 0.0;
   int rays = 16;
   double tol = 1e-4;
@@ -57,6 +58,11 @@ int main(int argc, char** argv) {
                  "refinement threshold: refine while B_q F_pq V A_p > eps x largest emitted power")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--oracle", o.oracle,
+                 "what --eps bounds: power (B_q F_pq V A_p, HSA'91), error (B_q V times the "
+                 "spread of the point form factor over either patch, x its area), both")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"power", "error", "both"}));
   app.add_option("--min-area", o.minArea,
                  "do not subdivide patches of this area (m^2) or less; 0: 1e-4 of the largest "
                  "top-level patch")
@@ -99,6 +105,9 @@ int main(int argc, char** argv) {
 
     rad::SpaceTimeOptions st;
     st.radiosity.eps = o.eps;
+    st.radiosity.oracle = o.oracle == "error"  ? rad::RefinementOracle::kError
+                          : o.oracle == "both" ? rad::RefinementOracle::kBoth
+                                               : rad::RefinementOracle::kPower;
     st.radiosity.rays = o.rays;
     st.radiosity.tol = o.tol;
     st.radiosity.minArea = o.minArea;
@@ -121,6 +130,7 @@ int main(int argc, char** argv) {
                              {"fps", o.fps},
                              {"key-step", o.keyStep},
                              {"eps", o.eps},
+                             {"oracle", o.oracle},
                              {"min-area", st.radiosity.minArea},
                              {"rays", o.rays},
                              {"tol", o.tol},
