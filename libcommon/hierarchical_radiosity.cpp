@@ -67,7 +67,7 @@ std::vector<glm::dvec2> convexHull2d(std::vector<glm::dvec2> p) {
 
 }  // namespace
 
-double linkFormFactor(const Polygon& p, const Polygon& q, int order) {
+double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relTol) {
   if (order != kAutoOrder) return polygonToPolygonFormFactor(p, q, order);
   // Integrate over the smaller patch and use reciprocity: a Gauss rule on the larger one misses
   // the log-singular strip along a shared edge (README of the reference: perp_common_edge_*).
@@ -79,7 +79,7 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order) {
   double size = std::max(polygonSize(from), polygonSize(to));
   double f;
   if (d < size)  // near contact: no fixed rule is accurate, adapt
-    f = polygonToPolygonFormFactorAdaptive(from, to, 1e-7, 1e-12, 4096).value;
+    f = polygonToPolygonFormFactorAdaptive(from, to, relTol, 1e-12, 4096).value;
   else
     f = polygonToPolygonFormFactor(from, to, kAutoOrder);
   return swap ? std::min(1.0, f * aq / ap) : f;
@@ -176,20 +176,33 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       SolverLink& l = s.links[li];
       const PatchNode& r = h.node(l.receiver);
       const PatchNode& q = h.node(l.shooter);
+      const Polygon& P = s.world[size_t(l.receiver)];
+      const Polygon& Q = s.world[size_t(l.shooter)];
+      auto shadowRays = [&] {
+        return input.visibility ? input.visibility->visibility(P, Q, opt.rays, linkSeed(r.id, q.id),
+                                                               r.id.top, q.id.top)
+                                : 1.0;
+      };
       if (input.reuse) {
         auto it = input.reuse->find({r.id.packed(), q.id.packed()});
         if (it != input.reuse->end()) {
-          l.formFactor = it->second.formFactor;
-          l.visibility = it->second.visibility;
-          l.estimate = it->second.estimate;
-          l.spreadArea = it->second.spreadArea;
-          l.accurate = it->second.accurate;
-          l.reused = true;
+          // The values, never a decision: F starts as the estimate as in a fresh evaluation,
+          // and computeAccurate takes the known accurate F instead of integrating again.
+          const CachedLink& c = it->second;
+          l.estimate = c.estimate;
+          l.spreadArea = c.spreadArea;
+          l.formFactor = l.estimate;
+          l.knownFormFactor = c.formFactor;
+          if (c.visibilityValid) {
+            l.visibility = c.visibility;
+            l.reused = true;
+          } else {
+            l.visibility = shadowRays();
+            l.visibilityOnly = true;
+          }
           return;
         }
       }
-      const Polygon& P = s.world[size_t(l.receiver)];
-      const Polygon& Q = s.world[size_t(l.shooter)];
       double ap = s.area[size_t(l.receiver)], aq = s.area[size_t(l.shooter)];
       // Both directions: the centroid estimate alone can miss a near-contact pair.
       double est = std::max(formFactorEstimate(P, Q), formFactorEstimate(Q, P) * aq / ap);
@@ -197,10 +210,7 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       l.formFactor = l.estimate;
       if (opt.oracle != RefinementOracle::kPower)
         l.spreadArea = std::max(ap * formFactorSpread(P, Q), aq * formFactorSpread(Q, P));
-      l.visibility = input.visibility
-                         ? (input.visibility->visibility(P, Q, opt.rays, linkSeed(r.id, q.id),
-                                                         r.id.top, q.id.top))
-                         : 1.0;
+      l.visibility = shadowRays();
     });
     evaluated = end;
   };
@@ -256,11 +266,17 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
     tbb::parallel_for(size_t(0), s.links.size(), [&](size_t li) {
       SolverLink& l = s.links[li];
       if (l.refined || l.accurate) return;
-      if (l.visibility > 0.0)
-        l.formFactor = (linkFormFactor(s.world[size_t(l.receiver)], s.world[size_t(l.shooter)],
-                                       opt.quadratureOrder));
+      if (l.visibility > 0.0) {
+        if (l.knownFormFactor >= 0.0) {
+          l.formFactor = l.knownFormFactor;
+        } else {
+          l.formFactor = linkFormFactor(s.world[size_t(l.receiver)], s.world[size_t(l.shooter)],
+                                        opt.quadratureOrder, opt.formFactorTolerance);
+          l.reused = false;  // computed here after all
+          l.visibilityOnly = false;
+        }
+      }
       l.accurate = true;
-      l.reused = false;  // computed here after all
     });
   };
 
@@ -339,7 +355,10 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       if (!s.links[i].refined) work.push_back(i);
   }
   (void)t0;
-  for (const SolverLink& l : s.links) (l.reused ? s.linksReused : s.linksComputed)++;
+  for (const SolverLink& l : s.links) {
+    (l.reused ? s.linksReused : s.linksComputed)++;
+    s.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
+  }
   s.radiosity = std::move(B);
   s.irradiance = std::move(irr);
   s.irradiance.resize(size_t(h.size()), glm::dvec3(0.0));

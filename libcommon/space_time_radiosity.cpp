@@ -82,6 +82,7 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
   for (const SolverLink& l : prev.links) {
     const PatchNode& r = h.node(l.receiver);
     const PatchNode& s = h.node(l.shooter);
+    // A moving end changes the geometry: nothing of the link is known.
     if (!isStatic(int(r.id.top)) || !isStatic(int(s.id.top))) continue;
     bool hit = false;
     for (const auto& box : swept)
@@ -90,13 +91,13 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
         hit = true;
         break;
       }
-    if (hit) continue;
     CachedLink c;
-    c.formFactor = l.formFactor;
-    c.visibility = l.visibility;
     c.estimate = l.estimate;
     c.spreadArea = l.spreadArea;
-    c.accurate = l.accurate;
+    // computeAccurate leaves F at the estimate for a link it finds invisible
+    c.formFactor = l.accurate && l.visibility > 0.0 ? l.formFactor : -1.0;
+    c.visibility = l.visibility;
+    c.visibilityValid = !hit;  // a moving object in the shaft: the shadow rays again
     cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
   }
   return cache;
@@ -138,6 +139,7 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     kr.links = s.links.size();
     kr.recomputed = s.linksComputed;
     kr.reused = s.linksReused;
+    kr.visibilityOnly = s.linksVisibilityOnly;
     kr.iterations = s.iterations;
     kr.refineRounds = s.refineRounds;
     kr.secondsLinks = s.secondsLinks;

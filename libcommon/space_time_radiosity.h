@@ -35,11 +35,12 @@ struct SpaceTimeOptions {
 
 struct KeyTimeReport {
   double time = 0;
-  size_t links = 0;       // all links of the key (refined ones included)
-  size_t recomputed = 0;  // F / V computed at this key
-  size_t reused = 0;      // F / V taken over from the previous key
-  size_t nodes = 0;       // nodes of this key's tree
-  int iterations = 0;     // Gauss-Seidel sweeps
+  size_t links = 0;           // all links of the key (refined ones included)
+  size_t recomputed = 0;      // F / V computed at this key
+  size_t reused = 0;          // F and V taken over from the previous key
+  size_t visibilityOnly = 0;  // of recomputed: F taken over, only V computed
+  size_t nodes = 0;           // nodes of this key's tree
+  int iterations = 0;         // Gauss-Seidel sweeps
   int refineRounds = 0;
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
 };
@@ -50,7 +51,8 @@ struct SpaceTimeReport {
   size_t unionNodes = 0, linkRows = 0, badPairs = 0;
 };
 
-// Link values of `previous` (solved at t0 on `hierarchy`) that stay valid until t1.
+// Link values of `previous` (solved at t0 on `hierarchy`) that stay valid until t1: F, its
+// estimate and spread while both ends are static; V too unless the shaft meets a swept bound.
 LinkCache reusableLinks(const KeySolution& previous, const PatchHierarchy& hierarchy,
                         const Scene& scene, double t0, double t1);
 

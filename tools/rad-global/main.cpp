@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
 
     // Report: per key time and totals, on stderr and optionally as JSON.
     nlohmann::json keys = nlohmann::json::array();
-    size_t recomputed = 0, reused = 0, total = 0;
+    size_t recomputed = 0, reused = 0, total = 0, visibilityOnly = 0;
     double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
     long iterations = 0;
     std::cerr << kTool << ": " << keyTimes.size() << " key times, " << scene.inputPolygons().size()
@@ -164,6 +164,7 @@ int main(int argc, char** argv) {
                       {"links", r.links},
                       {"recomputed", r.recomputed},
                       {"reused", r.reused},
+                      {"visibility_only", r.visibilityOnly},
                       {"nodes", r.nodes},
                       {"iterations", r.iterations},
                       {"refine_rounds", r.refineRounds},
@@ -177,6 +178,7 @@ int main(int argc, char** argv) {
                 << "\n";
       recomputed += r.recomputed;
       reused += r.reused;
+      visibilityOnly += r.visibilityOnly;
       total += r.links;
       secondsLinks += r.secondsLinks;
       secondsSolve += r.secondsSolve;
@@ -190,6 +192,7 @@ int main(int argc, char** argv) {
                          {{"links", total},
                           {"recomputed", recomputed},
                           {"reused", reused},
+                          {"visibility_only", visibilityOnly},
                           {"iterations", iterations},
                           {"union_nodes", rep.unionNodes},
                           {"link_rows", rep.linkRows},
@@ -205,8 +208,9 @@ int main(int argc, char** argv) {
                           {"total", secondsTotal}}},
                         {"peak_memory_mb", rad::peakMemoryMb()},
                         {"coherence", !o.noCoherence}};
-    std::cerr << "  total: " << total << " links, " << recomputed << " recomputed, " << reused
-              << " reused; " << rep.unionNodes << " union nodes, " << rep.linkRows << " link rows, "
+    std::cerr << "  total: " << total << " links, " << recomputed << " recomputed ("
+              << visibilityOnly << " of them visibility only), " << reused << " reused; "
+              << rep.unionNodes << " union nodes, " << rep.linkRows << " link rows, "
               << rep.badPairs << " bad pairs\n"
               << "  seconds: links " << secondsLinks << ", solve " << secondsSolve << ", merge "
               << rep.secondsMerge << ", write " << secondsWrite << ", total " << secondsTotal
