@@ -7,7 +7,7 @@
 // rad.provenance (Provenance::toJson().dump()). Readable with exrheader / oiiotool / rad-inspect.
 //
 // PNG: 8-bit sRGB of the radiance scaled by 2^exposureEV (frame_composer.h toSrgb8), written
-// with OpenImageIO; the provenance goes into its "ImageDescription" text chunk.
+// with libpng; the provenance goes into its "Description" text chunk (zTXt).
 //
 // Both writes are atomic (formats/atomic_file.h) and deterministic (no time stamps).
 #pragma once

@@ -1,5 +1,6 @@
 // rad-compose's frame loop with lazily loaded, evicted texture movies (paper §5: the movie
-// files are the disk cache; only the movies of the current frame are in memory).
+// files are the disk cache; only the movies of the current frame, and of each only the key
+// textures around the current time, are in memory).
 #include "formats/frame_sequence.h"
 
 #include <algorithm>
@@ -23,13 +24,14 @@ class MovieCache {
   MovieCache(const TextureIntervals& intervals, std::string dir)
       : intervals_(intervals), dir_(std::move(dir)) {}
 
-  // Loads (once) and returns the movie of interval `index`.
-  TextureMovie& get(size_t index) {
+  // Opens (once) and returns the movie of interval `index`.
+  TextureMovieStream& get(size_t index) {
     auto it = loaded_.find(index);
     if (it != loaded_.end()) return *it->second;
     const TextureInterval& iv = intervals_.movies[index];
     std::string path = textureMoviePath(dir_, iv.movie);
-    auto movie = std::make_unique<TextureMovie>(readTextureMovie(path));
+    auto stream = std::make_unique<TextureMovieStream>(path);
+    const TextureMovie* movie = &stream->movie();
     auto differs = [&](const std::string& what, const std::string& got,
                        const std::string& expected) {
       throw inputError(path, what + " " + got + " differs from the intervals' " + expected +
@@ -43,8 +45,8 @@ class MovieCache {
       differs("texture size", std::to_string(movie->width) + "x" + std::to_string(movie->height),
               std::to_string(iv.width) + "x" + std::to_string(iv.height));
     ++read_;
-    TextureMovie& ref = *movie;
-    loaded_.emplace(index, std::move(movie));
+    TextureMovieStream& ref = *stream;
+    loaded_.emplace(index, std::move(stream));
     peak_ = std::max(peak_, int(loaded_.size()));
     return ref;
   }
@@ -65,7 +67,7 @@ class MovieCache {
  private:
   const TextureIntervals& intervals_;
   std::string dir_;
-  std::map<size_t, std::unique_ptr<TextureMovie>> loaded_;
+  std::map<size_t, std::unique_ptr<TextureMovieStream>> loaded_;
   long long read_ = 0;
   int peak_ = 0;
 };
@@ -139,16 +141,17 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
     for (size_t i = 0; i < intervals.movies.size(); ++i) {
       const TextureInterval& iv = intervals.movies[i];
       if (iv.firstFrame > f || iv.lastFrame < f) continue;
-      TextureMovie& movie = cache.get(i);
+      TextureMovieStream& stream = cache.get(i);
+      const TextureMovie& movie = stream.movie();
       MovieTexture mt;
       mt.patch = movie.patch;
       mt.width = movie.width;
       mt.height = movie.height;
       if (movie.constant()) {
-        mt.irradiance = movie.keys.front().data();
+        mt.irradiance = stream.key(0).data();
       } else {
         if (textures.size() <= used) textures.resize(used + 1);
-        movie.textureAt(t, textures[used]);
+        stream.textureAt(t, textures[used]);
         mt.irradiance = textures[used].data();
         ++used;
       }

@@ -18,6 +18,7 @@
 #include <OpenEXR/ImfOutputPart.h>
 #include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/openexr.h>
 
 #include "formats/atomic_file.h"
 #include "libcommon/error.h"
@@ -123,64 +124,198 @@ const A& attr(const Imf::Header& h, const char* name, const std::string& path) {
 
 }  // namespace
 
-TextureMovie readTextureMovie(const std::string& path) {
+namespace {
+
+// Every part's header checked and the movie's metadata filled in (keys left empty).
+TextureMovie readHeaders(Imf::MultiPartInputFile& in, const std::string& path) {
   TextureMovie m;
-  try {
-    Imf::MultiPartInputFile in(path.c_str());
-    int parts = in.parts();
-    if (parts < 1) throw inputError(path, "no parts");
-    for (int k = 0; k < parts; ++k) {
-      const Imf::Header& h = in.header(k);
-      const std::string fmt = attr<Imf::StringAttribute>(h, "rad.format", path).value();
-      if (fmt.rfind("texture-movie ", 0) != 0) throw inputError(path, "not a texture movie");
-      int major = std::atoi(fmt.c_str() + 14);
-      if (major != kTextureMovieMajor)
-        throw inputError(path, "texture-movie version " + fmt.substr(14) + ", expected " +
-                                   std::to_string(kTextureMovieMajor) + ".x");
-      const Imath::Box2i dw = h.dataWindow();
-      int w = dw.max.x - dw.min.x + 1, hh = dw.max.y - dw.min.y + 1;
-      if (dw.min.x != 0 || dw.min.y != 0 || w < 1 || hh < 1 || w > 16384 || hh > 16384)
-        throw inputError(path, "part " + std::to_string(k) + ": invalid data window");
-      if (attr<Imf::IntAttribute>(h, "rad.keyCount", path).value() != parts ||
-          attr<Imf::IntAttribute>(h, "rad.keyIndex", path).value() != k)
-        throw inputError(path, "part " + std::to_string(k) + ": key index/count disagree");
-      for (const char* c : {"R", "G", "B"})
-        if (!h.channels().findChannel(c) || h.channels().findChannel(c)->type != Imf::FLOAT)
-          throw inputError(path,
-                           std::string("part ") + std::to_string(k) + ": no FLOAT channel " + c);
-      if (k == 0) {
-        m.width = w;
-        m.height = hh;
-        m.movie = uint32_t(attr<Imf::IntAttribute>(h, "rad.movie", path).value());
-        m.patch = PatchId::fromPacked(
-            std::stoull(attr<Imf::StringAttribute>(h, "rad.patchPacked", path).value()));
-        m.firstFrame = attr<Imf::IntAttribute>(h, "rad.firstFrame", path).value();
-        m.lastFrame = attr<Imf::IntAttribute>(h, "rad.lastFrame", path).value();
-        if (auto* p = h.findTypedAttribute<Imf::StringAttribute>("rad.provenance"))
-          m.provenanceJson = p->value();
-      } else if (w != m.width || hh != m.height) {
-        throw inputError(path, "parts differ in size");
-      }
-      m.keyFrames.push_back(attr<Imf::IntAttribute>(h, "rad.keyFrame", path).value());
-      m.keyTimes.push_back(attr<Imf::DoubleAttribute>(h, "rad.keyTime", path).value());
-      if (k > 0 && !(m.keyTimes[k] > m.keyTimes[k - 1]))
-        throw inputError(path, "key times are not increasing");
-      std::vector<float> px(size_t(w) * hh * 3);
-      Imf::InputPart part(in, k);
-      part.setFrameBuffer(rgbFrameBuffer(px.data(), w));
-      part.readPixels(0, hh - 1);
-      for (float v : px)
-        if (!std::isfinite(v))
-          throw inputError(path, "non-finite irradiance in part " + std::to_string(k));
-      m.keys.push_back(std::move(px));
+  int parts = in.parts();
+  if (parts < 1) throw inputError(path, "no parts");
+  for (int k = 0; k < parts; ++k) {
+    const Imf::Header& h = in.header(k);
+    const std::string fmt = attr<Imf::StringAttribute>(h, "rad.format", path).value();
+    if (fmt.rfind("texture-movie ", 0) != 0) throw inputError(path, "not a texture movie");
+    int major = std::atoi(fmt.c_str() + 14);
+    if (major != kTextureMovieMajor)
+      throw inputError(path, "texture-movie version " + fmt.substr(14) + ", expected " +
+                                 std::to_string(kTextureMovieMajor) + ".x");
+    const Imath::Box2i dw = h.dataWindow();
+    int w = dw.max.x - dw.min.x + 1, hh = dw.max.y - dw.min.y + 1;
+    if (dw.min.x != 0 || dw.min.y != 0 || w < 1 || hh < 1 || w > 16384 || hh > 16384)
+      throw inputError(path, "part " + std::to_string(k) + ": invalid data window");
+    if (attr<Imf::IntAttribute>(h, "rad.keyCount", path).value() != parts ||
+        attr<Imf::IntAttribute>(h, "rad.keyIndex", path).value() != k)
+      throw inputError(path, "part " + std::to_string(k) + ": key index/count disagree");
+    for (const char* c : {"R", "G", "B"})
+      if (!h.channels().findChannel(c) || h.channels().findChannel(c)->type != Imf::FLOAT)
+        throw inputError(path,
+                         std::string("part ") + std::to_string(k) + ": no FLOAT channel " + c);
+    if (k == 0) {
+      m.width = w;
+      m.height = hh;
+      m.movie = uint32_t(attr<Imf::IntAttribute>(h, "rad.movie", path).value());
+      m.patch = PatchId::fromPacked(
+          std::stoull(attr<Imf::StringAttribute>(h, "rad.patchPacked", path).value()));
+      m.firstFrame = attr<Imf::IntAttribute>(h, "rad.firstFrame", path).value();
+      m.lastFrame = attr<Imf::IntAttribute>(h, "rad.lastFrame", path).value();
+      if (auto* p = h.findTypedAttribute<Imf::StringAttribute>("rad.provenance"))
+        m.provenanceJson = p->value();
+    } else if (w != m.width || hh != m.height) {
+      throw inputError(path, "parts differ in size");
     }
+    m.keyFrames.push_back(attr<Imf::IntAttribute>(h, "rad.keyFrame", path).value());
+    m.keyTimes.push_back(attr<Imf::DoubleAttribute>(h, "rad.keyTime", path).value());
+    if (k > 0 && !(m.keyTimes[size_t(k)] > m.keyTimes[size_t(k) - 1]))
+      throw inputError(path, "key times are not increasing");
+  }
+  if (m.firstFrame > m.lastFrame) throw inputError(path, "first frame after last frame");
+  return m;
+}
+
+// The pixels of part k (headers already checked), finite.
+std::vector<float> readKey(Imf::MultiPartInputFile& in, int k, const TextureMovie& m,
+                           const std::string& path) {
+  std::vector<float> px(size_t(m.width) * size_t(m.height) * 3);
+  Imf::InputPart part(in, k);
+  part.setFrameBuffer(rgbFrameBuffer(px.data(), m.width));
+  part.readPixels(0, m.height - 1);
+  for (float v : px)
+    if (!std::isfinite(v))
+      throw inputError(path, "non-finite irradiance in part " + std::to_string(k));
+  return px;
+}
+
+// Maps OpenEXR's exceptions to rad's one-line input error.
+template <class F>
+auto readingExr(const std::string& path, F&& f) {
+  try {
+    return f();
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
     throw inputError(path, e.what());
   }
-  if (m.firstFrame > m.lastFrame) throw inputError(path, "first frame after last frame");
-  return m;
+}
+
+}  // namespace
+
+TextureMovie readTextureMovie(const std::string& path) {
+  return readingExr(path, [&] {
+    Imf::MultiPartInputFile in(path.c_str());
+    TextureMovie m = readHeaders(in, path);
+    for (int k = 0; k < in.parts(); ++k) m.keys.push_back(readKey(in, k, m, path));
+    return m;
+  });
+}
+
+// The pixels are read with OpenEXR's core (C) API: the C++ MultiPartInputFile keeps a decoder
+// for every part it has read until the file is closed (690 MiB for the table scene's movies),
+// and reopening it for each key parses every part's header each time (compose 2.2x slower).
+// The core context holds only the headers and the chunk tables of the parts read.
+struct TextureMovieStream::Reader {
+  exr_context_t ctx = nullptr;
+  ~Reader() {
+    if (ctx) exr_finish(&ctx);
+  }
+};
+
+namespace {
+
+void quietExrError(exr_const_context_t, exr_result_t, const char*) {}
+
+void checkExr(exr_result_t rv, const std::string& path, const char* what) {
+  if (rv != EXR_ERR_SUCCESS)
+    throw inputError(path, std::string(what) + ": " + exr_get_default_error_message(rv));
+}
+
+}  // namespace
+
+TextureMovieStream::TextureMovieStream(std::string path) : path_(std::move(path)) {
+  movie_ = readingExr(path_, [&] {
+    Imf::MultiPartInputFile in(path_.c_str());
+    return readHeaders(in, path_);
+  });
+  movie_.keys.resize(movie_.keyTimes.size());
+  reader_ = std::make_unique<Reader>();
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.error_handler_fn = quietExrError;  // errors become rad::inputError, not stderr lines
+  checkExr(exr_start_read(&reader_->ctx, path_.c_str(), &init), path_, "cannot open");
+}
+
+TextureMovieStream::~TextureMovieStream() = default;
+
+void TextureMovieStream::load(size_t k) {
+  if (!movie_.keys[k].empty()) return;
+  const int part = int(k), w = movie_.width, h = movie_.height;
+  exr_context_t ctx = reader_->ctx;
+  std::vector<float> px(size_t(w) * size_t(h) * 3);
+  int32_t linesPerChunk = 0;
+  checkExr(exr_get_scanlines_per_chunk(ctx, part, &linesPerChunk), path_, "part header");
+  if (linesPerChunk < 1) throw inputError(path_, "part " + std::to_string(k) + ": no scanlines");
+  exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
+  struct Destroy {
+    exr_context_t ctx;
+    exr_decode_pipeline_t* d;
+    ~Destroy() { exr_decoding_destroy(ctx, d); }
+  } destroy{ctx, &decoder};
+  bool first = true;
+  for (int y = 0; y < h; y += linesPerChunk) {
+    exr_chunk_info_t chunk;
+    checkExr(exr_read_scanline_chunk_info(ctx, part, y, &chunk), path_, "chunk table");
+    if (chunk.start_y < 0 || chunk.height < 1 || chunk.start_y + chunk.height > h ||
+        chunk.width != w)
+      throw inputError(path_, "part " + std::to_string(k) + ": chunk outside the image");
+    checkExr(first ? exr_decoding_initialize(ctx, part, &chunk, &decoder)
+                   : exr_decoding_update(ctx, part, &chunk, &decoder),
+             path_, "decoding");
+    for (int c = 0; c < decoder.channel_count; ++c) {
+      exr_coding_channel_info_t& ch = decoder.channels[c];
+      std::string name = ch.channel_name ? ch.channel_name : "";
+      int offset = name == "R" ? 0 : name == "G" ? 1 : name == "B" ? 2 : -1;
+      if (offset < 0 || ch.height != chunk.height || ch.width != w) {
+        ch.decode_to_ptr = nullptr;  // not ours (or subsampled): skipped
+        continue;
+      }
+      ch.decode_to_ptr =
+          reinterpret_cast<uint8_t*>(px.data() + size_t(chunk.start_y) * size_t(w) * 3 + offset);
+      ch.user_pixel_stride = 3 * int32_t(sizeof(float));
+      ch.user_line_stride = w * 3 * int32_t(sizeof(float));
+      ch.user_data_type = EXR_PIXEL_FLOAT;
+      ch.user_bytes_per_element = int16_t(sizeof(float));
+    }
+    if (first)
+      checkExr(exr_decoding_choose_default_routines(ctx, part, &decoder), path_, "decoding");
+    first = false;
+    checkExr(exr_decoding_run(ctx, part, &decoder), path_, "decoding");
+  }
+  for (float v : px)
+    if (!std::isfinite(v))
+      throw inputError(path_, "non-finite irradiance in part " + std::to_string(k));
+  movie_.keys[k] = std::move(px);
+  ++keysRead_;
+}
+
+const std::vector<float>& TextureMovieStream::key(size_t k) {
+  if (k >= movie_.keys.size())
+    throw Error(ExitCode::kInternal, path_, "no key " + std::to_string(k));
+  load(k);
+  return movie_.keys[k];
+}
+
+void TextureMovieStream::textureAt(double t, std::vector<float>& out) {
+  // The keys TextureMovie::textureAt reads at t; every other one is dropped.
+  const std::vector<double>& kt = movie_.keyTimes;
+  size_t k1 =
+      kt.size() == 1 || t <= kt.front()
+          ? 0
+          : (t >= kt.back() ? kt.size() - 1
+                            : size_t(std::upper_bound(kt.begin(), kt.end(), t) - kt.begin()));
+  size_t k0 = k1 > 0 && t < kt.back() ? k1 - 1 : k1;
+  for (size_t k = 0; k < movie_.keys.size(); ++k)
+    if (k != k0 && k != k1) std::vector<float>().swap(movie_.keys[k]);
+  load(k0);
+  load(k1);
+  movie_.textureAt(t, out);
 }
 
 nlohmann::json summarizeTextureMovieDirectory(const std::string& dir) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,34 @@ void writeTextureMovie(const std::string& path, const TextureMovie& movie);
 // Reads and validates (part count, sizes, attributes, finite values). Throws
 // rad::inputError(path, ...), never crashes on a truncated or corrupted file.
 TextureMovie readTextureMovie(const std::string& path);
+
+// A movie read as it plays: every part's header is read and checked at construction, the
+// pixels of a key only when textureAt needs them, and at most the two keys around the current
+// time are held. rad-compose's memory is then the same whatever the movie's length (a static
+// patch's movie spans the whole animation). textureAt gives exactly TextureMovie::textureAt.
+class TextureMovieStream {
+ public:
+  // Checks every part's header and opens the file for reading (it stays open until
+  // destruction); throws rad::inputError(path, ...).
+  explicit TextureMovieStream(std::string path);
+  ~TextureMovieStream();
+  TextureMovieStream(const TextureMovieStream&) = delete;
+  TextureMovieStream& operator=(const TextureMovieStream&) = delete;
+  // The movie's metadata; keys[k] is empty unless key k is loaded.
+  const TextureMovie& movie() const { return movie_; }
+  void textureAt(double t, std::vector<float>& out);
+  // Key k's texture, loaded if it is not (for a constant movie: its only texture).
+  const std::vector<float>& key(size_t k);
+  long long keysRead() const { return keysRead_; }
+
+ private:
+  void load(size_t k);
+  std::string path_;
+  struct Reader;  // OpenEXR core context, open for the stream's lifetime
+  std::unique_ptr<Reader> reader_;
+  TextureMovie movie_;
+  long long keysRead_ = 0;
+};
 
 // rad-inspect's summary of a movies folder: every NNNNNN.exr read and validated; counts of
 // movies, keys and constant movies, texels, frame range, levels, bytes on disk, irradiance

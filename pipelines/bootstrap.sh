@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 packages=(
   cmake g++ make pkg-config git
   libtinygltf-dev libstb-dev libglm-dev libopenexr-dev openexr libopenimageio-dev openimageio-tools
-  libosmesa6-dev libembree-dev libtbb-dev libcli11-dev nlohmann-json3-dev
+  libosmesa6-dev libembree-dev libtbb-dev libcli11-dev nlohmann-json3-dev libpng-dev
   libgtest-dev libbenchmark-dev ffmpeg python3 gnuplot-nox
 )
 

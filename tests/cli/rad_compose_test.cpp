@@ -197,6 +197,11 @@ TEST_F(RadCompose, PngIsSrgbOfExposureScaledRadiance) {
   std::vector<uint8_t> png(size_t(kSize.pixelCount()) * 3);
   ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, png.data()));
   EXPECT_EQ(png, toSrgb8(e.rgb, -1.5));
+  // The provenance travels in the PNG too (zTXt "Description", read back by OpenImageIO).
+  std::string description = spec.get_string_attribute("ImageDescription");
+  EXPECT_EQ(description.rfind("rad frame 1, exposure -1.5 EV; provenance {", 0), 0u)
+      << description;
+  EXPECT_NE(description.find("rad-compose"), std::string::npos);
   // A wall pixel by hand: L = 0.5/pi * 8 (blue) at 2^-1.5.
   size_t wall =
       std::find(items.id.begin(), items.id.end(), uint32_t(kWallTop + 1)) - items.id.begin();

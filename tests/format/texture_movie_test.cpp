@@ -140,6 +140,70 @@ TEST_F(TextureMovieFormat, TruncatedFilesGiveOneLineErrors) {
   }
 }
 
+// rad-compose's reader: the same textures as the whole-file reader at every time, at most
+// the two keys around the time in memory, and truncated or corrupted files as one-line errors.
+TEST_F(TextureMovieFormat, StreamGivesTheSameTexturesHoldingTwoKeys) {
+  TextureMovie m = sampleMovie(6);
+  m.width = 37;  // several scanline chunks (ZIP: 16 lines each)
+  m.height = 41;
+  for (auto& k : m.keys) {
+    k.resize(size_t(m.width) * m.height * 3);
+    for (size_t i = 0; i < k.size(); ++i) k[i] = float(i % 97) * 0.25f + float(&k - &m.keys[0]);
+  }
+  std::string path = dir() + "/s.exr";
+  writeTextureMovie(path, m);
+  TextureMovie whole = readTextureMovie(path);
+  TextureMovieStream stream(path);
+  EXPECT_EQ(stream.movie().keyTimes, whole.keyTimes);
+  EXPECT_EQ(stream.movie().patch, whole.patch);
+  EXPECT_EQ(stream.keysRead(), 0);  // headers only so far
+  std::vector<float> a, b;
+  for (double t = m.keyTimes.front() - 0.1; t <= m.keyTimes.back() + 0.1; t += 1 / 48.0) {
+    whole.textureAt(t, a);
+    stream.textureAt(t, b);
+    ASSERT_EQ(a, b) << t;
+    size_t held = 0;
+    for (const auto& k : stream.movie().keys) held += k.empty() ? 0 : 1;
+    EXPECT_LE(held, 2u) << t;
+  }
+  EXPECT_EQ(stream.keysRead(), 6);  // each key read once while playing forwards
+  EXPECT_EQ(stream.key(0), m.keys[0]);
+
+  // Truncated: the header check or the first key read fails with one line naming the file.
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  for (size_t cut : {size_t(40), bytes.size() / 2, bytes.size() - 1}) {
+    std::string t = dir() + "/cut" + std::to_string(cut) + ".exr";
+    std::ofstream(t, std::ios::binary).write(bytes.data(), std::streamsize(cut));
+    try {
+      TextureMovieStream s(t);
+      std::vector<float> out;
+      for (size_t k = 0; k < s.movie().keyTimes.size(); ++k)
+        s.textureAt(s.movie().keyTimes[k], out);
+      ADD_FAILURE() << "no error for a file cut at " << cut;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ExitCode::kBadInput);
+      EXPECT_EQ(std::string(e.what()).rfind(t + ": ", 0), 0u) << e.what();
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    }
+  }
+  // Corrupted pixel data: an error or textures, never a crash.
+  for (size_t at = bytes.size() / 3; at < bytes.size(); at += bytes.size() / 7) {
+    std::vector<char> bad = bytes;
+    bad[at] = char(bad[at] ^ 0x5a);
+    std::string t = dir() + "/bad.exr";
+    std::ofstream(t, std::ios::binary | std::ios::trunc)
+        .write(bad.data(), std::streamsize(bad.size()));
+    try {
+      TextureMovieStream s(t);
+      std::vector<float> out;
+      for (double time : s.movie().keyTimes) s.textureAt(time, out);
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    }
+  }
+}
+
 TEST_F(TextureMovieFormat, NotAMovieAndFutureVersionsAreRefusedByName) {
   std::string missing = dir() + "/missing.exr";
   EXPECT_EQ(errorOf(missing).rfind(missing + ": ", 0), 0u);
