@@ -335,3 +335,47 @@ TEST(PathTracer, DoubleSidedReceiverReflectsOnItsBack) {
 
 }  // namespace
 }  // namespace rad
+
+namespace rad {
+namespace {
+
+// --pixel-centres (what rad-compose point-samples): every primary ray goes through its pixel's
+// centre, so a pixel that sees an emitter directly (rho 0: nothing else contributes) is exactly
+// L_e or exactly 0; area sampling instead averages the edge pixels to values in between.
+TEST(PathTracer, PixelCentresPointSampleEdges) {
+  const glm::dvec3 le(1.0, 2.0, 3.0);
+  // A rectangle facing the camera, its edges at no pixel boundary.
+  Scene scene =
+      sceneOf({{{{-0.23, -0.17, -1}, {0.31, -0.17, -1}, {0.31, 0.2, -1}, {-0.23, 0.2, -1}}}},
+              {material(glm::dvec3(0.0), le)});
+  addCamera(scene, {0, 0, 0}, 1.0);
+  PathTracer tracer(scene, 0.0);
+  const CameraView view = scene.cameraAt(scene.cameraNode(""), 0.0);
+  PathTracerOptions o = unbiasedOptions();
+  o.samplesPerPixel = 16;
+  auto count = [&](const FloatImage& im, int& lit, int& dark, int& between) {
+    lit = dark = between = 0;
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 24; ++x) {
+        double v = im.at(x, y, 2);
+        (v == 0.0 ? dark : v == float(le.z) ? lit : between)++;
+      }
+  };
+  int lit, dark, between;
+  o.pixelCentres = true;
+  count(tracer.render(view, {24, 16}, o), lit, dark, between);
+  EXPECT_EQ(between, 0);
+  EXPECT_GT(lit, 10);
+  EXPECT_GT(dark, 10);
+  const int litCentres = lit;
+  o.pixelCentres = false;
+  count(tracer.render(view, {24, 16}, o), lit, dark, between);
+  EXPECT_GT(between, 8) << "edge pixels are averaged";
+  EXPECT_LT(lit, litCentres);
+  std::printf(
+      "  emitter seen directly: %d lit pixels at centres; %d partly lit with area samples\n",
+      litCentres, between);
+}
+
+}  // namespace
+}  // namespace rad
