@@ -1,6 +1,7 @@
 # Measurement targets (issue 7; DESIGN.md §8). Both print their figures and write CSV.
 #
 #   make -f pipelines/bench.mk tables   [BENCH_FRAMES=400] [BENCH_SIZE=352x240] [BENCH_ONLY=cubes-1,cubes-32]
+#       (BENCH_ONLY=cornell-moving BENCH_FRAMES=96: the bundled scene, per stage)
 #       the paper's Tables 2-5: every configuration coherent and from scratch (same binaries,
 #       one run), total and per-frame time, speed-up, peak memory, links updated per key;
 #       out/bench/tables.csv
