@@ -16,16 +16,17 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// What the merge needs of one key-time solve.
+// What the merge needs of one key-time solve besides its links (which go straight into the
+// per-link sample lists, so every key's links are held once, not twice).
 struct KeyRecord {
-  struct Link {
-    uint32_t receiver, shooter;
-    float fv, visibility;
-    bool refined;
-  };
-  std::vector<Link> links;
-  std::vector<char> split;
   std::vector<glm::vec3> radiosity;  // per node of the union hierarchy at that time (push-down)
+};
+
+// One key time's value of one link.
+struct LinkSample {
+  uint32_t key;
+  float fv, visibility;
+  bool refined;
 };
 
 // Radiosity of every node, nodes outside the key's tree taking their parent's value.
@@ -118,6 +119,9 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
   rep.secondsSetup = secondsSince(tSetup);
 
   std::vector<KeyRecord> records(K);
+  // Per link (receiver << 32 | shooter): its value at every key where it exists, in key order.
+  std::unordered_map<uint64_t, std::vector<LinkSample>> perLink;
+  std::vector<char> badPair(size_t(T) * size_t(T), 0);  // paper §3.1, over all key times
   KeySolution prev;
   for (size_t k = 0; k < K; ++k) {
     double t = keyTimes[k];
@@ -148,11 +152,28 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     rep.keys.push_back(kr);
 
     KeyRecord& rec = records[k];
-    rec.links.reserve(s.links.size());
-    for (const SolverLink& l : s.links)
-      rec.links.push_back({uint32_t(l.receiver), uint32_t(l.shooter), float(l.fv()),
-                           float(l.visibility), l.refined});
-    rec.split = s.split;
+    for (const SolverLink& l : s.links) {
+      perLink[(uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter)].push_back(
+          {uint32_t(k), float(l.fv()), float(l.visibility), l.refined});
+      // Bad pairs: by shooter top (and partial visibility).
+      uint32_t rt = h.node(l.receiver).id.top, st = h.node(l.shooter).id.top;
+      char& bad = badPair[size_t(rt) * size_t(T) + st];
+      switch (opt.badLinks) {
+        case BadLinkRule::kNone:
+          break;
+        case BadLinkRule::kAll:
+          bad = 1;
+          break;
+        case BadLinkRule::kLights:
+          bad |= surfaces[st].isEmitter();
+          break;
+        case BadLinkRule::kPartial:
+          bad |= surfaces[st].isEmitter() ||
+                 (!l.refined && float(l.visibility) > opt.partialThreshold &&
+                  float(l.visibility) < 1.0f);
+          break;
+      }
+    }
     std::vector<glm::dvec3> b = pushedDown(s, h);
     rec.radiosity.assign(b.begin(), b.end());
     prev = std::move(s);
@@ -175,48 +196,27 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     }
   }
 
-  // Bad pairs (paper §3.1): by shooter top (and partial visibility), over all key times.
-  std::vector<char> badPair(size_t(T) * size_t(T), 0);
-  for (const KeyRecord& rec : records)
-    for (const KeyRecord::Link& l : rec.links) {
-      uint32_t rt = h.node(int(l.receiver)).id.top, st = h.node(int(l.shooter)).id.top;
-      char& bad = badPair[size_t(rt) * size_t(T) + st];
-      switch (opt.badLinks) {
-        case BadLinkRule::kNone:
-          break;
-        case BadLinkRule::kAll:
-          bad = 1;
-          break;
-        case BadLinkRule::kLights:
-          bad |= surfaces[st].isEmitter();
-          break;
-        case BadLinkRule::kPartial:
-          bad |= surfaces[st].isEmitter() ||
-                 (!l.refined && l.visibility > opt.partialThreshold && l.visibility < 1.0f);
-          break;
-      }
-    }
   for (uint32_t r = 0; r < uint32_t(T); ++r)
     for (uint32_t s = 0; s < uint32_t(T); ++s)
       if (badPair[size_t(r) * size_t(T) + s]) g.badPairs.emplace_back(r, s);
 
   // Links: one row per activity interval (maximal run of consecutive keys, same refined flag).
-  struct Sample {
-    uint32_t key;
-    float fv, visibility;
-    bool refined;
-  };
-  std::unordered_map<uint64_t, std::vector<Sample>> perLink;
-  for (size_t k = 0; k < K; ++k)
-    for (const KeyRecord::Link& l : records[k].links)
-      perLink[(uint64_t(l.receiver) << 32) | l.shooter].push_back(
-          {uint32_t(k), l.fv, l.visibility, l.refined});
   std::vector<uint64_t> linkKeys;
   linkKeys.reserve(perLink.size());
   for (const auto& [key, v] : perLink) linkKeys.push_back(key);
   std::sort(linkKeys.begin(), linkKeys.end());
+  // Good-link irradiance gathered at each node at each key (summed in link order: the same
+  // whatever the thread count or the coherence).
+  std::vector<glm::dvec3> goodH(N * K, glm::dvec3(0.0));
   for (uint64_t key : linkKeys) {
-    const std::vector<Sample>& v = perLink[key];  // ascending keys (filled in key order)
+    uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
+    if (badPair[size_t(h.node(int(rcv)).id.top) * size_t(T) + h.node(int(sh)).id.top]) continue;
+    for (const LinkSample& x : perLink[key])
+      if (!x.refined)
+        goodH[x.key * N + rcv] += double(x.fv) * glm::dvec3(records[x.key].radiosity[sh]);
+  }
+  for (uint64_t key : linkKeys) {
+    const std::vector<LinkSample>& v = perLink[key];  // ascending keys (filled in key order)
     uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
     bool bad = badPair[size_t(h.node(int(rcv)).id.top) * size_t(T) + h.node(int(sh)).id.top];
     for (size_t a = 0; a < v.size();) {
@@ -279,16 +279,9 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     }
   }
   g.leafVertexGoodIrradiance.assign(L * K * 4, glm::vec3(0.0f));
-  std::vector<glm::dvec3> nodeH(N), leafH(L), vertexSum(vertexCount.size());
+  std::vector<glm::dvec3> leafH(L), vertexSum(vertexCount.size());
   for (size_t k = 0; k < K; ++k) {
-    std::fill(nodeH.begin(), nodeH.end(), glm::dvec3(0.0));
-    for (const KeyRecord::Link& l : records[k].links) {
-      if (l.refined) continue;
-      if (badPair[size_t(h.node(int(l.receiver)).id.top) * size_t(T) +
-                  h.node(int(l.shooter)).id.top])
-        continue;
-      nodeH[l.receiver] += double(l.fv) * glm::dvec3(records[k].radiosity[l.shooter]);
-    }
+    const glm::dvec3* nodeH = &goodH[k * N];
     std::fill(vertexSum.begin(), vertexSum.end(), glm::dvec3(0.0));
     for (size_t li = 0; li < L; ++li) {
       glm::dvec3 H(0.0);
