@@ -30,13 +30,22 @@ std::string framePath(const std::string& dir, int frame, const std::string& ext)
   return dir + name + ext;
 }
 
+int frameCompressionOf(const std::string& name) {
+  if (name == "none") return int(Imf::NO_COMPRESSION);
+  if (name == "rle") return int(Imf::RLE_COMPRESSION);
+  if (name == "zip") return int(Imf::ZIP_COMPRESSION);
+  if (name == "piz") return int(Imf::PIZ_COMPRESSION);
+  throw Error(ExitCode::kUsage, "--compression",
+              "expected none, rle, zip or piz, got '" + name + "'");
+}
+
 void writeFrameExr(const std::string& path, const ComposedFrame& frame, const FrameImageInfo& info,
-                   bool half) {
+                   bool half, int compression) {
   const int w = frame.size.width, h = frame.size.height;
   if (w < 1 || h < 1 || frame.rgb.size() != size_t(w) * h * 3)
     throw Error(ExitCode::kInternal, path, "frame has the wrong size");
   Imf::Header header(w, h);
-  header.compression() = Imf::ZIP_COMPRESSION;
+  header.compression() = Imf::Compression(compression);
   header.lineOrder() = Imf::INCREASING_Y;
   const Imf::PixelType type = half ? Imf::HALF : Imf::FLOAT;
   for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(type));

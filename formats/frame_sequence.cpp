@@ -159,7 +159,8 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
     }
     composer.compose(t, active, frame);
     info.frame = f;
-    writeFrameExr(framePath(options.framesDir, f, ".exr"), frame, info, options.half);
+    writeFrameExr(framePath(options.framesDir, f, ".exr"), frame, info, options.half,
+                  options.compression);
     if (options.png) writeFramePng(framePath(options.framesDir, f, ".png"), frame, info);
     if (frame.fallbackPixels > 0 && warn)
       warn("frame " + std::to_string(f) + ": " + std::to_string(frame.fallbackPixels) +

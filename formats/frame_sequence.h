@@ -28,6 +28,7 @@ struct ComposeSequenceOptions {
   bool autoExposure = false;  // one EV for the whole sequence (autoExposureEV)
   double exposureEV = 0.0;    // used when !autoExposure
   bool half = false;          // HALF EXR channels
+  int compression = 0;        // frameCompressionOf(); 0: none
   bool png = true;            // also write NNNN.png
 };
 

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <regex>
 
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -199,8 +201,7 @@ TEST_F(RadCompose, PngIsSrgbOfExposureScaledRadiance) {
   EXPECT_EQ(png, toSrgb8(e.rgb, -1.5));
   // The provenance travels in the PNG too (zTXt "Description", read back by OpenImageIO).
   std::string description = spec.get_string_attribute("ImageDescription");
-  EXPECT_EQ(description.rfind("rad frame 1, exposure -1.5 EV; provenance {", 0), 0u)
-      << description;
+  EXPECT_EQ(description.rfind("rad frame 1, exposure -1.5 EV; provenance {", 0), 0u) << description;
   EXPECT_NE(description.find("rad-compose"), std::string::npos);
   // A wall pixel by hand: L = 0.5/pi * 8 (blue) at 2^-1.5.
   size_t wall =
@@ -208,6 +209,22 @@ TEST_F(RadCompose, PngIsSrgbOfExposureScaledRadiance) {
   double blue = 0.5 / kPi * kWallH0.z * std::exp2(-1.5);
   EXPECT_EQ(png[3 * wall + 2],
             uint8_t(std::lround(255 * (1.055 * std::pow(blue, 1 / 2.4) - 0.055))));
+}
+
+// Frames are uncompressed by default; --compression changes the bytes, never the pixels.
+TEST_F(RadCompose, CompressionChangesBytesNotPixels) {
+  std::string plain = (dir / "plain").string(), zip = (dir / "zip").string();
+  ASSERT_EQ(runCommand(command(plain, "--frames 1 --no-png")).exitCode, 0);
+  CommandResult r = runCommand(command(zip, "--frames 1 --no-png --compression zip"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  Imf::InputFile a(framePath(plain, 1, ".exr").c_str()), b(framePath(zip, 1, ".exr").c_str());
+  EXPECT_EQ(a.header().compression(), Imf::NO_COMPRESSION);
+  EXPECT_EQ(b.header().compression(), Imf::ZIP_COMPRESSION);
+  EXPECT_EQ(readFrameExr(framePath(plain, 1, ".exr")).rgb,
+            readFrameExr(framePath(zip, 1, ".exr")).rgb);
+  CommandResult bad = runCommand(command(zip, "--compression lzw"));
+  EXPECT_EQ(bad.exitCode, 2);
+  EXPECT_EQ(countLines(bad.err), 1) << bad.err;
 }
 
 TEST_F(RadCompose, AutoExposureIsOneValueForTheSequence) {

@@ -10,6 +10,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/container.h"
+#include "formats/frame_image.h"
 #include "formats/frame_sequence.h"
 #include "formats/gltf_scene.h"
 #include "formats/link_hierarchy.h"
@@ -31,6 +32,7 @@ struct Options {
   std::optional<double> exposure;
   bool autoExposure = false;
   bool half = false;
+  std::string compression = "none";
   bool noPng = false;
   std::string report;
 };
@@ -78,6 +80,7 @@ int run(const Options& o, int argc, char** argv) {
   c.autoExposure = o.autoExposure;
   c.exposureEV = o.exposure.value_or(0.0);
   c.half = o.half;
+  c.compression = rad::frameCompressionOf(o.compression);
   c.png = !o.noPng;
 
   nlohmann::json parameters = {
@@ -91,6 +94,7 @@ int run(const Options& o, int argc, char** argv) {
       {"exposure", c.exposureEV},
       {"auto-exposure", c.autoExposure},
       {"half", c.half},
+      {"compression", o.compression},
       {"no-png", o.noPng}};
   rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
   rad::addInput(provenance, o.scene);
@@ -163,6 +167,11 @@ int main(int argc, char** argv) {
                "solution's non-emitter radiance maps to white")
       ->excludes(exposure);
   app.add_flag("--half", o.half, "write HALF instead of FLOAT EXR channels");
+  app.add_option("--compression", o.compression,
+                 "EXR compression: none, rle, zip, piz (ZIP saves ~7 % of noise-free float "
+                 "radiance and doubles the compose time)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "rle", "zip", "piz"}));
   app.add_flag("--no-png", o.noPng, "write only the EXR frames");
   app.add_option("--report", o.report, "write per-frame times and fallback pixel counts as JSON");
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
