@@ -97,6 +97,7 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
+            {"form_factor_max_scan", secondsFormFactorScan},
             {"transmittance", secondsTransmittance},
             {"combine", secondsCombine}}},
           {"warnings", warnings}};
@@ -332,6 +333,7 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
     if (p.coherent) {
       formFactorsAt(p, 0, p.formFactor);
       for (double v : p.formFactor) maxF = std::max(maxF, v);
+      stats_.secondsFormFactor += secondsSince(clock);
     } else {
       for (int k = 0; k < K; ++k) {
         formFactorsAt(p, k, keyFormFactor);
@@ -341,8 +343,8 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
                                      options_.maxSamples) == saturatedSamples)
           break;
       }
+      stats_.secondsFormFactorScan += secondsSince(clock);
     }
-    stats_.secondsFormFactor += secondsSince(clock);
     if (!(maxF > 0.0)) continue;  // the shooter cannot reach this patch during the movie
 
     // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie.

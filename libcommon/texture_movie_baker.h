@@ -98,6 +98,9 @@ struct TextureMovieBakerStats {
   long passesSavedByCoherence = 0;               // static-blocker renders not repeated
   long keyStepRaised = 0;  // always 0: the key step no longer depends on the memory budget
   double secondsGood = 0, secondsFormFactor = 0, secondsTransmittance = 0, secondsCombine = 0;
+  // Moving pairs' form factors computed ahead of the keys only to find their largest value
+  // (which fixes N): the price of baking key by key without every key's form factors held.
+  double secondsFormFactorScan = 0;
   std::vector<std::string> warnings;
   nlohmann::json toJson() const;
 };
