@@ -2,9 +2,13 @@
 #include "libcommon/texture_movie_baker.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+
+#include <unistd.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -66,6 +70,67 @@ void parallelRows(int height, F&& body) {
     for (int j = r.begin(); j != r.end(); ++j) body(j);
   });
 }
+
+// A moving pair's per-key form factors, computed ahead of the keys to find their largest value,
+// are spilled to an unlinked temporary file and read back when their key is baked: the page
+// cache holds them (the kernel writes them out under memory pressure), not the process, and
+// reading them back costs far less than recomputing. Any failure (no temporary directory, a
+// full disk) only means the set is recomputed: same values, bit for bit.
+class FormFactorSpill {
+ public:
+  FormFactorSpill() = default;
+  FormFactorSpill(const FormFactorSpill&) = delete;
+  FormFactorSpill& operator=(const FormFactorSpill&) = delete;
+  ~FormFactorSpill() {
+    if (file_) std::fclose(file_);
+  }
+  // Offset of the stored set, or -1 when it could not be stored.
+  long long put(const std::vector<double>& f) {
+    if (failed_) return -1;
+    if (!file_ && !(file_ = std::tmpfile())) {
+      failed_ = true;
+      return -1;
+    }
+    const char* p = reinterpret_cast<const char*>(f.data());
+    size_t left = f.size() * sizeof(double);
+    long long at = size_;
+    off_t offset = off_t(size_);
+    while (left > 0) {
+      ssize_t n = ::pwrite(fileno(file_), p, left, offset);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        failed_ = true;
+        return -1;
+      }
+      p += n;
+      left -= size_t(n);
+      offset += n;
+    }
+    size_ += (long long)(f.size() * sizeof(double));
+    return at;
+  }
+  // Reads a stored set of f.size() values; false on failure.
+  bool get(long long at, std::vector<double>& f) const {
+    if (!file_ || at < 0) return false;
+    char* p = reinterpret_cast<char*>(f.data());
+    size_t left = f.size() * sizeof(double);
+    off_t offset = off_t(at);
+    while (left > 0) {
+      ssize_t n = ::pread(fileno(file_), p, left, offset);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) return false;
+      p += n;
+      left -= size_t(n);
+      offset += n;
+    }
+    return true;
+  }
+
+ private:
+  std::FILE* file_ = nullptr;
+  long long size_ = 0;
+  bool failed_ = false;
+};
 
 }  // namespace
 
@@ -177,6 +242,7 @@ struct TextureMovieBaker::Pair {
   SampleMask valid = 0;                    // coherent
   std::vector<double> formFactor;          // coherent: F(x -> S), once per movie
   std::vector<SampleMask> staticMask;      // coherent: static blockers; empty = none (all 0)
+  std::vector<long long> spilled;          // moving: key k's form factors in the spill, or -1
 };
 
 BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
@@ -310,6 +376,7 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
                                                         options_.minSamples, options_.maxSamples);
   std::vector<Pair> pairs;
   std::vector<double> keyFormFactor;
+  FormFactorSpill spill;
   for (uint32_t S : badShooters) {
     if (S >= tops_.size()) continue;
     const InputPolygon& shooterTop = tops_[S];
@@ -326,8 +393,9 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
           scene_.worldTransform(shooterTop.node, movie.keyTimes[size_t(k)]));
 
     // The largest form factor over the movie fixes N (and whether the pair matters at all).
-    // A coherent pair keeps its one set; a moving pair's sets are recomputed key by key, and
-    // this scan stops once N has reached its maximum (then more keys cannot change it).
+    // A coherent pair keeps its one set; a moving pair's sets are spilled as they are scanned
+    // (FormFactorSpill) and the scan stops once N has reached its maximum (more keys cannot
+    // change it; their sets are computed when their key is baked).
     auto clock = Clock::now();
     double maxF = 0.0;
     if (p.coherent) {
@@ -335,9 +403,11 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
       for (double v : p.formFactor) maxF = std::max(maxF, v);
       stats_.secondsFormFactor += secondsSince(clock);
     } else {
+      p.spilled.assign(static_cast<size_t>(K), -1);
       for (int k = 0; k < K; ++k) {
         formFactorsAt(p, k, keyFormFactor);
         for (double v : keyFormFactor) maxF = std::max(maxF, v);
+        p.spilled[size_t(k)] = spill.put(keyFormFactor);
         if (maxF > 0.0 &&
             transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
                                      options_.maxSamples) == saturatedSamples)
@@ -448,7 +518,8 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
           transmittance[x] = float(transmittanceFromMask(keyMask[x], valid));
         stats_.secondsTransmittance += secondsSince(clock);
         clock = Clock::now();
-        formFactorsAt(p, k, keyFormFactor);
+        keyFormFactor.resize(texels);
+        if (!spill.get(p.spilled[size_t(k)], keyFormFactor)) formFactorsAt(p, k, keyFormFactor);
         stats_.secondsFormFactor += secondsSince(clock);
       }
 
