@@ -291,13 +291,15 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
   // Working memory: one key's buffers and the per-pair ones, whatever the number of keys.
   const double bytes = movieWorkingBytes(w, h, badShooters.size());
   const double budget = options_.maxTextureMemoryMiB * 1024.0 * 1024.0;
-  if (bytes > budget)
+  if (bytes > budget) {
+    char budgetText[32];
+    std::snprintf(budgetText, sizeof budgetText, "%g", options_.maxTextureMemoryMiB);
     throw Error(ExitCode::kEnvironment, where,
                 "texture " + std::to_string(w) + "x" + std::to_string(h) + " with " +
-                    std::to_string(badShooters.size()) + " bad shooters needs " +
+                    std::to_string(badShooters.size()) + " bad shooter(s) needs " +
                     std::to_string(int(std::ceil(bytes / 1048576.0))) +
-                    " MiB of working memory; --max-texture-memory is " +
-                    std::to_string(options_.maxTextureMemoryMiB) + " MiB");
+                    " MiB of working memory; --max-texture-memory is " + budgetText + " MiB");
+  }
 
   BakedMovie movie;
   movie.keyStep = options_.keyStep;
