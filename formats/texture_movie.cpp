@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <regex>
@@ -65,14 +66,13 @@ std::string textureMoviePath(const std::string& dir, uint32_t id) {
   return dir + name;
 }
 
-void writeTextureMovie(const std::string& path, const TextureMovie& m) {
-  if (m.keys.empty() || m.keys.size() != m.keyTimes.size() || m.keys.size() != m.keyFrames.size())
-    throw Error(ExitCode::kInternal, path, "texture movie keys, times and frames differ");
-  size_t n = size_t(m.width) * m.height * 3;
+namespace {
+
+// The part headers of a movie with the given keys (key frames/times of the parts).
+std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<int>& keyFrames,
+                                      const std::vector<double>& keyTimes) {
   std::vector<Imf::Header> headers;
-  for (size_t k = 0; k < m.keys.size(); ++k) {
-    if (m.keys[k].size() != n)
-      throw Error(ExitCode::kInternal, path, "texture movie key has the wrong size");
+  for (size_t k = 0; k < keyFrames.size(); ++k) {
     Imf::Header h(m.width, m.height);
     h.compression() = Imf::ZIP_COMPRESSION;
     h.lineOrder() = Imf::INCREASING_Y;
@@ -90,27 +90,132 @@ void writeTextureMovie(const std::string& path, const TextureMovie& m) {
     h.insert("rad.level", Imf::IntAttribute(m.patch.level()));
     h.insert("rad.firstFrame", Imf::IntAttribute(m.firstFrame));
     h.insert("rad.lastFrame", Imf::IntAttribute(m.lastFrame));
-    h.insert("rad.keyCount", Imf::IntAttribute(int(m.keys.size())));
+    h.insert("rad.keyCount", Imf::IntAttribute(int(keyFrames.size())));
     h.insert("rad.keyIndex", Imf::IntAttribute(int(k)));
-    h.insert("rad.keyFrame", Imf::IntAttribute(m.keyFrames[k]));
-    h.insert("rad.keyTime", Imf::DoubleAttribute(m.keyTimes[k]));
+    h.insert("rad.keyFrame", Imf::IntAttribute(keyFrames[k]));
+    h.insert("rad.keyTime", Imf::DoubleAttribute(keyTimes[k]));
     h.insert("rad.units", Imf::StringAttribute("irradiance W/m^2"));
     if (k == 0 && !m.provenanceJson.empty())
       h.insert("rad.provenance", Imf::StringAttribute(m.provenanceJson));
     headers.push_back(h);
   }
-  AtomicFile file(path);
+  return headers;
+}
+
+}  // namespace
+
+// Member order matters: the OpenEXR file is closed (its chunk tables written) before the
+// AtomicFile renames or removes the temporary.
+struct TextureMovieWriter::File {
+  AtomicFile atomic;
+  std::unique_ptr<Imf::MultiPartOutputFile> exr;
+  explicit File(const std::string& path) : atomic(path) {}
+};
+
+TextureMovieWriter::TextureMovieWriter(std::string path, const TextureMovie& movie,
+                                       bool storeConstantAsOneKey)
+    : path_(std::move(path)), collapse_(storeConstantAsOneKey) {
+  meta_.movie = movie.movie;
+  meta_.patch = movie.patch;
+  meta_.firstFrame = movie.firstFrame;
+  meta_.lastFrame = movie.lastFrame;
+  meta_.width = movie.width;
+  meta_.height = movie.height;
+  meta_.keyFrames = movie.keyFrames;
+  meta_.keyTimes = movie.keyTimes;
+  meta_.provenanceJson = movie.provenanceJson;
+  if (meta_.keyFrames.empty() || meta_.keyFrames.size() != meta_.keyTimes.size())
+    throw Error(ExitCode::kInternal, path_, "texture movie keys, times and frames differ");
+  if (meta_.width < 1 || meta_.height < 1)
+    throw Error(ExitCode::kInternal, path_, "texture movie has no texel");
+  texelFloats_ = size_t(meta_.width) * size_t(meta_.height) * 3;
+}
+
+TextureMovieWriter::~TextureMovieWriter() = default;
+
+void TextureMovieWriter::open(size_t parts) {
+  std::vector<int> frames(meta_.keyFrames.begin(), meta_.keyFrames.begin() + long(parts));
+  std::vector<double> times(meta_.keyTimes.begin(), meta_.keyTimes.begin() + long(parts));
+  std::vector<Imf::Header> headers = movieHeaders(meta_, frames, times);
+  if (!file_) file_ = std::make_unique<File>(path_);
+  file_->exr.reset();
   try {
-    Imf::MultiPartOutputFile out(file.tempPath().c_str(), headers.data(), int(headers.size()));
-    for (size_t k = 0; k < m.keys.size(); ++k) {
-      Imf::OutputPart part(out, int(k));
-      part.setFrameBuffer(rgbFrameBuffer(const_cast<float*>(m.keys[k].data()), m.width));
-      part.writePixels(m.height);
-    }
+    file_->exr = std::make_unique<Imf::MultiPartOutputFile>(file_->atomic.tempPath().c_str(),
+                                                            headers.data(), int(headers.size()));
   } catch (const std::exception& e) {
-    throw outputError(path, e.what());
+    throw outputError(path_, e.what());
   }
-  file.commit();
+}
+
+void TextureMovieWriter::writePart(size_t k, const std::vector<float>& rgb) {
+  try {
+    Imf::OutputPart part(*file_->exr, int(k));
+    part.setFrameBuffer(rgbFrameBuffer(const_cast<float*>(rgb.data()), meta_.width));
+    part.writePixels(meta_.height);
+  } catch (const std::exception& e) {
+    throw outputError(path_, e.what());
+  }
+}
+
+void TextureMovieWriter::writeKey(size_t k, const std::vector<float>& rgb) {
+  if (committed_ || k != next_ || k >= meta_.keyFrames.size())
+    throw Error(ExitCode::kInternal, path_,
+                "texture movie key " + std::to_string(k) + " written out of order");
+  if (rgb.size() != texelFloats_)
+    throw Error(ExitCode::kInternal, path_, "texture movie key has the wrong size");
+  if (collapse_ && !diverged_) {
+    if (k == 0) {
+      key0_ = rgb;
+      ++next_;
+      return;
+    }
+    if (std::memcmp(key0_.data(), rgb.data(), texelFloats_ * sizeof(float)) == 0) {
+      ++next_;
+      return;
+    }
+    // Key k differs: the movie is not constant; keys 0..k-1 were all key 0.
+    diverged_ = true;
+    open(meta_.keyFrames.size());
+    for (size_t i = 0; i < k; ++i) writePart(i, key0_);
+    std::vector<float>().swap(key0_);
+  } else if (!file_) {
+    open(meta_.keyFrames.size());
+  }
+  writePart(k, rgb);
+  ++next_;
+}
+
+size_t TextureMovieWriter::commit() {
+  if (committed_ || next_ != meta_.keyFrames.size())
+    throw Error(ExitCode::kInternal, path_,
+                "texture movie committed after " + std::to_string(next_) + " of " +
+                    std::to_string(meta_.keyFrames.size()) + " keys");
+  size_t parts = meta_.keyFrames.size();
+  if (collapse_ && !diverged_) {
+    parts = 1;
+    open(1);
+    writePart(0, key0_);
+  }
+  try {
+    file_->exr.reset();  // writes the chunk tables and closes the file
+  } catch (const std::exception& e) {
+    throw outputError(path_, e.what());
+  }
+  file_->atomic.commit();
+  committed_ = true;
+  return parts;
+}
+
+void writeTextureMovie(const std::string& path, const TextureMovie& m) {
+  if (m.keys.empty() || m.keys.size() != m.keyTimes.size() || m.keys.size() != m.keyFrames.size())
+    throw Error(ExitCode::kInternal, path, "texture movie keys, times and frames differ");
+  const size_t n = size_t(m.width) * m.height * 3;
+  for (const std::vector<float>& key : m.keys)
+    if (key.size() != n)
+      throw Error(ExitCode::kInternal, path, "texture movie key has the wrong size");
+  TextureMovieWriter writer(path, m, false);
+  for (size_t k = 0; k < m.keys.size(); ++k) writer.writeKey(k, m.keys[k]);
+  writer.commit();
 }
 
 namespace {

@@ -40,8 +40,48 @@ struct TextureMovie {
 // Path of movie `id` in `dir`: dir/000042.exr.
 std::string textureMoviePath(const std::string& dir, uint32_t id);
 
-// Atomic write (temporary + rename). Throws rad::outputError(path, ...).
+// Atomic write (temporary + rename). Throws rad::outputError(path, ...). The movie is written
+// as given (no constant detection); a thin wrapper over TextureMovieWriter.
 void writeTextureMovie(const std::string& path, const TextureMovie& movie);
+
+// Writes a movie key by key as its keys are computed, so that only O(1) keys are in memory
+// (rad-movies: peak memory independent of the movie's length). The file is the one
+// writeTextureMovie writes, byte for byte. Atomic: the movie appears at `path` on commit()
+// only; a writer destroyed without commit() (exception, early return) leaves nothing behind.
+//
+// storeConstantAsOneKey: while every key written so far is bit-equal to key 0, only key 0 is
+// held (nothing is written); the first key that differs writes keys 0..k-1 (copies of key 0)
+// and then streams. If all K keys were equal, commit() writes the movie with one key
+// (keyFrames[0], keyTimes[0]): a constant movie (texture_movie.md).
+class TextureMovieWriter {
+ public:
+  // `movie`: metadata plus the keyFrames and keyTimes of all K keys (its keys are ignored).
+  // Throws rad::Error(kInternal) for inconsistent metadata.
+  TextureMovieWriter(std::string path, const TextureMovie& movie, bool storeConstantAsOneKey);
+  ~TextureMovieWriter();
+  TextureMovieWriter(const TextureMovieWriter&) = delete;
+  TextureMovieWriter& operator=(const TextureMovieWriter&) = delete;
+
+  // Key k (k = 0, 1, ... in order): width * height * 3 floats. Throws rad::outputError(path,
+  // ...) on a write failure and rad::Error(kInternal) for a key out of order or of the wrong size.
+  void writeKey(size_t k, const std::vector<float>& rgb);
+  // After all K keys: closes, renames onto path. Returns the number of keys stored (1 for a
+  // constant movie). Throws rad::outputError(path, ...).
+  size_t commit();
+  // True while every key written so far equals key 0 (only with storeConstantAsOneKey).
+  bool constantSoFar() const { return collapse_ && !diverged_; }
+
+ private:
+  void open(size_t parts);
+  void writePart(size_t k, const std::vector<float>& rgb);
+  std::string path_;
+  TextureMovie meta_;  // keys empty
+  bool collapse_ = false, diverged_ = false, committed_ = false;
+  size_t next_ = 0, texelFloats_ = 0;
+  std::vector<float> key0_;  // held while the movie may be constant
+  struct File;               // AtomicFile + OpenEXR multi-part output
+  std::unique_ptr<File> file_;
+};
 // Reads and validates (part count, sizes, attributes, finite values). Throws
 // rad::inputError(path, ...), never crashes on a truncated or corrupted file.
 TextureMovie readTextureMovie(const std::string& path);

@@ -2,9 +2,13 @@
 #include "libcommon/texture_movie_baker.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+
+#include <unistd.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -67,6 +71,67 @@ void parallelRows(int height, F&& body) {
   });
 }
 
+// A moving pair's per-key form factors, computed ahead of the keys to find their largest value,
+// are spilled to an unlinked temporary file and read back when their key is baked: the page
+// cache holds them (the kernel writes them out under memory pressure), not the process, and
+// reading them back costs far less than recomputing. Any failure (no temporary directory, a
+// full disk) only means the set is recomputed: same values, bit for bit.
+class FormFactorSpill {
+ public:
+  FormFactorSpill() = default;
+  FormFactorSpill(const FormFactorSpill&) = delete;
+  FormFactorSpill& operator=(const FormFactorSpill&) = delete;
+  ~FormFactorSpill() {
+    if (file_) std::fclose(file_);
+  }
+  // Offset of the stored set, or -1 when it could not be stored.
+  long long put(const std::vector<double>& f) {
+    if (failed_) return -1;
+    if (!file_ && !(file_ = std::tmpfile())) {
+      failed_ = true;
+      return -1;
+    }
+    const char* p = reinterpret_cast<const char*>(f.data());
+    size_t left = f.size() * sizeof(double);
+    long long at = size_;
+    off_t offset = off_t(size_);
+    while (left > 0) {
+      ssize_t n = ::pwrite(fileno(file_), p, left, offset);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        failed_ = true;
+        return -1;
+      }
+      p += n;
+      left -= size_t(n);
+      offset += n;
+    }
+    size_ += (long long)(f.size() * sizeof(double));
+    return at;
+  }
+  // Reads a stored set of f.size() values; false on failure.
+  bool get(long long at, std::vector<double>& f) const {
+    if (!file_ || at < 0) return false;
+    char* p = reinterpret_cast<char*>(f.data());
+    size_t left = f.size() * sizeof(double);
+    off_t offset = off_t(at);
+    while (left > 0) {
+      ssize_t n = ::pread(fileno(file_), p, left, offset);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) return false;
+      p += n;
+      left -= size_t(n);
+      offset += n;
+    }
+    return true;
+  }
+
+ private:
+  std::FILE* file_ = nullptr;
+  long long size_ = 0;
+  bool failed_ = false;
+};
+
 }  // namespace
 
 nlohmann::json TextureMovieBakerOptions::toJson() const {
@@ -97,6 +162,7 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
+            {"form_factor_max_scan", secondsFormFactorScan},
             {"transmittance", secondsTransmittance},
             {"combine", secondsCombine}}},
           {"warnings", warnings}};
@@ -153,7 +219,56 @@ std::string TextureMovieBaker::rendererName() const {
   return renderer_ ? renderer_->rendererName() : std::string();
 }
 
+double TextureMovieBaker::movieWorkingBytes(int width, int height, size_t badShooters) {
+  // Per texel: texel (u,v) and local point (16 + 24); the key's double accumulator (24), its
+  // float texture (12) and the sink's copy of key 0 (12, constant-movie check); one pair's
+  // float transmittance (4), per-key sample mask (8) and per-key form factor (8). Per coherent
+  // bad pair: its form factors (8) and static-blocker sample mask (8).
+  const double perTexel = 16 + 24 + 24 + 12 + 12 + 4 + 8 + 8 + 16.0 * double(badShooters);
+  return double(width) * double(height) * perTexel;
+}
+
+// A bad pair's per-movie data, computed before the first key (paper §5: what the coherence
+// makes per-movie instead of per-key).
+struct TextureMovieBaker::Pair {
+  uint32_t shooter = 0;
+  bool coherent = false;
+  std::vector<Polygon> shooterWorld;       // per key
+  int samples = 0;                         // N
+  std::vector<glm::dvec2> unitSamples;     // fixed in the shooter's frame
+  std::vector<int> candidates;             // non-coherent: every possible blocker
+  std::vector<int> dynamicList;            // coherent: moving blockers in the swept shaft
+  std::vector<glm::dvec3> keyZeroSamples;  // coherent: the samples (the pair does not move)
+  SampleMask valid = 0;                    // coherent
+  std::vector<double> formFactor;          // coherent: F(x -> S), once per movie
+  std::vector<SampleMask> staticMask;      // coherent: static blockers; empty = none (all 0)
+  std::vector<long long> spilled;          // moving: key k's form factors in the spill, or -1
+};
+
 BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
+  // Collects the keys; a movie whose keys all agree keeps one (coherence on).
+  struct Collector : BakedKeySink {
+    bool collapse = false;
+    std::vector<std::vector<float>> keys;
+    void begin(const BakedMovie&) override {}
+    void key(size_t, const std::vector<float>& texture) override { keys.push_back(texture); }
+    size_t finish() override {
+      bool constant = collapse && keys.size() > 1;
+      for (size_t k = 1; k < keys.size() && constant; ++k)
+        constant = std::memcmp(keys[0].data(), keys[k].data(), keys[0].size() * sizeof(float)) == 0;
+      if (constant) keys.resize(1);
+      return keys.size();
+    }
+  } collector;
+  collector.collapse = options_.coherence;
+  BakedMovie movie = bake(req, collector);
+  movie.keys = std::move(collector.keys);
+  movie.keyFrames.resize(movie.keys.size());
+  movie.keyTimes.resize(movie.keys.size());
+  return movie;
+}
+
+BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) {
   const std::string where = "movie " + std::to_string(req.movie);
   if (req.patch.top >= tops_.size())
     throw inputError(where, "patch " + req.patch.toString() + " names top-level patch " +
@@ -171,32 +286,26 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
   const bool triangle = receiverTop.local.count == 3;
   const int w = req.width, h = req.height;
   const size_t texels = size_t(w) * h;
+  const std::vector<uint32_t> badShooters = solution_.badShooters(R);
 
-  // Key frames, within the memory budget: float key textures plus the double accumulators.
-  BakedMovie movie;
-  int step = options_.keyStep;
-  std::vector<int> frames = movieKeyFrames(req.firstFrame, req.lastFrame, step);
-  const double bytesPerKey = double(texels) * (3 * sizeof(float) + 3 * sizeof(double) + 8);
+  // Working memory: one key's buffers and the per-pair ones, whatever the number of keys.
+  const double bytes = movieWorkingBytes(w, h, badShooters.size());
   const double budget = options_.maxTextureMemoryMiB * 1024.0 * 1024.0;
-  if (double(std::min<size_t>(frames.size(), 2)) * bytesPerKey > budget)
+  if (bytes > budget) {
+    char budgetText[32];
+    std::snprintf(budgetText, sizeof budgetText, "%g", options_.maxTextureMemoryMiB);
     throw Error(ExitCode::kEnvironment, where,
-                "texture " + std::to_string(w) + "x" + std::to_string(h) + " needs " +
-                    std::to_string(int(std::ceil(2 * bytesPerKey / 1048576.0))) +
-                    " MiB for two keys; --max-texture-memory is " +
-                    std::to_string(options_.maxTextureMemoryMiB) + " MiB");
-  if (double(frames.size()) * bytesPerKey > budget) {
-    while (double(frames.size()) * bytesPerKey > budget && frames.size() > 2) {
-      step *= 2;
-      frames = movieKeyFrames(req.firstFrame, req.lastFrame, step);
-    }
-    ++stats_.keyStepRaised;
-    stats_.warnings.push_back(where + ": key step raised to " + std::to_string(step) +
-                              " to fit --max-texture-memory");
+                "texture " + std::to_string(w) + "x" + std::to_string(h) + " with " +
+                    std::to_string(badShooters.size()) + " bad shooter(s) needs " +
+                    std::to_string(int(std::ceil(bytes / 1048576.0))) +
+                    " MiB of working memory; --max-texture-memory is " + budgetText + " MiB");
   }
-  movie.keyStep = step;
-  movie.keyFrames = frames;
-  const int K = int(frames.size());
-  for (int f : frames) movie.keyTimes.push_back(f / fps_);
+
+  BakedMovie movie;
+  movie.keyStep = options_.keyStep;
+  movie.keyFrames = movieKeyFrames(req.firstFrame, req.lastFrame, movie.keyStep);
+  const int K = int(movie.keyFrames.size());
+  for (int f : movie.keyFrames) movie.keyTimes.push_back(f / fps_);
   const double t0 = movie.keyTimes.front(), t1 = movie.keyTimes.back();
 
   // Texel centres: node (u,v) -> top (u,v) -> local point.
@@ -209,21 +318,6 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
       localPoint[x] = polygonPointAt(receiverTop.local, topUv[x]);
     }
 
-  // Good layer (paper §3.1: Gouraud over the patch from the global solution).
-  auto clock = Clock::now();
-  std::vector<std::vector<glm::dvec3>> acc(static_cast<size_t>(K), std::vector<glm::dvec3>(texels));
-  for (int k = 0; k < K; ++k) {
-    std::vector<glm::dvec3>& a = acc[size_t(k)];
-    const double t = movie.keyTimes[size_t(k)];
-    parallelRows(h, [&](int j) {
-      for (int i = 0; i < w; ++i) {
-        size_t x = size_t(j) * w + i;
-        a[x] = solution_.goodIrradiance(int(R), topUv[x], t);
-      }
-    });
-  }
-  stats_.secondsGood += secondsSince(clock);
-
   const bool receiverDynamic = scene_.isDynamic(receiverTop.node, t0, t1);
   std::vector<Polygon> receiverWorld(static_cast<size_t>(K));
   std::vector<glm::dmat4> receiverTransform(static_cast<size_t>(K));
@@ -235,57 +329,103 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
   }
   const glm::dvec3 receiverNormalLocal = receiverTop.local.normal();
 
-  for (uint32_t S : solution_.badShooters(R)) {
+  // Unoccluded form factors F(x -> S) per texel at key k.
+  auto formFactorsAt = [&](const Pair& p, int k, std::vector<double>& f) {
+    f.resize(texels);
+    const glm::dmat4& m = receiverTransform[size_t(k)];
+    glm::dvec3 n = glm::normalize(
+        glm::dvec3(glm::transpose(glm::inverse(m)) * glm::dvec4(receiverNormalLocal, 0.0)));
+    const Polygon& sw = p.shooterWorld[size_t(k)];
+    parallelRows(h, [&](int j) {
+      for (int i = 0; i < w; ++i) {
+        size_t x = size_t(j) * w + i;
+        glm::dvec3 pt(m * glm::dvec4(localPoint[x], 1.0));
+        f[x] = pointToPolygonFormFactor(pt, n, sw);
+      }
+    });
+  };
+  auto samplesAt = [&](const Pair& p, int k) {
+    std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
+    for (int i = 0; i < p.samples; ++i)
+      s[size_t(i)] = samplePointOnPolygon(p.shooterWorld[size_t(k)], p.unitSamples[size_t(i)]);
+    return s;
+  };
+  auto shaftAt = [&](const Pair& p, int k) {
+    Box box;
+    box.grow(receiverWorld[size_t(k)]);
+    box.grow(p.shooterWorld[size_t(k)]);
+    return box;
+  };
+  auto worldPolygon = [&](int b, double t) {
+    return tops_[size_t(b)].local.transformed(scene_.worldTransform(tops_[size_t(b)].node, t));
+  };
+  // Blockers of candidate list `list` in the pair's shaft at key k, as world triangles.
+  auto blockersAt = [&](const Pair& p, const std::vector<int>& list, int k) {
+    Box shaft = shaftAt(p, k);
+    std::vector<BlockerTriangle> tris;
+    for (int b : list) {
+      Polygon poly = worldPolygon(b, movie.keyTimes[size_t(k)]);
+      Box pb;
+      pb.grow(poly);
+      if (pb.overlaps(shaft)) appendTriangles(poly, tris);
+    }
+    return tris;
+  };
+
+  // Per-movie part of every bad pair, in badShooters order.
+  const int saturatedSamples = transmittanceSampleCount(std::numeric_limits<double>::infinity(),
+                                                        options_.samplesPerFormFactor,
+                                                        options_.minSamples, options_.maxSamples);
+  std::vector<Pair> pairs;
+  std::vector<double> keyFormFactor;
+  FormFactorSpill spill;
+  for (uint32_t S : badShooters) {
     if (S >= tops_.size()) continue;
     const InputPolygon& shooterTop = tops_[S];
     ++stats_.badPairs;
     const bool shooterDynamic = scene_.isDynamic(shooterTop.node, t0, t1);
     const bool pairStatic = !receiverDynamic && !shooterDynamic;
     (pairStatic ? stats_.staticPairs : stats_.dynamicPairs) += 1;
-    const bool coherent = options_.coherence && pairStatic;
-
-    std::vector<Polygon> shooterWorld(static_cast<size_t>(K));
+    Pair p;
+    p.shooter = S;
+    p.coherent = options_.coherence && pairStatic;
+    p.shooterWorld.resize(static_cast<size_t>(K));
     for (int k = 0; k < K; ++k)
-      shooterWorld[size_t(k)] = shooterTop.local.transformed(
+      p.shooterWorld[size_t(k)] = shooterTop.local.transformed(
           scene_.worldTransform(shooterTop.node, movie.keyTimes[size_t(k)]));
 
-    // Unoccluded form factors F(x -> S) per texel (once for a static pair when coherent).
-    clock = Clock::now();
-    const int formFactorSets = coherent ? 1 : K;
-    std::vector<std::vector<double>> formFactor(static_cast<size_t>(formFactorSets),
-                                                std::vector<double>(texels));
+    // The largest form factor over the movie fixes N (and whether the pair matters at all).
+    // A coherent pair keeps its one set; a moving pair's sets are spilled as they are scanned
+    // (FormFactorSpill) and the scan stops once N has reached its maximum (more keys cannot
+    // change it; their sets are computed when their key is baked).
+    auto clock = Clock::now();
     double maxF = 0.0;
-    for (int k = 0; k < formFactorSets; ++k) {
-      const glm::dmat4& m = receiverTransform[size_t(k)];
-      glm::dvec3 n = glm::normalize(
-          glm::dvec3(glm::transpose(glm::inverse(m)) * glm::dvec4(receiverNormalLocal, 0.0)));
-      std::vector<double>& f = formFactor[size_t(k)];
-      const Polygon& sw = shooterWorld[size_t(k)];
-      parallelRows(h, [&](int j) {
-        for (int i = 0; i < w; ++i) {
-          size_t x = size_t(j) * w + i;
-          glm::dvec3 p(m * glm::dvec4(localPoint[x], 1.0));
-          f[x] = pointToPolygonFormFactor(p, n, sw);
-        }
-      });
-      for (double v : f) maxF = std::max(maxF, v);
+    if (p.coherent) {
+      formFactorsAt(p, 0, p.formFactor);
+      for (double v : p.formFactor) maxF = std::max(maxF, v);
+      stats_.secondsFormFactor += secondsSince(clock);
+    } else {
+      p.spilled.assign(static_cast<size_t>(K), -1);
+      for (int k = 0; k < K; ++k) {
+        formFactorsAt(p, k, keyFormFactor);
+        for (double v : keyFormFactor) maxF = std::max(maxF, v);
+        p.spilled[size_t(k)] = spill.put(keyFormFactor);
+        if (maxF > 0.0 &&
+            transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
+                                     options_.maxSamples) == saturatedSamples)
+          break;
+      }
+      stats_.secondsFormFactorScan += secondsSince(clock);
     }
-    stats_.secondsFormFactor += secondsSince(clock);
     if (!(maxF > 0.0)) continue;  // the shooter cannot reach this patch during the movie
 
     // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie.
     clock = Clock::now();
-    const int N = transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
-                                           options_.maxSamples);
-    stats_.samples += N;
+    p.samples = transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
+                                         options_.maxSamples);
+    stats_.samples += p.samples;
     const uint32_t seed = mix32(req.patch.packed() * 0x9e3779b97f4a7c15ull ^ S);
-    const std::vector<glm::dvec2> unitSamples = multiJitteredPoints(N, seed);
-    auto samplesAt = [&](int k) {
-      std::vector<glm::dvec3> s(static_cast<size_t>(N));
-      for (int i = 0; i < N; ++i)
-        s[size_t(i)] = samplePointOnPolygon(shooterWorld[size_t(k)], unitSamples[size_t(i)]);
-      return s;
-    };
+    p.unitSamples = multiJitteredPoints(p.samples, seed);
 
     // Blocker candidates: every top-level patch but the two ends (and their reversed copies).
     std::vector<int> candidates;
@@ -295,36 +435,10 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
         continue;
       candidates.push_back(int(b));
     }
-    auto shaftAt = [&](int k) {
-      Box box;
-      box.grow(receiverWorld[size_t(k)]);
-      box.grow(shooterWorld[size_t(k)]);
-      return box;
-    };
-    auto worldPolygon = [&](int b, double t) {
-      return tops_[size_t(b)].local.transformed(scene_.worldTransform(tops_[size_t(b)].node, t));
-    };
-    // Blockers of candidate list `list` in the shaft at key k, as world triangles.
-    auto blockersAt = [&](const std::vector<int>& list, int k) {
-      Box shaft = shaftAt(k);
-      std::vector<BlockerTriangle> tris;
-      for (int b : list) {
-        Polygon p = worldPolygon(b, movie.keyTimes[size_t(k)]);
-        Box pb;
-        pb.grow(p);
-        if (pb.overlaps(shaft)) appendTriangles(p, tris);
-      }
-      return tris;
-    };
-
-    TransmittanceRenderer& gl = renderer();
-    std::vector<SampleMask> staticMask, keyMask;
-    std::vector<std::vector<float>> transmittance(static_cast<size_t>(K),
-                                                  std::vector<float>(texels, 1.0f));
-    if (coherent) {
+    if (p.coherent) {
       // §5: split the shaft's blockers into static ones (once per movie) and dynamic ones.
-      Box shaft = shaftAt(0);
-      std::vector<int> staticList, dynamicList;
+      Box shaft = shaftAt(p, 0);
+      std::vector<int> staticList;
       for (int b : candidates) {
         int node = tops_[size_t(b)].node;
         if (!scene_.isDynamic(node, t0, t1)) {
@@ -334,95 +448,111 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
         } else {
           std::array<glm::dvec3, 2> sb = scene_.sweptBounds(node, t0, t1);
           Box swept{sb[0], sb[1]};
-          if (swept.overlaps(shaft)) dynamicList.push_back(b);
+          if (swept.overlaps(shaft)) p.dynamicList.push_back(b);
         }
       }
       stats_.staticBlockers += long(staticList.size());
-      stats_.dynamicBlockers += long(dynamicList.size());
-      const std::vector<glm::dvec3> samples = samplesAt(0);
-      const SampleMask valid = frontSampleMask(receiverWorld[0], samples);
-      std::vector<BlockerTriangle> staticTris = blockersAt(staticList, 0);
-      gl.render(receiverWorld[0], w, h, samples, staticTris, staticMask);
-      if (!staticTris.empty()) stats_.passesSavedByCoherence += K - 1;
-      for (int k = 0; k < K; ++k) {
-        std::vector<BlockerTriangle> dynamicTris =
-            dynamicList.empty() ? std::vector<BlockerTriangle>() : blockersAt(dynamicList, k);
-        gl.render(receiverWorld[0], w, h, samples, dynamicTris, keyMask);
-        std::vector<float>& t = transmittance[size_t(k)];
-        if (options_.merge == MergeMode::kExact) {
-          for (size_t x = 0; x < texels; ++x)
-            t[x] = float(transmittanceFromMask(staticMask[x] | keyMask[x], valid));
-        } else {
-          for (size_t x = 0; x < texels; ++x)
-            t[x] = float(mergeTransmittance(options_.merge,
-                                            transmittanceFromMask(staticMask[x], valid),
-                                            transmittanceFromMask(keyMask[x], valid)));
-        }
-      }
+      stats_.dynamicBlockers += long(p.dynamicList.size());
+      p.keyZeroSamples = samplesAt(p, 0);
+      p.valid = frontSampleMask(receiverWorld[0], p.keyZeroSamples);
+      std::vector<BlockerTriangle> staticTris = blockersAt(p, staticList, 0);
+      renderer().render(receiverWorld[0], w, h, p.keyZeroSamples, staticTris, p.staticMask);
+      if (!staticTris.empty())
+        stats_.passesSavedByCoherence += K - 1;
+      else
+        std::vector<SampleMask>().swap(p.staticMask);  // all zero: not kept
     } else {
       // A moving end (or the baseline): every blocker in the key's shaft at every key.
-      long counted = 0;
       for (int b : candidates) {
         bool dyn = scene_.isDynamic(tops_[size_t(b)].node, t0, t1);
         (dyn ? stats_.dynamicBlockers : stats_.staticBlockers) += 1;
-        ++counted;
       }
-      (void)counted;
-      for (int k = 0; k < K; ++k) {
-        const std::vector<glm::dvec3> samples = samplesAt(k);
-        const SampleMask valid = frontSampleMask(receiverWorld[size_t(k)], samples);
-        gl.render(receiverWorld[size_t(k)], w, h, samples, blockersAt(candidates, k), keyMask);
-        std::vector<float>& t = transmittance[size_t(k)];
-        for (size_t x = 0; x < texels; ++x) t[x] = float(transmittanceFromMask(keyMask[x], valid));
-      }
+      p.candidates = std::move(candidates);
     }
     stats_.secondsTransmittance += secondsSince(clock);
-
-    // Bad layer: B_S(t) F T, accumulated per key.
-    clock = Clock::now();
-    for (int k = 0; k < K; ++k) {
-      const glm::dvec3 B = solution_.radiosity(int(S), movie.keyTimes[size_t(k)]);
-      const std::vector<double>& f = formFactor[size_t(coherent ? 0 : k)];
-      const std::vector<float>& t = transmittance[size_t(k)];
-      std::vector<glm::dvec3>& a = acc[size_t(k)];
-      for (size_t x = 0; x < texels; ++x) a[x] += B * (f[x] * double(t[x]));
-    }
-    stats_.secondsCombine += secondsSince(clock);
+    pairs.push_back(std::move(p));
   }
 
-  clock = Clock::now();
-  movie.keys.assign(static_cast<size_t>(K), std::vector<float>(texels * 3));
+  // Key by key: H = G + sum over the pairs, in badShooters order, of B_S F T (the same
+  // arithmetic and per-texel order as accumulating pair by pair over all keys).
+  sink.begin(movie);
+  std::vector<glm::dvec3> acc(texels);
+  std::vector<float> transmittance(texels), texture(texels * 3);
+  std::vector<SampleMask> keyMask;
   for (int k = 0; k < K; ++k) {
-    std::vector<float>& out = movie.keys[size_t(k)];
-    const std::vector<glm::dvec3>& a = acc[size_t(k)];
+    const double t = movie.keyTimes[size_t(k)];
+    // Good layer (paper §3.1: Gouraud over the patch from the global solution).
+    auto clock = Clock::now();
+    parallelRows(h, [&](int j) {
+      for (int i = 0; i < w; ++i) {
+        size_t x = size_t(j) * w + i;
+        acc[x] = solution_.goodIrradiance(int(R), topUv[x], t);
+      }
+    });
+    stats_.secondsGood += secondsSince(clock);
+
+    for (const Pair& p : pairs) {
+      TransmittanceRenderer& gl = renderer();
+      clock = Clock::now();
+      if (p.coherent) {
+        std::vector<BlockerTriangle> dynamicTris = p.dynamicList.empty()
+                                                       ? std::vector<BlockerTriangle>()
+                                                       : blockersAt(p, p.dynamicList, k);
+        gl.render(receiverWorld[0], w, h, p.keyZeroSamples, dynamicTris, keyMask);
+        const bool noStatic = p.staticMask.empty();
+        if (options_.merge == MergeMode::kExact) {
+          for (size_t x = 0; x < texels; ++x)
+            transmittance[x] = float(transmittanceFromMask(
+                (noStatic ? SampleMask(0) : p.staticMask[x]) | keyMask[x], p.valid));
+        } else {
+          for (size_t x = 0; x < texels; ++x)
+            transmittance[x] = float(mergeTransmittance(
+                options_.merge,
+                transmittanceFromMask(noStatic ? SampleMask(0) : p.staticMask[x], p.valid),
+                transmittanceFromMask(keyMask[x], p.valid)));
+        }
+        stats_.secondsTransmittance += secondsSince(clock);
+      } else {
+        const std::vector<glm::dvec3> samples = samplesAt(p, k);
+        const SampleMask valid = frontSampleMask(receiverWorld[size_t(k)], samples);
+        gl.render(receiverWorld[size_t(k)], w, h, samples, blockersAt(p, p.candidates, k), keyMask);
+        for (size_t x = 0; x < texels; ++x)
+          transmittance[x] = float(transmittanceFromMask(keyMask[x], valid));
+        stats_.secondsTransmittance += secondsSince(clock);
+        clock = Clock::now();
+        keyFormFactor.resize(texels);
+        if (!spill.get(p.spilled[size_t(k)], keyFormFactor)) formFactorsAt(p, k, keyFormFactor);
+        stats_.secondsFormFactor += secondsSince(clock);
+      }
+
+      // Bad layer: B_S(t) F T.
+      clock = Clock::now();
+      const glm::dvec3 B = solution_.radiosity(int(p.shooter), t);
+      const std::vector<double>& f = p.coherent ? p.formFactor : keyFormFactor;
+      for (size_t x = 0; x < texels; ++x) acc[x] += B * (f[x] * double(transmittance[x]));
+      stats_.secondsCombine += secondsSince(clock);
+    }
+
+    clock = Clock::now();
     for (size_t x = 0; x < texels; ++x)
       for (int c = 0; c < 3; ++c) {
-        double v = a[x][c];
+        double v = acc[x][c];
         // Irradiance is never negative or NaN (DESIGN.md §9); clamp rounding only.
-        out[3 * x + size_t(c)] = std::isfinite(v) ? float(std::max(v, 0.0)) : 0.0f;
+        texture[3 * x + size_t(c)] = std::isfinite(v) ? float(std::max(v, 0.0)) : 0.0f;
       }
+    stats_.secondsCombine += secondsSince(clock);
+    sink.key(size_t(k), texture);
   }
-  // A movie whose key textures all agree is stored with one key.
-  if (options_.coherence && K > 1) {
-    bool constant = true;
-    for (int k = 1; k < K && constant; ++k)
-      constant = std::memcmp(movie.keys[0].data(), movie.keys[size_t(k)].data(),
-                             texels * 3 * sizeof(float)) == 0;
-    if (constant) {
-      movie.keys.resize(1);
-      movie.keyFrames.resize(1);
-      movie.keyTimes.resize(1);
-    }
-  }
-  stats_.secondsCombine += secondsSince(clock);
+  const size_t stored = sink.finish();
+
   if (renderer_) {
     stats_.passes = renderer_->passes();
     stats_.samplePasses = renderer_->samplePasses();
   }
   ++stats_.movies;
-  if (movie.keys.size() == 1) ++stats_.constantMovies;
-  stats_.keys += long(movie.keys.size());
-  stats_.texels += long(texels * movie.keys.size());
+  if (stored == 1) ++stats_.constantMovies;
+  stats_.keys += long(stored);
+  stats_.texels += long(texels * stored);
   return movie;
 }
 

@@ -18,6 +18,13 @@
 // identical the movie is stored with one key (a "constant" movie). With coherence off every
 // bad pair recomputes F and renders every blocker at every key and all keys are stored: the
 // per-frame method the paper compares against, same binary.
+//
+// Memory: a movie is baked key-major. What does not depend on the key (texel positions; per
+// coherent bad pair its form factors, valid-sample mask and static-blocker sample mask) is
+// computed first; then each key's irradiance is accumulated (good layer, then the bad shooters
+// in badShooters order: the same arithmetic and order as shooter-major) and handed to a
+// BakedKeySink before the next key starts. The working memory is then
+// texels x (per-key buffers + per coherent pair buffers), whatever the number of keys.
 #pragma once
 
 #include <cstdint>
@@ -42,7 +49,9 @@ struct TextureMovieBakerOptions {
   double samplesPerFormFactor = 256.0;  // N = ceil(this * max texel form factor), then clamped
   MergeMode merge = MergeMode::kExact;  // static/dynamic occlusion merge
   bool coherence = true;                // false: the per-key baseline
-  double maxTextureMemoryMiB = 1024.0;  // key textures of one movie in memory
+  // Working memory of one movie (one key's buffers plus the per-pair buffers, see
+  // movieWorkingBytes); a movie that needs more is refused with an environment error.
+  double maxTextureMemoryMiB = 1024.0;
   nlohmann::json toJson() const;
 };
 
@@ -56,11 +65,27 @@ struct MovieRequest {
 
 // The result, as formats/texture_movie.h stores it: keys[k] has width * height * 3 floats
 // (RGB irradiance, W/m^2), row j = 0 at v = 0, texel (i, j) at node (u,v) = ((i+.5)/w, (j+.5)/h).
+// bake(request, sink) fills in keyFrames, keyTimes and keyStep only (the keys went to the sink).
 struct BakedMovie {
   std::vector<int> keyFrames;
   std::vector<double> keyTimes;
   std::vector<std::vector<float>> keys;
-  int keyStep = 0;  // the key step used (raised when the memory budget asks for it)
+  int keyStep = 0;  // the key step used
+};
+
+// Receives one movie's key textures in key order as they are baked (only one key texture is
+// alive in the baker at a time). rad-movies streams them into the movie file
+// (formats/texture_movie.h TextureMovieWriter).
+class BakedKeySink {
+ public:
+  virtual ~BakedKeySink() = default;
+  // Before the first key: keyFrames, keyTimes and keyStep of the movie (keys empty).
+  virtual void begin(const BakedMovie& plan) = 0;
+  // Key k = 0, 1, ... K-1 in order: width * height * 3 floats, valid during the call only.
+  virtual void key(size_t k, const std::vector<float>& texture) = 0;
+  // After the last key: the number of keys stored (1 when a movie whose keys are all equal is
+  // stored as a constant movie, else K). Counted in the stats.
+  virtual size_t finish() = 0;
 };
 
 // Counters for --report, summed over movies.
@@ -71,8 +96,11 @@ struct TextureMovieBakerStats {
   long staticBlockers = 0, dynamicBlockers = 0;  // per pair, in the pair's (swept) shaft
   long passes = 0, samplePasses = 0;             // transmittance renders
   long passesSavedByCoherence = 0;               // static-blocker renders not repeated
-  long keyStepRaised = 0;                        // movies whose key step the budget raised
+  long keyStepRaised = 0;  // always 0: the key step no longer depends on the memory budget
   double secondsGood = 0, secondsFormFactor = 0, secondsTransmittance = 0, secondsCombine = 0;
+  // Moving pairs' form factors computed ahead of the keys only to find their largest value
+  // (which fixes N): the price of baking key by key without every key's form factors held.
+  double secondsFormFactorScan = 0;
   std::vector<std::string> warnings;
   nlohmann::json toJson() const;
 };
@@ -85,10 +113,18 @@ class TextureMovieBaker {
                     TextureMovieBakerOptions options);
   ~TextureMovieBaker();
 
-  // Bakes one movie. Throws rad::inputError("movie N", ...) when the request names a patch
-  // outside the scene or a bad size. Creates the GL context on first need (a scene without bad
-  // pairs never touches GL).
+  // Bakes one movie, streaming its keys to `sink`. Throws rad::inputError("movie N", ...) when
+  // the request names a patch outside the scene or a bad size, an environment Error when the
+  // movie's working memory exceeds maxTextureMemoryMiB. Creates the GL context on first need
+  // (a scene without bad pairs never touches GL).
+  BakedMovie bake(const MovieRequest& request, BakedKeySink& sink);
+  // The same with the keys collected in memory (K keys alive; for tests and small movies). A
+  // movie whose keys are all bit-equal keeps one key when coherence is on.
   BakedMovie bake(const MovieRequest& request);
+
+  // Bytes bake() holds for a w x h movie of a receiver with `badShooters` bad shooters: one
+  // key's buffers plus the per-pair ones, independent of the number of keys.
+  static double movieWorkingBytes(int width, int height, size_t badShooters);
 
   const TextureMovieBakerStats& stats() const { return stats_; }
   const TextureMovieBakerOptions& options() const { return options_; }

@@ -158,5 +158,16 @@ TEST_F(RadMoviesCli, UsageAndInputErrorsAreOneLine) {
   EXPECT_NE(r.err.find("intervals.rti"), std::string::npos) << r.err;
 }
 
+TEST_F(RadMoviesCli, MovieBeyondTheMemoryBudgetIsRefusedAndLeavesNoFile) {
+  // 8x6 texels need far more than 1e-4 MiB of working buffers, whatever the number of keys.
+  CommandResult r = runCommand(command("tiny", "--max-texture-memory 0.0001"));
+  EXPECT_EQ(r.exitCode, 4) << r.err;
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--max-texture-memory"), std::string::npos) << r.err;
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(path("tiny"))) files += !e.path().empty();
+  EXPECT_EQ(files, 0) << "no movie and no temporary left behind";
+}
+
 }  // namespace
 }  // namespace rad::test

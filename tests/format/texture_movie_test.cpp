@@ -1,6 +1,8 @@
 // movies/MMMMMM.exr (formats/texture_movie.md): round trip of keys, times and attributes;
 // constant movies; interpolation between keys; truncated, corrupted, non-movie and
-// future-version files give one-line errors naming the file, never a crash.
+// future-version files give one-line errors naming the file, never a crash; the streaming
+// TextureMovieWriter writes writeTextureMovie's bytes, detects constant movies and leaves
+// nothing behind when it fails.
 #include "formats/texture_movie.h"
 
 #include <gtest/gtest.h>
@@ -10,7 +12,9 @@
 #include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -238,6 +242,129 @@ TEST_F(TextureMovieFormat, WriterRefusesInconsistentMovies) {
   m.keys[1].pop_back();
   EXPECT_THROW(writeTextureMovie(dir() + "/y.exr", m), Error);
   EXPECT_FALSE(fs::exists(dir() + "/y.exr"));
+}
+
+std::string bytesOf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Every file in the directory (hidden temporaries included).
+std::vector<std::string> filesIn(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+size_t streamMovie(const std::string& path, const TextureMovie& m, bool collapse) {
+  TextureMovie meta = m;
+  meta.keys.clear();  // the writer only needs the metadata and key frames/times
+  TextureMovieWriter writer(path, meta, collapse);
+  for (size_t k = 0; k < m.keys.size(); ++k) writer.writeKey(k, m.keys[k]);
+  return writer.commit();
+}
+
+TEST_F(TextureMovieFormat, StreamingWriterWritesWriteTextureMoviesBytes) {
+  TextureMovie m = sampleMovie(5);
+  writeTextureMovie(dir() + "/whole.exr", m);
+  EXPECT_EQ(streamMovie(dir() + "/streamed.exr", m, false), 5u);
+  EXPECT_EQ(streamMovie(dir() + "/collapsing.exr", m, true), 5u) << "keys differ: all stored";
+  const std::string whole = bytesOf(dir() + "/whole.exr");
+  EXPECT_GT(whole.size(), 1000u);
+  EXPECT_EQ(bytesOf(dir() + "/streamed.exr"), whole);
+  EXPECT_EQ(bytesOf(dir() + "/collapsing.exr"), whole);
+  TextureMovie r = readTextureMovie(dir() + "/streamed.exr");
+  EXPECT_EQ(r.keys, m.keys);
+  EXPECT_EQ(r.keyFrames, m.keyFrames);
+  EXPECT_EQ(filesIn(dir()),
+            (std::vector<std::string>{"collapsing.exr", "streamed.exr", "whole.exr"}));
+}
+
+TEST_F(TextureMovieFormat, StreamingWriterStoresAConstantMovieWithOneKey) {
+  TextureMovie m = sampleMovie(4);
+  for (auto& key : m.keys) key = m.keys[0];
+  TextureMovie one = m;
+  one.keys.resize(1);
+  one.keyFrames.resize(1);
+  one.keyTimes.resize(1);
+  writeTextureMovie(dir() + "/one.exr", one);
+  writeTextureMovie(dir() + "/all.exr", m);
+  EXPECT_EQ(streamMovie(dir() + "/constant.exr", m, true), 1u);
+  EXPECT_EQ(bytesOf(dir() + "/constant.exr"), bytesOf(dir() + "/one.exr"));
+  TextureMovie r = readTextureMovie(dir() + "/constant.exr");
+  EXPECT_TRUE(r.constant());
+  EXPECT_EQ(r.keyFrames, std::vector<int>{m.firstFrame});
+  EXPECT_EQ(r.lastFrame, m.lastFrame);
+  // Without collapsing every key is stored.
+  EXPECT_EQ(streamMovie(dir() + "/kept.exr", m, false), 4u);
+  EXPECT_EQ(bytesOf(dir() + "/kept.exr"), bytesOf(dir() + "/all.exr"));
+
+  // Equal keys first, then one that differs by one bit: keys 0..2 are written as copies of
+  // key 0 when key 3 arrives; the file is the full movie's.
+  TextureMovie late = m;
+  uint32_t bits;
+  std::memcpy(&bits, &late.keys[3][7], 4);
+  bits ^= 1u;
+  std::memcpy(&late.keys[3][7], &bits, 4);
+  writeTextureMovie(dir() + "/late.exr", late);
+  {
+    TextureMovie meta = late;
+    meta.keys.clear();
+    TextureMovieWriter writer(dir() + "/late-streamed.exr", meta, true);
+    for (size_t k = 0; k < 3; ++k) {
+      writer.writeKey(k, late.keys[k]);
+      EXPECT_TRUE(writer.constantSoFar()) << k;
+    }
+    writer.writeKey(3, late.keys[3]);
+    EXPECT_FALSE(writer.constantSoFar());
+    EXPECT_EQ(writer.commit(), 4u);
+  }
+  EXPECT_EQ(bytesOf(dir() + "/late-streamed.exr"), bytesOf(dir() + "/late.exr"));
+}
+
+TEST_F(TextureMovieFormat, StreamingWriterLeavesNothingBehindOnFailure) {
+  TextureMovie m = sampleMovie(4);
+  TextureMovie meta = m;
+  meta.keys.clear();
+  const std::string path = dir() + "/000042.exr";
+  for (bool collapse : {false, true}) {
+    {  // abandoned after two keys (an exception in the baker)
+      TextureMovieWriter writer(path, meta, collapse);
+      writer.writeKey(0, m.keys[0]);
+      writer.writeKey(1, m.keys[1]);
+    }
+    EXPECT_TRUE(filesIn(dir()).empty()) << "collapse " << collapse;
+    {  // committed too early, then a key out of order and one of the wrong size
+      TextureMovieWriter writer(path, meta, collapse);
+      writer.writeKey(0, m.keys[0]);
+      EXPECT_THROW(writer.commit(), Error);
+      EXPECT_THROW(writer.writeKey(2, m.keys[2]), Error);
+      std::vector<float> small(m.keys[1].begin(), m.keys[1].end() - 1);
+      EXPECT_THROW(writer.writeKey(1, small), Error);
+    }
+    EXPECT_TRUE(filesIn(dir()).empty()) << "collapse " << collapse;
+  }
+  // A previous version of the movie survives an abandoned rewrite untouched.
+  writeTextureMovie(path, sampleMovie(2));
+  const std::string before = bytesOf(path);
+  {
+    TextureMovieWriter writer(path, meta, false);
+    writer.writeKey(0, m.keys[0]);
+  }
+  EXPECT_EQ(bytesOf(path), before);
+  EXPECT_EQ(filesIn(dir()), std::vector<std::string>{"000042.exr"});
+  // An unwritable place is an output error naming the movie, and nothing is created.
+  try {
+    TextureMovieWriter writer(dir() + "/no/such/dir/000001.exr", meta, false);
+    for (size_t k = 0; k < m.keys.size(); ++k) writer.writeKey(k, m.keys[k]);
+    writer.commit();
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::kOutput) << e.what();
+    EXPECT_NE(std::string(e.what()).find("000001.exr"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir() + "/no"));
 }
 
 }  // namespace

@@ -328,18 +328,62 @@ TEST(TextureMovieBaker, ChildPatchTexelsAreTheTopsTexelsAtTheSamePoints) {
   EXPECT_LT(worst, 1e-6);
 }
 
-TEST(TextureMovieBaker, MemoryBudgetRaisesTheKeyStepAndRefusesWhatCannotFit) {
+TEST(TextureMovieBaker, MemoryBudgetBoundsOneKeyNotTheMovieLength) {
   TestScene t = makeScene(false, true);
   TextureMovieBakerOptions o;
-  o.maxTextureMemoryMiB = 64.0 * 64 * 36 * 3 / 1048576.0;  // about 3 keys of 64x64
+  const double need = TextureMovieBaker::movieWorkingBytes(64, 64, 1) / 1048576.0;
+  EXPECT_LT(need, 1.0) << "64x64, one bad shooter";
+  o.maxTextureMemoryMiB = need * 1.01;  // one key's buffers fit, nowhere near all keys
   TextureMovieBaker baker(t.scene, t.solution, kFps, o);
   BakedMovie m = baker.bake(request(t, 64, 64, 0, 48));
-  EXPECT_GT(m.keyStep, 6);
-  EXPECT_LE(m.keys.size(), 3u);
-  EXPECT_EQ(baker.stats().keyStepRaised, 1);
-  o.maxTextureMemoryMiB = 0.01;
+  EXPECT_EQ(m.keyStep, 6) << "the key step no longer depends on the budget";
+  EXPECT_EQ(m.keyFrames, movieKeyFrames(0, 48, 6));
+  EXPECT_EQ(m.keys.size(), 9u);
+  EXPECT_EQ(baker.stats().keyStepRaised, 0);
+  o.maxTextureMemoryMiB = need * 0.99;
   TextureMovieBaker tiny(t.scene, t.solution, kFps, o);
-  EXPECT_THROW(tiny.bake(request(t, 64, 64, 0, 48)), Error);
+  try {
+    tiny.bake(request(t, 64, 64, 0, 0));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::kEnvironment);
+    EXPECT_NE(std::string(e.what()).find("--max-texture-memory"), std::string::npos) << e.what();
+  }
+}
+
+// The streaming bake hands the keys over in order, one at a time, equal to the in-memory bake.
+TEST(TextureMovieBaker, SinkGetsTheKeysInOrderBitEqualToTheInMemoryBake) {
+  TestScene t = makeScene(true, true);
+  MovieRequest r = request(t, 17, 11, 2, 20);
+  BakedMovie whole = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
+  struct Recorder : BakedKeySink {
+    std::vector<int> frames;
+    std::vector<std::vector<float>> keys;
+    bool begun = false, finished = false;
+    void begin(const BakedMovie& plan) override {
+      begun = true;
+      frames = plan.keyFrames;
+      EXPECT_TRUE(plan.keys.empty());
+    }
+    void key(size_t k, const std::vector<float>& texture) override {
+      EXPECT_TRUE(begun);
+      EXPECT_EQ(k, keys.size());
+      keys.push_back(texture);
+    }
+    size_t finish() override {
+      finished = true;
+      return keys.size();
+    }
+  } rec;
+  TextureMovieBaker baker(t.scene, t.solution, kFps, {});
+  BakedMovie plan = baker.bake(r, rec);
+  EXPECT_TRUE(rec.finished);
+  EXPECT_EQ(plan.keyFrames, movieKeyFrames(2, 20, 6));
+  EXPECT_EQ(rec.frames, plan.keyFrames);
+  ASSERT_EQ(rec.keys.size(), whole.keys.size()) << "a moving blocker: not constant";
+  for (size_t k = 0; k < rec.keys.size(); ++k)
+    EXPECT_EQ(0, std::memcmp(rec.keys[k].data(), whole.keys[k].data(), rec.keys[k].size() * 4));
+  EXPECT_EQ(baker.stats().keys, long(rec.keys.size()));
 }
 
 TEST(TextureMovieBaker, BadRequestsAreInputErrors) {

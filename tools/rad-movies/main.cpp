@@ -1,11 +1,13 @@
 // rad-movies: bakes the texture movies of intervals.rti from the global solution (paper §3.1
 // transmittance textures, §5 frame-to-frame coherence; DESIGN.md §6 "rad-movies"). One
-// multi-part OpenEXR per movie (formats/texture_movie.md), written atomically as each movie
-// finishes, so peak memory is one movie's keys whatever the animation's length.
+// multi-part OpenEXR per movie (formats/texture_movie.md), streamed key by key as the baker
+// produces the keys (TextureMovieWriter) and committed atomically when the movie is done, so
+// peak memory is one key's working buffers whatever the animation's length.
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "formats/atomic_file.h"
 #include "formats/gltf_scene.h"
@@ -85,8 +87,37 @@ int run(const Options& o, int argc, char** argv) {
   for (const rad::TextureInterval& m : intervals.movies)
     if (int(m.movie % uint32_t(shardCount)) == shardIndex) mine.push_back(&m);
 
+  // Streams each baked key into the movie's file (constant movies collapse to one key when
+  // coherence is on, as the baker's in-memory bake does).
+  struct MovieFileSink : rad::BakedKeySink {
+    rad::TextureMovie meta;
+    std::string path;
+    bool collapse = false;
+    double secondsWrite = 0.0;
+    std::unique_ptr<rad::TextureMovieWriter> writer;
+    void begin(const rad::BakedMovie& plan) override {
+      auto t = Clock::now();
+      meta.keyFrames = plan.keyFrames;
+      meta.keyTimes = plan.keyTimes;
+      writer = std::make_unique<rad::TextureMovieWriter>(path, meta, collapse);
+      secondsWrite += since(t);
+    }
+    void key(size_t k, const std::vector<float>& texture) override {
+      auto t = Clock::now();
+      writer->writeKey(k, texture);
+      secondsWrite += since(t);
+    }
+    size_t finish() override {
+      auto t = Clock::now();
+      size_t stored = writer->commit();
+      writer.reset();
+      secondsWrite += since(t);
+      return stored;
+    }
+  } sink;
+  sink.collapse = bo.coherence;
+
   rad::Progress progress("rad-movies", long(mine.size()));
-  double secondsWrite = 0.0;
   for (const rad::TextureInterval* m : mine) {
     rad::MovieRequest r;
     r.movie = m->movie;
@@ -95,28 +126,23 @@ int run(const Options& o, int argc, char** argv) {
     r.lastFrame = m->lastFrame;
     r.width = m->width;
     r.height = m->height;
-    rad::BakedMovie baked;
+    sink.meta = rad::TextureMovie();
+    sink.meta.movie = m->movie;
+    sink.meta.patch = m->patch;
+    sink.meta.firstFrame = m->firstFrame;
+    sink.meta.lastFrame = m->lastFrame;
+    sink.meta.width = m->width;
+    sink.meta.height = m->height;
+    sink.meta.provenanceJson = provenanceJson;
+    sink.path = rad::textureMoviePath(o.outDir, m->movie);
     try {
-      baked = baker.bake(r);
+      baker.bake(r, sink);
     } catch (const rad::Error& e) {
+      sink.writer.reset();  // the half-written movie is discarded
       // Name the file the bad movie came from.
       if (e.code() == rad::ExitCode::kBadInput) throw rad::inputError(o.intervals, e.what());
       throw;
     }
-    auto t = Clock::now();
-    rad::TextureMovie movie;
-    movie.movie = m->movie;
-    movie.patch = m->patch;
-    movie.firstFrame = m->firstFrame;
-    movie.lastFrame = m->lastFrame;
-    movie.width = m->width;
-    movie.height = m->height;
-    movie.keyFrames = std::move(baked.keyFrames);
-    movie.keyTimes = std::move(baked.keyTimes);
-    movie.keys = std::move(baked.keys);
-    movie.provenanceJson = provenanceJson;
-    rad::writeTextureMovie(rad::textureMoviePath(o.outDir, m->movie), movie);
-    secondsWrite += since(t);
     progress.advance();
   }
   progress.done();
@@ -131,7 +157,7 @@ int run(const Options& o, int argc, char** argv) {
     report["parameters"] = parameters;
     report["renderer"] = baker.rendererName();
     report["seconds"]["read"] = secondsRead;
-    report["seconds"]["write"] = secondsWrite;
+    report["seconds"]["write"] = sink.secondsWrite;
     report["seconds"]["total"] = since(start);
     report["peak_memory_mb"] = rad::peakMemoryMb();
     rad::AtomicFile file(o.report);
@@ -179,7 +205,9 @@ int main(int argc, char** argv) {
                "key (the per-frame baseline)");
   app.add_option("--shard", o.shard, "bake only movies with id % n == i")->capture_default_str();
   app.add_option("--max-texture-memory", o.maxTextureMemory,
-                 "MiB of key textures per movie in memory; longer movies get a larger key step")
+                 "MiB of working memory per movie: one key's texel buffers plus, per bad shooter "
+                 "of a static pair, its form factors and static-blocker masks (independent of "
+                 "the number of keys); a movie that needs more is refused (exit 4)")
       ->capture_default_str();
   app.add_option("--report", o.report, "write timings and counts as JSON to this file");
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
