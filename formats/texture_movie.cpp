@@ -74,7 +74,8 @@ std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<i
   std::vector<Imf::Header> headers;
   for (size_t k = 0; k < keyFrames.size(); ++k) {
     Imf::Header h(m.width, m.height);
-    // ZIP kept 96 % of the bytes of the table scene's movies and took half of rad-movies' time.
+    // ZIP kept 91 % of the bytes of the table scene's movies (206 of 227 MB) and took half of
+    // rad-movies' time (6.0 of 11.3 s).
     h.compression() = Imf::NO_COMPRESSION;
     h.lineOrder() = Imf::INCREASING_Y;
     for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));

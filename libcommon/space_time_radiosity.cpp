@@ -150,6 +150,7 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     kr.secondsSolve = s.secondsSolve;
     for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
     rep.keys.push_back(kr);
+    if (opt.onKeySolved) opt.onKeySolved();
 
     KeyRecord& rec = records[k];
     for (const SolverLink& l : s.links) {

@@ -12,6 +12,7 @@
 // independent solve (the baseline of the speed-up, and of the tests).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,7 @@ struct SpaceTimeOptions {
   // partial: a pair is also bad when one of its gathered links has partialThreshold < V < 1.
   double partialThreshold = 0.0;
   bool coherence = true;
+  std::function<void()> onKeySolved;  // called after each key time's solve (progress)
 };
 
 struct KeyTimeReport {

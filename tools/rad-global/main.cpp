@@ -123,8 +123,11 @@ int main(int argc, char** argv) {
     st.partialThreshold = o.partialThreshold;
     st.coherence = !o.noCoherence;
 
+    rad::Progress progress(kTool, long(keyTimes.size()));
+    st.onKeySolved = [&]() { progress.advance(); };
     rad::SpaceTimeReport rep;
     rad::GlobalSolution g = rad::solveSpaceTime(scene, keyTimes, st, &rep);
+    progress.done();
 
     nlohmann::json params = {{"frames", o.frames},
                              {"fps", o.fps},
