@@ -72,6 +72,17 @@ void AtomicFile::commit() {
   }
 }
 
+void writeTextFile(const std::string& path, const std::string& text) {
+  AtomicFile file(path);
+  int fd = ::open(file.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw outputError(path, std::string("cannot create: ") + std::strerror(errno));
+  bool ok = writeAll(fd, text.data(), text.size());
+  const int err = errno;
+  ok = ::close(fd) == 0 && ok;
+  if (!ok) throw outputError(path, std::string("cannot write: ") + std::strerror(err));
+  file.commit();
+}
+
 bool writeAll(int fd, const void* data, std::size_t size) {
   const char* p = static_cast<const char*>(data);
   while (size > 0) {

@@ -36,6 +36,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// The whole of `text` into `path`, atomically (a stage's JSON report, ...). Throws
+// rad::outputError(path, ...).
+void writeTextFile(const std::string& path, const std::string& text);
+
 // Writes `size` bytes to `fd`, retrying on EINTR and short writes. Returns false with errno set
 // on failure. Shared by the writers that use POSIX descriptors.
 bool writeAll(int fd, const void* data, std::size_t size);

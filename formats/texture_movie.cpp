@@ -41,19 +41,26 @@ Imf::FrameBuffer rgbFrameBuffer(float* rgb, int width) {
 
 }  // namespace
 
+void TextureMovie::keysAround(double t, size_t& k0, size_t& k1) const {
+  if (keyTimes.size() == 1 || t <= keyTimes.front()) {
+    k0 = k1 = 0;
+  } else if (t >= keyTimes.back()) {
+    k0 = k1 = keyTimes.size() - 1;
+  } else {
+    k1 = size_t(std::upper_bound(keyTimes.begin(), keyTimes.end(), t) - keyTimes.begin());
+    k0 = k1 - 1;
+  }
+}
+
 void TextureMovie::textureAt(double t, std::vector<float>& out) const {
   size_t n = size_t(width) * height * 3;
   out.resize(n);
-  if (keys.size() == 1 || t <= keyTimes.front()) {
-    std::copy(keys.front().begin(), keys.front().end(), out.begin());
+  size_t k0, k1;
+  keysAround(t, k0, k1);
+  if (k0 == k1) {
+    std::copy(keys[k0].begin(), keys[k0].end(), out.begin());
     return;
   }
-  if (t >= keyTimes.back()) {
-    std::copy(keys.back().begin(), keys.back().end(), out.begin());
-    return;
-  }
-  size_t k1 = size_t(std::upper_bound(keyTimes.begin(), keyTimes.end(), t) - keyTimes.begin());
-  size_t k0 = k1 - 1;
   float w = float((t - keyTimes[k0]) / (keyTimes[k1] - keyTimes[k0]));
   const float* a = keys[k0].data();
   const float* b = keys[k1].data();
@@ -411,13 +418,8 @@ const std::vector<float>& TextureMovieStream::key(size_t k) {
 
 void TextureMovieStream::textureAt(double t, std::vector<float>& out) {
   // The keys TextureMovie::textureAt reads at t; every other one is dropped.
-  const std::vector<double>& kt = movie_.keyTimes;
-  size_t k1 =
-      kt.size() == 1 || t <= kt.front()
-          ? 0
-          : (t >= kt.back() ? kt.size() - 1
-                            : size_t(std::upper_bound(kt.begin(), kt.end(), t) - kt.begin()));
-  size_t k0 = k1 > 0 && t < kt.back() ? k1 - 1 : k1;
+  size_t k0, k1;
+  movie_.keysAround(t, k0, k1);
   for (size_t k = 0; k < movie_.keys.size(); ++k)
     if (k != k0 && k != k1) std::vector<float>().swap(movie_.keys[k]);
   load(k0);

@@ -35,6 +35,8 @@ struct TextureMovie {
   // Irradiance texture at time t: linear between the two key textures around t (held before
   // the first and after the last). out gets width * height * 3 floats.
   void textureAt(double t, std::vector<float>& out) const;
+  // The keys textureAt(t) reads: k0 == k1 when t is at or outside the ends (or one key).
+  void keysAround(double t, size_t& k0, size_t& k1) const;
 };
 
 // Path of movie `id` in `dir`: dir/000042.exr.

@@ -430,9 +430,9 @@ double formFactorEstimate(const Polygon& from, const Polygon& to) {
   return pointToPolygonFormFactor(from.centroid(), from.normal(), to);
 }
 
-double formFactorSpread(const Polygon& from, const Polygon& to) {
+double formFactorSpread(const Polygon& from, const Polygon& to, double atCentroid) {
   glm::dvec3 n = from.normal();
-  double lo = pointToPolygonFormFactor(from.centroid(), n, to), hi = lo;
+  double lo = atCentroid, hi = atCentroid;
   for (int i = 0; i < from.count; ++i) {
     double f = pointToPolygonFormFactor(from.v[size_t(i)], n, to);
     lo = std::min(lo, f);

@@ -100,7 +100,8 @@ double formFactorEstimate(const Polygon& from, const Polygon& to);
 // (spread over the shooter) x (B variation) x A_shooter on the shooting side: the error
 // oracle of hierarchical radiosity (Lischinski, Tampieri, Greenberg 1993; Holzschuch and
 // Sillion 1998 bound the same quantity). Large near contact, ~0 in the far field.
-double formFactorSpread(const Polygon& from, const Polygon& to);
+// `atCentroid` is formFactorEstimate(from, to), which the caller has already computed.
+double formFactorSpread(const Polygon& from, const Polygon& to, double atCentroid);
 
 // Helpers shared with the tests.
 std::vector<glm::dvec3> polygonVertices(const Polygon& poly);

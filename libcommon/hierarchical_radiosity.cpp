@@ -205,11 +205,11 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
       }
       double ap = s.area[size_t(l.receiver)], aq = s.area[size_t(l.shooter)];
       // Both directions: the centroid estimate alone can miss a near-contact pair.
-      double est = std::max(formFactorEstimate(P, Q), formFactorEstimate(Q, P) * aq / ap);
-      l.estimate = std::min(1.0, est);
+      const double fpq = formFactorEstimate(P, Q), fqp = formFactorEstimate(Q, P);
+      l.estimate = std::min(1.0, std::max(fpq, fqp * aq / ap));
       l.formFactor = l.estimate;
       if (opt.oracle != RefinementOracle::kPower)
-        l.spreadArea = std::max(ap * formFactorSpread(P, Q), aq * formFactorSpread(Q, P));
+        l.spreadArea = std::max(ap * formFactorSpread(P, Q, fpq), aq * formFactorSpread(Q, P, fqp));
       l.visibility = shadowRays();
     });
     evaluated = end;

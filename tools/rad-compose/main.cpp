@@ -37,17 +37,6 @@ struct Options {
   std::string report;
 };
 
-void writeReport(const std::string& path, const nlohmann::json& report) {
-  rad::AtomicFile file(path);
-  std::string text = report.dump(1) + "\n";
-  FILE* f = std::fopen(file.tempPath().c_str(), "wb");
-  if (!f) throw rad::outputError(path, "cannot write");
-  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  ok = std::fclose(f) == 0 && ok;
-  if (!ok) throw rad::outputError(path, "write failed");
-  file.commit();
-}
-
 int run(const Options& o, int argc, char** argv) {
   rad::Scene scene = rad::readGltfScene(o.scene);
   rad::ContainerReader globalReader = rad::ContainerReader::open(o.global);
@@ -129,7 +118,7 @@ int run(const Options& o, int argc, char** argv) {
   if (!o.report.empty()) {
     nlohmann::json j = report.toJson();
     j["provenance"] = provenance.toJson();
-    writeReport(o.report, j);
+    rad::writeTextFile(o.report, j.dump(1) + "\n");
   }
   return 0;
 }

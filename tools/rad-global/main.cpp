@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 
@@ -218,15 +217,7 @@ int main(int argc, char** argv) {
               << "  seconds: links " << secondsLinks << ", solve " << secondsSolve << ", merge "
               << rep.secondsMerge << ", write " << secondsWrite << ", total " << secondsTotal
               << "; peak memory " << std::setprecision(1) << rad::peakMemoryMb() << " MB\n";
-    if (!o.report.empty()) {
-      rad::AtomicFile f(o.report);
-      {
-        std::ofstream out(f.tempPath());
-        out << j.dump(1) << "\n";
-        if (!out.flush()) throw rad::outputError(o.report, "cannot write");
-      }
-      f.commit();
-    }
+    if (!o.report.empty()) rad::writeTextFile(o.report, j.dump(1) + "\n");
     return 0;
   });
 }

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
 #include "formats/atomic_file.h"
@@ -150,15 +149,7 @@ int run(const Options& given, int argc, char** argv) {
   report["setup_seconds"] = setupSeconds;
   report["total_seconds"] = totalSeconds;
   report["ms_per_frame"] = 1e3 * (totalSeconds - setupSeconds) / n;
-  if (!o.report.empty()) {
-    rad::AtomicFile file(o.report);
-    {
-      std::ofstream out(file.tempPath());
-      out << report.dump(1) << "\n";
-      if (!out.flush()) throw rad::outputError(o.report, "cannot write");
-    }
-    file.commit();
-  }
+  if (!o.report.empty()) rad::writeTextFile(o.report, report.dump(1) + "\n");
   std::fprintf(stderr,
                "%s: %d frames, %zu movies, mean length %.1f frames, %.0f texels/frame, "
                "item buffer %.2f ms/frame (median %.2f), %.2f ms/frame total\n",

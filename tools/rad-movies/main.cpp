@@ -5,7 +5,6 @@
 // peak memory is one key's working buffers whatever the animation's length.
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -160,13 +159,7 @@ int run(const Options& o, int argc, char** argv) {
     report["seconds"]["write"] = sink.secondsWrite;
     report["seconds"]["total"] = since(start);
     report["peak_memory_mb"] = rad::peakMemoryMb();
-    rad::AtomicFile file(o.report);
-    {
-      std::ofstream out(file.tempPath());
-      out << report.dump(1) << "\n";
-      if (!out) throw rad::outputError(o.report, "cannot write the report");
-    }
-    file.commit();
+    rad::writeTextFile(o.report, report.dump(1) + "\n");
   }
   return 0;
 }
