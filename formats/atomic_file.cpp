@@ -27,7 +27,8 @@ std::string directoryOf(const std::string& path) {
 
 }  // namespace
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+AtomicFile::AtomicFile(std::string path, Durability durability)
+    : path_(std::move(path)), durability_(durability) {
   const auto slash = path_.find_last_of('/');
   const std::string dir = slash == std::string::npos ? "" : path_.substr(0, slash + 1);
   const std::string name = slash == std::string::npos ? path_ : path_.substr(slash + 1);
@@ -46,6 +47,14 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::commit() {
   if (committed_) return;
+  if (durability_ == Durability::kDeferred) {
+    if (::rename(tempPath_.c_str(), path_.c_str()) != 0) {
+      throw outputError(
+          path_, std::string("cannot rename temporary file into place: ") + std::strerror(errno));
+    }
+    committed_ = true;
+    return;
+  }
   // Flush the data before the rename makes it visible, so a crash cannot leave a complete
   // name with incomplete content.
   int fd = ::open(tempPath_.c_str(), O_RDONLY | O_CLOEXEC);
@@ -70,6 +79,15 @@ void AtomicFile::commit() {
     ::fsync(dirFd);
     ::close(dirFd);
   }
+}
+
+void syncFileSystemOf(const std::string& path) {
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw outputError(path, std::string("cannot open to sync: ") + std::strerror(errno));
+  const bool ok = ::syncfs(fd) == 0;
+  const int err = errno;
+  ::close(fd);
+  if (!ok) throw outputError(path, std::string("cannot sync: ") + std::strerror(err));
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {

@@ -17,7 +17,17 @@ namespace rad {
 // output. Not thread-safe per object; distinct objects may be used from distinct threads.
 class AtomicFile {
  public:
-  explicit AtomicFile(std::string path);
+  // How commit() makes the file durable (survive a power loss, not only a crash of the process;
+  // either way no reader ever sees a half file under `path`).
+  enum class Durability {
+    kEachFile,  // fsync the temporary before the rename and the directory after it
+    // Rename only. For a stage writing thousands of small files (rad-movies), where one fsync
+    // per file was most of the write time: the stage calls syncFileSystemOf() once before it
+    // reports success, and Make's completion stamp is written after that, so after a power
+    // loss either the stamp is missing (the stage is re-run) or every file is on disk.
+    kDeferred,
+  };
+  explicit AtomicFile(std::string path, Durability durability = Durability::kEachFile);
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -25,7 +35,7 @@ class AtomicFile {
   const std::string& path() const { return path_; }
   const std::string& tempPath() const { return tempPath_; }
 
-  // fsyncs the temporary, renames it onto path() and fsyncs the directory. Throws
+  // fsyncs the temporary (kEachFile), renames it onto path() and fsyncs the directory. Throws
   // rad::outputError(path, ...) on failure (the temporary is then removed by the destructor).
   void commit();
   bool committed() const { return committed_; }
@@ -33,8 +43,13 @@ class AtomicFile {
  private:
   std::string path_;
   std::string tempPath_;
+  Durability durability_;
   bool committed_ = false;
 };
+
+// Flushes the whole file system holding `path` (syncfs(2)): the one sync that makes files
+// committed with AtomicFile::Durability::kDeferred durable. Throws rad::outputError(path, ...).
+void syncFileSystemOf(const std::string& path);
 
 // The whole of `text` into `path`, atomically (a stage's JSON report, ...). Throws
 // rad::outputError(path, ...).

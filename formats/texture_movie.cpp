@@ -118,12 +118,13 @@ std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<i
 struct TextureMovieWriter::File {
   AtomicFile atomic;
   std::unique_ptr<Imf::MultiPartOutputFile> exr;
-  explicit File(const std::string& path) : atomic(path) {}
+  File(const std::string& path, AtomicFile::Durability d) : atomic(path, d) {}
 };
 
 TextureMovieWriter::TextureMovieWriter(std::string path, const TextureMovie& movie,
-                                       bool storeConstantAsOneKey)
-    : path_(std::move(path)), collapse_(storeConstantAsOneKey) {
+                                       bool storeConstantAsOneKey,
+                                       AtomicFile::Durability durability)
+    : path_(std::move(path)), durability_(durability), collapse_(storeConstantAsOneKey) {
   meta_.movie = movie.movie;
   meta_.patch = movie.patch;
   meta_.firstFrame = movie.firstFrame;
@@ -146,7 +147,7 @@ void TextureMovieWriter::open(size_t parts) {
   std::vector<int> frames(meta_.keyFrames.begin(), meta_.keyFrames.begin() + long(parts));
   std::vector<double> times(meta_.keyTimes.begin(), meta_.keyTimes.begin() + long(parts));
   std::vector<Imf::Header> headers = movieHeaders(meta_, frames, times);
-  if (!file_) file_ = std::make_unique<File>(path_);
+  if (!file_) file_ = std::make_unique<File>(path_, durability_);
   file_->exr.reset();
   try {
     file_->exr = std::make_unique<Imf::MultiPartOutputFile>(file_->atomic.tempPath().c_str(),

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "formats/atomic_file.h"
 #include "formats/provenance.h"
 #include "libcommon/patch_hierarchy.h"
 
@@ -58,8 +59,10 @@ void writeTextureMovie(const std::string& path, const TextureMovie& movie);
 class TextureMovieWriter {
  public:
   // `movie`: metadata plus the keyFrames and keyTimes of all K keys (its keys are ignored).
-  // Throws rad::Error(kInternal) for inconsistent metadata.
-  TextureMovieWriter(std::string path, const TextureMovie& movie, bool storeConstantAsOneKey);
+  // Throws rad::Error(kInternal) for inconsistent metadata. `durability`: see AtomicFile
+  // (kDeferred: the caller syncs the output's file system once when all movies are written).
+  TextureMovieWriter(std::string path, const TextureMovie& movie, bool storeConstantAsOneKey,
+                     AtomicFile::Durability durability = AtomicFile::Durability::kEachFile);
   ~TextureMovieWriter();
   TextureMovieWriter(const TextureMovieWriter&) = delete;
   TextureMovieWriter& operator=(const TextureMovieWriter&) = delete;
@@ -77,6 +80,7 @@ class TextureMovieWriter {
   void open(size_t parts);
   void writePart(size_t k, const std::vector<float>& rgb);
   std::string path_;
+  AtomicFile::Durability durability_;
   TextureMovie meta_;  // keys empty
   bool collapse_ = false, diverged_ = false, committed_ = false;
   size_t next_ = 0, texelFloats_ = 0;

@@ -341,6 +341,34 @@ TEST_F(ContainerTest, AtomicFileTempNameAndCleanup) {
               ExitCode::kOutput);
 }
 
+TEST_F(ContainerTest, AtomicFileDeferredDurability) {
+  // kDeferred renames without syncing; the tool syncs the file system once at the end.
+  const std::string target = file("000001.exr");
+  std::string temp;
+  {
+    AtomicFile f(target, AtomicFile::Durability::kDeferred);
+    temp = f.tempPath();
+    writeBytes(temp, {4, 5});
+    EXPECT_FALSE(fs::exists(target));  // invisible until committed
+    f.commit();
+  }
+  EXPECT_FALSE(fs::exists(temp));
+  EXPECT_EQ(readBytes(target), (std::vector<uint8_t>{4, 5}));
+  {
+    AtomicFile f(file("dropped.exr"), AtomicFile::Durability::kDeferred);
+    temp = f.tempPath();
+    writeBytes(temp, {6});
+  }  // not committed: removed, as with kEachFile
+  EXPECT_FALSE(fs::exists(temp));
+  EXPECT_FALSE(fs::exists(file("dropped.exr")));
+  // Nothing to rename: a one-line output error, not a silent success.
+  AtomicFile never(file("never.exr"), AtomicFile::Durability::kDeferred);
+  expectError([&] { never.commit(); }, file("never.exr"), "cannot rename", ExitCode::kOutput);
+  syncFileSystemOf(dir_.string());
+  expectError([&] { syncFileSystemOf(file("missing/dir")); }, file("missing/dir"),
+              "cannot open to sync", ExitCode::kOutput);
+}
+
 TEST_F(ContainerTest, MissingFileAndNotAContainer) {
   expectError([&] { ContainerReader::open(file("missing.rlh")); }, file("missing.rlh"),
               "cannot open");

@@ -98,7 +98,8 @@ int run(const Options& o, int argc, char** argv) {
       auto t = Clock::now();
       meta.keyFrames = plan.keyFrames;
       meta.keyTimes = plan.keyTimes;
-      writer = std::make_unique<rad::TextureMovieWriter>(path, meta, collapse);
+      writer = std::make_unique<rad::TextureMovieWriter>(path, meta, collapse,
+                                                         rad::AtomicFile::Durability::kDeferred);
       secondsWrite += since(t);
     }
     void key(size_t k, const std::vector<float>& texture) override {
@@ -145,6 +146,13 @@ int run(const Options& o, int argc, char** argv) {
     progress.advance();
   }
   progress.done();
+  {
+    // One sync for all movies (AtomicFile::Durability::kDeferred) before the tool reports
+    // success: Make's movies/.done stamp follows our exit status.
+    auto t = Clock::now();
+    rad::syncFileSystemOf(o.outDir);
+    sink.secondsWrite += since(t);
+  }
   const rad::TextureMovieBakerStats& stats = baker.stats();
   for (const std::string& w : stats.warnings) std::cerr << kTool << ": warning: " << w << "\n";
 
