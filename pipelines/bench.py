@@ -14,17 +14,27 @@ Wall time and peak resident memory are measured per stage from the child process
 (os.wait4), so no external timer is needed. Speed-up = scratch time / coherent time, measured
 as a ratio in one run. The coherent and scratch frames are compared with rad-diff.
 
+Both are compared with rad-reference at one frame (midway between two key times near the
+middle; --reference-spp, 0 skips it): two independent path-traced references A and B (seeds 0
+and 1) give the error of a frame T with the references' own noise removed, d^2 = (rmse(T,A)^2 + rmse(T,B)^2)/2 - rmse(A,B)^2/2
+(E rmse(T,A)^2 = d^2 + s^2 and E rmse(A,B)^2 = 2 s^2 for reference noise s), reported as a
+relative L2 (d over the references' rms).
+
 A finished run of one configuration and mode is kept in OUT/NAME/MODE/result.json with the
 frames, size, binaries' commit and pinned CPUs it was measured with; a later invocation with the
 same settings reuses it, so a long full run that is interrupted resumes where it stopped
-(--fresh measures everything again).
+(--fresh measures everything again). The texture movies are deleted once a mode is measured
+(tens of GB for a full run; --keep-movies keeps them).
 
 usage: bench.py [--frames N] [--size WxH] [--out DIR] [--bin DIR] [--only NAME,...] [--fresh]
+                [--reference-spp N] [--keep-movies]
 """
 import argparse
 import csv
 import json
+import math
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -96,7 +106,7 @@ def settings_of(bin_dir, frames, size):
             "cpus": sorted(os.sched_getaffinity(0))}
 
 
-def measured(bin_dir, scene, out, frames, size, flags, log, settings, fresh):
+def measured(bin_dir, scene, out, frames, size, flags, log, settings, fresh, keep_movies):
     """pipeline(), or the stored result of an identical earlier run."""
     path = os.path.join(out, "result.json")
     if not fresh and os.path.exists(path):
@@ -116,6 +126,8 @@ def measured(bin_dir, scene, out, frames, size, flags, log, settings, fresh):
     with open(tmp, "w") as f:
         json.dump({"settings": settings, "result": result}, f, indent=1)
     os.replace(tmp, path)  # atomic: a killed run leaves no half-written result
+    if not keep_movies:
+        shutil.rmtree(os.path.join(out, "movies"), ignore_errors=True)
     return result
 
 
@@ -150,6 +162,45 @@ def frame_difference(bin_dir, a, b):
         return None
 
 
+def reference_difference(bin_dir, scene, out, frame, size, spp, tests, log):
+    """Relative L2 of each tests[name] frame file against the path-traced reference at `frame`,
+    the references' noise removed (see the module docstring); rendered once and kept in
+    OUT/reference-FRAME-SPP/. Returns {name: {...}} or None."""
+    ref = os.path.join(bin_dir, "rad-reference")
+    diff = os.path.join(bin_dir, "rad-diff")
+    if not (os.path.exists(ref) and os.path.exists(diff)):
+        return None
+    name = "%04d.exr" % frame
+    refs = []
+    for seed in (0, 1):
+        d = os.path.join(out, "reference-%d-%dspp-seed%d" % (frame, spp, seed))
+        if not os.path.exists(os.path.join(d, name)):
+            run([ref, scene, "-o", d, "--frames", "%d-%d" % (frame, frame), "--size", size,
+                 "--spp", str(spp), "--seed", str(seed), "--pixel-centres"], log)
+        refs.append(os.path.join(d, name))
+
+    def compare(a, b):
+        p = subprocess.run([diff, a, b, "--json"], capture_output=True, text=True)
+        if p.returncode != 0:
+            raise RuntimeError("rad-diff %s %s: %s" % (a, b, p.stderr.strip()))
+        return json.loads(p.stdout)["difference"]
+
+    between = compare(refs[1], refs[0])
+    noise2 = between["rmse"] ** 2 / 2.0  # one reference's noise variance per pixel channel
+    result = {"frame": frame, "spp": spp, "reference_noise_relative_l2":
+              math.sqrt(noise2) * between["relative_l2"] / between["rmse"]
+              if between["rmse"] > 0 else 0.0}
+    for label, path in tests.items():
+        if not os.path.exists(path):
+            continue
+        da, db = compare(path, refs[0]), compare(path, refs[1])
+        d2 = max(0.0, (da["rmse"] ** 2 + db["rmse"] ** 2) / 2.0 - noise2)
+        scale = da["relative_l2"] / da["rmse"] if da["rmse"] > 0 else 0.0  # 1 / rms(reference)
+        result[label] = {"relative_l2": math.sqrt(d2) * scale,
+                         "raw_relative_l2": (da["relative_l2"] + db["relative_l2"]) / 2.0}
+    return result
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     ap.add_argument("--frames", type=int, default=400)
@@ -158,6 +209,10 @@ def main():
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--only", default="")
     ap.add_argument("--fresh", action="store_true", help="ignore results of earlier runs")
+    ap.add_argument("--reference-spp", type=int, default=128,
+                    help="samples per pixel of each of the two references (0: no reference)")
+    ap.add_argument("--keep-movies", action="store_true",
+                    help="keep the texture movies of measured runs")
     a = ap.parse_args()
     settings = settings_of(a.bin, a.frames, a.size)
     print("bench: commit %s, CPUs %s" % (settings["commit"], settings["cpus"]), file=sys.stderr)
@@ -178,10 +233,18 @@ def main():
                   file=sys.stderr, flush=True)
             row[mode] = measured(a.bin, scene, out, a.frames, a.size,
                                  SCRATCH_FLAGS if mode == "scratch" else {}, log, settings,
-                                 a.fresh)
+                                 a.fresh, a.keep_movies)
         row["links"] = link_stats(os.path.join(a.out, name, "coherent", "global-report.json"))
         row["difference"] = frame_difference(a.bin, os.path.join(a.out, name, "coherent", "frames"),
                                              os.path.join(a.out, name, "scratch", "frames"))
+        if a.reference_spp > 0:
+            # Midway between two key times of rad-movies (--key-step 6), where interpolation
+            # between keys is at its worst; at a key time coherent and scratch agree.
+            mid = min(a.frames - 1, (a.frames // 2) // 6 * 6 + 3)
+            row["reference"] = reference_difference(
+                a.bin, scene, os.path.join(a.out, name), mid, a.size, a.reference_spp,
+                {m: os.path.join(a.out, name, m, "frames", "%04d.exr" % mid)
+                 for m in ("coherent", "scratch")}, log)
         rows.append(row)
         print_tables(rows, a.frames, a.size, sys.stderr)
     write_csv(rows, a.frames, os.path.join(a.out, "tables.csv"))
@@ -229,6 +292,13 @@ def print_tables(rows, frames, size, out):
         for name, d in diffs:
             print("%-22s coherent vs scratch: %s" % (name, json.dumps(d.get("difference", d))[:200]),
                   file=out)
+        refs = [(r["scene"], r["reference"]) for r in sel if r.get("reference")]
+        for name, d in refs:
+            print("%-22s vs rad-reference at frame %d (%d spp x 2, noise %.2f %% removed): "
+                  "coherent %.2f %%, scratch %.2f %% relative L2" % (
+                      name, d["frame"], d["spp"], 100 * d["reference_noise_relative_l2"],
+                      100 * d.get("coherent", {}).get("relative_l2", float("nan")),
+                      100 * d.get("scratch", {}).get("relative_l2", float("nan"))), file=out)
     out.flush()
 
 
@@ -237,13 +307,16 @@ def write_csv(rows, frames, path):
         w = csv.writer(f)
         w.writerow(["scene", "frames", "coherent_s", "coherent_s_per_frame", "scratch_s",
                     "scratch_s_per_frame", "speedup", "coherent_peak_mib", "scratch_peak_mib",
-                    "links_min", "links_max", "links_mean", "links_percent"]
+                    "links_min", "links_max", "links_mean", "links_percent",
+                    "coherent_vs_reference_rel_l2", "scratch_vs_reference_rel_l2"]
                    + ["coherent_%s_s" % s for s in ("global", "intervals", "movies", "compose")]
                    + ["scratch_%s_s" % s for s in ("global", "intervals", "movies", "compose")])
         for r in rows:
             l = r.get("links") or {}
+            ref = r.get("reference") or {}
             w.writerow(list(fmt_row(r, frames)[:1]) + [frames] + list(fmt_row(r, frames)[1:])
                        + [l.get("min"), l.get("max"), l.get("mean"), l.get("percent")]
+                       + [ref.get(m, {}).get("relative_l2") for m in ("coherent", "scratch")]
                        + [r["coherent"]["stages"][s][0] for s in
                           ("global", "intervals", "movies", "compose")]
                        + [r["scratch"]["stages"][s][0] for s in
