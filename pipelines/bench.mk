@@ -6,7 +6,7 @@
 #       one run), total and per-frame time, speed-up, peak memory, links updated per key;
 #       coherent and scratch against two rad-reference renders at one frame (0: skip);
 #       out/bench/tables.csv
-#   make -f pipelines/bench.mk tradeoff [TRADEOFF_FRAMES=0-11] [TRADEOFF_SIZE=176x120] [TRADEOFF_SPP=1024]
+#   make -f pipelines/bench.mk tradeoff [TRADEOFF_FRAMES=0-47] [TRADEOFF_SIZE=176x120] [TRADEOFF_SPP=128] [TRADEOFF_REPEAT=3]
 #       each accuracy knob swept against a converged rad-reference render: time per frame vs
 #       RMSE, Pareto front; out/tradeoff/tradeoff.csv and tradeoff.png (gnuplot)
 
@@ -16,9 +16,10 @@ BENCH_SIZE ?= 352x240
 BENCH_ONLY ?=
 BENCH_REFERENCE_SPP ?= 128
 TRADEOFF_SCENE ?= pipelines/scenes/cornell-moving.gltf
-TRADEOFF_FRAMES ?= 0-11
+TRADEOFF_FRAMES ?= 0-47
 TRADEOFF_SIZE ?= 176x120
-TRADEOFF_SPP ?= 1024
+TRADEOFF_SPP ?= 128
+TRADEOFF_REPEAT ?= 3
 
 .PHONY: tables tradeoff
 tables:
@@ -27,4 +28,4 @@ tables:
 
 tradeoff:
 	python3 pipelines/tradeoff.py --bin $(BIN) --scene $(TRADEOFF_SCENE) --frames $(TRADEOFF_FRAMES) \
-	  --size $(TRADEOFF_SIZE) --spp $(TRADEOFF_SPP) --out out/tradeoff
+	  --size $(TRADEOFF_SIZE) --spp $(TRADEOFF_SPP) --repeat $(TRADEOFF_REPEAT) --out out/tradeoff

@@ -50,7 +50,7 @@ BUNDLED = {"cornell-moving": os.path.join(HERE, "scenes", "cornell-moving.gltf")
 
 
 def run(cmd, log):
-    """Runs cmd; returns (seconds, peak RSS in MiB). Raises on failure."""
+    """Runs cmd; returns (seconds, peak RSS in MiB, CPU seconds). Raises on failure."""
     t0 = time.monotonic()
     with open(log, "ab") as f:
         f.write(("$ " + " ".join(cmd) + "\n").encode())
@@ -60,7 +60,7 @@ def run(cmd, log):
     dt = time.monotonic() - t0
     if os.waitstatus_to_exitcode(status) != 0:
         raise RuntimeError("%s failed (see %s)" % (os.path.basename(cmd[0]), log))
-    return dt, usage.ru_maxrss / 1024.0
+    return dt, usage.ru_maxrss / 1024.0, usage.ru_utime + usage.ru_stime
 
 
 SCRATCH_FLAGS = {"global": ["--no-coherence"], "intervals": ["--max-length", "1"],
@@ -69,7 +69,7 @@ SCRATCH_FLAGS = {"global": ["--no-coherence"], "intervals": ["--max-length", "1"
 
 def pipeline(bin_dir, scene, out, frames, size, flags, log):
     """Runs the four stages into out/; flags: stage name -> extra arguments. Returns per-stage
-    (seconds, peak MiB), total seconds and overall peak MiB."""
+    (seconds, peak MiB, CPU seconds), total seconds and CPU seconds, and overall peak MiB."""
     os.makedirs(out, exist_ok=True)
     fr = frames if isinstance(frames, str) else "0-%d" % (frames - 1)
     g, i, m, c = (os.path.join(bin_dir, t) for t in
@@ -89,7 +89,8 @@ def pipeline(bin_dir, scene, out, frames, size, flags, log):
                             + f("compose"), log)
     total = sum(s[0] for s in stages.values())
     peak = max(s[1] for s in stages.values())
-    return {"stages": stages, "total": total, "peak_mib": peak}
+    cpu = sum(s[2] for s in stages.values())
+    return {"stages": stages, "total": total, "cpu_total": cpu, "peak_mib": peak}
 
 
 def settings_of(bin_dir, frames, size):

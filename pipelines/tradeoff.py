@@ -7,11 +7,21 @@ reference (rad-reference). Writes OUT/tradeoff.csv (knob, value, seconds per fra
 relative L2), OUT/tradeoff.gp and, when gnuplot is installed, OUT/tradeoff.png with the Pareto
 front (the settings no other setting beats in both time and error) marked.
 
-usage: tradeoff.py [--scene GLTF] [--frames 0-11] [--size 176x120] [--spp 1024] [--out DIR]
+Two references with independent noise (seeds 0 and 1) take the reference's own Monte Carlo
+noise out of the error, which otherwise hides the knobs' effects: for frames T and references
+A and B, E rmse(T,A)^2 = d^2 + s^2 and E rmse(A,B)^2 = 2 s^2, so the error of T is
+d = sqrt((rmse(T,A)^2 + rmse(T,B)^2)/2 - rmse(A,B)^2/2). Each setting runs --repeat times and
+the least CPU time of the four stages (user + system, all threads) is kept: the outputs are
+bit-identical, and CPU time is what other processes on the machine disturb least (wall time of
+the same run is in the CSV).
+
+usage: tradeoff.py [--scene GLTF] [--frames 0-47] [--size 176x120] [--spp 128] [--repeat 3]
+                   [--out DIR]
 """
 import argparse
 import csv
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -22,13 +32,15 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import bench  # noqa: E402
 
-# knob name -> (stage, flag, values); the first value of each list is not special.
+# knob name -> (stage, flag, the tool's default, the other values swept). The default setting is
+# run once (row "default") and belongs to every knob's curve.
 KNOBS = [
-    ("eps", "global", "--eps", ["0.5", "0.1", "0.02", "0.005"]),
-    ("key-step", "global", "--key-step", ["12", "6", "3", "1"]),
-    ("bad-links", "global", "--bad-links", ["none", "lights", "partial", "all"]),
-    ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "1", "2"]),
-    ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32", "64"]),
+    ("eps", "global", "--eps", "0.001", ["0.5", "0.1", "0.02", "0.005", "0.0005"]),
+    ("key-step", "global", "--key-step", "4", ["12", "8", "2", "1"]),
+    ("bad-links", "global", "--bad-links", "lights", ["none", "partial", "all"]),
+    ("texel-density", "intervals", "--texel-density", "1", ["0.25", "0.5", "2"]),
+    ("movie-key-step", "movies", "--key-step", "6", ["24", "12", "3", "1"]),
+    ("max-samples", "movies", "--max-samples", "64", ["4", "8", "16", "32"]),
 ]
 
 
@@ -44,11 +56,12 @@ def pareto(points):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     ap.add_argument("--scene", default=os.path.join(HERE, "scenes", "cornell-moving.gltf"))
-    ap.add_argument("--frames", default="0-11")
+    ap.add_argument("--frames", default="0-47")
     ap.add_argument("--size", default="176x120")
-    ap.add_argument("--spp", type=int, default=1024)
+    ap.add_argument("--spp", type=int, default=128)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "tradeoff"))
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--repeat", type=int, default=3, help="timed runs per setting (fastest kept)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     log = os.path.join(a.out, "tradeoff.log")
@@ -57,34 +70,51 @@ def main():
 
     # Pixel-centre samples: rad-compose point-samples pixels, so an antialiased reference would
     # add an edge-coverage error floor that no accuracy knob moves.
-    ref = os.path.join(a.out, "reference-centres-%dspp" % a.spp)
-    if not os.path.exists(os.path.join(ref, "%04d.exr" % last)):
-        print("tradeoff: reference, %d spp" % a.spp, file=sys.stderr, flush=True)
-        t, _ = bench.run([os.path.join(a.bin, "rad-reference"), a.scene, "-o", ref, "--frames",
-                          a.frames, "--fps", "24", "--size", a.size, "--spp", str(a.spp),
-                          "--pixel-centres"], log)
-        print("tradeoff: reference took %.1f s (%.2f s/frame)" % (t, t / nframes), file=sys.stderr)
+    refs = []
+    for seed in (0, 1):
+        ref = os.path.join(a.out, "reference-centres-%dspp-seed%d" % (a.spp, seed))
+        if not os.path.exists(os.path.join(ref, "%04d.exr" % last)):
+            print("tradeoff: reference, %d spp, seed %d" % (a.spp, seed), file=sys.stderr,
+                  flush=True)
+            t, _, _ = bench.run([os.path.join(a.bin, "rad-reference"), a.scene, "-o", ref,
+                              "--frames", a.frames, "--fps", "24", "--size", a.size, "--spp",
+                              str(a.spp), "--seed", str(seed), "--pixel-centres"], log)
+            print("tradeoff: reference took %.1f s (%.2f s/frame)" % (t, t / nframes),
+                  file=sys.stderr)
+        refs.append(ref)
+    between = compare(a.bin, refs[1], refs[0])
+    noise2 = between["rmse"] ** 2 / 2.0
+    scale = between["relative_l2"] / between["rmse"]  # 1 / rms of the reference
+    print("tradeoff: reference noise %.3g rmse (%.2f %% relative L2), removed from the errors"
+          % (math.sqrt(noise2), 100 * math.sqrt(noise2) * scale), file=sys.stderr)
 
     rows = []
-    runs = [("default", None, None, "-")] + [(k, s, f, v) for k, s, f, vs in KNOBS for v in vs]
+    runs = [("default", None, None, "-")] + [(k, s, f, v) for k, s, f, _, vs in KNOBS for v in vs]
+    # One untimed run first: the first run pays for cold caches (binaries, scene, references).
+    bench.pipeline(a.bin, a.scene, os.path.join(a.out, "runs", "warm-up"), a.frames, a.size, {},
+                   log)
     for knob, stage, flag, value in runs:
         out = os.path.join(a.out, "runs", "%s-%s" % (knob, value))
         flags = {stage: [flag, value]} if stage else {}
         print("tradeoff: %s = %s" % (knob, value), file=sys.stderr, flush=True)
         try:
-            r = bench.pipeline(a.bin, a.scene, out, a.frames, a.size, flags, log)
+            times, walls = [], []
+            for _ in range(max(1, a.repeat)):
+                r = bench.pipeline(a.bin, a.scene, out, a.frames, a.size, flags, log)
+                times.append(r["cpu_total"])
+                walls.append(r["total"])
+            da = compare(a.bin, os.path.join(out, "frames"), refs[0])
+            db = compare(a.bin, os.path.join(out, "frames"), refs[1])
         except RuntimeError as e:
             print("tradeoff: %s = %s: %s" % (knob, value, e), file=sys.stderr)
             continue
-        p = subprocess.run([os.path.join(a.bin, "rad-diff"), os.path.join(out, "frames"), ref,
-                            "--json"], capture_output=True, text=True)
-        if p.returncode != 0:
-            print("tradeoff: rad-diff: " + p.stderr.strip(), file=sys.stderr)
-            continue
-        d = json.loads(p.stdout)["difference"]
-        rows.append({"knob": knob, "value": value, "seconds_per_frame": r["total"] / nframes,
-                     "rmse": float(d["rmse"]), "relative_l2": float(d["relative_l2"]),
-                     "peak_mib": r["peak_mib"]})
+        raw2 = (da["rmse"] ** 2 + db["rmse"] ** 2) / 2.0
+        rmse = math.sqrt(max(0.0, raw2 - noise2))
+        rows.append({"knob": knob, "value": value, "seconds_per_frame": min(times) / nframes,
+                     "seconds_spread": (max(times) - min(times)) / min(times),
+                     "wall_seconds_per_frame": min(walls) / nframes,
+                     "rmse": rmse, "relative_l2": rmse * scale,
+                     "raw_relative_l2": math.sqrt(raw2) * scale, "peak_mib": r["peak_mib"]})
         shutil.rmtree(os.path.join(out, "movies"), ignore_errors=True)  # keep the disk small
 
     front = pareto([(r["seconds_per_frame"], r["rmse"]) for r in rows])
@@ -92,47 +122,63 @@ def main():
         r["pareto"] = int(i in front)
     csv_path = os.path.join(a.out, "tradeoff.csv")
     with open(csv_path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["knob", "value", "seconds_per_frame", "rmse",
-                                          "relative_l2", "peak_mib", "pareto"])
+        w = csv.DictWriter(f, fieldnames=["knob", "value", "seconds_per_frame", "seconds_spread",
+                                          "wall_seconds_per_frame",
+                                          "rmse", "relative_l2", "raw_relative_l2", "peak_mib",
+                                          "pareto"])
         w.writeheader()
         w.writerows(rows)
-    print("%-14s %-8s %12s %12s %12s %s" % ("knob", "value", "s/frame", "rmse", "rel. L2",
-                                             "pareto"))
+    print("%-14s %-8s %10s %8s %12s %9s %9s %s" % ("knob", "value", "CPU s/fr", "spread",
+                                                   "rmse", "rel. L2", "raw", "pareto"))
     for r in rows:
-        print("%-14s %-8s %12.4f %12.5g %12.5g %s" % (r["knob"], r["value"],
-                                                      r["seconds_per_frame"], r["rmse"],
-                                                      r["relative_l2"], "*" if r["pareto"] else ""))
+        print("%-14s %-8s %10.4f %7.1f%% %12.5g %8.3f%% %8.3f%% %s" % (
+            r["knob"], r["value"], r["seconds_per_frame"], 100 * r["seconds_spread"], r["rmse"],
+            100 * r["relative_l2"], 100 * r["raw_relative_l2"], "*" if r["pareto"] else ""))
     write_plot(a.out, rows, front)
+
+
+def compare(bin_dir, test, reference):
+    p = subprocess.run([os.path.join(bin_dir, "rad-diff"), test, reference, "--json"],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError("rad-diff: " + p.stderr.strip())
+    return json.loads(p.stdout)["difference"]
 
 
 def write_plot(out, rows, front):
     dat = os.path.join(out, "tradeoff.dat")
     with open(dat, "w") as f:
-        knobs = []
-        for r in rows:
-            if r["knob"] not in knobs:
-                knobs.append(r["knob"])
+        default = [r for r in rows if r["knob"] == "default"]
+        knobs = [k for k, _, _, _, _ in KNOBS if any(r["knob"] == k for r in rows)]
         for k in knobs:
+            # Each knob's curve passes through the default setting, labelled with its value.
+            dv = next(d for name, _, _, d, _ in KNOBS if name == k)
+            pts = [(r["seconds_per_frame"], r["rmse"], r["value"]) for r in rows if r["knob"] == k]
+            pts += [(r["seconds_per_frame"], r["rmse"], dv) for r in default]
             f.write("# %s\n" % k)
-            for r in rows:
-                if r["knob"] == k:
-                    f.write("%g %g \"%s\"\n" % (r["seconds_per_frame"], r["rmse"], r["value"]))
+            for t, e, v in sorted(pts):
+                f.write("%g %g \"%s\"\n" % (t, e, v))
             f.write("\n\n")
         f.write("# pareto\n")
         for i in front:
             f.write("%g %g\n" % (rows[i]["seconds_per_frame"], rows[i]["rmse"]))
+        f.write("\n\n# default\n")
+        for r in default:
+            f.write("%g %g\n" % (r["seconds_per_frame"], r["rmse"]))
     gp = os.path.join(out, "tradeoff.gp")
     plots = ["'%s' index %d using 1:2 with linespoints title '%s', '' index %d using 1:2:3 "
              "with labels offset 0.8,0.6 font ',8' notitle" % (dat, i, k, i)
              for i, k in enumerate(knobs)]
     plots.append("'%s' index %d using 1:2 with lines lw 3 lc rgb '#80000000' title 'Pareto front'"
                  % (dat, len(knobs)))
+    plots.append("'%s' index %d using 1:2 with points pt 7 ps 2 lc rgb 'black' title 'default'"
+                 % (dat, len(knobs) + 1))
     with open(gp, "w") as f:
         f.write("set terminal pngcairo size 900,600\n" if has_cairo() else
                 "set terminal png size 900,600\n")
         f.write("set output '%s'\n" % os.path.join(out, "tradeoff.png"))
-        f.write("set logscale xy\nset xlabel 'seconds per frame'\nset ylabel 'RMSE vs path-traced"
-                " reference (W/m^2/sr)'\nset key outside right\nset grid\n")
+        f.write("set logscale xy\nset xlabel 'CPU seconds per frame'\nset ylabel 'RMSE vs path-traced"
+                " reference, its noise removed (W/m^2/sr)'\nset key outside right\nset grid\n")
         f.write("plot " + ", \\\n     ".join(plots) + "\n")
     if shutil.which("gnuplot"):
         subprocess.run(["gnuplot", gp], check=False)
