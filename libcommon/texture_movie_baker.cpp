@@ -2,11 +2,13 @@
 #include "libcommon/texture_movie_baker.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <unordered_map>
 
 #include <unistd.h>
 
@@ -318,7 +320,23 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
       localPoint[x] = polygonPointAt(receiverTop.local, topUv[x]);
     }
 
-  const bool receiverDynamic = scene_.isDynamic(receiverTop.node, t0, t1);
+  // Whether a node moves during the movie, and its swept bounds, are asked for every blocker
+  // candidate of every bad pair (with 32 moving cubes that was over half of rad-movies' time,
+  // recomputing the same answers); each node's answer over [t0, t1] is computed once.
+  std::vector<signed char> nodeMoves(scene_.nodes.size(), -1);
+  auto movesDuringMovie = [&](int node) {
+    if (node < 0 || node >= int(nodeMoves.size())) return scene_.isDynamic(node, t0, t1);
+    signed char& m = nodeMoves[size_t(node)];
+    if (m < 0) m = scene_.isDynamic(node, t0, t1) ? 1 : 0;
+    return m == 1;
+  };
+  std::unordered_map<int, std::array<glm::dvec3, 2>> nodeSwept;
+  auto sweptDuringMovie = [&](int node) -> const std::array<glm::dvec3, 2>& {
+    auto it = nodeSwept.find(node);
+    if (it == nodeSwept.end()) it = nodeSwept.emplace(node, scene_.sweptBounds(node, t0, t1)).first;
+    return it->second;
+  };
+  const bool receiverDynamic = movesDuringMovie(receiverTop.node);
   std::vector<Polygon> receiverWorld(static_cast<size_t>(K));
   std::vector<glm::dmat4> receiverTransform(static_cast<size_t>(K));
   for (int k = 0; k < K; ++k) {
@@ -356,15 +374,24 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
     box.grow(p.shooterWorld[size_t(k)]);
     return box;
   };
-  auto worldPolygon = [&](int b, double t) {
-    return tops_[size_t(b)].local.transformed(scene_.worldTransform(tops_[size_t(b)].node, t));
+  // World transform of a node at key k, once per movie: the blockers of every pair at every
+  // key are placed with it, several polygons per node.
+  std::unordered_map<long long, glm::dmat4> nodeWorldAtKey;
+  auto worldPolygon = [&](int b, int k) {
+    const int node = tops_[size_t(b)].node;
+    const long long key = (long long)k * (long long)(scene_.nodes.size() + 1) + (node + 1);
+    auto it = nodeWorldAtKey.find(key);
+    if (it == nodeWorldAtKey.end())
+      it =
+          nodeWorldAtKey.emplace(key, scene_.worldTransform(node, movie.keyTimes[size_t(k)])).first;
+    return tops_[size_t(b)].local.transformed(it->second);
   };
   // Blockers of candidate list `list` in the pair's shaft at key k, as world triangles.
   auto blockersAt = [&](const Pair& p, const std::vector<int>& list, int k) {
     Box shaft = shaftAt(p, k);
     std::vector<BlockerTriangle> tris;
     for (int b : list) {
-      Polygon poly = worldPolygon(b, movie.keyTimes[size_t(k)]);
+      Polygon poly = worldPolygon(b, k);
       Box pb;
       pb.grow(poly);
       if (pb.overlaps(shaft)) appendTriangles(poly, tris);
@@ -383,7 +410,7 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
     if (S >= tops_.size()) continue;
     const InputPolygon& shooterTop = tops_[S];
     ++stats_.badPairs;
-    const bool shooterDynamic = scene_.isDynamic(shooterTop.node, t0, t1);
+    const bool shooterDynamic = movesDuringMovie(shooterTop.node);
     const bool pairStatic = !receiverDynamic && !shooterDynamic;
     (pairStatic ? stats_.staticPairs : stats_.dynamicPairs) += 1;
     Pair p;
@@ -441,12 +468,12 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
       std::vector<int> staticList;
       for (int b : candidates) {
         int node = tops_[size_t(b)].node;
-        if (!scene_.isDynamic(node, t0, t1)) {
+        if (!movesDuringMovie(node)) {
           Box pb;
-          pb.grow(worldPolygon(b, t0));
+          pb.grow(worldPolygon(b, 0));  // t0 is key 0's time
           if (pb.overlaps(shaft)) staticList.push_back(b);
         } else {
-          std::array<glm::dvec3, 2> sb = scene_.sweptBounds(node, t0, t1);
+          const std::array<glm::dvec3, 2>& sb = sweptDuringMovie(node);
           Box swept{sb[0], sb[1]};
           if (swept.overlaps(shaft)) p.dynamicList.push_back(b);
         }
@@ -464,7 +491,7 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
     } else {
       // A moving end (or the baseline): every blocker in the key's shaft at every key.
       for (int b : candidates) {
-        bool dyn = scene_.isDynamic(tops_[size_t(b)].node, t0, t1);
+        bool dyn = movesDuringMovie(tops_[size_t(b)].node);
         (dyn ? stats_.dynamicBlockers : stats_.staticBlockers) += 1;
       }
       p.candidates = std::move(candidates);
