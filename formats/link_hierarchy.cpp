@@ -70,7 +70,11 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
   w.write(path);
 }
 
-GlobalSolution readLinkHierarchy(const ContainerReader& r, const Scene& scene) {
+namespace {
+
+// radiosityOnly: keyTimes, hierarchy, nodeRadiosity and leafRow only (links, link samples,
+// good irradiance and bad pairs stay empty; readLinkHierarchyRadiosity).
+GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool radiosityOnly) {
   const std::string& where = r.path();
   r.requireKind(kLinkHierarchyKind, kLinkHierarchyMajor);
   GlobalSolution s;
@@ -106,6 +110,10 @@ GlobalSolution readLinkHierarchy(const ContainerReader& r, const Scene& scene) {
   if (b.size() != N * K * 3) throw inputError(where, "node_radiosity has the wrong size");
   s.nodeRadiosity = unflatten(b);
   s.leafRow = r.array<int32_t>("leaf_row");
+  if (radiosityOnly) {
+    s.validateRadiosity(where);
+    return s;
+  }
   s.leafVertexGoodIrradiance = unflatten(r.array<float>("leaf_vertex_good_irradiance"));
   std::vector<uint32_t> cols = r.array<uint32_t>("links");
   std::vector<uint8_t> flags = r.array<uint8_t>("link_flags");
@@ -123,6 +131,16 @@ GlobalSolution readLinkHierarchy(const ContainerReader& r, const Scene& scene) {
   for (size_t i = 0; i < pairs.size(); i += 2) s.badPairs.emplace_back(pairs[i], pairs[i + 1]);
   s.validate(where);
   return s;
+}
+
+}  // namespace
+
+GlobalSolution readLinkHierarchy(const ContainerReader& r, const Scene& scene) {
+  return readSolution(r, scene, false);
+}
+
+GlobalSolution readLinkHierarchyRadiosity(const ContainerReader& r, const Scene& scene) {
+  return readSolution(r, scene, true);
 }
 
 GlobalSolution readLinkHierarchy(const std::string& path, const Scene& scene) {

@@ -26,6 +26,11 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& solution,
 // must form the hierarchy in subdivision order. Errors are rad::inputError(path, ...).
 GlobalSolution readLinkHierarchy(const ContainerReader& reader, const Scene& scene);
 GlobalSolution readLinkHierarchy(const std::string& path, const Scene& scene);
+// The same checks and content without the links, their F·V samples, the good irradiance and
+// the bad pairs (left empty): keyTimes, hierarchy, nodeRadiosity and leafRow, all rad-compose
+// reads (radiosity(), leafAtTopUv, autoExposureEV). The container's checksums still cover the
+// arrays not copied. Saves rad-compose ~45 MB on the 32-cube scene.
+GlobalSolution readLinkHierarchyRadiosity(const ContainerReader& reader, const Scene& scene);
 
 // rad-inspect's content summary of a linkhier container (no scene needed).
 nlohmann::json summarizeLinkHierarchy(const ContainerReader& reader);

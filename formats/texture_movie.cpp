@@ -61,7 +61,7 @@ void TextureMovie::textureAt(double t, std::vector<float>& out) const {
     std::copy(keys[k0].begin(), keys[k0].end(), out.begin());
     return;
   }
-  float w = float((t - keyTimes[k0]) / (keyTimes[k1] - keyTimes[k0]));
+  float w = keyWeight(t, k0, k1);
   const float* a = keys[k0].data();
   const float* b = keys[k1].data();
   for (size_t i = 0; i < n; ++i) out[i] = (1.0f - w) * a[i] + w * b[i];
@@ -417,15 +417,27 @@ const std::vector<float>& TextureMovieStream::key(size_t k) {
   return movie_.keys[k];
 }
 
-void TextureMovieStream::textureAt(double t, std::vector<float>& out) {
+void TextureMovieStream::loadAround(double t, size_t& k0, size_t& k1) {
   // The keys TextureMovie::textureAt reads at t; every other one is dropped.
-  size_t k0, k1;
   movie_.keysAround(t, k0, k1);
   for (size_t k = 0; k < movie_.keys.size(); ++k)
     if (k != k0 && k != k1) std::vector<float>().swap(movie_.keys[k]);
   load(k0);
   load(k1);
+}
+
+void TextureMovieStream::textureAt(double t, std::vector<float>& out) {
+  size_t k0, k1;
+  loadAround(t, k0, k1);
   movie_.textureAt(t, out);
+}
+
+void TextureMovieStream::keysAt(double t, const float*& from, const float*& to, float& weight) {
+  size_t k0, k1;
+  loadAround(t, k0, k1);
+  from = movie_.keys[k0].data();
+  to = k0 == k1 ? nullptr : movie_.keys[k1].data();
+  weight = k0 == k1 ? 0.0f : movie_.keyWeight(t, k0, k1);
 }
 
 nlohmann::json summarizeTextureMovieDirectory(const std::string& dir) {

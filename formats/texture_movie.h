@@ -38,6 +38,10 @@ struct TextureMovie {
   void textureAt(double t, std::vector<float>& out) const;
   // The keys textureAt(t) reads: k0 == k1 when t is at or outside the ends (or one key).
   void keysAround(double t, size_t& k0, size_t& k1) const;
+  // textureAt's weight of key k1 at t (k0 < k1 from keysAround): texel = (1 - w) k0 + w k1.
+  float keyWeight(double t, size_t k0, size_t k1) const {
+    return float((t - keyTimes[k0]) / (keyTimes[k1] - keyTimes[k0]));
+  }
 };
 
 // Path of movie `id` in `dir`: dir/000042.exr.
@@ -107,12 +111,18 @@ class TextureMovieStream {
   // The movie's metadata; keys[k] is empty unless key k is loaded.
   const TextureMovie& movie() const { return movie_; }
   void textureAt(double t, std::vector<float>& out);
+  // What textureAt(t) blends, without blending it into a copy (rad-compose blends the texels it
+  // samples): `from` = key k0, `to` = key k1 or null when textureAt copies k0 alone, `weight`
+  // = keyWeight(t, k0, k1). Keys other than k0, k1 are dropped; the pointers stay valid until
+  // the next textureAt/keysAt/key call.
+  void keysAt(double t, const float*& from, const float*& to, float& weight);
   // Key k's texture, loaded if it is not (for a constant movie: its only texture).
   const std::vector<float>& key(size_t k);
   long long keysRead() const { return keysRead_; }
 
  private:
   void load(size_t k);
+  void loadAround(double t, size_t& k0, size_t& k1);
   std::string path_;
   struct Reader;  // OpenEXR core context, open for the stream's lifetime
   std::unique_ptr<Reader> reader_;

@@ -17,16 +17,25 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // Bilinear sample with texel centres at ((i+.5)/w, (j+.5)/h) and clamp-to-edge: what GL_LINEAR
-// with GL_CLAMP_TO_EDGE returns (in double, without GL's 8-bit weight quantisation).
-glm::dvec3 sampleClamped(const float* rgb, int w, int h, glm::dvec2 uv) {
+// with GL_CLAMP_TO_EDGE returns (in double, without GL's 8-bit weight quantisation). With a
+// second key `next`, each texel is first blended in float exactly as TextureMovie::textureAt
+// blends the whole texture: (1 - weight) * rgb + weight * next.
+glm::dvec3 sampleClamped(const float* rgb, const float* next, float weight, int w, int h,
+                         glm::dvec2 uv) {
   double x = std::clamp(uv.x * w - 0.5, 0.0, double(w - 1));
   double y = std::clamp(uv.y * h - 0.5, 0.0, double(h - 1));
   int i0 = std::min(int(x), w - 1), j0 = std::min(int(y), h - 1);
   int i1 = std::min(i0 + 1, w - 1), j1 = std::min(j0 + 1, h - 1);
   double fx = x - i0, fy = y - j0;
+  const float keep = 1.0f - weight;
   auto at = [&](int i, int j) {
-    const float* p = rgb + (size_t(j) * w + i) * 3;
-    return glm::dvec3(p[0], p[1], p[2]);
+    const size_t o = (size_t(j) * w + i) * 3;
+    const float* p = rgb + o;
+    if (!next) return glm::dvec3(p[0], p[1], p[2]);
+    const float* q = next + o;
+    const float r = keep * p[0] + weight * q[0], g = keep * p[1] + weight * q[1],
+                b = keep * p[2] + weight * q[2];
+    return glm::dvec3(r, g, b);
   };
   return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
          fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
@@ -220,7 +229,8 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
         if (found >= 0) {
           // $L = L_e + \frac{\rho(x)}{\pi} H(x)$
           const MovieTexture& mt = movies[size_t(found)];
-          glm::dvec3 H = sampleClamped(mt.irradiance, mt.width, mt.height, foundUv);
+          glm::dvec3 H = sampleClamped(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width,
+                                       mt.height, foundUv);
           L = mat.emission + (mat.reflectance * texFactor / kPi) * H;
           out.source[p] = PixelSource::kMovie;
           ++rowMovie[row];

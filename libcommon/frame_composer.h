@@ -34,10 +34,16 @@ namespace rad {
 
 // One texture movie's irradiance at the frame's time (TextureMovie::textureAt): W/m^2, RGB,
 // width * height texels row-major from j = 0 (v = 0). Not owned; must outlive compose().
+// Between two key textures, the blend TextureMovie::textureAt would compute is done per texel
+// as it is sampled, with the same float arithmetic (so the frame is bit-identical), instead of
+// into a copy of the whole texture: irradiance = key k0, nextIrradiance = key k1, weight = w,
+// texel = (1 - w) * k0 + w * k1 in float.
 struct MovieTexture {
   PatchId patch;
   int width = 1, height = 1;
   const float* irradiance = nullptr;
+  const float* nextIrradiance = nullptr;  // null: irradiance alone
+  float weight = 0.0f;                    // of nextIrradiance
 };
 
 // Where a pixel's radiance came from.

@@ -150,7 +150,7 @@ bool GlobalSolution::isBadPair(uint32_t receiverTop, uint32_t shooterTop) const 
                             std::make_pair(receiverTop, shooterTop));
 }
 
-void GlobalSolution::validate(const std::string& where) const {
+void GlobalSolution::validateRadiosity(const std::string& where) const {
   auto bad = [&](const std::string& what) { throw inputError(where, what); };
   size_t K = keyTimes.size(), N = size_t(hierarchy.size());
   if (K == 0) bad("no key times");
@@ -170,6 +170,14 @@ void GlobalSolution::validate(const std::string& where) const {
       bad("leaf node without a leaf row");
     }
   }
+}
+
+void GlobalSolution::validate(const std::string& where) const {
+  validateRadiosity(where);
+  auto bad = [&](const std::string& what) { throw inputError(where, what); };
+  size_t K = keyTimes.size(), N = size_t(hierarchy.size());
+  size_t leaves = 0;
+  for (int32_t row : leafRow) leaves += row >= 0;
   if (leafVertexGoodIrradiance.size() != leaves * K * 4) bad("leaf irradiance has the wrong size");
   if (linkSampleKeys.size() != linkSampleValues.size()) bad("link sample arrays differ in size");
   for (const GlobalLink& l : links) {

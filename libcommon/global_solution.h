@@ -79,6 +79,9 @@ class GlobalSolution {
 
   // Throws rad::inputError(where, ...) when sizes or indices are inconsistent.
   void validate(const std::string& where) const;
+  // The part of validate() that covers keyTimes, hierarchy, nodeRadiosity and leafRow only:
+  // all a solution read without its links and good irradiance (rad-compose) must satisfy.
+  void validateRadiosity(const std::string& where) const;
 };
 
 // Where a point of a node lies in its top-level patch's (u,v) square, and back: subdivision

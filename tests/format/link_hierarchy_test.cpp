@@ -67,6 +67,21 @@ TEST(LinkHierarchy, RoundTrip) {
   EXPECT_GT(g.hierarchy.size(), g.hierarchy.topCount());
   // Queries answer the same.
   EXPECT_EQ(r.goodIrradiance(0, {0.3, 0.6}, 0.1), g.goodIrradiance(0, {0.3, 0.6}, 0.1));
+
+  // rad-compose's read: the same hierarchy and radiosity, nothing of the links.
+  GlobalSolution c = readLinkHierarchyRadiosity(ContainerReader::open(path), scene);
+  EXPECT_EQ(c.keyTimes, g.keyTimes);
+  ASSERT_EQ(c.hierarchy.size(), g.hierarchy.size());
+  for (int i = 0; i < g.hierarchy.size(); ++i)
+    EXPECT_EQ(c.hierarchy.node(i).id, g.hierarchy.node(i).id);
+  EXPECT_EQ(c.nodeRadiosity, g.nodeRadiosity);
+  EXPECT_EQ(c.leafRow, g.leafRow);
+  EXPECT_EQ(c.radiosity(3, 0.1), g.radiosity(3, 0.1));
+  EXPECT_FALSE(g.links.empty());
+  EXPECT_TRUE(c.links.empty());
+  EXPECT_TRUE(c.linkSampleKeys.empty());
+  EXPECT_TRUE(c.linkSampleValues.empty());
+  EXPECT_TRUE(c.leafVertexGoodIrradiance.empty());
   std::filesystem::remove(path);
 }
 

@@ -208,6 +208,45 @@ TEST_F(TextureMovieFormat, StreamGivesTheSameTexturesHoldingTwoKeys) {
   }
 }
 
+// rad-compose blends the two keys per sampled texel (keysAt) instead of copying textureAt's
+// blend: the same float arithmetic must give textureAt's texels bit for bit, at every time
+// (before, between, on and after the keys), with only the two keys around t held.
+TEST_F(TextureMovieFormat, StreamKeysAtBlendIsTextureAtBitForBit) {
+  TextureMovie m = sampleMovie(5);
+  for (auto& k : m.keys)
+    for (size_t i = 0; i < k.size(); ++i)
+      k[i] = std::sin(float(i) * 0.37f + float(&k - &m.keys[0])) * 3.1f + 3.3f;
+  std::string path = dir() + "/k.exr";
+  writeTextureMovie(path, m);
+  TextureMovie whole = readTextureMovie(path);
+  TextureMovieStream stream(path);
+  std::vector<float> expected, blended;
+  int between = 0, alone = 0;
+  for (double t = m.keyTimes.front() - 0.1; t <= m.keyTimes.back() + 0.1; t += 1 / 96.0) {
+    whole.textureAt(t, expected);
+    const float* from = nullptr;
+    const float* to = nullptr;
+    float w = -1.0f;
+    stream.keysAt(t, from, to, w);
+    ASSERT_NE(from, nullptr);
+    blended.assign(expected.size(), 0.0f);
+    for (size_t i = 0; i < blended.size(); ++i)
+      blended[i] = to ? (1.0f - w) * from[i] + w * to[i] : from[i];
+    ASSERT_EQ(0, std::memcmp(blended.data(), expected.data(), blended.size() * sizeof(float))) << t;
+    (to ? between : alone)++;
+    if (to) {
+      EXPECT_GE(w, 0.0f);
+      EXPECT_LT(w, 1.0f);
+    }
+    size_t held = 0;
+    for (const auto& k : stream.movie().keys) held += k.empty() ? 0 : 1;
+    EXPECT_LE(held, 2u) << t;
+  }
+  EXPECT_GT(between, 10);  // both branches were exercised
+  EXPECT_GT(alone, 2);
+  EXPECT_EQ(stream.keysRead(), 5);
+}
+
 TEST_F(TextureMovieFormat, NotAMovieAndFutureVersionsAreRefusedByName) {
   std::string missing = dir() + "/missing.exr";
   EXPECT_EQ(errorOf(missing).rfind(missing + ": ", 0), 0u);
