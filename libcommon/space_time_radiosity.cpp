@@ -78,11 +78,12 @@ class LinkIntervals {
     lr.last = index;
   }
 
-  // (link, first row) in ascending link order.
-  std::vector<std::pair<uint64_t, uint32_t>> sortedLinks() const {
+  // (link, first row) in ascending link order. Ends the adding (the link index is freed).
+  std::vector<std::pair<uint64_t, uint32_t>> takeSortedLinks() {
     std::vector<std::pair<uint64_t, uint32_t>> v;
     v.reserve(links_.size());
     for (const auto& [key, lr] : links_) v.emplace_back(key, lr.first);
+    std::unordered_map<uint64_t, LinkRows>().swap(links_);
     std::sort(v.begin(), v.end());
     return v;
   }
@@ -328,7 +329,7 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
   // the coherence).
   std::vector<glm::dvec3> goodH(N * K, glm::dvec3(0.0));
   {
-    const std::vector<std::pair<uint64_t, uint32_t>> linkKeys = intervals.sortedLinks();
+    const std::vector<std::pair<uint64_t, uint32_t>> linkKeys = intervals.takeSortedLinks();
     size_t sampleTotal = 0;
     for (uint32_t i = 0; i < uint32_t(intervals.rowCount()); ++i)
       sampleTotal += LinkIntervals::sampleCount(intervals.row(i));
