@@ -200,6 +200,16 @@ ContainerWriter::ContainerWriter(std::string kind, int kindMajor, int kindMinor)
 
 void ContainerWriter::addRaw(const std::string& name, DType dtype, std::vector<uint64_t> shape,
                              const void* data, std::size_t nbytes) {
+  addPending(name, dtype, std::move(shape), data, nbytes, true);
+}
+
+void ContainerWriter::addRawView(const std::string& name, DType dtype, std::vector<uint64_t> shape,
+                                 const void* data, std::size_t nbytes) {
+  addPending(name, dtype, std::move(shape), data, nbytes, false);
+}
+
+void ContainerWriter::addPending(const std::string& name, DType dtype, std::vector<uint64_t> shape,
+                                 const void* data, std::size_t nbytes, bool copy) {
   if (name.empty()) throw Error(ExitCode::kInternal, kind_, "array with an empty name");
   for (const auto& p : arrays_) {
     if (p.info.name == name)
@@ -217,12 +227,16 @@ void ContainerWriter::addRaw(const std::string& name, DType dtype, std::vector<u
   p.info.dtype = dtype;
   p.info.shape = std::move(shape);
   p.info.nbytes = nbytes;
-  p.bytes.assign(static_cast<const uint8_t*>(data), static_cast<const uint8_t*>(data) + nbytes);
-  p.info.hash = formatFnv1a64(fnv1a64(p.bytes.data(), p.bytes.size()));
+  if (copy)
+    p.bytes.assign(static_cast<const uint8_t*>(data), static_cast<const uint8_t*>(data) + nbytes);
+  else
+    p.view = nbytes ? static_cast<const uint8_t*>(data) : p.bytes.data();
+  p.info.hash = formatFnv1a64(fnv1a64(p.data(), nbytes));
   arrays_.push_back(std::move(p));
 }
 
-std::vector<uint8_t> ContainerWriter::serialize() const {
+std::vector<uint8_t> ContainerWriter::headerBytes(std::vector<uint64_t>& offsets,
+                                                  uint64_t& dataBytes) const {
   nlohmann::json header;
   header["kind"] = kind_;
   header["kind_version"] = {kindMajor_, kindMinor_};
@@ -230,7 +244,7 @@ std::vector<uint8_t> ContainerWriter::serialize() const {
   header["metadata"] = metadata_;
   nlohmann::json table = nlohmann::json::array();
   uint64_t offset = 0;
-  std::vector<uint64_t> offsets;
+  offsets.clear();
   for (const auto& p : arrays_) {
     offsets.push_back(offset);
     table.push_back({{"name", p.info.name},
@@ -242,12 +256,13 @@ std::vector<uint8_t> ContainerWriter::serialize() const {
     offset = alignUp(offset + p.info.nbytes);
   }
   header["arrays"] = table;
+  dataBytes = offset;
   // Indented so `head -c 4000 file` is readable; the cost is a few hundred bytes.
   const std::string text = header.dump(1);
 
   std::vector<uint8_t> out;
   const uint64_t dataStart = alignUp(kPreambleSize + text.size());
-  out.reserve(static_cast<std::size_t>(dataStart + offset));
+  out.reserve(static_cast<std::size_t>(dataStart));
   out.insert(out.end(), kMagic, kMagic + sizeof kMagic);
   storeLE<uint32_t>(out, kContainerMajor);
   storeLE<uint32_t>(out, kContainerMinor);
@@ -256,23 +271,46 @@ std::vector<uint8_t> ContainerWriter::serialize() const {
   storeLE<uint64_t>(out, sum);
   out.insert(out.end(), text.begin(), text.end());
   out.resize(static_cast<std::size_t>(dataStart), 0);
+  return out;
+}
+
+std::vector<uint8_t> ContainerWriter::serialize() const {
+  std::vector<uint64_t> offsets;
+  uint64_t dataBytes = 0;
+  std::vector<uint8_t> out = headerBytes(offsets, dataBytes);
+  const uint64_t dataStart = out.size();
+  out.reserve(static_cast<std::size_t>(dataStart + dataBytes));
   for (std::size_t i = 0; i < arrays_.size(); ++i) {
     out.resize(static_cast<std::size_t>(dataStart + offsets[i]), 0);
-    out.insert(out.end(), arrays_[i].bytes.begin(), arrays_[i].bytes.end());
+    out.insert(out.end(), arrays_[i].data(), arrays_[i].data() + arrays_[i].info.nbytes);
   }
-  out.resize(static_cast<std::size_t>(dataStart + offset), 0);
+  out.resize(static_cast<std::size_t>(dataStart + dataBytes), 0);
   return out;
 }
 
 void ContainerWriter::write(const std::string& path) const {
-  const std::vector<uint8_t> bytes = serialize();
+  std::vector<uint64_t> offsets;
+  uint64_t dataBytes = 0;
+  const std::vector<uint8_t> header = headerBytes(offsets, dataBytes);
   AtomicFile file(path);
   int fd = ::open(file.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) {
     throw outputError(
         path, "cannot create temporary file " + file.tempPath() + ": " + std::strerror(errno));
   }
-  const bool ok = writeAll(fd, bytes.data(), bytes.size());
+  // The same bytes as serialize(), array by array with the zero padding between them.
+  const uint8_t zeros[kContainerAlignment] = {};
+  bool ok = writeAll(fd, header.data(), header.size());
+  uint64_t written = 0;  // of the data section
+  for (std::size_t i = 0; ok && i <= arrays_.size(); ++i) {
+    const uint64_t start = i < arrays_.size() ? offsets[i] : dataBytes;
+    ok = writeAll(fd, zeros, static_cast<std::size_t>(start - written));
+    written = start;
+    if (ok && i < arrays_.size()) {
+      ok = writeAll(fd, arrays_[i].data(), static_cast<std::size_t>(arrays_[i].info.nbytes));
+      written += arrays_[i].info.nbytes;
+    }
+  }
   const int err = errno;
   if (::close(fd) != 0 || !ok) {
     throw outputError(path, std::string("cannot write: ") + std::strerror(ok ? errno : err));

@@ -92,19 +92,36 @@ class ContainerWriter {
   // Untyped form of addArray: `nbytes` bytes at `data`, already little-endian.
   void addRaw(const std::string& name, DType dtype, std::vector<uint64_t> shape, const void* data,
               std::size_t nbytes);
+  // Like addArray / addRaw but without the copy: the writer keeps `data` and reads it again in
+  // write() / serialize(), so it must stay alive and unchanged until then (large outputs are
+  // then held once, not twice). The file's bytes are the same as with addArray.
+  template <class T>
+  void addArrayView(const std::string& name, const std::vector<T>& values,
+                    std::vector<uint64_t> shape = {}) {
+    if (shape.empty()) shape = {static_cast<uint64_t>(values.size())};
+    addRawView(name, dtypeOf<T>(), std::move(shape), values.data(), values.size() * sizeof(T));
+  }
+  void addRawView(const std::string& name, DType dtype, std::vector<uint64_t> shape,
+                  const void* data, std::size_t nbytes);
 
   // Serialises the whole file to memory (used by write(); handy for tests).
   std::vector<uint8_t> serialize() const;
   // Atomic: writes a hidden temporary beside `path`, fsyncs and renames it (AtomicFile). On
   // failure nothing appears at `path`, no temporary is left, and rad::outputError(path, ...)
-  // is thrown.
+  // is thrown. Streams the arrays to the file (the bytes of serialize(), never all in memory).
   void write(const std::string& path) const;
 
  private:
   struct Pending {
     ArrayInfo info;
-    std::vector<uint8_t> bytes;
+    std::vector<uint8_t> bytes;     // addArray / addRaw: the copy
+    const uint8_t* view = nullptr;  // addArrayView / addRawView: the caller's bytes
+    const uint8_t* data() const { return view ? view : bytes.data(); }
   };
+  void addPending(const std::string& name, DType dtype, std::vector<uint64_t> shape,
+                  const void* data, std::size_t nbytes, bool copy);
+  // Preamble + JSON header + zero padding up to the data section; each array's offset in it.
+  std::vector<uint8_t> headerBytes(std::vector<uint64_t>& offsets, uint64_t& dataBytes) const;
   std::string kind_;
   int kindMajor_, kindMinor_;
   nlohmann::json provenance_;  // null until setProvenance

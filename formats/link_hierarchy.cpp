@@ -8,13 +8,6 @@ namespace rad {
 
 namespace {
 
-std::vector<float> flatten(const std::vector<glm::vec3>& v) {
-  std::vector<float> out(v.size() * 3);
-  for (size_t i = 0; i < v.size(); ++i)
-    for (int c = 0; c < 3; ++c) out[i * 3 + c] = v[i][c];
-  return out;
-}
-
 std::vector<glm::vec3> unflatten(const std::vector<float>& f) {
   std::vector<glm::vec3> out(f.size() / 3);
   for (size_t i = 0; i < out.size(); ++i) out[i] = {f[i * 3], f[i * 3 + 1], f[i * 3 + 2]};
@@ -44,10 +37,16 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
   }
   w.addArray("node_ids", ids);
   w.addArray("node_parent", parent);
-  w.addArray("node_radiosity", flatten(s.nodeRadiosity), {N, K, 3});
+  // The large arrays are handed to the writer as views (no copy): they stay alive in `s`
+  // until w.write() below, and the file holds exactly their bytes (glm::vec3 is 3 floats).
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 is not 3 packed floats");
+  w.addRawView("node_radiosity", DType::kF32, {N, K, 3}, s.nodeRadiosity.data(),
+               s.nodeRadiosity.size() * sizeof(glm::vec3));
   w.addArray("leaf_row", s.leafRow);
   size_t L = s.leafVertexGoodIrradiance.size() / std::max<size_t>(1, K * 4);
-  w.addArray("leaf_vertex_good_irradiance", flatten(s.leafVertexGoodIrradiance), {L, K, 4, 3});
+  w.addRawView("leaf_vertex_good_irradiance", DType::kF32, {L, K, 4, 3},
+               s.leafVertexGoodIrradiance.data(),
+               s.leafVertexGoodIrradiance.size() * sizeof(glm::vec3));
   size_t M = s.links.size();
   std::vector<uint32_t> cols(M * 6);
   std::vector<uint8_t> flags(M);
@@ -57,10 +56,10 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
     std::copy(row, row + 6, cols.begin() + i * 6);
     flags[i] = l.flags;
   }
-  w.addArray("links", cols, {M, 6});
-  w.addArray("link_flags", flags);
-  w.addArray("link_sample_keys", s.linkSampleKeys);
-  w.addArray("link_sample_values", s.linkSampleValues);
+  w.addArrayView("links", cols, {M, 6});
+  w.addArrayView("link_flags", flags);
+  w.addArrayView("link_sample_keys", s.linkSampleKeys);
+  w.addArrayView("link_sample_values", s.linkSampleValues);
   std::vector<uint32_t> pairs;
   for (auto& p : s.badPairs) {
     pairs.push_back(p.first);

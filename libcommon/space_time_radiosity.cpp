@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <map>
+#include <memory>
 #include <unordered_map>
 
 #include "libcommon/error.h"
@@ -17,16 +19,135 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
 }
 
 // What the merge needs of one key-time solve besides its links (which go straight into the
-// per-link sample lists, so every key's links are held once, not twice).
+// LinkIntervals store as each key finishes).
 struct KeyRecord {
   std::vector<glm::vec3> radiosity;  // per node of the union hierarchy at that time (push-down)
 };
 
-// One key time's value of one link.
-struct LinkSample {
-  uint32_t key;
-  float fv, visibility;
-  bool refined;
+// The links' activity intervals (paper §4.2), built incrementally as each key time finishes so
+// that memory holds the compact result, not every key's links: per link, its rows (maximal runs
+// of consecutive keys with the same refined flag) and, for a row whose F·V changes, its F·V at
+// every key of the run. A row whose F·V has not changed (yet) keeps only its first value; when
+// it first changes, the run so far is written out as copies of that value. The rows and their
+// values are exactly those of GlobalSolution::links / linkSample* (keys are implied: a row's
+// samples are at firstKey..lastKey, or only at firstKey when constant).
+class LinkIntervals {
+ public:
+  static constexpr uint32_t kNone = ~uint32_t(0);
+
+  struct Row {
+    uint32_t firstKey = 0, lastKey = 0;
+    float firstFv = 0, firstVisibility = 0;
+    // F·V at every key of the run once one differed from firstFv (in its bits), else none.
+    uint32_t firstBlock = kNone, lastBlock = kNone;
+    uint32_t valueCount = 0;
+    uint32_t nextRow = kNone;  // the same link's next row (later keys)
+    bool refined = false, constant = true, visibilityChanged = false;
+  };
+
+  // The link's value at key `key`; keys arrive in non-decreasing order.
+  void add(uint64_t link, uint32_t key, float fv, float visibility, bool refined) {
+    auto [it, fresh] = links_.try_emplace(link, LinkRows{kNone, kNone});
+    LinkRows& lr = it->second;
+    if (!fresh) {
+      Row& r = rows_[lr.last];
+      if (r.lastKey + 1 == key && r.refined == refined) {  // the run goes on
+        r.lastKey = key;
+        r.visibilityChanged |= visibility != r.firstVisibility;
+        r.constant &= fv == r.firstFv;
+        // Values are kept from the first one that differs in its bits (F·V changed, or only
+        // the sign of a zero: such a row stays constant, but its values are kept exact).
+        if (r.valueCount == 0 && (!r.constant || !sameBits(fv, r.firstFv)))
+          for (uint32_t k = r.firstKey; k < key; ++k) append(r, r.firstFv);
+        if (r.valueCount > 0) append(r, fv);
+        return;
+      }
+    }
+    // A new row: the link's first, or a gap / a change of the refined flag ends the last one.
+    Row r;
+    r.firstKey = r.lastKey = key;
+    r.firstFv = fv;
+    r.firstVisibility = visibility;
+    r.refined = refined;
+    uint32_t index = uint32_t(rows_.size());
+    rows_.push_back(r);
+    if (fresh)
+      lr.first = index;
+    else
+      rows_[lr.last].nextRow = index;
+    lr.last = index;
+  }
+
+  // (link, first row) in ascending link order. Ends the adding (the link index is freed).
+  std::vector<std::pair<uint64_t, uint32_t>> takeSortedLinks() {
+    std::vector<std::pair<uint64_t, uint32_t>> v;
+    v.reserve(links_.size());
+    for (const auto& [key, lr] : links_) v.emplace_back(key, lr.first);
+    std::unordered_map<uint64_t, LinkRows>().swap(links_);
+    std::sort(v.begin(), v.end());
+    return v;
+  }
+  const Row& row(uint32_t i) const { return rows_[i]; }
+  size_t rowCount() const { return rows_.size(); }
+  // The samples a row contributes to GlobalSolution::linkSample*.
+  static uint32_t sampleCount(const Row& r) { return r.constant ? 1 : r.valueCount; }
+  // Calls f(key, fv) for every key of the row's run.
+  template <class F>
+  void forEachKey(const Row& r, F&& f) const {
+    if (r.valueCount == 0) {  // every value had the bits of the first
+      for (uint32_t k = r.firstKey; k <= r.lastKey; ++k) f(k, r.firstFv);
+      return;
+    }
+    uint32_t k = r.firstKey, left = r.valueCount;
+    for (uint32_t b = r.firstBlock; b != kNone && left > 0; b = block(b).next) {
+      const Block& blk = block(b);
+      for (uint32_t j = 0; j < kBlockValues && left > 0; ++j, --left) f(k++, blk.values[j]);
+    }
+  }
+
+ private:
+  // Values live in fixed-size blocks chained per row, allocated from slabs that never move: no
+  // per-link vector slack and no reallocation copies (a row wastes less than one block).
+  static constexpr uint32_t kBlockValues = 15;
+  struct Block {
+    float values[kBlockValues];
+    uint32_t next;
+  };
+  static bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+  static constexpr uint32_t kSlabShift = 14;  // 16384 blocks of 64 bytes: 1 MiB slabs
+  struct LinkRows {
+    uint32_t first, last;
+  };
+
+  Block& block(uint32_t i) { return slabs_[i >> kSlabShift][i & ((1u << kSlabShift) - 1)]; }
+  const Block& block(uint32_t i) const {
+    return slabs_[i >> kSlabShift][i & ((1u << kSlabShift) - 1)];
+  }
+  uint32_t newBlock() {
+    if ((blockCount_ >> kSlabShift) >= slabs_.size())
+      slabs_.push_back(std::make_unique<Block[]>(size_t(1) << kSlabShift));
+    uint32_t i = blockCount_++;
+    block(i).next = kNone;
+    return i;
+  }
+  void append(Row& r, float fv) {
+    uint32_t slot = r.valueCount % kBlockValues;
+    if (slot == 0) {
+      uint32_t b = newBlock();
+      if (r.lastBlock == kNone)
+        r.firstBlock = b;
+      else
+        block(r.lastBlock).next = b;
+      r.lastBlock = b;
+    }
+    block(r.lastBlock).values[slot] = fv;
+    ++r.valueCount;
+  }
+
+  std::unordered_map<uint64_t, LinkRows> links_;
+  std::vector<Row> rows_;
+  std::vector<std::unique_ptr<Block[]>> slabs_;
+  uint32_t blockCount_ = 0;
 };
 
 // Radiosity of every node, nodes outside the key's tree taking their parent's value.
@@ -119,8 +240,9 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
   rep.secondsSetup = secondsSince(tSetup);
 
   std::vector<KeyRecord> records(K);
-  // Per link (receiver << 32 | shooter): its value at every key where it exists, in key order.
-  std::unordered_map<uint64_t, std::vector<LinkSample>> perLink;
+  // Per link (receiver << 32 | shooter): its activity intervals so far, compacted as each key
+  // time finishes (memory: the compact result, not every key's links).
+  LinkIntervals intervals;
   std::vector<char> badPair(size_t(T) * size_t(T), 0);  // paper §3.1, over all key times
   KeySolution prev;
   for (size_t k = 0; k < K; ++k) {
@@ -154,8 +276,8 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
 
     KeyRecord& rec = records[k];
     for (const SolverLink& l : s.links) {
-      perLink[(uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter)].push_back(
-          {uint32_t(k), float(l.fv()), float(l.visibility), l.refined});
+      intervals.add((uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter), uint32_t(k),
+                    float(l.fv()), float(l.visibility), l.refined);
       // Bad pairs: by shooter top (and partial visibility).
       uint32_t rt = h.node(l.receiver).id.top, st = h.node(l.shooter).id.top;
       char& bad = badPair[size_t(rt) * size_t(T) + st];
@@ -201,50 +323,51 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     for (uint32_t s = 0; s < uint32_t(T); ++s)
       if (badPair[size_t(r) * size_t(T) + s]) g.badPairs.emplace_back(r, s);
 
-  // Links: one row per activity interval (maximal run of consecutive keys, same refined flag).
-  std::vector<uint64_t> linkKeys;
-  linkKeys.reserve(perLink.size());
-  for (const auto& [key, v] : perLink) linkKeys.push_back(key);
-  std::sort(linkKeys.begin(), linkKeys.end());
-  // Good-link irradiance gathered at each node at each key (summed in link order: the same
-  // whatever the thread count or the coherence).
+  // Links: one row per activity interval (maximal run of consecutive keys, same refined flag),
+  // in ascending (receiver, shooter) order, rows in key order. Good-link irradiance gathered at
+  // each node at each key, summed in that link order (the same whatever the thread count or
+  // the coherence).
   std::vector<glm::dvec3> goodH(N * K, glm::dvec3(0.0));
-  for (uint64_t key : linkKeys) {
-    uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
-    if (badPair[size_t(h.node(int(rcv)).id.top) * size_t(T) + h.node(int(sh)).id.top]) continue;
-    for (const LinkSample& x : perLink[key])
-      if (!x.refined)
-        goodH[x.key * N + rcv] += double(x.fv) * glm::dvec3(records[x.key].radiosity[sh]);
-  }
-  for (uint64_t key : linkKeys) {
-    const std::vector<LinkSample>& v = perLink[key];  // ascending keys (filled in key order)
-    uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
-    bool bad = badPair[size_t(h.node(int(rcv)).id.top) * size_t(T) + h.node(int(sh)).id.top];
-    for (size_t a = 0; a < v.size();) {
-      size_t b = a + 1;
-      while (b < v.size() && v[b].key == v[b - 1].key + 1 && v[b].refined == v[a].refined) ++b;
-      GlobalLink gl;
-      gl.receiver = rcv;
-      gl.shooter = sh;
-      gl.firstKey = v[a].key;
-      gl.lastKey = v[b - 1].key;
-      gl.sampleOffset = uint32_t(g.linkSampleKeys.size());
-      bool constant = true, visChanged = false;
-      for (size_t j = a + 1; j < b; ++j) {
-        constant &= v[j].fv == v[a].fv;
-        visChanged |= v[j].visibility != v[a].visibility;
+  {
+    const std::vector<std::pair<uint64_t, uint32_t>> linkKeys = intervals.takeSortedLinks();
+    size_t sampleTotal = 0;
+    for (uint32_t i = 0; i < uint32_t(intervals.rowCount()); ++i)
+      sampleTotal += LinkIntervals::sampleCount(intervals.row(i));
+    g.links.reserve(intervals.rowCount());
+    g.linkSampleKeys.reserve(sampleTotal);
+    g.linkSampleValues.reserve(sampleTotal);
+    for (const auto& [key, firstRow] : linkKeys) {
+      uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
+      bool bad = badPair[size_t(h.node(int(rcv)).id.top) * size_t(T) + h.node(int(sh)).id.top];
+      for (uint32_t ri = firstRow; ri != LinkIntervals::kNone; ri = intervals.row(ri).nextRow) {
+        const LinkIntervals::Row& r = intervals.row(ri);
+        if (!bad && !r.refined)
+          intervals.forEachKey(r, [&](uint32_t k, float fv) {
+            goodH[k * N + rcv] += double(fv) * glm::dvec3(records[k].radiosity[sh]);
+          });
+        GlobalLink gl;
+        gl.receiver = rcv;
+        gl.shooter = sh;
+        gl.firstKey = r.firstKey;
+        gl.lastKey = r.lastKey;
+        gl.sampleOffset = uint32_t(g.linkSampleKeys.size());
+        if (r.constant) {
+          g.linkSampleKeys.push_back(r.firstKey);
+          g.linkSampleValues.push_back(r.firstFv);
+        } else {
+          intervals.forEachKey(r, [&](uint32_t k, float fv) {
+            g.linkSampleKeys.push_back(k);
+            g.linkSampleValues.push_back(fv);
+          });
+        }
+        gl.sampleCount = uint32_t(g.linkSampleKeys.size()) - gl.sampleOffset;
+        gl.flags = uint8_t((bad ? kLinkBad : 0) | (r.visibilityChanged ? kLinkVisibilityEvent : 0) |
+                           (r.refined ? kLinkRefined : 0));
+        g.links.push_back(gl);
       }
-      for (size_t j = a; j < (constant ? a + 1 : b); ++j) {
-        g.linkSampleKeys.push_back(v[j].key);
-        g.linkSampleValues.push_back(v[j].fv);
-      }
-      gl.sampleCount = uint32_t(g.linkSampleKeys.size()) - gl.sampleOffset;
-      gl.flags = uint8_t((bad ? kLinkBad : 0) | (visChanged ? kLinkVisibilityEvent : 0) |
-                         (v[a].refined ? kLinkRefined : 0));
-      g.links.push_back(gl);
-      a = b;
     }
   }
+  intervals = LinkIntervals();  // its memory back before the leaf arrays
 
   // Good-link irradiance at the union leaves' vertices (Gouraud: averaged over the leaves of
   // the same top-level patch that share the vertex, in exact dyadic top-level (u,v)).

@@ -10,6 +10,10 @@
 // and, since the solve makes the same decisions from them, the coherent solution is
 // bit-identical to independent per-key solves. Without coherence every key time is an
 // independent solve (the baseline of the speed-up, and of the tests).
+//
+// Memory: each key time's links are folded into the links' activity intervals as soon as the
+// key is solved (a run whose F·V does not change keeps one value), so the peak is one key's
+// solve plus the compact result, not key times x links.
 #pragma once
 
 #include <functional>

@@ -144,6 +144,45 @@ TEST_F(ContainerTest, RoundTripsEveryDtypeAndShape) {
   roundTripDtype<double>(file("f64.rc"), DType::kF64);
 }
 
+// write() streams the arrays to the file instead of assembling it in memory, and views
+// (addArrayView / addRawView: the caller's bytes, not a copy) give the same file as copies:
+// the bytes of serialize(), padding and empty arrays included.
+TEST_F(ContainerTest, StreamedWriteAndViewsGiveTheSerializedBytes) {
+  const std::vector<uint32_t> links = {1, 2, 3, 4, 5, 6};
+  const std::vector<float> radiosity = {0.5f, 1e30f, -0.0f};
+  const std::vector<uint8_t> flags = {1, 0, 1};
+  const std::vector<double> empty;
+  std::vector<uint8_t> odd(129);  // not a multiple of the alignment: padding follows
+  for (std::size_t i = 0; i < odd.size(); ++i) odd[i] = uint8_t(i * 7 + 1);
+  ContainerWriter copies("linkhier", 1, 2), views("linkhier", 1, 2);
+  for (ContainerWriter* w : {&copies, &views}) {
+    w->setProvenance(sampleProvenance());
+    w->metadata()["frames"] = 400;
+  }
+  copies.addArray("links", links, {3, 2});
+  copies.addArray("radiosity", radiosity);
+  copies.addArray("empty", empty);
+  copies.addArray("odd", odd);
+  copies.addArray("flags", flags);
+  views.addArrayView("links", links, {3, 2});
+  views.addRawView("radiosity", DType::kF32, {3}, radiosity.data(), radiosity.size() * 4);
+  views.addArrayView("empty", empty);
+  views.addArrayView("odd", odd);
+  views.addArrayView("flags", flags);
+  const std::vector<uint8_t> serialized = copies.serialize();
+  EXPECT_EQ(views.serialize(), serialized);
+  copies.write(file("copies.rc"));
+  views.write(file("views.rc"));
+  EXPECT_EQ(readBytes(file("copies.rc")), serialized);
+  EXPECT_EQ(readBytes(file("views.rc")), serialized);
+  const ContainerReader r = ContainerReader::open(file("views.rc"));
+  EXPECT_EQ(r.array<uint8_t>("odd"), odd);
+  EXPECT_EQ(r.array<uint8_t>("flags"), flags);
+  EXPECT_TRUE(r.array<double>("empty").empty());
+  // A view's shape is checked like a copy's.
+  EXPECT_THROW(views.addArrayView("bad", links, {4, 2}), Error);
+}
+
 TEST_F(ContainerTest, LayoutIsAlignedAndSelfDescribing) {
   const std::vector<uint8_t> bytes = sampleWriter().serialize();
   EXPECT_EQ(bytes.size() % 64, 0u);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <map>
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -155,6 +156,97 @@ TEST(SpaceTimeRadiosity, MergedSolutionIsConsistent) {
   glm::dvec3 b = g.goodIrradianceAtKey(floorTop, {0.5 + 1e-9, 0.5}, 0);
   EXPECT_NEAR(a.y, b.y, 1e-5 * (1 + a.y));
   EXPECT_GT(a.y, 0.0);
+}
+
+// The link rows are compacted as each key time finishes (memory: the compact result, not every
+// key's links); they must be exactly the rows of the plain merge of the per-key link lists: per
+// link (ascending receiver, shooter), the maximal runs of consecutive keys with the same refined
+// flag, one sample when F·V is the same at every key of the run, else one per key. Twenty key
+// times, so that runs outgrow the store's 15-value blocks.
+TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
+  Scene scene = cornell();
+  std::vector<double> keys;
+  for (int k = 0; k < 20; ++k) keys.push_back(k * 2 / 24.0);
+  SpaceTimeOptions o = fastOptions();
+  o.coherence = false;
+  GlobalSolution g = solveSpaceTime(scene, keys, o);
+
+  // The same independent key solves on the same shared hierarchy, every key's links kept.
+  PatchHierarchy h(scene.inputPolygons());
+  std::vector<SurfaceProperties> surfaces = surfacePropertiesOf(scene, h);
+  SceneVisibility vis(scene, h, keys.front(), keys.back());
+  struct Sample {
+    uint32_t key;
+    float fv, visibility;
+    bool refined;
+  };
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<Sample>> perLink;
+  for (size_t k = 0; k < keys.size(); ++k) {
+    vis.setTime(keys[k]);
+    KeySolveInput in;
+    in.topToWorld = topTransforms(scene, h, keys[k]);
+    in.visibility = &vis.visibility();
+    KeySolution s = solveKeyTime(h, surfaces, in, o.radiosity);
+    for (const SolverLink& l : s.links)
+      perLink[{uint32_t(l.receiver), uint32_t(l.shooter)}].push_back(
+          {uint32_t(k), float(l.fv()), float(l.visibility), l.refined});
+  }
+  ASSERT_EQ(h.size(), g.hierarchy.size());
+  std::vector<GlobalLink> rows;
+  std::vector<uint32_t> sampleKeys;
+  std::vector<float> sampleValues;
+  for (const auto& [link, v] : perLink)
+    for (size_t a = 0; a < v.size();) {
+      size_t b = a + 1;
+      while (b < v.size() && v[b].key == v[b - 1].key + 1 && v[b].refined == v[a].refined) ++b;
+      bool constant = true, visibilityChanged = false;
+      for (size_t j = a + 1; j < b; ++j) {
+        constant &= v[j].fv == v[a].fv;
+        visibilityChanged |= v[j].visibility != v[a].visibility;
+      }
+      GlobalLink r;
+      r.receiver = link.first;
+      r.shooter = link.second;
+      r.firstKey = v[a].key;
+      r.lastKey = v[b - 1].key;
+      r.sampleOffset = uint32_t(sampleKeys.size());
+      for (size_t j = a; j < (constant ? a + 1 : b); ++j) {
+        sampleKeys.push_back(v[j].key);
+        sampleValues.push_back(v[j].fv);
+      }
+      r.sampleCount = uint32_t(sampleKeys.size()) - r.sampleOffset;
+      // --bad-links lights (the default): a link is bad when its shooter emits.
+      bool bad = surfaces[h.node(int(link.second)).id.top].isEmitter();
+      r.flags = uint8_t((bad ? kLinkBad : 0) | (visibilityChanged ? kLinkVisibilityEvent : 0) |
+                        (v[a].refined ? kLinkRefined : 0));
+      rows.push_back(r);
+      a = b;
+    }
+  size_t longRuns = 0, constantRuns = 0, splitLinks = 0;
+  for (const GlobalLink& r : rows) {
+    longRuns += r.sampleCount > 15;
+    constantRuns += r.sampleCount == 1 && r.lastKey > r.firstKey;
+  }
+  for (size_t i = 1; i < rows.size(); ++i)
+    splitLinks +=
+        rows[i].receiver == rows[i - 1].receiver && rows[i].shooter == rows[i - 1].shooter;
+  std::cout << rows.size() << " link rows: " << longRuns << " with more than 15 samples, "
+            << constantRuns << " constant over several keys, " << splitLinks
+            << " continuing an earlier row of their link\n";
+  EXPECT_GT(longRuns, 0u);
+  EXPECT_GT(constantRuns, 0u);
+  EXPECT_GT(splitLinks, 0u);
+
+  ASSERT_EQ(g.links.size(), rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const GlobalLink &x = g.links[i], &y = rows[i];
+    ASSERT_TRUE(x.receiver == y.receiver && x.shooter == y.shooter && x.firstKey == y.firstKey &&
+                x.lastKey == y.lastKey && x.sampleOffset == y.sampleOffset &&
+                x.sampleCount == y.sampleCount && x.flags == y.flags)
+        << "link row " << i;
+  }
+  EXPECT_TRUE(g.linkSampleKeys == sampleKeys);
+  EXPECT_TRUE(g.linkSampleValues == sampleValues);
 }
 
 }  // namespace
