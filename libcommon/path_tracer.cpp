@@ -381,6 +381,8 @@ struct PathTracer::Impl {
     double tNear = ray.tNear, tFar = ray.tFar;
     std::uint32_t from = kNoPolygon;
     double pdfBsdf = 0.0;  // solid-angle density of the continuation that reached this hit
+    constexpr int kMaxCulledPasses = 64;  // back faces a primary ray may pass through
+    int culledPasses = 0;
     for (int bounce = 0;; ++bounce) {
       const Hit h = intersect(origin, dir, tNear, tFar, from);
       if (h.surface == kNoPolygon) break;
@@ -390,6 +392,19 @@ struct PathTracer::Impl {
       glm::dvec3 n = s.normal;
       int emitter = s.frontEmitter;
       if (glm::dot(dir, n) >= 0.0) {
+        if (!s.doubleSided && bounce == 0 && culledPasses < kMaxCulledPasses) {
+          // The camera does not see the back of a one-sided polygon: glTF culls back faces
+          // (doubleSided false), and so does rad-compose's item buffer (DESIGN.md §4:
+          // one-sided by winding). The primary ray goes on past it. Light paths still treat
+          // the polygon as opaque, as the radiosity stages' visibility does.
+          ++culledPasses;
+          origin += t * dir;
+          tFar -= t;
+          tNear = 0.0;
+          from = hit;
+          --bounce;  // still the primary ray
+          continue;
+        }
         if (!s.doubleSided) break;  // back of a one-sided polygon: black, absorbing
         n = -n;
         emitter = s.backEmitter;

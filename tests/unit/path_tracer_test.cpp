@@ -279,6 +279,36 @@ TEST(PathTracer, EmitterFacingAwayOrBlockedGivesNoLight) {
   EXPECT_EQ(t2.estimateRadiance(r, 200, 3, PathTracerOptions()).mean, glm::dvec3(0.0));
 }
 
+// The camera does not see the back of a one-sided polygon (glTF back-face culling, as
+// rad-compose's item buffer): a primary ray passes through it and sees the emitter behind, at
+// exactly L_e. Seen from the front the same sheet (black) hides the emitter.
+TEST(PathTracer, PrimaryRaysPassThroughTheBackOfOneSidedPolygons) {
+  SquareLight sl;
+  const double z = 0.5 * sl.h;
+  std::vector<glm::dvec3> sheetFacingUp = {{-1, -1, z}, {1, -1, z}, {1, 1, z}, {-1, 1, z}};
+  std::vector<glm::dvec3> sheetFacingDown(sheetFacingUp.rbegin(), sheetFacingUp.rend());
+  const std::vector<Material> materials = {material(glm::dvec3(0.0), sl.le),
+                                           material(glm::dvec3(0.0), glm::dvec3(0.0))};
+  Ray up;
+  up.origin = glm::dvec3(0.1, 0.05, 0.0);
+  up.direction = glm::dvec3(0.0, 0.0, 1.0);
+  up.tNear = 0.0;
+  up.tFar = std::numeric_limits<double>::infinity();
+  PathTracer culled(sceneOf({{sl.emitterFacingDown(), 0}, {sheetFacingUp, 1}}, materials), 0.0);
+  EXPECT_EQ(culled.estimateRadiance(up, 16, 5, PathTracerOptions()).mean, sl.le);
+  PathTracer seen(sceneOf({{sl.emitterFacingDown(), 0}, {sheetFacingDown, 1}}, materials), 0.0);
+  EXPECT_EQ(seen.estimateRadiance(up, 16, 5, PathTracerOptions()).mean, glm::dvec3(0.0));
+  // Two culled sheets in a row, and a tFar short of the emitter: nothing is seen.
+  std::vector<glm::dvec3> second = sheetFacingUp;
+  for (glm::dvec3& v : second) v.z = 0.75 * sl.h;
+  PathTracer twice(
+      sceneOf({{sl.emitterFacingDown(), 0}, {sheetFacingUp, 1}, {second, 1}}, materials), 0.0);
+  EXPECT_EQ(twice.estimateRadiance(up, 16, 5, PathTracerOptions()).mean, sl.le);
+  Ray shortRay = up;
+  shortRay.tFar = 0.9 * sl.h;
+  EXPECT_EQ(twice.estimateRadiance(shortRay, 16, 5, PathTracerOptions()).mean, glm::dvec3(0.0));
+}
+
 // A textured receiver: reflectance = baseColorFactor x texel at the hit's uv (bilinear,
 // texel centres at half-integers), not the material's mean.
 TEST(PathTracer, TexturedReceiverUsesTheTexelUnderTheHit) {
