@@ -163,13 +163,44 @@ def frame_difference(bin_dir, a, b):
         return None
 
 
+def rad_diff(bin_dir, test, reference):
+    """rad-diff's figures (the "difference" object of --json) of test against reference."""
+    p = subprocess.run([os.path.join(bin_dir, "rad-diff"), test, reference, "--json"],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError("rad-diff %s %s: %s" % (test, reference, p.stderr.strip()))
+    return json.loads(p.stdout)["difference"]
+
+
+class ReferenceNoise:
+    """Error against two path-traced references A, B (files or frame directories) with
+    independent noise, the references' noise removed: E rmse(T,A)^2 = d^2 + s^2 and
+    E rmse(A,B)^2 = 2 s^2, so d^2 = (rmse(T,A)^2 + rmse(T,B)^2)/2 - rmse(A,B)^2/2."""
+
+    def __init__(self, bin_dir, refs):
+        self.bin_dir, self.refs = bin_dir, refs
+        between = rad_diff(bin_dir, refs[1], refs[0])
+        self.noise2 = between["rmse"] ** 2 / 2.0  # one reference's variance per pixel channel
+        # 1 / rms of the reference: turns an rmse into a relative L2
+        self.scale = between["relative_l2"] / between["rmse"] if between["rmse"] > 0 else 0.0
+
+    def relative_l2(self):
+        return math.sqrt(self.noise2) * self.scale
+
+    def error_of(self, test):
+        da, db = (rad_diff(self.bin_dir, test, r) for r in self.refs)
+        raw2 = (da["rmse"] ** 2 + db["rmse"] ** 2) / 2.0
+        rmse = math.sqrt(max(0.0, raw2 - self.noise2))
+        return {"rmse": rmse, "relative_l2": rmse * self.scale,
+                "raw_relative_l2": math.sqrt(raw2) * self.scale}
+
+
 def reference_difference(bin_dir, scene, out, frame, size, spp, tests, log):
     """Relative L2 of each tests[name] frame file against the path-traced reference at `frame`,
     the references' noise removed (see the module docstring); rendered once and kept in
     OUT/reference-FRAME-SPP/. Returns {name: {...}} or None."""
     ref = os.path.join(bin_dir, "rad-reference")
-    diff = os.path.join(bin_dir, "rad-diff")
-    if not (os.path.exists(ref) and os.path.exists(diff)):
+    if not (os.path.exists(ref) and os.path.exists(os.path.join(bin_dir, "rad-diff"))):
         return None
     name = "%04d.exr" % frame
     refs = []
@@ -180,25 +211,11 @@ def reference_difference(bin_dir, scene, out, frame, size, spp, tests, log):
                  "--spp", str(spp), "--seed", str(seed), "--pixel-centres"], log)
         refs.append(os.path.join(d, name))
 
-    def compare(a, b):
-        p = subprocess.run([diff, a, b, "--json"], capture_output=True, text=True)
-        if p.returncode != 0:
-            raise RuntimeError("rad-diff %s %s: %s" % (a, b, p.stderr.strip()))
-        return json.loads(p.stdout)["difference"]
-
-    between = compare(refs[1], refs[0])
-    noise2 = between["rmse"] ** 2 / 2.0  # one reference's noise variance per pixel channel
-    result = {"frame": frame, "spp": spp, "reference_noise_relative_l2":
-              math.sqrt(noise2) * between["relative_l2"] / between["rmse"]
-              if between["rmse"] > 0 else 0.0}
+    noise = ReferenceNoise(bin_dir, refs)
+    result = {"frame": frame, "spp": spp, "reference_noise_relative_l2": noise.relative_l2()}
     for label, path in tests.items():
-        if not os.path.exists(path):
-            continue
-        da, db = compare(path, refs[0]), compare(path, refs[1])
-        d2 = max(0.0, (da["rmse"] ** 2 + db["rmse"] ** 2) / 2.0 - noise2)
-        scale = da["relative_l2"] / da["rmse"] if da["rmse"] > 0 else 0.0  # 1 / rms(reference)
-        result[label] = {"relative_l2": math.sqrt(d2) * scale,
-                         "raw_relative_l2": (da["relative_l2"] + db["relative_l2"]) / 2.0}
+        if os.path.exists(path):
+            result[label] = noise.error_of(path)
     return result
 
 

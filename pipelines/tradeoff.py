@@ -8,12 +8,10 @@ relative L2), OUT/tradeoff.gp and, when gnuplot is installed, OUT/tradeoff.png w
 front (the settings no other setting beats in both time and error) marked.
 
 Two references with independent noise (seeds 0 and 1) take the reference's own Monte Carlo
-noise out of the error, which otherwise hides the knobs' effects: for frames T and references
-A and B, E rmse(T,A)^2 = d^2 + s^2 and E rmse(A,B)^2 = 2 s^2, so the error of T is
-d = sqrt((rmse(T,A)^2 + rmse(T,B)^2)/2 - rmse(A,B)^2/2). Each setting runs --repeat times and
-the least CPU time of the four stages (user + system, all threads) is kept: the outputs are
-bit-identical, and CPU time is what other processes on the machine disturb least (wall time of
-the same run is in the CSV).
+noise out of the error, which otherwise hides the knobs' effects (bench.ReferenceNoise gives
+the estimator). Each setting runs --repeat times and the least CPU time of the four stages
+(user + system, all threads) is kept: the outputs are bit-identical, and CPU time is what other
+processes on the machine disturb least (wall time of the same run is in the CSV).
 
 usage: tradeoff.py [--scene GLTF] [--frames 0-47] [--size 176x120] [--spp 128] [--repeat 3]
                    [--out DIR]
@@ -21,7 +19,6 @@ usage: tradeoff.py [--scene GLTF] [--frames 0-47] [--size 176x120] [--spp 128] [
 import argparse
 import csv
 import json
-import math
 import os
 import shutil
 import subprocess
@@ -82,11 +79,9 @@ def main():
             print("tradeoff: reference took %.1f s (%.2f s/frame)" % (t, t / nframes),
                   file=sys.stderr)
         refs.append(ref)
-    between = compare(a.bin, refs[1], refs[0])
-    noise2 = between["rmse"] ** 2 / 2.0
-    scale = between["relative_l2"] / between["rmse"]  # 1 / rms of the reference
-    print("tradeoff: reference noise %.3g rmse (%.2f %% relative L2), removed from the errors"
-          % (math.sqrt(noise2), 100 * math.sqrt(noise2) * scale), file=sys.stderr)
+    noise = bench.ReferenceNoise(a.bin, refs)
+    print("tradeoff: reference noise %.2f %% relative L2, removed from the errors"
+          % (100 * noise.relative_l2()), file=sys.stderr)
 
     rows = []
     runs = [("default", None, None, "-")] + [(k, s, f, v) for k, s, f, _, vs in KNOBS for v in vs]
@@ -103,18 +98,15 @@ def main():
                 r = bench.pipeline(a.bin, a.scene, out, a.frames, a.size, flags, log)
                 times.append(r["cpu_total"])
                 walls.append(r["total"])
-            da = compare(a.bin, os.path.join(out, "frames"), refs[0])
-            db = compare(a.bin, os.path.join(out, "frames"), refs[1])
+            err = noise.error_of(os.path.join(out, "frames"))
         except RuntimeError as e:
             print("tradeoff: %s = %s: %s" % (knob, value, e), file=sys.stderr)
             continue
-        raw2 = (da["rmse"] ** 2 + db["rmse"] ** 2) / 2.0
-        rmse = math.sqrt(max(0.0, raw2 - noise2))
         rows.append({"knob": knob, "value": value, "seconds_per_frame": min(times) / nframes,
                      "seconds_spread": (max(times) - min(times)) / min(times),
                      "wall_seconds_per_frame": min(walls) / nframes,
-                     "rmse": rmse, "relative_l2": rmse * scale,
-                     "raw_relative_l2": math.sqrt(raw2) * scale, "peak_mib": r["peak_mib"]})
+                     "rmse": err["rmse"], "relative_l2": err["relative_l2"],
+                     "raw_relative_l2": err["raw_relative_l2"], "peak_mib": r["peak_mib"]})
         shutil.rmtree(os.path.join(out, "movies"), ignore_errors=True)  # keep the disk small
 
     front = pareto([(r["seconds_per_frame"], r["rmse"]) for r in rows])
@@ -135,14 +127,6 @@ def main():
             r["knob"], r["value"], r["seconds_per_frame"], 100 * r["seconds_spread"], r["rmse"],
             100 * r["relative_l2"], 100 * r["raw_relative_l2"], "*" if r["pareto"] else ""))
     write_plot(a.out, rows, front)
-
-
-def compare(bin_dir, test, reference):
-    p = subprocess.run([os.path.join(bin_dir, "rad-diff"), test, reference, "--json"],
-                       capture_output=True, text=True)
-    if p.returncode != 0:
-        raise RuntimeError("rad-diff: " + p.stderr.strip())
-    return json.loads(p.stdout)["difference"]
 
 
 def write_plot(out, rows, front):
