@@ -16,6 +16,7 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <png.h>
 
@@ -72,9 +73,11 @@ void writeFrameExr(const std::string& path, const ComposedFrame& frame, const Fr
     base = reinterpret_cast<const char*>(halves.data());
     elem = sizeof(Imath::half);
   }
-  AtomicFile file(path);
+  // Encoded in memory and written with one system call: an uncompressed file is one chunk per
+  // scanline, and OpenEXR writes each with its own writev (240 per frame at 352x240).
+  Imf::StdOSStream encoded;
   try {
-    Imf::OutputFile out(file.tempPath().c_str(), header);
+    Imf::OutputFile out(encoded, header);
     Imf::FrameBuffer fb;
     const size_t xs = 3 * elem, ys = size_t(w) * xs;
     fb.insert("R", Imf::Slice(type, const_cast<char*>(base), xs, ys));
@@ -85,7 +88,8 @@ void writeFrameExr(const std::string& path, const ComposedFrame& frame, const Fr
   } catch (const std::exception& e) {
     throw outputError(path, e.what());
   }
-  file.commit();
+  const std::string bytes = encoded.str();
+  writeWholeFile(path, bytes.data(), bytes.size(), info.durability);
 }
 
 namespace {
@@ -114,7 +118,7 @@ void writeFramePng(const std::string& path, const ComposedFrame& frame,
   for (int y = 0; y < h; ++y) rows[size_t(y)] = pixels.data() + size_t(y) * size_t(w) * 3;
   std::string message;
 
-  AtomicFile file(path);
+  AtomicFile file(path, info.durability);
   FILE* fp = std::fopen(file.tempPath().c_str(), "wb");
   if (!fp) throw outputError(path, "cannot create");
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &message, pngError, pngWarning);

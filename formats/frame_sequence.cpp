@@ -126,6 +126,9 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
   FrameImageInfo info;
   info.exposureEV = report.exposureEV;
   info.provenanceJson = provenance.toJson().dump();
+  // One sync for all frames before returning (Make's frames/.done stamp follows the exit status,
+  // and animation.mk removes frames/ before a re-run).
+  info.durability = AtomicFile::Durability::kDeferred;
 
   FrameComposer composer(scene, solution, options.size, options.cameraNode);
   MovieCache cache(intervals, options.moviesDir);
@@ -173,6 +176,7 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
     report.frames.push_back(s);
     if (progress) progress();
   }
+  syncFileSystemOf(options.framesDir);
   report.moviesRead = cache.read();
   report.peakLoadedMovies = cache.peak();
   report.seconds = std::chrono::duration<double>(Clock::now() - start).count();

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -163,10 +164,13 @@ std::string hashFile(const std::string& path) {
     ::close(fd);
     throw inputError(path, "not a regular file");
   }
-  std::vector<unsigned char> buf(1 << 20);
+  // 64 KiB, not zero-filled: rad-compose hashes every movie it reads (74,000 in a from-scratch
+  // run), and a fresh zeroed 1 MiB buffer per file cost a memset and 256 page faults each.
+  constexpr size_t kChunk = size_t(1) << 16;
+  std::unique_ptr<unsigned char[]> buf(new unsigned char[kChunk]);
   uint64_t h = kFnv1a64Offset;
   for (;;) {
-    const ssize_t n = ::read(fd, buf.data(), buf.size());
+    const ssize_t n = ::read(fd, buf.get(), kChunk);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
       const int err = errno;
@@ -174,7 +178,7 @@ std::string hashFile(const std::string& path) {
       throw inputError(path, std::string("cannot read: ") + std::strerror(err));
     }
     if (n == 0) break;
-    h = fnv1a64(buf.data(), static_cast<std::size_t>(n), h);
+    h = fnv1a64(buf.get(), static_cast<std::size_t>(n), h);
   }
   ::close(fd);
   return formatFnv1a64(h);

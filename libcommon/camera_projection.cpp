@@ -137,18 +137,25 @@ ProjectedPoint projectToPixel(const CameraView& view, ImageSize size, const glm:
   return p;
 }
 
-Ray primaryRay(const CameraView& view, ImageSize size, const glm::dvec2& pixel) {
-  const Camera& lens = view.lens;
-  validate(lens, size);
-  double xn = 2.0 * pixel.x / size.width - 1.0;
-  double yn = 1.0 - 2.0 * pixel.y / size.height;
+PrimaryRays::PrimaryRays(const CameraView& view, ImageSize size) : view_(view), size_(size) {
+  validate(view.lens, size);
+  if (view.lens.perspective) {
+    halfTan_ = std::tan(0.5 * view.lens.yfov);
+    aspect_ = effectiveAspect(view.lens, size);
+  }
+}
+
+Ray PrimaryRays::at(const glm::dvec2& pixel) const {
+  const Camera& lens = view_.lens;
+  double xn = 2.0 * pixel.x / size_.width - 1.0;
+  double yn = 1.0 - 2.0 * pixel.y / size_.height;
   const double inf = std::numeric_limits<double>::infinity();
   glm::dvec3 originEye, dirEye;
   Ray r;
   if (lens.perspective) {
-    double t = std::tan(0.5 * lens.yfov);
+    const double t = halfTan_;
     // Inverse of the projection's x, y rows at eye depth 1.
-    dirEye = glm::dvec3(xn * effectiveAspect(lens, size) * t, yn * t, -1.0);
+    dirEye = glm::dvec3(xn * aspect_ * t, yn * t, -1.0);
     originEye = glm::dvec3(0.0);
     double len = glm::length(dirEye);  // ray length per unit of eye depth
     r.tNear = lens.znear * len;
@@ -160,7 +167,7 @@ Ray primaryRay(const CameraView& view, ImageSize size, const glm::dvec2& pixel) 
     r.tNear = lens.znear;
     r.tFar = lens.zfar;
   }
-  const glm::dmat4& m = view.worldFromCamera;
+  const glm::dmat4& m = view_.worldFromCamera;
   r.origin = glm::dvec3(m * glm::dvec4(originEye, 1.0));
   glm::dvec3 d = glm::dvec3(m * glm::dvec4(dirEye, 0.0));
   double dl = glm::length(d);
@@ -170,6 +177,10 @@ Ray primaryRay(const CameraView& view, ImageSize size, const glm::dvec2& pixel) 
   r.tNear *= dl;
   r.tFar *= dl;
   return r;
+}
+
+Ray primaryRay(const CameraView& view, ImageSize size, const glm::dvec2& pixel) {
+  return PrimaryRays(view, size).at(pixel);
 }
 
 }  // namespace rad

@@ -82,8 +82,25 @@ struct Ray {
   double tNear = 0.0, tFar = 0.0;
 };
 
-// Primary ray through a continuous pixel position (row 0 at the top). Perspective: from the
-// eye. Orthographic: from the eye plane (z_eye = 0), along the view axis.
+// Primary rays of one view: the lens is validated and tan(yfov/2) evaluated once, not per
+// pixel (they were 14 % of rad-compose's time). Gives bit-identical rays to primaryRay().
+class PrimaryRays {
+ public:
+  // Throws like projectionMatrix() on an unusable lens.
+  PrimaryRays(const CameraView& view, ImageSize size);
+  // Ray through a continuous pixel position (row 0 at the top). Perspective: from the eye.
+  // Orthographic: from the eye plane (z_eye = 0), along the view axis.
+  Ray at(const glm::dvec2& pixel) const;
+  // Ray through the centre of pixel (col, row).
+  Ray pixelCentre(int col, int row) const { return at(glm::dvec2(col + 0.5, row + 0.5)); }
+
+ private:
+  CameraView view_;
+  ImageSize size_;
+  double halfTan_ = 0.0, aspect_ = 1.0;  // perspective: tan(yfov/2), effectiveAspect()
+};
+
+// One ray, for callers that need a few: PrimaryRays(view, size).at(pixel).
 Ray primaryRay(const CameraView& view, ImageSize size, const glm::dvec2& pixel);
 // Ray through the centre of pixel (col, row).
 inline Ray pixelCentreRay(const CameraView& view, ImageSize size, int col, int row) {

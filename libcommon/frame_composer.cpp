@@ -140,14 +140,21 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
 
   // World polygons at t (affine maps keep the (u,v) parameterisation, so the hit's (u,v) in
   // the world polygon is its top-level (u,v)).
+  // Their normals and (u,v) maps are set up once per frame here, not per pixel.
   std::vector<Polygon> world(topCount);
+  std::vector<glm::dvec3> normals(topCount);
+  std::vector<PolygonUvMap> uvMaps(topCount);
   std::vector<char> seen(topCount, 0);
   for (uint32_t id : m.items.id)
     if (id != kNoItem) seen[id - 1] = 1;
   std::unordered_map<int, size_t> objectOfNode;
   for (size_t k = 0; k < m.objectNodes.size(); ++k) objectOfNode[m.objectNodes[k]] = k;
   for (int i = 0; i < topCount; ++i)
-    if (seen[i]) world[i] = m.tops[i].local.transformed(m.transforms[objectOfNode[m.tops[i].node]]);
+    if (seen[i]) {
+      world[i] = m.tops[i].local.transformed(m.transforms[objectOfNode[m.tops[i].node]]);
+      normals[i] = world[i].normal();
+      uvMaps[i] = PolygonUvMap(world[i]);
+    }
 
   // Active movies per top, by patch id; the deepest level per top bounds the descent.
   std::unordered_map<uint64_t, size_t> movieOf;
@@ -161,7 +168,8 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
     deepest[mt.patch.top] = std::max(deepest[mt.patch.top], mt.patch.level());
   }
 
-  // Per pixel rays need the lens valid; primaryRay checks it.
+  // The frame's primary rays (the lens is validated here, once).
+  const PrimaryRays rays(view, size);
   out.size = size;
   out.time = t;
   const size_t n = size_t(size.pixelCount());
@@ -183,15 +191,21 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
         const Material& mat = m.materials[top];
 
         // Hit point of the pixel-centre ray with the patch's plane.
-        Ray ray = pixelCentreRay(view, size, col, row);
-        glm::dvec3 nrm = poly.normal();
-        double denom = glm::dot(nrm, ray.direction);
-        glm::dvec3 hit = poly.centroid();
+        // (A ray parallel to the plane cannot hit it; its centroid stands in.)
+        const Ray ray = rays.pixelCentre(col, row);
+        const glm::dvec3& nrm = normals[size_t(top)];
+        const double denom = glm::dot(nrm, ray.direction);
+        bool onPlane = false;
+        glm::dvec3 hit;
         if (std::abs(denom) > 1e-300) {
           double s = glm::dot(nrm, poly.v[0] - ray.origin) / denom;
-          if (std::isfinite(s)) hit = ray.origin + s * ray.direction;
+          if (std::isfinite(s)) {
+            hit = ray.origin + s * ray.direction;
+            onPlane = true;
+          }
         }
-        glm::dvec2 topUv = clampToParameterDomain(polygonUvAt(poly, hit), triangle);
+        if (!onPlane) hit = poly.centroid();
+        glm::dvec2 topUv = clampToParameterDomain(uvMaps[size_t(top)].uvAt(hit), triangle);
 
         // Base colour texture factor tex(x) / mean(tex) (Material::reflectance already holds
         // the mean), 1 without a texture.

@@ -71,22 +71,33 @@ glm::dvec3 polygonPointAt(const Polygon& p, glm::dvec2 uv) {
   return p.v[0] + u * (p.v[1] - p.v[0]) + v * (p.v[2] - p.v[0]);
 }
 
-glm::dvec2 polygonUvAt(const Polygon& p, const glm::dvec3& x) {
+PolygonUvMap::PolygonUvMap(const Polygon& p) : p_(p) {
   // Work in the polygon's plane with a 2D basis; triangles invert the affine map directly,
   // quads invert the bilinear map with Newton's method started from the affine guess.
-  glm::dvec3 e1 = p.v[1] - p.v[0];
-  glm::dvec3 e2 = (p.count == 4 ? p.v[3] : p.v[2]) - p.v[0];
-  glm::dvec3 d = x - p.v[0];
-  double a = glm::dot(e1, e1), b = glm::dot(e1, e2), c = glm::dot(e2, e2);
-  double det = a * c - b * b;
-  if (!(det > 0.0)) return glm::dvec2(0.0);
-  double r1 = glm::dot(d, e1), r2 = glm::dot(d, e2);
-  glm::dvec2 uv((c * r1 - b * r2) / det, (a * r2 - b * r1) / det);
-  if (p.count == 3) return uv;
+  e1_ = p.v[1] - p.v[0];
+  e2_ = (p.count == 4 ? p.v[3] : p.v[2]) - p.v[0];
+  a_ = glm::dot(e1_, e1_);
+  b_ = glm::dot(e1_, e2_);
+  c_ = glm::dot(e2_, e2_);
+  det_ = a_ * c_ - b_ * b_;
+  if (p.count == 4) {
+    d10_ = p.v[1] - p.v[0];
+    d23_ = p.v[2] - p.v[3];
+    d30_ = p.v[3] - p.v[0];
+    d21_ = p.v[2] - p.v[1];
+  }
+}
+
+glm::dvec2 PolygonUvMap::uvAt(const glm::dvec3& x) const {
+  if (!(det_ > 0.0)) return glm::dvec2(0.0);
+  glm::dvec3 d = x - p_.v[0];
+  double r1 = glm::dot(d, e1_), r2 = glm::dot(d, e2_);
+  glm::dvec2 uv((c_ * r1 - b_ * r2) / det_, (a_ * r2 - b_ * r1) / det_);
+  if (p_.count == 3) return uv;
   for (int it = 0; it < 20; ++it) {
-    glm::dvec3 f = polygonPointAt(p, uv) - x;
-    glm::dvec3 du = (1 - uv.y) * (p.v[1] - p.v[0]) + uv.y * (p.v[2] - p.v[3]);
-    glm::dvec3 dv = (1 - uv.x) * (p.v[3] - p.v[0]) + uv.x * (p.v[2] - p.v[1]);
+    glm::dvec3 f = polygonPointAt(p_, uv) - x;
+    glm::dvec3 du = (1 - uv.y) * d10_ + uv.y * d23_;
+    glm::dvec3 dv = (1 - uv.x) * d30_ + uv.x * d21_;
     double aa = glm::dot(du, du), bb = glm::dot(du, dv), cc = glm::dot(dv, dv);
     double dd = aa * cc - bb * bb;
     if (!(dd > 0.0)) break;
@@ -96,6 +107,10 @@ glm::dvec2 polygonUvAt(const Polygon& p, const glm::dvec3& x) {
     if (std::abs(step.x) + std::abs(step.y) < 1e-15) break;
   }
   return uv;
+}
+
+glm::dvec2 polygonUvAt(const Polygon& p, const glm::dvec3& x) {
+  return PolygonUvMap(p).uvAt(x);
 }
 
 PatchHierarchy::PatchHierarchy(std::vector<InputPolygon> tops) : tops_(std::move(tops)) {

@@ -85,6 +85,22 @@ class PatchHierarchy {
 // The (u,v) map of a single polygon (see PatchHierarchy::pointAt).
 glm::dvec3 polygonPointAt(const Polygon& p, glm::dvec2 uv);
 glm::dvec2 polygonUvAt(const Polygon& p, const glm::dvec3& x);
+
+// polygonUvAt for many points of one polygon: the polygon's edges and the Gram matrix of the
+// affine guess are computed once. Bit-identical to polygonUvAt (rad-compose inverts the map
+// at every pixel; the per-call setup was a third of that).
+class PolygonUvMap {
+ public:
+  PolygonUvMap() = default;
+  explicit PolygonUvMap(const Polygon& p);
+  glm::dvec2 uvAt(const glm::dvec3& x) const;
+
+ private:
+  Polygon p_;
+  glm::dvec3 e1_{0.0}, e2_{0.0};                    // affine guess: v1 - v0, (v3 or v2) - v0
+  double a_ = 0.0, b_ = 0.0, c_ = 0.0, det_ = 0.0;  // Gram matrix of e1, e2 and its determinant
+  glm::dvec3 d10_{0.0}, d23_{0.0}, d30_{0.0}, d21_{0.0};  // quad edges of the Newton Jacobian
+};
 // The 4 children of a polygon in child order (see PatchHierarchy::subdivide).
 std::array<Polygon, 4> subdividePolygon(const Polygon& p);
 

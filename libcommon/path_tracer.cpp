@@ -499,6 +499,7 @@ FloatImage PathTracer::render(const CameraView& view, ImageSize size,
   const int strata = int(std::floor(std::sqrt(double(spp))));  // strata x strata jittered grid
   std::uint64_t base = splitMix64(options.seed ^ 0x7265666572656E63ull);  // "referenc"
   if (options.decorrelateFrames) base = splitMix64(base ^ splitMix64(std::uint64_t(frame)));
+  const PrimaryRays rays(view, size);
   tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& r) {
     for (int row = r.begin(); row < r.end(); ++row) {
       for (int col = 0; col < size.width; ++col) {
@@ -519,7 +520,7 @@ FloatImage PathTracer::render(const CameraView& view, ImageSize size,
           } else {
             pixel = glm::dvec2(col + jx, row + jy);
           }
-          const Ray ray = primaryRay(view, size, pixel);
+          const Ray ray = rays.at(pixel);
           const glm::dvec3 L = impl_->radiance(ray, sampleSeed, options);
           if (std::isfinite(L.x) && std::isfinite(L.y) && std::isfinite(L.z)) sum += L;
         }

@@ -208,6 +208,25 @@ TEST_F(TextureMovieFormat, StreamGivesTheSameTexturesHoldingTwoKeys) {
   }
 }
 
+// The stream reads through a 64 KiB window (one pread per window instead of one per scanline).
+// Keys larger than the window, read out of order, must still come back bit for bit.
+TEST_F(TextureMovieFormat, StreamReadsKeysLargerThanItsReadWindowInAnyOrder) {
+  TextureMovie m = sampleMovie(4);
+  m.width = 160;  // 160 x 120 x 3 floats: 230 KB per key, 3.5 windows
+  m.height = 120;
+  for (auto& k : m.keys) {
+    k.resize(size_t(m.width) * m.height * 3);
+    for (size_t i = 0; i < k.size(); ++i)
+      k[i] = float(i % 1009) * 0.125f + 1000.0f * float(&k - &m.keys[0]);
+  }
+  std::string path = dir() + "/big.exr";
+  writeTextureMovie(path, m);
+  TextureMovieStream stream(path);
+  for (size_t k : {size_t(3), size_t(0), size_t(2), size_t(1)})
+    ASSERT_EQ(stream.key(k), m.keys[k]) << "key " << k;
+  EXPECT_EQ(stream.keysRead(), 4);
+}
+
 // rad-compose blends the two keys per sampled texel (keysAt) instead of copying textureAt's
 // blend: the same float arithmetic must give textureAt's texels bit for bit, at every time
 // (before, between, on and after the keys), with only the two keys around t held.
