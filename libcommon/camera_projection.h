@@ -93,11 +93,23 @@ class PrimaryRays {
   Ray at(const glm::dvec2& pixel) const;
   // Ray through the centre of pixel (col, row).
   Ray pixelCentre(int col, int row) const { return at(glm::dvec2(col + 0.5, row + 0.5)); }
+  // The line of that ray as a point and a direction that is NOT unit length, affine in the
+  // pixel position (two multiply-adds per component): for intersecting planes, where the
+  // scale of the direction cancels. Same line as at() up to rounding.
+  void line(const glm::dvec2& pixel, glm::dvec3& origin, glm::dvec3& direction) const {
+    const double xn = 2.0 * pixel.x / size_.width - 1.0;
+    const double yn = 1.0 - 2.0 * pixel.y / size_.height;
+    origin = origin0_ + xn * originX_ + yn * originY_;
+    direction = direction0_ + xn * directionX_ + yn * directionY_;
+  }
 
  private:
   CameraView view_;
   ImageSize size_;
   double halfTan_ = 0.0, aspect_ = 1.0;  // perspective: tan(yfov/2), effectiveAspect()
+  // line(): origin and direction as affine functions of NDC x, y.
+  glm::dvec3 origin0_{0.0}, originX_{0.0}, originY_{0.0};
+  glm::dvec3 direction0_{0.0}, directionX_{0.0}, directionY_{0.0};
 };
 
 // One ray, for callers that need a few: PrimaryRays(view, size).at(pixel).

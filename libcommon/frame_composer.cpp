@@ -69,6 +69,47 @@ glm::dvec2 interpolateCorners(const std::array<glm::dvec2, 4>& c, int count, glm
          (1 - uv.x) * uv.y * c[3];
 }
 
+// Active movie by packed patch id: open addressing with a multiplicative hash. Every covered
+// pixel looks up each level of its descent; std::unordered_map's modulo by a prime was a
+// visible share of rad-compose's per-pixel time.
+class PatchIndex {
+ public:
+  explicit PatchIndex(size_t count) {
+    size_t capacity = 16;
+    while (capacity < 2 * count) capacity *= 2;
+    shift_ = 64;
+    for (size_t c = capacity; c > 1; c /= 2) --shift_;
+    mask_ = capacity - 1;
+    slots_.assign(capacity, Slot{kEmpty, 0});
+  }
+  void insert(uint64_t key, size_t value) {
+    for (size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (slots_[i].key == kEmpty || slots_[i].key == key) {
+        slots_[i] = Slot{key, value};  // a repeated patch: the last movie wins
+        return;
+      }
+    }
+  }
+  long find(uint64_t key) const {
+    for (size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (slots_[i].key == key) return long(slots_[i].value);
+      if (slots_[i].key == kEmpty) return -1;
+    }
+  }
+
+ private:
+  static constexpr uint64_t kEmpty =
+      ~uint64_t(0);  // no PatchId packs to this (path has a 1 marker)
+  struct Slot {
+    uint64_t key;
+    size_t value;
+  };
+  size_t slot(uint64_t key) const { return size_t((key * 0x9E3779B97F4A7C15ull) >> shift_); }
+  std::vector<Slot> slots_;
+  size_t mask_ = 0;
+  int shift_ = 60;
+};
+
 }  // namespace
 
 struct FrameComposer::Impl {
@@ -157,14 +198,14 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
     }
 
   // Active movies per top, by patch id; the deepest level per top bounds the descent.
-  std::unordered_map<uint64_t, size_t> movieOf;
+  PatchIndex movieOf(movies.size());
   std::vector<int> deepest(topCount, -1);
   for (size_t k = 0; k < movies.size(); ++k) {
     const MovieTexture& mt = movies[k];
     if (mt.patch.top >= uint32_t(topCount) || !mt.irradiance || mt.width < 1 || mt.height < 1)
       throw Error(ExitCode::kInternal, "compose",
                   "movie of patch " + mt.patch.toString() + " is invalid for this scene");
-    movieOf[mt.patch.packed()] = k;
+    movieOf.insert(mt.patch.packed(), k);
     deepest[mt.patch.top] = std::max(deepest[mt.patch.top], mt.patch.level());
   }
 
@@ -192,15 +233,16 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
 
         // Hit point of the pixel-centre ray with the patch's plane.
         // (A ray parallel to the plane cannot hit it; its centroid stands in.)
-        const Ray ray = rays.pixelCentre(col, row);
+        glm::dvec3 origin, direction;  // direction not unit length: its scale cancels in s
+        rays.line(glm::dvec2(col + 0.5, row + 0.5), origin, direction);
         const glm::dvec3& nrm = normals[size_t(top)];
-        const double denom = glm::dot(nrm, ray.direction);
+        const double denom = glm::dot(nrm, direction);
         bool onPlane = false;
         glm::dvec3 hit;
         if (std::abs(denom) > 1e-300) {
-          double s = glm::dot(nrm, poly.v[0] - ray.origin) / denom;
+          double s = glm::dot(nrm, poly.v[0] - origin) / denom;
           if (std::isfinite(s)) {
-            hit = ray.origin + s * ray.direction;
+            hit = origin + s * direction;
             onPlane = true;
           }
         }
@@ -229,9 +271,9 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
           PatchId node{uint32_t(top), 1u};
           glm::dvec2 uv = topUv;
           for (int level = 0;; ++level) {
-            auto it = movieOf.find(node.packed());
-            if (it != movieOf.end()) {
-              found = int(it->second);
+            const long k = movieOf.find(node.packed());
+            if (k >= 0) {
+              found = int(k);
               foundUv = uv;
             }
             if (level >= deepest[top]) break;

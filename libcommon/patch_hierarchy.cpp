@@ -2,6 +2,7 @@
 // subdivision of input polygons.
 #include "libcommon/patch_hierarchy.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <sstream>
@@ -74,26 +75,32 @@ glm::dvec3 polygonPointAt(const Polygon& p, glm::dvec2 uv) {
 PolygonUvMap::PolygonUvMap(const Polygon& p) : p_(p) {
   // Work in the polygon's plane with a 2D basis; triangles invert the affine map directly,
   // quads invert the bilinear map with Newton's method started from the affine guess.
-  e1_ = p.v[1] - p.v[0];
-  e2_ = (p.count == 4 ? p.v[3] : p.v[2]) - p.v[0];
-  a_ = glm::dot(e1_, e1_);
-  b_ = glm::dot(e1_, e2_);
-  c_ = glm::dot(e2_, e2_);
-  det_ = a_ * c_ - b_ * b_;
+  const glm::dvec3 e1 = p.v[1] - p.v[0];
+  const glm::dvec3 e2 = (p.count == 4 ? p.v[3] : p.v[2]) - p.v[0];
+  const double a = glm::dot(e1, e1), b = glm::dot(e1, e2), c = glm::dot(e2, e2);
+  const double det = a * c - b * b;
+  valid_ = det > 0.0;
+  if (!valid_) return;
+  // u = (c (d.e1) - b (d.e2)) / det, v = (a (d.e2) - b (d.e1)) / det for d = x - v0.
+  gradU_ = (c * e1 - b * e2) / det;
+  gradV_ = (a * e2 - b * e1) / det;
+  affine_ = p.count == 3;
   if (p.count == 4) {
     d10_ = p.v[1] - p.v[0];
     d23_ = p.v[2] - p.v[3];
     d30_ = p.v[3] - p.v[0];
     d21_ = p.v[2] - p.v[1];
+    // The bilinear term's coefficient v0 - v1 + v2 - v3 = d23 - d10.
+    const double size = std::sqrt(std::max(a, c));
+    affine_ = glm::length(d23_ - d10_) <= 1e-12 * size;
   }
 }
 
 glm::dvec2 PolygonUvMap::uvAt(const glm::dvec3& x) const {
-  if (!(det_ > 0.0)) return glm::dvec2(0.0);
-  glm::dvec3 d = x - p_.v[0];
-  double r1 = glm::dot(d, e1_), r2 = glm::dot(d, e2_);
-  glm::dvec2 uv((c_ * r1 - b_ * r2) / det_, (a_ * r2 - b_ * r1) / det_);
-  if (p_.count == 3) return uv;
+  if (!valid_) return glm::dvec2(0.0);
+  const glm::dvec3 d = x - p_.v[0];
+  glm::dvec2 uv(glm::dot(d, gradU_), glm::dot(d, gradV_));
+  if (affine_) return uv;
   for (int it = 0; it < 20; ++it) {
     glm::dvec3 f = polygonPointAt(p_, uv) - x;
     glm::dvec3 du = (1 - uv.y) * d10_ + uv.y * d23_;

@@ -86,9 +86,9 @@ class PatchHierarchy {
 glm::dvec3 polygonPointAt(const Polygon& p, glm::dvec2 uv);
 glm::dvec2 polygonUvAt(const Polygon& p, const glm::dvec3& x);
 
-// polygonUvAt for many points of one polygon: the polygon's edges and the Gram matrix of the
-// affine guess are computed once. Bit-identical to polygonUvAt (rad-compose inverts the map
-// at every pixel; the per-call setup was a third of that).
+// polygonUvAt for many points of one polygon, set up once (rad-compose inverts the map at every
+// pixel). Triangles and parallelograms (the bilinear map is then affine) take two dot products
+// with the rows of the affine inverse; other quads refine the affine guess by Newton's method.
 class PolygonUvMap {
  public:
   PolygonUvMap() = default;
@@ -97,10 +97,12 @@ class PolygonUvMap {
 
  private:
   Polygon p_;
-  glm::dvec3 e1_{0.0}, e2_{0.0};                    // affine guess: v1 - v0, (v3 or v2) - v0
-  double a_ = 0.0, b_ = 0.0, c_ = 0.0, det_ = 0.0;  // Gram matrix of e1, e2 and its determinant
+  bool valid_ = false;   // non-degenerate: the Gram determinant of the edges is > 0
+  bool affine_ = false;  // triangle, or a quad with v0 + v2 = v1 + v3 (to 1e-12 of its size)
+  glm::dvec3 gradU_{0.0}, gradV_{0.0};  // rows of the affine inverse: u = gradU . (x - v0)
   glm::dvec3 d10_{0.0}, d23_{0.0}, d30_{0.0}, d21_{0.0};  // quad edges of the Newton Jacobian
 };
+
 // The 4 children of a polygon in child order (see PatchHierarchy::subdivide).
 std::array<Polygon, 4> subdividePolygon(const Polygon& p);
 

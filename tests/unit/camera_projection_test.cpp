@@ -175,6 +175,42 @@ TEST(CameraProjection, RayThroughPixelCentreReprojectsToIt) {
   }
 }
 
+// rad-compose intersects planes with PrimaryRays::line (unnormalised, affine in the pixel);
+// it must be the line of at(), for both projections and an aspect the camera imposes.
+TEST(CameraProjection, PrimaryRaysLineIsTheRayOfAt) {
+  ImageSize size{352, 240};
+  std::mt19937 rng(11);
+  for (bool perspective : {true, false}) {
+    CameraView v = perspectiveView(0.9, perspective ? 1.7 : 0.0);
+    v.lens.perspective = perspective;
+    v.lens.xmag = 3.0;
+    v.lens.ymag = 2.0;
+    v.lens.zfar = 1000.0;
+    v.worldFromCamera = tiltedCamera();
+    const PrimaryRays rays(v, size);
+    for (int i = 0; i < 200; ++i) {
+      glm::dvec2 pixel(std::uniform_real_distribution<double>(0.0, 352.0)(rng),
+                       std::uniform_real_distribution<double>(0.0, 240.0)(rng));
+      Ray r = rays.at(pixel);
+      glm::dvec3 o, d;
+      rays.line(pixel, o, d);
+      ASSERT_GT(glm::length(d), 0.0);
+      // Same direction (parallel and pointing the same way) ...
+      EXPECT_NEAR(glm::length(glm::cross(glm::normalize(d), r.direction)), 0.0, 1e-14);
+      EXPECT_GT(glm::dot(d, r.direction), 0.0);
+      // ... through the same points.
+      glm::dvec3 offset = o - r.origin;
+      EXPECT_NEAR(glm::length(offset - glm::dot(offset, r.direction) * r.direction), 0.0, 1e-12);
+      if (perspective) EXPECT_EQ(o, r.origin);  // the eye
+      // And bit-identical to the one-ray function.
+      Ray one = primaryRay(v, size, pixel);
+      EXPECT_EQ(one.origin, r.origin);
+      EXPECT_EQ(one.direction, r.direction);
+      EXPECT_EQ(one.tNear, r.tNear);
+    }
+  }
+}
+
 TEST(CameraProjection, BadLensIsRejected) {
   ImageSize size{10, 10};
   CameraView v = perspectiveView(0.8);

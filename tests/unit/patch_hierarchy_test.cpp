@@ -106,6 +106,33 @@ TEST(PatchHierarchy, UvMapRoundTripsAndMatchesChildren) {
   EXPECT_EQ(h.pointAt(1, {0, 1}), h.node(1).local.v[2]);
 }
 
+// PolygonUvMap takes the affine inverse for triangles and parallelograms (no Newton) and
+// Newton's method for other quads: all must invert polygonPointAt.
+TEST(PatchHierarchy, PolygonUvMapInvertsPointAtForEveryShape) {
+  std::vector<Polygon> shapes = {
+      {4, {glm::dvec3(0, 0, 0), {2, 0, 0}, {2.5, 1, 0}, {0.3, 1.2, 0}}},        // general quad
+      {4, {glm::dvec3(1, 1, 1), {3, 1.5, 1}, {3.5, 2.5, 2}, {1.5, 2, 2}}},      // parallelogram
+      {4, {glm::dvec3(0, 0, 5), {1e-3, 0, 5}, {1e-3, 2e-3, 5}, {0, 2e-3, 5}}},  // mm rectangle
+      {3, {glm::dvec3(0, 0, 1), {1, 0, 1}, {0.2, 3, 1.5}, {}}}};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  for (const Polygon& p : shapes) {
+    const PolygonUvMap map(p);
+    for (int s = 0; s < 200; ++s) {
+      glm::dvec2 uv(U(rng), U(rng));
+      if (p.count == 3 && uv.x + uv.y > 1) uv = glm::dvec2(1.0) - uv;
+      glm::dvec3 x = polygonPointAt(p, uv);
+      glm::dvec2 back = map.uvAt(x);
+      EXPECT_NEAR(back.x, uv.x, 1e-10) << p.count;
+      EXPECT_NEAR(back.y, uv.y, 1e-10) << p.count;
+      EXPECT_EQ(back, polygonUvAt(p, x));
+    }
+  }
+  // A degenerate polygon gives (0,0), as polygonUvAt always did.
+  Polygon line{4, {glm::dvec3(0), {1, 0, 0}, {2, 0, 0}, {3, 0, 0}}};
+  EXPECT_EQ(PolygonUvMap(line).uvAt(glm::dvec3(1, 0, 0)), glm::dvec2(0.0));
+}
+
 TEST(PatchHierarchy, CentroidOfChildrenIsParentCentroid) {
   PatchHierarchy h = sample();
   for (int t = 0; t < 2; ++t) {
