@@ -33,7 +33,7 @@ import bench  # noqa: E402
 # run once (row "default") and belongs to every knob's curve.
 KNOBS = [
     ("eps", "global", "--eps", "0.001", ["0.5", "0.1", "0.02", "0.005", "0.0005"]),
-    ("key-step", "global", "--key-step", "4", ["12", "8", "2", "1"]),
+    ("key-step", "global", "--key-step", "8", ["16", "12", "4", "2"]),
     ("bad-links", "global", "--bad-links", "lights", ["none", "partial", "all"]),
     ("texel-density", "intervals", "--texel-density", "1", ["0.25", "0.5", "2"]),
     ("movie-key-step", "movies", "--key-step", "6", ["24", "12", "3", "1"]),

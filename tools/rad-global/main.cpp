@@ -22,7 +22,11 @@ struct Options {
   std::string output;
   std::string frames = "0-0";
   double fps = 24.0;
-  int keyStep = 4;
+  // 8, not 4: on four scenes (the bundled one, 8 cubes, the table with moving lights, static
+  // and following camera; 48 frames, tradeoff.py) 8 gave the same error against the path-traced
+  // reference to 0.03 % and 17-28 % less CPU time; the good links' indirect light between
+  // keys is smooth, and the lights' (bad) links are re-evaluated per movie key anyway.
+  int keyStep = 8;
   double eps = 1e-3;
   std::string oracle = "power";
   double minArea = 0.0;
@@ -42,7 +46,7 @@ int main(int argc, char** argv) {
       "range with temporal coherence and writes the link hierarchy global.rlh."};
   Options o;
   rad::setUpApp(app, kTool,
-                "rad-global scene.gltf -o global.rlh --frames 0-95 --fps 24 --key-step 4");
+                "rad-global scene.gltf -o global.rlh --frames 0-95 --fps 24 --key-step 8");
   app.add_option("SCENE", o.scene, "glTF scene")->required();
   app.add_option("-o,--output", o.output, "output link hierarchy (.rlh)")->required();
   app.add_option("--frames", o.frames, "frame range a-b (time = frame / fps)")
