@@ -84,7 +84,11 @@ def main():
           % (100 * noise.relative_l2()), file=sys.stderr)
 
     rows = []
-    runs = [("default", None, None, "-")] + [(k, s, f, v) for k, s, f, _, vs in KNOBS for v in vs]
+    # The default is timed first and again last (its least CPU time over both is kept): the
+    # machine's speed drifts over a 10-minute sweep (another job ending on the other core made
+    # later settings 7 % faster than the same computation timed first).
+    runs = ([("default", None, None, "-")] + [(k, s, f, v) for k, s, f, _, vs in KNOBS for v in vs]
+            + [("default", None, None, "-")])
     # One untimed run first: the first run pays for cold caches (binaries, scene, references).
     bench.pipeline(a.bin, a.scene, os.path.join(a.out, "runs", "warm-up"), a.frames, a.size, {},
                    log)
@@ -102,11 +106,23 @@ def main():
         except RuntimeError as e:
             print("tradeoff: %s = %s: %s" % (knob, value, e), file=sys.stderr)
             continue
+        again = next((r for r in rows if r["knob"] == knob and r["value"] == value), None)
+        if again:  # the default's second timing
+            times += again["times"]
+            walls += again["walls"]
+            rows.remove(again)
+            rows.insert(0, again)
+            again.update({"seconds_per_frame": min(times) / nframes,
+                          "seconds_spread": (max(times) - min(times)) / min(times),
+                          "wall_seconds_per_frame": min(walls) / nframes,
+                          "times": times, "walls": walls})
+            continue
         rows.append({"knob": knob, "value": value, "seconds_per_frame": min(times) / nframes,
                      "seconds_spread": (max(times) - min(times)) / min(times),
                      "wall_seconds_per_frame": min(walls) / nframes,
                      "rmse": err["rmse"], "relative_l2": err["relative_l2"],
-                     "raw_relative_l2": err["raw_relative_l2"], "peak_mib": r["peak_mib"]})
+                     "raw_relative_l2": err["raw_relative_l2"], "peak_mib": r["peak_mib"],
+                     "times": times, "walls": walls})
         shutil.rmtree(os.path.join(out, "movies"), ignore_errors=True)  # keep the disk small
 
     front = pareto([(r["seconds_per_frame"], r["rmse"]) for r in rows])
@@ -117,7 +133,7 @@ def main():
         w = csv.DictWriter(f, fieldnames=["knob", "value", "seconds_per_frame", "seconds_spread",
                                           "wall_seconds_per_frame",
                                           "rmse", "relative_l2", "raw_relative_l2", "peak_mib",
-                                          "pareto"])
+                                          "pareto"], extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
     print("%-14s %-8s %10s %8s %12s %9s %9s %s" % ("knob", "value", "CPU s/fr", "spread",
