@@ -201,7 +201,9 @@ TEST(CameraProjection, PrimaryRaysLineIsTheRayOfAt) {
       // ... through the same points.
       glm::dvec3 offset = o - r.origin;
       EXPECT_NEAR(glm::length(offset - glm::dot(offset, r.direction) * r.direction), 0.0, 1e-12);
-      if (perspective) EXPECT_EQ(o, r.origin);  // the eye
+      if (perspective) {
+        EXPECT_EQ(o, r.origin);  // the eye
+      }
       // And bit-identical to the one-ray function.
       Ray one = primaryRay(v, size, pixel);
       EXPECT_EQ(one.origin, r.origin);
