@@ -91,15 +91,10 @@ void syncFileSystemOf(const std::string& path) {
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {
-  writeWholeFile(path, text.data(), text.size());
-}
-
-void writeWholeFile(const std::string& path, const void* data, std::size_t size,
-                    AtomicFile::Durability durability) {
-  AtomicFile file(path, durability);
+  AtomicFile file(path);
   int fd = ::open(file.tempPath().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw outputError(path, std::string("cannot create: ") + std::strerror(errno));
-  bool ok = writeAll(fd, data, size);
+  bool ok = writeAll(fd, text.data(), text.size());
   const int err = errno;
   ok = ::close(fd) == 0 && ok;
   if (!ok) throw outputError(path, std::string("cannot write: ") + std::strerror(err));

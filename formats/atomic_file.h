@@ -54,10 +54,6 @@ void syncFileSystemOf(const std::string& path);
 // The whole of `text` into `path`, atomically (a stage's JSON report, ...). Throws
 // rad::outputError(path, ...).
 void writeTextFile(const std::string& path, const std::string& text);
-// The same for bytes already assembled in memory (a frame EXR encoded in memory: one write
-// instead of one per scanline).
-void writeWholeFile(const std::string& path, const void* data, std::size_t size,
-                    AtomicFile::Durability durability = AtomicFile::Durability::kEachFile);
 
 // Writes `size` bytes to `fd`, retrying on EINTR and short writes. Returns false with errno set
 // on failure. Shared by the writers that use POSIX descriptors.

@@ -1,5 +1,11 @@
 #include "formats/exr_image.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
@@ -75,6 +81,51 @@ void writeExrImage(const std::string& path, const FloatImage& image,
     throw outputError(path, e.what());
   }
   file.commit();
+}
+
+namespace {
+constexpr size_t kExrFlushBytes = size_t(1) << 20;
+}  // namespace
+
+ExrFileStream::ExrFileStream(const std::string& path, const std::string& name)
+    : Imf::OStream(name.c_str()), name_(name) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw outputError(name_, std::string("cannot create: ") + std::strerror(errno));
+}
+
+ExrFileStream::~ExrFileStream() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void ExrFileStream::write(const char c[], int n) {
+  // A write that does not continue or overlap the buffered run starts a new run.
+  if (pos_ < start_ || pos_ > start_ + buffer_.size()) {
+    flush();
+    start_ = pos_;
+  }
+  const size_t at = size_t(pos_ - start_), end = at + size_t(n);
+  if (end > buffer_.size()) buffer_.resize(end);
+  std::memcpy(buffer_.data() + at, c, size_t(n));
+  pos_ += uint64_t(n);
+  if (buffer_.size() >= kExrFlushBytes) {
+    flush();
+    start_ = pos_;
+  }
+}
+
+void ExrFileStream::flush() {
+  if (buffer_.empty()) return;
+  if (::lseek(fd_, off_t(start_), SEEK_SET) < 0 || !writeAll(fd_, buffer_.data(), buffer_.size()))
+    throw outputError(name_, std::string("cannot write: ") + std::strerror(errno));
+  buffer_.clear();
+}
+
+void ExrFileStream::close() {
+  flush();
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0)
+    throw outputError(name_, std::string("cannot write: ") + std::strerror(errno));
 }
 
 }  // namespace rad

@@ -16,7 +16,6 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
-#include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <png.h>
 
@@ -73,11 +72,12 @@ void writeFrameExr(const std::string& path, const ComposedFrame& frame, const Fr
     base = reinterpret_cast<const char*>(halves.data());
     elem = sizeof(Imath::half);
   }
-  // Encoded in memory and written with one system call: an uncompressed file is one chunk per
-  // scanline, and OpenEXR writes each with its own writev (240 per frame at 352x240).
-  Imf::StdOSStream encoded;
+  // Through ExrFileStream: an uncompressed file is one chunk per scanline, and OpenEXR writes
+  // each with its own system call (240 per frame at 352x240).
+  AtomicFile file(path, info.durability);
+  ExrFileStream stream(file.tempPath(), path);
   try {
-    Imf::OutputFile out(encoded, header);
+    Imf::OutputFile out(stream, header);
     Imf::FrameBuffer fb;
     const size_t xs = 3 * elem, ys = size_t(w) * xs;
     fb.insert("R", Imf::Slice(type, const_cast<char*>(base), xs, ys));
@@ -85,11 +85,13 @@ void writeFrameExr(const std::string& path, const ComposedFrame& frame, const Fr
     fb.insert("B", Imf::Slice(type, const_cast<char*>(base + 2 * elem), xs, ys));
     out.setFrameBuffer(fb);
     out.writePixels(h);
+  } catch (const Error&) {
+    throw;
   } catch (const std::exception& e) {
     throw outputError(path, e.what());
   }
-  const std::string bytes = encoded.str();
-  writeWholeFile(path, bytes.data(), bytes.size(), info.durability);
+  stream.close();
+  file.commit();
 }
 
 namespace {

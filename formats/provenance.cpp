@@ -192,11 +192,15 @@ void addInput(Provenance& provenance, const std::string& path) {
   provenance.inputs.push_back({path, hashFile(path), nullptr});
 }
 
-void addInput(Provenance& provenance, const ContainerReader& input) {
+InputRecord inputRecordOf(const ContainerReader& input) {
   InputRecord r{input.path(), input.fileHash(), nullptr};
   const auto& prov = input.header().find("provenance");
   if (prov != input.header().end() && prov->is_object()) r.history = *prov;
-  provenance.inputs.push_back(std::move(r));
+  return r;
+}
+
+void addInput(Provenance& provenance, const ContainerReader& input) {
+  provenance.inputs.push_back(inputRecordOf(input));
 }
 
 std::vector<std::string> parameterMismatch(const nlohmann::json& built,

@@ -59,6 +59,9 @@ std::string hashFile(const std::string& path);
 void addInput(Provenance& provenance, const std::string& path);
 // Same for a container already open: no second read of the file.
 void addInput(Provenance& provenance, const ContainerReader& input);
+// The record addInput appends for a container, for a caller that must release the reader
+// before the provenance exists (rad-compose drops global.rlh's bytes once read).
+InputRecord inputRecordOf(const ContainerReader& input);
 
 // Compares the parameters a file was built with against those this run needs, for each of
 // `keys`. Returns one message per difference, e.g. "built with --eps 0.02; this run expects

@@ -27,6 +27,7 @@
 #include <OpenEXR/openexr.h>
 
 #include "formats/atomic_file.h"
+#include "formats/exr_image.h"
 #include "libcommon/error.h"
 
 namespace rad {
@@ -119,74 +120,11 @@ std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<i
 }  // namespace
 
 // Member order matters: the OpenEXR file is closed (its chunk tables written) before the
-// AtomicFile renames or removes the temporary.
-namespace {
-
-// An OpenEXR output stream that collects writes in memory and hands them to the file in large
-// pwrites. Uncompressed parts are one chunk per scanline and OpenEXR writes each chunk (and
-// seeks for each chunk table) separately: 127,000 system calls for the table scene's 1,325
-// movies, a third of rad-movies' write phase on the 32-cube scene's 21,870 small movies. The
-// buffer is flushed at 1 MiB, so memory stays bounded whatever the movie's length.
-class BufferedFileStream : public Imf::OStream {
- public:
-  BufferedFileStream(const std::string& path, const std::string& name)
-      : Imf::OStream(name.c_str()), name_(name) {
-    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw outputError(name_, std::string("cannot create: ") + std::strerror(errno));
-  }
-  ~BufferedFileStream() override {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  void write(const char c[], int n) override {
-    // A write that does not continue or overlap the buffered run starts a new run.
-    if (pos_ < start_ || pos_ > start_ + buffer_.size()) {
-      flush();
-      start_ = pos_;
-    }
-    const size_t at = size_t(pos_ - start_), end = at + size_t(n);
-    if (end > buffer_.size()) buffer_.resize(end);
-    std::memcpy(buffer_.data() + at, c, size_t(n));
-    pos_ += uint64_t(n);
-    if (buffer_.size() >= kFlushBytes) {
-      flush();
-      start_ = pos_;
-    }
-  }
-  uint64_t tellp() override { return pos_; }
-  void seekp(uint64_t pos) override { pos_ = pos; }
-  // Writes what is buffered and closes the file; throws rad::outputError on failure.
-  void close() {
-    flush();
-    const int fd = fd_;
-    fd_ = -1;
-    if (::close(fd) != 0)
-      throw outputError(name_, std::string("cannot write: ") + std::strerror(errno));
-  }
-
- private:
-  static constexpr size_t kFlushBytes = size_t(1) << 20;
-  void flush() {
-    size_t done = 0;
-    while (done < buffer_.size()) {
-      const ssize_t n =
-          ::pwrite(fd_, buffer_.data() + done, buffer_.size() - done, off_t(start_ + done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) throw outputError(name_, std::string("cannot write: ") + std::strerror(errno));
-      done += size_t(n);
-    }
-    buffer_.clear();
-  }
-  std::string name_;
-  int fd_ = -1;
-  std::vector<char> buffer_;
-  uint64_t start_ = 0, pos_ = 0;  // file offset of buffer_[0]; the stream's position
-};
-
-}  // namespace
-
+// stream hands its last bytes to the temporary, and both before the AtomicFile renames or
+// removes it.
 struct TextureMovieWriter::File {
   AtomicFile atomic;
-  std::unique_ptr<BufferedFileStream> stream;
+  std::unique_ptr<ExrFileStream> stream;
   std::unique_ptr<Imf::MultiPartOutputFile> exr;
   File(const std::string& path, AtomicFile::Durability d) : atomic(path, d) {}
 };
@@ -220,7 +158,7 @@ void TextureMovieWriter::open(size_t parts) {
   if (!file_) file_ = std::make_unique<File>(path_, durability_);
   file_->exr.reset();
   file_->stream.reset();
-  file_->stream = std::make_unique<BufferedFileStream>(file_->atomic.tempPath(), path_);
+  file_->stream = std::make_unique<ExrFileStream>(file_->atomic.tempPath(), path_);
   try {
     file_->exr = std::make_unique<Imf::MultiPartOutputFile>(*file_->stream, headers.data(),
                                                             int(headers.size()));

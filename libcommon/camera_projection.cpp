@@ -142,19 +142,17 @@ PrimaryRays::PrimaryRays(const CameraView& view, ImageSize size) : view_(view), 
   const Camera& lens = view.lens;
   const glm::dmat4& m = view.worldFromCamera;
   const glm::dvec3 right(m[0]), up(m[1]), back(m[2]), eye(m[3]);
+  origin0_ = eye;
+  direction0_ = -back;
   if (lens.perspective) {
     halfTan_ = std::tan(0.5 * lens.yfov);
     aspect_ = effectiveAspect(lens, size);
     // Eye direction (xn aspect t, yn t, -1), as at() builds it before normalising.
-    origin0_ = eye;
-    direction0_ = -back;
     directionX_ = (aspect_ * halfTan_) * right;
     directionY_ = halfTan_ * up;
   } else {
-    origin0_ = eye;
     originX_ = lens.xmag * right;
     originY_ = lens.ymag * up;
-    direction0_ = -back;
   }
 }
 

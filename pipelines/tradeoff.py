@@ -124,7 +124,6 @@ def main():
     print("tradeoff: reference noise %.2f %% relative L2, removed from the errors"
           % (100 * noise.relative_l2()), file=sys.stderr)
 
-    rows = []
     # The default is timed first and again last (its least CPU time over both is kept): the
     # machine's speed drifts over a 10-minute sweep (another job ending on the other core made
     # later settings 7 % faster than the same computation timed first).
@@ -133,6 +132,7 @@ def main():
     # One untimed run first: the first run pays for cold caches (binaries, scene, references).
     bench.pipeline(a.bin, a.scene, os.path.join(a.out, "runs", "warm-up"), a.frames, a.size, {},
                    log)
+    settings = {}  # (knob, value) -> row; insertion order, so the default comes first
     for knob, stage, flag, value in runs:
         out = os.path.join(a.out, "runs", "%s-%s" % (knob, value))
         flags = {stage: [flag, value]} if stage else {}
@@ -143,29 +143,26 @@ def main():
                 r = bench.pipeline(a.bin, a.scene, out, a.frames, a.size, flags, log)
                 times.append(r["cpu_total"])
                 walls.append(r["total"])
-            err = noise.error_of(os.path.join(out, "frames"))
+            row = settings.get((knob, value))
+            if row is None:  # the frames are compared once: a second timing gives the same frames
+                err = noise.error_of(os.path.join(out, "frames"))
+                row = settings[(knob, value)] = {
+                    "knob": knob, "value": value, "rmse": err["rmse"],
+                    "relative_l2": err["relative_l2"], "raw_relative_l2": err["raw_relative_l2"],
+                    "peak_mib": r["peak_mib"], "times": [], "walls": []}
         except RuntimeError as e:
             print("tradeoff: %s = %s: %s" % (knob, value, e), file=sys.stderr)
             continue
-        again = next((r for r in rows if r["knob"] == knob and r["value"] == value), None)
-        if again:  # the default's second timing
-            times += again["times"]
-            walls += again["walls"]
-            rows.remove(again)
-            rows.insert(0, again)
-            again.update({"seconds_per_frame": min(times) / nframes,
-                          "seconds_spread": (max(times) - min(times)) / min(times),
-                          "wall_seconds_per_frame": min(walls) / nframes,
-                          "times": times, "walls": walls})
-            continue
-        rows.append({"knob": knob, "value": value, "seconds_per_frame": min(times) / nframes,
-                     "seconds_spread": (max(times) - min(times)) / min(times),
-                     "wall_seconds_per_frame": min(walls) / nframes,
-                     "rmse": err["rmse"], "relative_l2": err["relative_l2"],
-                     "raw_relative_l2": err["raw_relative_l2"], "peak_mib": r["peak_mib"],
-                     "times": times, "walls": walls})
+        row["times"] += times
+        row["walls"] += walls
         shutil.rmtree(os.path.join(out, "movies"), ignore_errors=True)  # keep the disk small
 
+    rows = list(settings.values())
+    for row in rows:
+        t, w = row["times"], row["walls"]
+        row.update({"seconds_per_frame": min(t) / nframes,
+                    "seconds_spread": (max(t) - min(t)) / min(t),
+                    "wall_seconds_per_frame": min(w) / nframes})
     report(a.out, rows)
 
 

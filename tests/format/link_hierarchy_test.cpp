@@ -31,6 +31,16 @@ GlobalSolution solution(const Scene& scene) {
   return solveSpaceTime(scene, {0.0, 0.25, 0.5}, o);
 }
 
+// What both reads give: key times, the hierarchy's ids, the node radiosity and leaf rows.
+void expectSameRadiosity(const GlobalSolution& r, const GlobalSolution& g) {
+  EXPECT_EQ(r.keyTimes, g.keyTimes);
+  ASSERT_EQ(r.hierarchy.size(), g.hierarchy.size());
+  for (int i = 0; i < g.hierarchy.size(); ++i)
+    EXPECT_EQ(r.hierarchy.node(i).id, g.hierarchy.node(i).id);
+  EXPECT_EQ(r.nodeRadiosity, g.nodeRadiosity);
+  EXPECT_EQ(r.leafRow, g.leafRow);
+}
+
 Provenance provenance() {
   const char* argv[] = {"rad-global", "scene.gltf"};
   Provenance p = makeProvenance("rad-global", 2, argv, {{"eps", 1e-2}});
@@ -44,12 +54,7 @@ TEST(LinkHierarchy, RoundTrip) {
   std::string path = tempPath("roundtrip.rlh");
   writeLinkHierarchy(path, g, provenance(), {{"note", "test"}});
   GlobalSolution r = readLinkHierarchy(path, scene);
-  EXPECT_EQ(r.keyTimes, g.keyTimes);
-  ASSERT_EQ(r.hierarchy.size(), g.hierarchy.size());
-  for (int i = 0; i < g.hierarchy.size(); ++i)
-    EXPECT_EQ(r.hierarchy.node(i).id, g.hierarchy.node(i).id);
-  EXPECT_EQ(r.nodeRadiosity, g.nodeRadiosity);
-  EXPECT_EQ(r.leafRow, g.leafRow);
+  expectSameRadiosity(r, g);
   EXPECT_EQ(r.leafVertexGoodIrradiance, g.leafVertexGoodIrradiance);
   ASSERT_EQ(r.links.size(), g.links.size());
   for (size_t i = 0; i < g.links.size(); ++i) {
@@ -70,12 +75,7 @@ TEST(LinkHierarchy, RoundTrip) {
 
   // rad-compose's read: the same hierarchy and radiosity, nothing of the links.
   GlobalSolution c = readLinkHierarchyRadiosity(ContainerReader::open(path), scene);
-  EXPECT_EQ(c.keyTimes, g.keyTimes);
-  ASSERT_EQ(c.hierarchy.size(), g.hierarchy.size());
-  for (int i = 0; i < g.hierarchy.size(); ++i)
-    EXPECT_EQ(c.hierarchy.node(i).id, g.hierarchy.node(i).id);
-  EXPECT_EQ(c.nodeRadiosity, g.nodeRadiosity);
-  EXPECT_EQ(c.leafRow, g.leafRow);
+  expectSameRadiosity(c, g);
   EXPECT_EQ(c.radiosity(3, 0.1), g.radiosity(3, 0.1));
   EXPECT_FALSE(g.links.empty());
   EXPECT_TRUE(c.links.empty());

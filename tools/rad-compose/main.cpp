@@ -44,11 +44,11 @@ int run(const Options& o, int argc, char** argv) {
   // bytes are released once read. On the 32-cube scene the file (49 MB) and a copy of its links
   // and F·V samples (45 MB) were otherwise held for the whole sequence.
   rad::GlobalSolution solution;
-  rad::Provenance globalInput;  // global.rlh's input record, taken while its bytes are held
+  rad::InputRecord globalInput;  // taken while the file's bytes are held
   {
     rad::ContainerReader globalReader = rad::ContainerReader::open(o.global);
     solution = rad::readLinkHierarchyRadiosity(globalReader, scene);
-    rad::addInput(globalInput, globalReader);
+    globalInput = rad::inputRecordOf(globalReader);
   }
   rad::ContainerReader intervalsReader = rad::ContainerReader::open(o.intervals);
   rad::TextureIntervals intervals = rad::readTextureIntervals(intervalsReader);
@@ -96,7 +96,7 @@ int run(const Options& o, int argc, char** argv) {
       {"no-png", o.noPng}};
   rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
   rad::addInput(provenance, o.scene);
-  provenance.inputs.push_back(std::move(globalInput.inputs.front()));
+  provenance.inputs.push_back(std::move(globalInput));
   rad::addInput(provenance, intervalsReader);
   rad::addMoviesInput(provenance, intervals, o.movies, c.frames);
 
