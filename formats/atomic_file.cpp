@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/provenance.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

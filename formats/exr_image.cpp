@@ -16,7 +16,7 @@
 #include <filesystem>
 
 #include "formats/atomic_file.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

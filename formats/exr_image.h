@@ -10,7 +10,7 @@
 
 #include <OpenEXR/ImfIO.h>
 
-#include "libcommon/float_image.h"
+#include "libcommon/core/float_image.h"
 
 namespace rad {
 

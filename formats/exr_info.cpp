@@ -14,7 +14,7 @@
 #include <OpenEXR/ImfStringVectorAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
 
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

@@ -20,7 +20,7 @@
 #include <png.h>
 
 #include "formats/atomic_file.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

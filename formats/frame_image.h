@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "formats/atomic_file.h"
-#include "libcommon/frame_composer.h"
+#include "libcommon/compose/frame_composer.h"
 
 namespace rad {
 

@@ -13,7 +13,7 @@
 #include "formats/exr_info.h"
 #include "formats/frame_image.h"
 #include "formats/texture_movie.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 namespace {

@@ -1,7 +1,7 @@
 // rad-compose's frame loop (DESIGN.md §6 "rad-compose"): for each frame, the texture movies
 // active at it are read lazily from MOVIES_DIR (movies/MMMMMM.exr) and dropped after their last
 // frame, so memory stays flat in the animation's length; each frame is composed
-// (libcommon/frame_composer.h) and written as FRAMES_DIR/NNNN.exr (+ .png), atomically.
+// (libcommon/compose/frame_composer.h) and written as FRAMES_DIR/NNNN.exr (+ .png), atomically.
 #pragma once
 
 #include <functional>
@@ -12,9 +12,9 @@
 
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
-#include "libcommon/frame_composer.h"
-#include "libcommon/global_solution.h"
-#include "libcommon/scene.h"
+#include "libcommon/compose/frame_composer.h"
+#include "libcommon/radiosity/global_solution.h"
+#include "libcommon/scene/scene.h"
 
 namespace rad {
 

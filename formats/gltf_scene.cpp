@@ -16,7 +16,7 @@
 #include <map>
 #include <sstream>
 
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "libcommon/scene.h"
+#include "libcommon/scene/scene.h"
 
 namespace rad {
 

@@ -13,7 +13,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include "formats/atomic_file.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

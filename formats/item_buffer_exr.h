@@ -11,7 +11,7 @@
 
 #include <string>
 
-#include "libcommon/item_buffer.h"
+#include "libcommon/gl/item_buffer.h"
 
 namespace rad {
 

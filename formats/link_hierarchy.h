@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/container.h"
-#include "libcommon/global_solution.h"
-#include "libcommon/scene.h"
+#include "libcommon/radiosity/global_solution.h"
+#include "libcommon/scene/scene.h"
 
 namespace rad {
 

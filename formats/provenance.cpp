@@ -12,7 +12,7 @@
 
 #include "formats/checksum.h"
 #include "formats/container.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

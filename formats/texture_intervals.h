@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/container.h"
-#include "libcommon/patch_hierarchy.h"
+#include "libcommon/scene/patch_hierarchy.h"
 
 namespace rad {
 

@@ -28,7 +28,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/exr_image.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 

@@ -12,7 +12,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/provenance.h"
-#include "libcommon/patch_hierarchy.h"
+#include "libcommon/scene/patch_hierarchy.h"
 
 namespace rad {
 

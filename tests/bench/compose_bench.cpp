@@ -7,7 +7,7 @@
 #include <string>
 
 #include "formats/gltf_scene.h"
-#include "libcommon/frame_composer.h"
+#include "libcommon/compose/frame_composer.h"
 
 int main(int argc, char** argv) {
   using namespace rad;

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "formats/gltf_scene.h"
-#include "libcommon/space_time_radiosity.h"
+#include "libcommon/radiosity/space_time_radiosity.h"
 
 using namespace rad;
 

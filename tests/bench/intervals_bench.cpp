@@ -14,8 +14,8 @@
 #include <string>
 
 #include "formats/gltf_scene.h"
-#include "libcommon/texture_intervals_builder.h"
-#include "libcommon/tool_main.h"
+#include "libcommon/intervals/texture_intervals_builder.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "libcommon/texture_movie_baker.h"
+#include "libcommon/movies/texture_movie_baker.h"
 
 using namespace rad;
 

@@ -15,8 +15,8 @@
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
 #include "formats/texture_movie.h"
-#include "libcommon/frame_composer.h"
-#include "libcommon/item_buffer.h"
+#include "libcommon/compose/frame_composer.h"
+#include "libcommon/gl/item_buffer.h"
 #include "tests/cli/cli_util.h"
 #include "tests/unit/compose_fixture.h"
 

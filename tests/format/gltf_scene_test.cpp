@@ -12,7 +12,7 @@
 #include <limits>
 
 #include "formats/gltf_scene.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 namespace {

@@ -9,8 +9,8 @@
 
 #include "formats/gltf_scene.h"
 #include "formats/provenance.h"
-#include "libcommon/error.h"
-#include "libcommon/space_time_radiosity.h"
+#include "libcommon/core/error.h"
+#include "libcommon/radiosity/space_time_radiosity.h"
 
 namespace rad {
 namespace {

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "formats/provenance.h"
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 namespace {

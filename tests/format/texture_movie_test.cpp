@@ -19,7 +19,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace fs = std::filesystem;
 

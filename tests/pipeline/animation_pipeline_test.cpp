@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "formats/exr_image.h"
-#include "libcommon/image_difference.h"
+#include "libcommon/reference/image_difference.h"
 #include "tests/cli/cli_util.h"
 
 namespace rad::test {

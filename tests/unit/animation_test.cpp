@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "libcommon/scene.h"
+#include "libcommon/scene/scene.h"
 
 namespace rad {
 namespace {

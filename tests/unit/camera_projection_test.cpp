@@ -1,4 +1,4 @@
-#include "libcommon/camera_projection.h"
+#include "libcommon/scene/camera_projection.h"
 
 #include <cmath>
 #include <limits>
@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 namespace {

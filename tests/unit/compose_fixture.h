@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "formats/gltf_scene.h"
-#include "libcommon/global_solution.h"
-#include "libcommon/scene.h"
+#include "libcommon/radiosity/global_solution.h"
+#include "libcommon/scene/scene.h"
 
 namespace rad::test {
 

@@ -1,5 +1,5 @@
 // Form factors against the exact references in tests/data/reference (see its README).
-#include "libcommon/form_factor.h"
+#include "libcommon/radiosity/form_factor.h"
 
 #include <chrono>
 #include <cmath>

@@ -1,6 +1,6 @@
 // FrameComposer (paper §3.1 last step): L = Le + rho/pi H from movies, B/pi fallback, pixel
 // agreement with the item buffer, texture orientation, sRGB encoding and auto exposure.
-#include "libcommon/frame_composer.h"
+#include "libcommon/compose/frame_composer.h"
 
 #include <cmath>
 #include <cstring>

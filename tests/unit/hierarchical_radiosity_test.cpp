@@ -1,7 +1,7 @@
 // Hierarchical radiosity at one time against tests/data/reference/furnace.json (see the README
 // there): uniform furnaces up to rho = 0.999, the exact one-emitter discrete systems, the
 // two-squares system, energy balance with refinement, and the shaft test.
-#include "libcommon/hierarchical_radiosity.h"
+#include "libcommon/radiosity/hierarchical_radiosity.h"
 
 #include <array>
 #include <chrono>

@@ -1,12 +1,12 @@
 // libcommon/image_difference: the error and flicker figures of rad-diff on synthetic images
 // whose answers are known exactly.
-#include "libcommon/image_difference.h"
+#include "libcommon/reference/image_difference.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 namespace {

@@ -1,4 +1,4 @@
-#include "libcommon/item_buffer.h"
+#include "libcommon/gl/item_buffer.h"
 
 #include <embree3/rtcore.h>
 
@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "libcommon/error.h"
-#include "libcommon/projected_area.h"
+#include "libcommon/core/error.h"
+#include "libcommon/intervals/projected_area.h"
 
 namespace rad {
 namespace {

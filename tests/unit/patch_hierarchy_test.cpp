@@ -1,4 +1,4 @@
-#include "libcommon/patch_hierarchy.h"
+#include "libcommon/scene/patch_hierarchy.h"
 
 #include <random>
 

@@ -4,7 +4,7 @@
 // B / pi = L_e / (1 - rho)) and a small receiver under a square emitter (L = rho / pi * pi L_e
 // * F, F from the exact point-to-polygon form factor). Monte Carlo figures are checked within
 // 4 standard errors.
-#include "libcommon/path_tracer.h"
+#include "libcommon/reference/path_tracer.h"
 
 #include <cmath>
 #include <fstream>
@@ -13,7 +13,7 @@
 #include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
-#include "libcommon/form_factor.h"
+#include "libcommon/radiosity/form_factor.h"
 
 namespace rad {
 namespace {

@@ -1,4 +1,4 @@
-#include "libcommon/projected_area.h"
+#include "libcommon/intervals/projected_area.h"
 
 #include <cmath>
 

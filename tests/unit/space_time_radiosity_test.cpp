@@ -2,7 +2,7 @@
 // as independent solves bit for bit, whatever the thread count; a static scene recomputes no link
 // after the first key time, and the merged GlobalSolution is consistent (activity intervals,
 // push-down, Gouraud vertices).
-#include "libcommon/space_time_radiosity.h"
+#include "libcommon/radiosity/space_time_radiosity.h"
 
 #include <cmath>
 #include <iostream>

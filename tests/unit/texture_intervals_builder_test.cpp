@@ -1,4 +1,4 @@
-#include "libcommon/texture_intervals_builder.h"
+#include "libcommon/intervals/texture_intervals_builder.h"
 
 #include <embree3/rtcore.h>
 
@@ -16,8 +16,8 @@
 #include "formats/item_buffer_exr.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
-#include "libcommon/error.h"
-#include "libcommon/projected_area.h"
+#include "libcommon/core/error.h"
+#include "libcommon/intervals/projected_area.h"
 
 namespace rad {
 namespace {

@@ -1,7 +1,7 @@
-// Texture-movie baking (libcommon/texture_movie_baker.h): unoccluded irradiance against the
+// Texture-movie baking (libcommon/movies/texture_movie_baker.h): unoccluded irradiance against the
 // exact form factor, shadows, coherence (static blockers once, exact OR merge) against the
 // per-key baseline, constant movies, determinism and the memory budget.
-#include "libcommon/texture_movie_baker.h"
+#include "libcommon/movies/texture_movie_baker.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "libcommon/error.h"
-#include "libcommon/form_factor.h"
+#include "libcommon/core/error.h"
+#include "libcommon/radiosity/form_factor.h"
 
 namespace rad {
 namespace {

@@ -1,7 +1,7 @@
-// Transmittance by projective shadows into sample masks (libcommon/transmittance.h): the
+// Transmittance by projective shadows into sample masks (libcommon/movies/transmittance.h): the
 // projection, the sample pattern, occlusion against hand-computed visible fractions and the
 // exact OR merge.
-#include "libcommon/transmittance.h"
+#include "libcommon/movies/transmittance.h"
 
 #include <algorithm>
 #include <bitset>
@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "libcommon/error.h"
-#include "libcommon/patch_hierarchy.h"
+#include "libcommon/core/error.h"
+#include "libcommon/scene/patch_hierarchy.h"
 
 namespace rad {
 namespace {

@@ -1,5 +1,5 @@
 // Embree shadow-ray visibility: exact cases, the half blocker, determinism, dynamic instances.
-#include "libcommon/visibility.h"
+#include "libcommon/radiosity/visibility.h"
 
 #include <cmath>
 #include <iostream>
@@ -9,7 +9,7 @@
 #include <tbb/global_control.h>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "libcommon/error.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 namespace {

@@ -1,7 +1,7 @@
 // rad-compose: final frames from the texture movies (paper §3.1 last step; DESIGN.md §6
 // "rad-compose"). Reads the scene, the global solution, the intervals and the movies; writes
 // FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The work is in
-// libcommon/frame_composer.h and formats/frame_sequence.h.
+// libcommon/compose/frame_composer.h and formats/frame_sequence.h.
 #include <unistd.h>
 
 #include <cstdio>
@@ -17,7 +17,7 @@
 #include "formats/link_hierarchy.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
-#include "libcommon/tool_main.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

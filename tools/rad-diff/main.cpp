@@ -12,8 +12,8 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/exr_image.h"
-#include "libcommon/image_difference.h"
-#include "libcommon/tool_main.h"
+#include "libcommon/reference/image_difference.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

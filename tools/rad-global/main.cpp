@@ -10,8 +10,8 @@
 #include "formats/gltf_scene.h"
 #include "formats/link_hierarchy.h"
 #include "formats/provenance.h"
-#include "libcommon/space_time_radiosity.h"
-#include "libcommon/tool_main.h"
+#include "libcommon/radiosity/space_time_radiosity.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

@@ -12,8 +12,8 @@
 #include "formats/gltf_scene.h"
 #include "formats/inspect_kinds.h"
 #include "formats/texture_movie.h"
-#include "libcommon/scene_summary.h"
-#include "libcommon/tool_main.h"
+#include "libcommon/scene/scene_summary.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // rad-intervals: texture-movie extents from per-frame item buffers (paper §4.1, §4.3;
-// DESIGN.md §6 rad-intervals). The algorithm is libcommon/texture_intervals_builder.h; this
+// DESIGN.md §6 rad-intervals). The algorithm is libcommon/intervals/texture_intervals_builder.h; this
 // main parses, reads the scene, runs the frames, writes intervals.rti and reports.
 #include <algorithm>
 #include <chrono>
@@ -14,8 +14,8 @@
 #include "formats/item_buffer_exr.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
-#include "libcommon/texture_intervals_builder.h"
-#include "libcommon/tool_main.h"
+#include "libcommon/intervals/texture_intervals_builder.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

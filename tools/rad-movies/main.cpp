@@ -14,8 +14,8 @@
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
 #include "formats/texture_movie.h"
-#include "libcommon/texture_movie_baker.h"
-#include "libcommon/tool_main.h"
+#include "libcommon/movies/texture_movie_baker.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

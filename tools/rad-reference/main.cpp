@@ -1,6 +1,6 @@
 // rad-reference: independent Monte Carlo path-traced frames of a scene (issue 7), the
 // "converged reference" of DESIGN.md §8 that rad-diff compares the pipeline's frames with.
-// Shares only the scene loader and the camera with the pipeline (see libcommon/path_tracer.h).
+// Shares only the scene loader and the camera with the pipeline (see libcommon/reference/path_tracer.h).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,8 +12,8 @@
 #include "formats/exr_image.h"
 #include "formats/gltf_scene.h"
 #include "formats/provenance.h"
-#include "libcommon/path_tracer.h"
-#include "libcommon/tool_main.h"
+#include "libcommon/reference/path_tracer.h"
+#include "tools/common/tool_main.h"
 
 namespace {
 

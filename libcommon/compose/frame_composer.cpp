@@ -1,0 +1,364 @@
+// Frame composition (paper §3.1 last step). Contracts in frame_composer.h.
+#include "libcommon/compose/frame_composer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <unordered_map>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "libcommon/core/error.h"
+
+namespace rad {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Bilinear sample with texel centres at ((i+.5)/w, (j+.5)/h) and clamp-to-edge: what GL_LINEAR
+// with GL_CLAMP_TO_EDGE returns (in double, without GL's 8-bit weight quantisation). With a
+// second key `next`, each texel is first blended in float exactly as TextureMovie::textureAt
+// blends the whole texture: (1 - weight) * rgb + weight * next.
+glm::dvec3 sampleClamped(const float* rgb, const float* next, float weight, int w, int h,
+                         glm::dvec2 uv) {
+  double x = std::clamp(uv.x * w - 0.5, 0.0, double(w - 1));
+  double y = std::clamp(uv.y * h - 0.5, 0.0, double(h - 1));
+  int i0 = std::min(int(x), w - 1), j0 = std::min(int(y), h - 1);
+  int i1 = std::min(i0 + 1, w - 1), j1 = std::min(j0 + 1, h - 1);
+  double fx = x - i0, fy = y - j0;
+  const float keep = 1.0f - weight;
+  auto at = [&](int i, int j) {
+    const size_t o = (size_t(j) * w + i) * 3;
+    const float* p = rgb + o;
+    if (!next) return glm::dvec3(p[0], p[1], p[2]);
+    const float* q = next + o;
+    const float r = keep * p[0] + weight * q[0], g = keep * p[1] + weight * q[1],
+                b = keep * p[2] + weight * q[2];
+    return glm::dvec3(r, g, b);
+  };
+  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
+         fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
+}
+
+// Bilinear sample of a glTF base colour texture (default sampler: LINEAR, REPEAT). glTF's
+// (u,v) = (0,0) is the first texel of the first row of the image (Texture::rgb row 0).
+glm::dvec3 sampleRepeat(const Texture& tex, glm::dvec2 uv) {
+  int w = tex.width, h = tex.height;
+  double x = uv.x * w - 0.5, y = uv.y * h - 0.5;
+  double fx0 = std::floor(x), fy0 = std::floor(y);
+  double fx = x - fx0, fy = y - fy0;
+  auto wrap = [](double i, int n) {
+    long long k = (long long)i % n;
+    return int(k < 0 ? k + n : k);
+  };
+  int i0 = wrap(fx0, w), i1 = wrap(fx0 + 1, w), j0 = wrap(fy0, h), j1 = wrap(fy0 + 1, h);
+  auto at = [&](int i, int j) {
+    const float* p = tex.rgb.data() + (size_t(j) * w + i) * 3;
+    return glm::dvec3(p[0], p[1], p[2]);
+  };
+  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
+         fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
+}
+
+// The attribute map of a polygon's (u,v) parameterisation applied to per-vertex values
+// (patch_hierarchy.h: quads bilinear over v0..v3, triangles affine over v0..v2).
+glm::dvec2 interpolateCorners(const std::array<glm::dvec2, 4>& c, int count, glm::dvec2 uv) {
+  if (count == 3) return c[0] + uv.x * (c[1] - c[0]) + uv.y * (c[2] - c[0]);
+  return (1 - uv.x) * (1 - uv.y) * c[0] + uv.x * (1 - uv.y) * c[1] + uv.x * uv.y * c[2] +
+         (1 - uv.x) * uv.y * c[3];
+}
+
+// Active movie by packed patch id: open addressing with a multiplicative hash. Every covered
+// pixel looks up each level of its descent; std::unordered_map's modulo by a prime was a
+// visible share of rad-compose's per-pixel time.
+class PatchIndex {
+ public:
+  explicit PatchIndex(size_t count) {
+    size_t capacity = 16;
+    while (capacity < 2 * count) capacity *= 2;
+    shift_ = 64;
+    for (size_t c = capacity; c > 1; c /= 2) --shift_;
+    mask_ = capacity - 1;
+    slots_.assign(capacity, Slot{kEmpty, 0});
+  }
+  void insert(uint64_t key, size_t value) {
+    for (size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (slots_[i].key == kEmpty || slots_[i].key == key) {
+        slots_[i] = Slot{key, value};  // a repeated patch: the last movie wins
+        return;
+      }
+    }
+  }
+  long find(uint64_t key) const {
+    for (size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (slots_[i].key == key) return long(slots_[i].value);
+      if (slots_[i].key == kEmpty) return -1;
+    }
+  }
+
+ private:
+  static constexpr uint64_t kEmpty =
+      ~uint64_t(0);  // no PatchId packs to this (path has a 1 marker)
+  struct Slot {
+    uint64_t key;
+    size_t value;
+  };
+  size_t slot(uint64_t key) const { return size_t((key * 0x9E3779B97F4A7C15ull) >> shift_); }
+  std::vector<Slot> slots_;
+  size_t mask_ = 0;
+  int shift_ = 60;
+};
+
+}  // namespace
+
+struct FrameComposer::Impl {
+  const Scene& scene;
+  const GlobalSolution& solution;
+  ImageSize size;
+  int cameraNode;
+  std::vector<InputPolygon> tops;
+  std::vector<int> objectNodes;        // mesh node of each item object
+  std::vector<glm::dmat4> transforms;  // per object, at the current time
+  std::vector<Material> materials;     // per top (default material where -1)
+  ItemBufferRenderer renderer;
+  ItemBuffer items;
+
+  Impl(const Scene& s, const GlobalSolution& g, ImageSize sz, int cam)
+      : scene(s), solution(g), size(sz), cameraNode(cam), tops(s.inputPolygons()), renderer(sz) {
+    if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
+      throw inputError(s.path, "node " + std::to_string(cam) + " is not a camera");
+    if (g.hierarchy.topCount() != int(tops.size()))
+      throw inputError(s.path, "global solution has " + std::to_string(g.hierarchy.topCount()) +
+                                   " top-level patches; the scene has " +
+                                   std::to_string(tops.size()));
+    // One item object per mesh node (rigid body), item id = top-level index + 1.
+    std::unordered_map<int, size_t> objectOf;
+    std::vector<ItemObject> objects;
+    for (size_t i = 0; i < tops.size(); ++i) {
+      int node = tops[i].node;
+      auto it = objectOf.find(node);
+      if (it == objectOf.end()) {
+        it = objectOf.emplace(node, objects.size()).first;
+        objects.emplace_back();
+        objectNodes.push_back(node);
+      }
+      objects[it->second].addPolygon(tops[i].local, uint32_t(i + 1));
+      int m = tops[i].material;
+      materials.push_back(m >= 0 && m < int(s.materials.size()) ? s.materials[m] : Material{});
+    }
+    renderer.setGeometry(objects);
+    transforms.resize(objects.size());
+  }
+};
+
+FrameComposer::FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size,
+                             int cameraNode)
+    : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode)) {}
+
+FrameComposer::~FrameComposer() = default;
+
+ImageSize FrameComposer::size() const {
+  return impl_->size;
+}
+
+ComposedFrame FrameComposer::compose(double t, const std::vector<MovieTexture>& movies) {
+  ComposedFrame out;
+  compose(t, movies, out);
+  return out;
+}
+
+void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, ComposedFrame& out) {
+  Impl& m = *impl_;
+  const ImageSize size = m.size;
+  const int topCount = int(m.tops.size());
+
+  // Visibility: the item buffer at time t.
+  CameraView view = m.scene.cameraAt(m.cameraNode, t);
+  for (size_t k = 0; k < m.objectNodes.size(); ++k)
+    m.transforms[k] = m.scene.worldTransform(m.objectNodes[k], t);
+  m.renderer.render(view, m.transforms, m.items);
+
+  // World polygons at t (affine maps keep the (u,v) parameterisation, so the hit's (u,v) in
+  // the world polygon is its top-level (u,v)).
+  // Their normals and (u,v) maps are set up once per frame here, not per pixel.
+  std::vector<Polygon> world(topCount);
+  std::vector<glm::dvec3> normals(topCount);
+  std::vector<PolygonUvMap> uvMaps(topCount);
+  std::vector<char> seen(topCount, 0);
+  for (uint32_t id : m.items.id)
+    if (id != kNoItem) seen[id - 1] = 1;
+  std::unordered_map<int, size_t> objectOfNode;
+  for (size_t k = 0; k < m.objectNodes.size(); ++k) objectOfNode[m.objectNodes[k]] = k;
+  for (int i = 0; i < topCount; ++i)
+    if (seen[i]) {
+      world[i] = m.tops[i].local.transformed(m.transforms[objectOfNode[m.tops[i].node]]);
+      normals[i] = world[i].normal();
+      uvMaps[i] = PolygonUvMap(world[i]);
+    }
+
+  // Active movies per top, by patch id; the deepest level per top bounds the descent.
+  PatchIndex movieOf(movies.size());
+  std::vector<int> deepest(topCount, -1);
+  for (size_t k = 0; k < movies.size(); ++k) {
+    const MovieTexture& mt = movies[k];
+    if (mt.patch.top >= uint32_t(topCount) || !mt.irradiance || mt.width < 1 || mt.height < 1)
+      throw Error(ExitCode::kInternal, "compose",
+                  "movie of patch " + mt.patch.toString() + " is invalid for this scene");
+    movieOf.insert(mt.patch.packed(), k);
+    deepest[mt.patch.top] = std::max(deepest[mt.patch.top], mt.patch.level());
+  }
+
+  // The frame's primary rays (the lens is validated here, once).
+  const PrimaryRays rays(view, size);
+  out.size = size;
+  out.time = t;
+  const size_t n = size_t(size.pixelCount());
+  out.rgb.assign(n * 3, 0.0f);
+  out.source.assign(n, PixelSource::kBackground);
+  std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0),
+      rowCovered(size.height, 0);
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& r) {
+    for (int row = r.begin(); row < r.end(); ++row) {
+      for (int col = 0; col < size.width; ++col) {
+        size_t p = size_t(row) * size.width + col;
+        uint32_t id = m.items.id[p];
+        if (id == kNoItem) continue;
+        ++rowCovered[row];
+        int top = int(id - 1);
+        const Polygon& poly = world[top];
+        const bool triangle = poly.count == 3;
+        const Material& mat = m.materials[top];
+
+        // Hit point of the pixel-centre ray with the patch's plane.
+        // (A ray parallel to the plane cannot hit it; its centroid stands in.)
+        glm::dvec3 origin, direction;  // direction not unit length: its scale cancels in s
+        rays.line(glm::dvec2(col + 0.5, row + 0.5), origin, direction);
+        const glm::dvec3& nrm = normals[size_t(top)];
+        const double denom = glm::dot(nrm, direction);
+        bool onPlane = false;
+        glm::dvec3 hit;
+        if (std::abs(denom) > 1e-300) {
+          double s = glm::dot(nrm, poly.v[0] - origin) / denom;
+          if (std::isfinite(s)) {
+            hit = origin + s * direction;
+            onPlane = true;
+          }
+        }
+        if (!onPlane) hit = poly.centroid();
+        glm::dvec2 topUv = clampToParameterDomain(uvMaps[size_t(top)].uvAt(hit), triangle);
+
+        // Base colour texture factor tex(x) / mean(tex) (Material::reflectance already holds
+        // the mean), 1 without a texture.
+        glm::dvec3 texFactor(1.0);
+        bool textured = false;
+        if (mat.baseColorTexture >= 0 && mat.baseColorTexture < int(m.scene.textures.size())) {
+          const Texture& tex = m.scene.textures[mat.baseColorTexture];
+          if (tex.width > 0 && tex.height > 0 &&
+              tex.rgb.size() == size_t(tex.width) * tex.height * 3) {
+            glm::dvec2 texUv = interpolateCorners(m.tops[top].uv, poly.count, topUv);
+            glm::dvec3 c = sampleRepeat(tex, texUv);
+            for (int a = 0; a < 3; ++a) texFactor[a] = tex.mean[a] > 0.0 ? c[a] / tex.mean[a] : 0.0;
+            textured = true;
+          }
+        }
+
+        // The deepest active movie whose patch contains the point.
+        int found = -1;
+        glm::dvec2 foundUv(0.0);
+        if (deepest[top] >= 0) {
+          PatchId node{uint32_t(top), 1u};
+          glm::dvec2 uv = topUv;
+          for (int level = 0;; ++level) {
+            const long k = movieOf.find(node.packed());
+            if (k >= 0) {
+              found = int(k);
+              foundUv = uv;
+            }
+            if (level >= deepest[top]) break;
+            node = node.child(descendToChild(uv, triangle));
+          }
+        }
+
+        glm::dvec3 L;
+        if (found >= 0) {
+          // $L = L_e + \frac{\rho(x)}{\pi} H(x)$
+          const MovieTexture& mt = movies[size_t(found)];
+          glm::dvec3 H = sampleClamped(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width,
+                                       mt.height, foundUv);
+          L = mat.emission + (mat.reflectance * texFactor / kPi) * H;
+          out.source[p] = PixelSource::kMovie;
+          ++rowMovie[row];
+        } else {
+          // Fallback: the union leaf's radiosity, $L = B / \pi$.
+          int leaf = leafAtTopUv(m.solution.hierarchy, top, topUv);
+          glm::dvec3 B = m.solution.radiosity(leaf, t);
+          if (textured)
+            L = mat.emission + texFactor * glm::max(B / kPi - mat.emission, glm::dvec3(0.0));
+          else
+            L = B / kPi;
+          out.source[p] = PixelSource::kFallback;
+          ++rowFallback[row];
+        }
+        for (int a = 0; a < 3; ++a)
+          out.rgb[p * 3 + a] = std::isfinite(L[a]) ? float(std::max(L[a], 0.0)) : 0.0f;
+      }
+    }
+  });
+  out.coveredPixels = out.moviePixels = out.fallbackPixels = 0;
+  for (int row = 0; row < size.height; ++row) {
+    out.coveredPixels += rowCovered[row];
+    out.moviePixels += rowMovie[row];
+    out.fallbackPixels += rowFallback[row];
+  }
+}
+
+double srgbEncode(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+}
+
+std::vector<uint8_t> toSrgb8(const std::vector<float>& rgb, double exposureEV) {
+  const double scale = std::exp2(exposureEV);
+  std::vector<uint8_t> out(rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    double v = std::isfinite(rgb[i]) ? double(rgb[i]) * scale : 0.0;
+    out[i] = uint8_t(std::lround(255.0 * srgbEncode(v)));
+  }
+  return out;
+}
+
+double autoExposureEV(const Scene& scene, const GlobalSolution& solution, double percentile) {
+  const PatchHierarchy& h = solution.hierarchy;
+  std::vector<std::pair<double, double>> lumArea;  // (luminance of B/pi, area)
+  for (int i = 0; i < h.size(); ++i) {
+    if (!h.isLeaf(i)) continue;
+    const InputPolygon& top = h.topOf(i);
+    if (top.material >= 0 && top.material < int(scene.materials.size()) &&
+        scene.materials[top.material].isEmitter())
+      continue;
+    double area = h.node(i).local.area();
+    if (!(area > 0.0)) continue;
+    for (int k = 0; k < solution.keyCount(); ++k) {
+      double y = luminance(solution.radiosityAtKey(i, k) / kPi);
+      if (std::isfinite(y) && y > 0.0) lumArea.push_back({y, area});
+    }
+  }
+  if (lumArea.empty()) return 0.0;
+  std::sort(lumArea.begin(), lumArea.end());
+  double total = 0.0;
+  for (const auto& la : lumArea) total += la.second;
+  double target = std::clamp(percentile, 0.0, 1.0) * total, acc = 0.0;
+  double y = lumArea.back().first;
+  for (const auto& la : lumArea) {
+    acc += la.second;
+    if (acc >= target) {
+      y = la.first;
+      break;
+    }
+  }
+  return -std::log2(y);
+}
+
+}  // namespace rad

@@ -1,0 +1,362 @@
+// Texture-movie extents from item buffers. Sources and rules in texture_intervals_builder.h.
+#include "libcommon/intervals/texture_intervals_builder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "libcommon/core/error.h"
+#include "libcommon/intervals/projected_area.h"
+
+namespace rad {
+namespace {
+
+// Side planes of the "whole patch" projection are this many image widths / heights out: the
+// area of a patch's image clipped only at the near and far planes, bounded so a patch that
+// crosses the eye plane edge-on cannot have an unbounded area.
+constexpr double kGuardBand = 64.0;
+
+// Largest subdivision the builder makes: ~480 bytes per node (patch hierarchy, GL and item
+// geometry), so at most ~250 MB.
+constexpr long kMaxNodes = 1L << 19;
+
+}  // namespace
+
+void TextureIntervalsOptions::validate() const {
+  auto bad = [](const std::string& flag, const std::string& what) {
+    return Error(ExitCode::kUsage, "", flag + ": " + what);
+  };
+  if (imageSize.width < 1 || imageSize.height < 1 || imageSize.width > 16384 ||
+      imageSize.height > 16384)
+    throw bad("--size", "must be between 1x1 and 16384x16384");
+  if (!(fps > 0.0) || !std::isfinite(fps)) throw bad("--fps", "must be > 0");
+  if (maxLevel < 0 || maxLevel > 8) throw bad("--max-level", "must be in [0, 8]");
+  if (!(minVisibleFraction >= 0.0 && minVisibleFraction <= 1.0))
+    throw bad("--min-visible-fraction", "must be in [0, 1]");
+  if (!(texelDensity > 0.0) || !std::isfinite(texelDensity))
+    throw bad("--texel-density", "must be > 0");
+  if (minSize < 1) throw bad("--min-size", "must be >= 1");
+  if (maxSize < minSize || maxSize > 16384)
+    throw bad("--max-size", "must be in [--min-size, 16384]");
+  if (!(levelHysteresis >= 0.0 && levelHysteresis <= 1.0))
+    throw bad("--level-hysteresis", "must be in [0, 1]");
+  if (!(resizeTolerance >= 0.0) || !std::isfinite(resizeTolerance))
+    throw bad("--resize-tolerance", "must be >= 0");
+  if (maxLength < 0) throw bad("--max-length", "must be >= 0 (0 = unlimited)");
+}
+
+int textureSideFor(double projectedPixels, int current, const TextureIntervalsOptions& o) {
+  // At least one texel per covered pixel: n^2 = area x density.
+  double n = std::sqrt(std::max(0.0, projectedPixels) * o.texelDensity);
+  if (current > 0) {
+    double tol = 1.0 + o.resizeTolerance;
+    if (n > current / (2.0 * tol) && n <= current * tol) return current;
+  }
+  long side = 1;
+  while (side < n && side < (1L << 20)) side <<= 1;
+  side = std::clamp<long>(side, o.minSize, o.maxSize);
+  return int(side);
+}
+
+struct TextureIntervalsBuilder::Impl {
+  const Scene& scene;
+  int cameraNode;
+  TextureIntervalsOptions options;
+  PatchHierarchy hierarchy;
+  std::vector<int> meshNodes;   // scene mesh node of each item object
+  std::vector<int> nodeObject;  // per dense node: index into meshNodes
+  std::unique_ptr<ItemBufferRenderer> renderer;
+  ItemBuffer buffer;
+
+  // Per-frame state.
+  std::vector<long> visible;
+  std::vector<double> area, inFrustum;  // -1 = not computed this frame
+  std::vector<glm::dmat4> clipFromObject, guardFromObject;
+  std::vector<int> chosen, chosenMovie;
+  // Open movie per dense node (-1 = none): index into movies.
+  std::vector<int> openMovie;
+  std::vector<int> openList;    // dense nodes with an open movie, ascending
+  std::vector<char> openBelow;  // per node: a descendant had an open movie last frame
+  std::vector<MovieExtent> movies;
+  int lastFrame = 0;
+  int frames = 0;
+  double itemSeconds = 0.0;
+
+  Impl(const Scene& s, int cam, TextureIntervalsOptions o)
+      : scene(s), cameraNode(cam), options(o) {}
+
+  void build() {
+    options.validate();
+    if (cameraNode < 0 || cameraNode >= int(scene.nodes.size()) ||
+        scene.nodes[cameraNode].camera < 0)
+      throw inputError(scene.path, "node " + std::to_string(cameraNode) + " is not a camera");
+    hierarchy = PatchHierarchy(scene.inputPolygons());
+    // Nodes of the full subdivision: tops x (4^(L+1) - 1) / 3.
+    double nodes = hierarchy.topCount() * (std::pow(4.0, options.maxLevel + 1) - 1.0) / 3.0;
+    if (nodes > double(kMaxNodes))
+      throw Error(ExitCode::kUsage, "",
+                  "--max-level " + std::to_string(options.maxLevel) + ": " +
+                      std::to_string(hierarchy.topCount()) + " top-level patches would make " +
+                      std::to_string((long long)nodes) + " patch nodes (at most " +
+                      std::to_string(kMaxNodes) + "); use a smaller --max-level");
+    // Regular subdivision down to maxLevel: level by level, so dense indices grow with depth
+    // and every child comes after its parent.
+    std::vector<int> level(hierarchy.topCount());
+    for (int i = 0; i < hierarchy.topCount(); ++i) level[i] = i;
+    for (int l = 0; l < options.maxLevel; ++l) {
+      std::vector<int> next;
+      next.reserve(level.size() * 4);
+      for (int i : level) {
+        int c = hierarchy.subdivide(i);
+        for (int k = 0; k < 4; ++k) next.push_back(c + k);
+      }
+      level.swap(next);
+    }
+    // One item object per mesh node that owns patches (scene order), leaves with id index+1.
+    std::map<int, int> objectOf;
+    for (int t = 0; t < hierarchy.topCount(); ++t) objectOf.emplace(hierarchy.top(t).node, 0);
+    for (auto& [node, obj] : objectOf) {
+      obj = int(meshNodes.size());
+      meshNodes.push_back(node);
+    }
+    std::vector<ItemObject> objects(meshNodes.size());
+    nodeObject.resize(hierarchy.size());
+    for (int i = 0; i < hierarchy.size(); ++i) {
+      nodeObject[i] = objectOf.at(hierarchy.topOf(i).node);
+      if (hierarchy.isLeaf(i))
+        objects[nodeObject[i]].addPolygon(hierarchy.node(i).local, uint32_t(i + 1));
+    }
+    renderer = std::make_unique<ItemBufferRenderer>(options.imageSize);
+    renderer->setGeometry(objects);
+    visible.assign(hierarchy.size(), 0);
+    area.assign(hierarchy.size(), 0.0);
+    inFrustum.assign(hierarchy.size(), 0.0);
+    openMovie.assign(hierarchy.size(), -1);
+    openBelow.assign(hierarchy.size(), 0);
+  }
+
+  // Whole-patch projected area (header: clipped at the near and far planes only).
+  double wholeArea(int i) {
+    if (area[i] < 0.0) {
+      const Polygon& p = hierarchy.node(i).local;
+      area[i] = kGuardBand * kGuardBand *
+                projectedAreaPixels(guardFromObject[nodeObject[i]], options.imageSize, p.v.data(),
+                                    p.count);
+    }
+    return area[i];
+  }
+  double areaInFrustum(int i) {
+    if (inFrustum[i] < 0.0) {
+      const Polygon& p = hierarchy.node(i).local;
+      inFrustum[i] = projectedAreaPixels(clipFromObject[nodeObject[i]], options.imageSize,
+                                         p.v.data(), p.count);
+    }
+    return inFrustum[i];
+  }
+
+  void choose(int i) {
+    if (visible[i] == 0) return;
+    wholeArea(i);
+    // Level hysteresis: a node represented by itself last frame keeps it down to theta - h; a
+    // node represented by descendants last frame needs theta + h to take over again.
+    double theta = options.minVisibleFraction;
+    if (openMovie[i] >= 0)
+      theta -= options.levelHysteresis;
+    else if (openBelow[i])
+      theta += options.levelHysteresis;
+    bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
+    if (enough || hierarchy.isLeaf(i)) {
+      chosen.push_back(i);
+      return;
+    }
+    int c = hierarchy.node(i).firstChild;
+    for (int k = 0; k < 4; ++k) choose(c + k);
+  }
+
+  // True when an ancestor or a descendant of node i is chosen this frame.
+  bool relativeChosen(int i, const std::vector<char>& isChosen) const {
+    for (int p = hierarchy.node(i).parent; p >= 0; p = hierarchy.node(p).parent)
+      if (isChosen[p]) return true;
+    // Descendants: dense indices of a subtree are not contiguous, so walk it.
+    std::vector<int> stack;
+    if (!hierarchy.isLeaf(i)) stack.push_back(i);
+    while (!stack.empty()) {
+      int n = stack.back();
+      stack.pop_back();
+      int c = hierarchy.node(n).firstChild;
+      for (int k = 0; k < 4; ++k) {
+        if (isChosen[c + k]) return true;
+        if (!hierarchy.isLeaf(c + k)) stack.push_back(c + k);
+      }
+    }
+    return false;
+  }
+
+  int openNew(int node, int frame, int side) {
+    MovieExtent m;
+    m.patch = hierarchy.node(node).id;
+    m.firstFrame = m.lastFrame = frame;
+    m.width = m.height = side;
+    m.end = MovieEnd::kWindow;
+    movies.push_back(m);
+    openMovie[node] = int(movies.size()) - 1;
+    return openMovie[node];
+  }
+
+  void addFrame(int frame, const std::function<void(const IntervalFrame&)>& observer) {
+    if (frames > 0 && frame <= lastFrame)
+      throw Error(ExitCode::kInternal, "", "frames must be strictly increasing");
+    double t = frame / options.fps;
+    CameraView view = scene.cameraAt(cameraNode, t);
+    std::vector<glm::dmat4> transforms(meshNodes.size());
+    for (size_t o = 0; o < meshNodes.size(); ++o)
+      transforms[o] = scene.worldTransform(meshNodes[o], t);
+
+    auto start = std::chrono::steady_clock::now();
+    renderer->render(view, transforms, buffer);
+    double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    itemSeconds += seconds;
+
+    // Visible pixels per leaf, then summed up the tree (children come after parents).
+    std::fill(visible.begin(), visible.end(), 0);
+    const long n = long(hierarchy.size());
+    for (uint32_t id : buffer.id) {
+      if (id == kNoItem) continue;
+      if (long(id) > n) throw Error(ExitCode::kInternal, "", "item buffer id out of range");
+      ++visible[id - 1];
+    }
+    for (int i = hierarchy.size() - 1; i >= hierarchy.topCount(); --i)
+      visible[hierarchy.node(i).parent] += visible[i];
+
+    // Projected areas, computed only where needed (nodes with visible pixels, closing movies):
+    // a frame then costs O(visible nodes), not O(all nodes).
+    glm::dmat4 clip = clipFromWorld(view, options.imageSize);
+    glm::dmat4 guard(1.0);
+    guard[0][0] = guard[1][1] = 1.0 / kGuardBand;
+    clipFromObject.resize(meshNodes.size());
+    guardFromObject.resize(meshNodes.size());
+    for (size_t o = 0; o < meshNodes.size(); ++o) {
+      clipFromObject[o] = clip * transforms[o];
+      guardFromObject[o] = guard * clipFromObject[o];
+    }
+    std::fill(area.begin(), area.end(), -1.0);
+    std::fill(inFrustum.begin(), inFrustum.end(), -1.0);
+
+    // Representation of each top-level patch.
+    std::fill(openBelow.begin(), openBelow.end(), 0);
+    for (int node : openList)
+      for (int p = hierarchy.node(node).parent; p >= 0 && !openBelow[p];
+           p = hierarchy.node(p).parent)
+        openBelow[p] = 1;
+    chosen.clear();
+    for (int top = 0; top < hierarchy.topCount(); ++top) choose(top);
+    std::sort(chosen.begin(), chosen.end());
+    std::vector<char> isChosen(hierarchy.size(), 0);
+    for (int i : chosen) isChosen[i] = 1;
+
+    // Close the movies whose node is no longer chosen (§4.1 events).
+    std::vector<int> stillOpen;
+    for (int node : openList) {
+      if (isChosen[node]) {
+        stillOpen.push_back(node);
+        continue;
+      }
+      MovieExtent& m = movies[openMovie[node]];
+      if (relativeChosen(node, isChosen))
+        m.end = MovieEnd::kLevelChange;
+      else if (areaInFrustum(node) <= 0.0)
+        m.end = MovieEnd::kLeftFrustum;
+      else
+        m.end = MovieEnd::kHidden;
+      openMovie[node] = -1;
+    }
+    // Continue, restart (size, length) or open the chosen nodes' movies.
+    chosenMovie.assign(chosen.size(), -1);
+    for (size_t c = 0; c < chosen.size(); ++c) {
+      int node = chosen[c];
+      int idx = openMovie[node];
+      if (idx >= 0) {
+        MovieExtent& m = movies[idx];
+        int side = textureSideFor(area[node], m.width, options);
+        bool full = options.maxLength > 0 && frame - m.firstFrame >= options.maxLength;
+        if (!full && side == m.width) {
+          m.lastFrame = frame;
+          chosenMovie[c] = idx;
+          continue;
+        }
+        m.end = full ? MovieEnd::kMaxLength : MovieEnd::kResize;
+        chosenMovie[c] = openNew(node, frame, side);
+      } else {
+        chosenMovie[c] = openNew(node, frame, textureSideFor(area[node], 0, options));
+      }
+    }
+    openList = chosen;
+    lastFrame = frame;
+    ++frames;
+
+    if (observer) {
+      IntervalFrame f;
+      f.frame = frame;
+      f.time = t;
+      f.itemBufferSeconds = seconds;
+      f.itemBuffer = &buffer;
+      f.visiblePixels = &visible;
+      f.projectedArea = &area;
+      f.areaInFrustum = &inFrustum;
+      f.chosen = &chosen;
+      f.chosenMovie = &chosenMovie;
+      observer(f);
+    }
+  }
+};
+
+TextureIntervalsBuilder::TextureIntervalsBuilder(const Scene& scene, int cameraNode,
+                                                 TextureIntervalsOptions options)
+    : impl_(std::make_unique<Impl>(scene, cameraNode, options)) {
+  impl_->build();
+}
+
+TextureIntervalsBuilder::~TextureIntervalsBuilder() = default;
+
+const PatchHierarchy& TextureIntervalsBuilder::hierarchy() const {
+  return impl_->hierarchy;
+}
+const TextureIntervalsOptions& TextureIntervalsBuilder::options() const {
+  return impl_->options;
+}
+void TextureIntervalsBuilder::addFrame(int frame,
+                                       const std::function<void(const IntervalFrame&)>& observer) {
+  impl_->addFrame(frame, observer);
+}
+const std::vector<MovieExtent>& TextureIntervalsBuilder::movies() const {
+  return impl_->movies;
+}
+double TextureIntervalsBuilder::itemBufferSeconds() const {
+  return impl_->itemSeconds;
+}
+int TextureIntervalsBuilder::framesAdded() const {
+  return impl_->frames;
+}
+
+std::vector<MovieExtent> TextureIntervalsBuilder::finish() {
+  // Open movies keep end == kWindow and their last frame.
+  std::vector<MovieExtent> out = impl_->movies;
+  std::stable_sort(out.begin(), out.end(), [](const MovieExtent& a, const MovieExtent& b) {
+    if (a.firstFrame != b.firstFrame) return a.firstFrame < b.firstFrame;
+    return a.patch.packed() < b.patch.packed();
+  });
+  return out;
+}
+
+std::vector<MovieExtent> buildTextureIntervals(
+    const Scene& scene, int cameraNode, const std::vector<int>& frames,
+    const TextureIntervalsOptions& options,
+    const std::function<void(const IntervalFrame&)>& observer) {
+  TextureIntervalsBuilder b(scene, cameraNode, options);
+  for (int f : frames) b.addFrame(f, observer);
+  return b.finish();
+}
+
+}  // namespace rad

@@ -1,0 +1,155 @@
+// Texture-movie extents from per-frame item buffers (Martín, Pueyo, Tost, "Frame rate
+// independent texture movies for animated radiosity", §4.1 "texture movies" and §4.3 "item
+// buffer"; DESIGN.md §6 rad-intervals).
+//
+// Each top-level patch is subdivided regularly down to maxLevel; every leaf is rendered into
+// an item buffer with its own id. Per frame:
+//  * visible pixels per node = sum over the leaves below it;
+//  * projected area per node (projected_area.h, occlusion ignored), twice: the part inside the
+//    frustum (zero: the node left the frustum), and the whole patch's image, clipped only at
+//    the near and far planes (in practice: the side planes are moved 64 image sizes out, so an
+//    edge-on patch crossing the eye plane still has a bounded area);
+//  * visible fraction = visible pixels / whole projected area. As the paper says (§4.1 item 2),
+//    a patch leaving the frustum has a shrinking visible fraction and goes down to its
+//    children, whose parts outside the frustum then need no texture;
+//  * representation (§4.3): a top-level patch stands for itself when its visible fraction is
+//    >= minVisibleFraction (theta), else its children do, recursively down to maxLevel; nodes
+//    without visible pixels get no movie. Every visible pixel is therefore covered by exactly
+//    one chosen node (the ancestor-or-self of its leaf where the descent stopped);
+//  * texture size: n = sqrt(whole projected area x texelDensity) texels per side (at least one
+//    texel per covered pixel: the texture spans the whole patch, so its texels per pixel are
+//    n^2 / whole area wherever the patch is on screen), rounded up to a power of two and
+//    clamped to [minSize, maxSize];
+//  * events (§4.1): a movie opens when its node becomes chosen and closes when the node leaves
+//    the frustum, is hidden, is replaced by an ancestor or descendant (level change), needs
+//    another size, or has lasted maxLength frames; movies open at the end of the window close
+//    with kWindow.
+//
+// Level hysteresis (levelHysteresis = h, beyond the paper, default 0): a node represented by
+// itself in the previous frame stays so while its visible fraction is >= theta - h; a node
+// represented by its descendants in the previous frame goes back to one texture only when
+// its fraction is >= theta + h. Other nodes use theta. This keeps patches whose fraction
+// hovers around theta from switching level every frame.
+//
+// Size hysteresis: a movie of size s (a power of two) is right for ideal sizes n in (s/2, s].
+// It keeps s while n stays in (s / (2 (1 + tol)), s (1 + tol)], i.e. within a factor (1 + tol)
+// of the interval it was rounded from, so small zooms do not close movies every frame.
+//
+// Deterministic: rendering, counting and events are sequential per frame; the result depends
+// only on the scene, the frames and the options.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "libcommon/scene/camera_projection.h"
+#include "libcommon/gl/item_buffer.h"
+#include "libcommon/scene/patch_hierarchy.h"
+#include "libcommon/scene/scene.h"
+
+namespace rad {
+
+struct TextureIntervalsOptions {
+  ImageSize imageSize{352, 240};
+  double fps = 24.0;                // frame f is at time f / fps
+  int maxLevel = 2;                 // depth of the regular subdivision (0 = top-level only)
+  double minVisibleFraction = 0.5;  // theta of §4.3
+  // Hysteresis on the level choice (0 = the paper's rule): see the header comment.
+  double levelHysteresis = 0.0;
+  double texelDensity = 1.0;       // texels per covered pixel
+  int minSize = 4, maxSize = 256;  // texture side bounds (powers of two not required)
+  double resizeTolerance = 0.5;    // hysteresis factor (see above)
+  int maxLength = 0;               // frames per movie; 0 = unlimited
+
+  // Throws rad::Error(kUsage) naming the flag of the first invalid value.
+  void validate() const;
+};
+
+// Why a movie ended. The codes are those of formats/texture_intervals.h's CloseReason (and of
+// the file format); libcommon does not include formats/, so the tool converts by value.
+enum class MovieEnd : uint8_t {
+  kLeftFrustum = 0,
+  kHidden = 1,
+  kLevelChange = 2,
+  kResize = 3,
+  kMaxLength = 4,
+  kWindow = 5,
+};
+
+struct MovieExtent {
+  PatchId patch;
+  int firstFrame = 0, lastFrame = 0;  // inclusive
+  int width = 1, height = 1;
+  MovieEnd end = MovieEnd::kWindow;
+  bool operator==(const MovieExtent& o) const {
+    return patch == o.patch && firstFrame == o.firstFrame && lastFrame == o.lastFrame &&
+           width == o.width && height == o.height && end == o.end;
+  }
+};
+
+// What one frame looked like (for reports, tests and --item-buffers).
+struct IntervalFrame {
+  int frame = 0;
+  double time = 0.0;
+  double itemBufferSeconds = 0.0;  // render + readback
+  const ItemBuffer* itemBuffer = nullptr;
+  // Per dense node index: visible pixels, projected area of the whole patch (pixels, see
+  // above) and the part of it inside the frustum. The areas are computed only where the
+  // algorithm needs them (nodes with visible pixels; the frustum area of nodes whose movie
+  // closed) and are -1 elsewhere.
+  const std::vector<long>* visiblePixels = nullptr;
+  const std::vector<double>* projectedArea = nullptr;
+  const std::vector<double>* areaInFrustum = nullptr;
+  // Dense node indices chosen this frame (ascending) and, parallel to it, the index into the
+  // builder's movie list of the movie covering each.
+  const std::vector<int>* chosen = nullptr;
+  const std::vector<int>* chosenMovie = nullptr;
+};
+
+class TextureIntervalsBuilder {
+ public:
+  // cameraNode: a scene node carrying a camera (Scene::cameraNode). Makes the GL context
+  // (throws rad::Error(kEnvironment) when it cannot).
+  TextureIntervalsBuilder(const Scene& scene, int cameraNode, TextureIntervalsOptions options);
+  ~TextureIntervalsBuilder();
+  TextureIntervalsBuilder(const TextureIntervalsBuilder&) = delete;
+  TextureIntervalsBuilder& operator=(const TextureIntervalsBuilder&) = delete;
+
+  const PatchHierarchy& hierarchy() const;
+  const TextureIntervalsOptions& options() const;
+  // Item id of a leaf = dense node index + 1; kNoItem = nothing.
+  static int nodeOfItem(uint32_t id) { return int(id) - 1; }
+
+  // Processes one frame; frames must be strictly increasing. With a step between frames, a
+  // movie is taken to cover the skipped frames between two frames where it is chosen.
+  // `observer` (may be empty) sees the frame before the next one is rendered.
+  void addFrame(int frame, const std::function<void(const IntervalFrame&)>& observer = {});
+  // Closes the movies still open (kWindow) and returns all, in id order: sorted by
+  // (firstFrame, patch.packed()).
+  std::vector<MovieExtent> finish();
+
+  // Movies so far (open ones have end == kWindow and lastFrame = the last frame added), in
+  // creation order.
+  const std::vector<MovieExtent>& movies() const;
+  double itemBufferSeconds() const;  // total over the frames added
+  int framesAdded() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Convenience: every frame of `frames` (increasing) through one builder.
+std::vector<MovieExtent> buildTextureIntervals(
+    const Scene& scene, int cameraNode, const std::vector<int>& frames,
+    const TextureIntervalsOptions& options,
+    const std::function<void(const IntervalFrame&)>& observer = {});
+
+// The size rule above: next size for a movie of current size `current` (0 = new movie) when
+// the projected area is `projectedPixels`.
+int textureSideFor(double projectedPixels, int current, const TextureIntervalsOptions& options);
+
+}  // namespace rad

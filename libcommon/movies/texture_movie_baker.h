@@ -1,0 +1,154 @@
+// Texture-movie baking, the second pass of Martín, Pueyo, Tost, "Frame-to-frame coherent
+// animation with two-pass radiosity" (§3.1 texture computation, §5 frame-to-frame coherence;
+// DESIGN.md §6 "rad-movies").
+//
+// Per movie (patch node P of top-level patch R, frames [f0, f1], texture w x h) and key time
+// t, the irradiance at texel centre x is
+//
+//   H(x, t) = G(x, t) + \sum_{S \in bad(R)} B_S(t) \, F(x \to S(t)) \, T(x, S, t)
+//
+// with G the global solution's good-link irradiance (Gouraud), B_S the shooter's radiosity,
+// F the exact point-to-polygon form factor and T the transmittance (transmittance.h).
+//
+// Coherence (§5): for a bad pair whose receiver and shooter are static over the movie, F is
+// computed once and the blockers in the pair's shaft are split by Scene::isDynamic: the static
+// ones are rendered once per movie into a sample mask, the dynamic ones once per key, and the
+// masks are ORed (exact) or their transmittances merged approximately (--merge). A pair with a
+// moving end renders every blocker at every key. When every key texture of a movie comes out
+// identical the movie is stored with one key (a "constant" movie). With coherence off every
+// bad pair recomputes F and renders every blocker at every key and all keys are stored: the
+// per-frame method the paper compares against, same binary.
+//
+// Memory: a movie is baked key-major. What does not depend on the key (texel positions; per
+// coherent bad pair its form factors, valid-sample mask and static-blocker sample mask) is
+// computed first; then each key's irradiance is accumulated (good layer, then the bad shooters
+// in badShooters order: the same arithmetic and order as shooter-major) and handed to a
+// BakedKeySink before the next key starts. The working memory is then
+// texels x (per-key buffers + per coherent pair buffers), whatever the number of keys.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "libcommon/radiosity/global_solution.h"
+#include "libcommon/scene/patch_hierarchy.h"
+#include "libcommon/scene/scene.h"
+#include "libcommon/movies/transmittance.h"
+
+namespace rad {
+
+struct TextureMovieBakerOptions {
+  int keyStep = 6;                      // frames between key textures (>= 1)
+  int minSamples = 4;                   // shooter samples per bad link, lower bound
+  int maxSamples = 64;                  // upper bound (<= 64)
+  double samplesPerFormFactor = 256.0;  // N = ceil(this * max texel form factor), then clamped
+  MergeMode merge = MergeMode::kExact;  // static/dynamic occlusion merge
+  bool coherence = true;                // false: the per-key baseline
+  // Working memory of one movie (one key's buffers plus the per-pair buffers, see
+  // movieWorkingBytes); a movie that needs more is refused with an environment error.
+  double maxTextureMemoryMiB = 1024.0;
+  nlohmann::json toJson() const;
+};
+
+// What to bake: one interval of intervals.rti (formats/texture_intervals.h).
+struct MovieRequest {
+  uint32_t movie = 0;
+  PatchId patch;
+  int firstFrame = 0, lastFrame = 0;
+  int width = 1, height = 1;
+};
+
+// The result, as formats/texture_movie.h stores it: keys[k] has width * height * 3 floats
+// (RGB irradiance, W/m^2), row j = 0 at v = 0, texel (i, j) at node (u,v) = ((i+.5)/w, (j+.5)/h).
+// bake(request, sink) fills in keyFrames, keyTimes and keyStep only (the keys went to the sink).
+struct BakedMovie {
+  std::vector<int> keyFrames;
+  std::vector<double> keyTimes;
+  std::vector<std::vector<float>> keys;
+  int keyStep = 0;  // the key step used
+};
+
+// Receives one movie's key textures in key order as they are baked (only one key texture is
+// alive in the baker at a time). rad-movies streams them into the movie file
+// (formats/texture_movie.h TextureMovieWriter).
+class BakedKeySink {
+ public:
+  virtual ~BakedKeySink() = default;
+  // Before the first key: keyFrames, keyTimes and keyStep of the movie (keys empty).
+  virtual void begin(const BakedMovie& plan) = 0;
+  // Key k = 0, 1, ... K-1 in order: width * height * 3 floats, valid during the call only.
+  virtual void key(size_t k, const std::vector<float>& texture) = 0;
+  // After the last key: the number of keys stored (1 when a movie whose keys are all equal is
+  // stored as a constant movie, else K). Counted in the stats.
+  virtual size_t finish() = 0;
+};
+
+// Counters for --report, summed over movies.
+struct TextureMovieBakerStats {
+  long movies = 0, constantMovies = 0, keys = 0, texels = 0;
+  long badPairs = 0, staticPairs = 0, dynamicPairs = 0;
+  long samples = 0;                              // shooter samples over all bad pairs
+  long staticBlockers = 0, dynamicBlockers = 0;  // per pair, in the pair's (swept) shaft
+  long passes = 0, samplePasses = 0;             // transmittance renders
+  long passesSavedByCoherence = 0;               // static-blocker renders not repeated
+  long keyStepRaised = 0;  // always 0: the key step no longer depends on the memory budget
+  double secondsGood = 0, secondsFormFactor = 0, secondsTransmittance = 0, secondsCombine = 0;
+  // Moving pairs' form factors computed ahead of the keys only to find their largest value
+  // (which fixes N): the price of baking key by key without every key's form factors held.
+  double secondsFormFactorScan = 0;
+  std::vector<std::string> warnings;
+  nlohmann::json toJson() const;
+};
+
+class TextureMovieBaker {
+ public:
+  // scene and solution must outlive the baker; fps converts frames to times (t = frame / fps).
+  // Throws a usage Error for inconsistent options.
+  TextureMovieBaker(const Scene& scene, const GlobalSolution& solution, double fps,
+                    TextureMovieBakerOptions options);
+  ~TextureMovieBaker();
+
+  // Bakes one movie, streaming its keys to `sink`. Throws rad::inputError("movie N", ...) when
+  // the request names a patch outside the scene or a bad size, an environment Error when the
+  // movie's working memory exceeds maxTextureMemoryMiB. Creates the GL context on first need
+  // (a scene without bad pairs never touches GL).
+  BakedMovie bake(const MovieRequest& request, BakedKeySink& sink);
+  // The same with the keys collected in memory (K keys alive; for tests and small movies). A
+  // movie whose keys are all bit-equal keeps one key when coherence is on.
+  BakedMovie bake(const MovieRequest& request);
+
+  // Bytes bake() holds for a w x h movie of a receiver with `badShooters` bad shooters: one
+  // key's buffers plus the per-pair ones, independent of the number of keys.
+  static double movieWorkingBytes(int width, int height, size_t badShooters);
+
+  const TextureMovieBakerStats& stats() const { return stats_; }
+  const TextureMovieBakerOptions& options() const { return options_; }
+  // The renderer's GL_RENDERER, or "" when no render was needed yet.
+  std::string rendererName() const;
+
+ private:
+  struct Pair;
+  const Scene& scene_;
+  const GlobalSolution& solution_;
+  double fps_;
+  TextureMovieBakerOptions options_;
+  std::vector<InputPolygon> tops_;
+  std::unique_ptr<TransmittanceRenderer> renderer_;
+  TextureMovieBakerStats stats_;
+
+  TransmittanceRenderer& renderer();
+};
+
+// Key frames of [f0, f1] every `step` frames, f1 always included.
+std::vector<int> movieKeyFrames(int firstFrame, int lastFrame, int step);
+
+// Texel centres of a node: world points at time t via the top polygon's (u,v) map.
+// out[j * w + i]; also the node's world polygon (corners in the patch (u,v) order).
+Polygon nodeWorldPolygon(const Scene& scene, const InputPolygon& top, PatchId node, double t);
+
+}  // namespace rad

@@ -1,0 +1,117 @@
+// Transmittance textures by projective shadows (Martín, Pueyo, Tost, "Frame-to-frame coherent
+// animation with two-pass radiosity", §3.1 "Transmittance Texture Computation" and §5; the
+// projective texture transform after Segal, Korobkin, van Widenfelt, Foran, Haeberli 1992,
+// "Fast shadows and lighting effects using texture mapping", and Herf & Heckbert 1997,
+// "Simulating soft shadows with graphics hardware"; stratified sample points by correlated
+// multi-jittered sampling, Kensler 2013, "Correlated Multi-Jittered Sampling").
+//
+// For N sample points s on a shooter polygon, the blockers are rendered with eye at s and the
+// receiver's plane as the image plane, the image plane mapped onto the receiver's texture
+// (u,v) square. A texel is covered by a blocker exactly when the segment from s to the texel
+// centre's point on the receiver plane crosses the blocker between s and the plane. Instead of
+// counting covered samples (the paper increments a counter) each sample writes its own bit
+// into an integer render target with glLogicOp(GL_OR): one 64-bit mask per texel. Occlusion
+// masks of disjoint blocker sets then merge exactly by OR (DESIGN.md §6 "rad-movies"), so the
+// coherent result (static blockers once per movie, dynamic ones per key) equals rendering all
+// blockers at every key bit for bit.
+//
+// Texture map of the receiver: texel (i, j) has its centre at (u,v) = ((i+.5)/w, (j+.5)/h) and
+// the (u,v) map of patch_hierarchy.h (triangles: affine; quads: bilinear). The render maps
+// the plane to (u,v) by a plane homography fixed by the polygon's corners (Heckbert 1989,
+// "Fundamentals of texture mapping", square-to-quad): exact for triangles and parallelograms;
+// for a quad whose bilinear map is not affine the homography and the bilinear map agree at the
+// corners and edges' ends only, and the shadow is taken at the homography's point for that
+// (u,v) (a displacement of second order in the quad's departure from a parallelogram).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcommon/scene/geometry.h"
+
+namespace rad {
+
+// One bit per shooter sample; sample s is bit s.
+using SampleMask = uint64_t;
+constexpr int kMaxTransmittanceSamples = 64;
+
+using BlockerTriangle = std::array<glm::dvec3, 3>;
+
+// Number of shooter samples for a bad link (paper §3.1: "proportional to the maximum form
+// factor between the shooter and the texels"): ceil(samplesPerFormFactor * maxFormFactor)
+// clamped to [minSamples, maxSamples], then rounded to the square m*m of a stratified grid
+// (m = ceil(sqrt(n)), lowered while m*m > maxSamples). maxSamples <= 64.
+int transmittanceSampleCount(double maxFormFactor, double samplesPerFormFactor, int minSamples,
+                             int maxSamples);
+
+// n = m*m correlated multi-jittered points in [0,1)^2 (one per cell of an m x m grid and one
+// per column of an n x 1 and a 1 x n grid, so an edge parallel to either axis is resolved to
+// 1/n). Deterministic in (n, seed).
+std::vector<glm::dvec2> multiJitteredPoints(int n, uint32_t seed);
+
+// Maps unit-square points onto a polygon's (u,v) domain and then into the polygon: quads by
+// their bilinear map, triangles by the area-preserving square-to-triangle warp
+// (u, v) -> (1 - sqrt(a), b sqrt(a)).
+glm::dvec3 samplePointOnPolygon(const Polygon& p, glm::dvec2 unitSquare);
+
+// Bit s set when samples[s] lies strictly in front of the receiver's plane (only those can
+// light it; a texel's transmittance counts only these).
+SampleMask frontSampleMask(const Polygon& receiver, const std::vector<glm::dvec3>& samples);
+
+// Visible fraction of the valid samples: popcount(valid & ~occluded) / popcount(valid); 1 when
+// no sample is valid.
+double transmittanceFromMask(SampleMask occluded, SampleMask valid);
+
+// Approximate merge operators for transmittances of two disjoint blocker sets (paper §5,
+// Figure 7): occlusions a = 1 - Ts and b = 1 - Td merge to max(a, b) (blockers overlap),
+// min(1, a + b) (disjoint) or 1 - (1 - a)(1 - b) (independent). kExact ORs the sample masks.
+enum class MergeMode { kExact, kMax, kSum, kIndependent };
+const char* mergeModeName(MergeMode m);
+// Throws a usage Error for an unknown name.
+MergeMode parseMergeMode(const std::string& name);
+double mergeTransmittance(MergeMode mode, double staticT, double dynamicT);
+
+// The 4x4 clip-from-world transform of one sample (before the origin shift): a point y maps to
+// clip (2U - C, 2V - C, 0, C) where (U/C, V/C) is the receiver-texture (u,v) of the point
+// where the ray from `sample` through y meets the receiver's plane. Exposed for tests.
+glm::dmat4 projectiveShadowMatrix(const Polygon& receiver, const glm::dvec3& sample);
+// (u,v) of a point of the receiver's plane under the render's homography.
+glm::dvec2 receiverPlaneUv(const Polygon& receiver, const glm::dvec3& pointOnPlane);
+
+// OSMesa renderer of occlusion masks. Owns its GL context (gl_context.h threading rules: one
+// renderer per thread).
+class TransmittanceRenderer {
+ public:
+  // Throws rad::Error(kEnvironment) when no GL context can be made.
+  TransmittanceRenderer();
+  ~TransmittanceRenderer();
+  TransmittanceRenderer(const TransmittanceRenderer&) = delete;
+  TransmittanceRenderer& operator=(const TransmittanceRenderer&) = delete;
+
+  // Occlusion masks of a w x h receiver texture (world-space receiver polygon, vertices in
+  // the patch_hierarchy.h (u,v) order): out[j * w + i] gets bit s when a blocker triangle
+  // (world space, either side) crosses the segment from samples[s] to texel (i, j)'s point on
+  // the receiver plane, strictly in front of the plane. Samples behind the plane get no bits.
+  // samples.size() in 1..64; an empty blocker list gives all-zero masks without rendering.
+  void render(const Polygon& receiver, int width, int height,
+              const std::vector<glm::dvec3>& samples, const std::vector<BlockerTriangle>& blockers,
+              std::vector<SampleMask>& out);
+
+  // Render passes so far (one per render() call that drew) and sample-passes (passes x
+  // samples): the cost figures of the report.
+  long passes() const;
+  long samplePasses() const;
+  long trianglesDrawn() const;  // blocker triangles x samples
+  std::string rendererName() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rad

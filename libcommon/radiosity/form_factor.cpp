@@ -1,0 +1,444 @@
+// Baum, Rushmeier, Winget 1989, "Improving radiosity solutions through the use of analytically
+// determined form-factors"; Gauss-Legendre area quadrature as in Cohen & Wallace ch. 4.
+#include "libcommon/radiosity/form_factor.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <queue>
+
+namespace rad {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr std::size_t kStackVertices = 16;
+
+// A vertex list that lives on the stack for the usual small polygons.
+class VertexBuffer {
+ public:
+  explicit VertexBuffer(std::size_t capacity) {
+    if (capacity > kStackVertices) heap_.reserve(capacity);
+    data_ = capacity > kStackVertices ? nullptr : stack_.data();
+  }
+  void push(const glm::dvec3& x) {
+    if (data_) {
+      stack_[size_++] = x;
+    } else {
+      heap_.push_back(x);
+      ++size_;
+    }
+  }
+  const glm::dvec3* data() const { return data_ ? data_ : heap_.data(); }
+  std::size_t size() const { return size_; }
+
+ private:
+  std::array<glm::dvec3, kStackVertices> stack_;
+  std::vector<glm::dvec3> heap_;
+  glm::dvec3* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+// Contour sum for a polygon entirely in front of the element's tangent plane:
+// \frac{1}{2\pi} \sum_k \gamma_k \hat n \cdot \widehat{R_{k+1} \times R_k}.
+// R_k \times R_{k+1} is computed as R_k \times (v_{k+1} - v_k): same value, no cancellation
+// when p is far away and R_k, R_{k+1} are nearly parallel.
+double contourSum(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3* w,
+                  std::size_t count) {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const glm::dvec3& a = w[k];
+    const glm::dvec3& b = w[(k + 1) % count];
+    glm::dvec3 rk = a - p;
+    glm::dvec3 rk1 = b - p;
+    glm::dvec3 c = glm::cross(rk, b - a);  // = R_k x R_{k+1}
+    double cl = glm::length(c);
+    if (!(cl > 0.0)) continue;  // p on the edge's line: the term vanishes
+    double gamma = std::atan2(cl, glm::dot(rk, rk1));
+    sum -= gamma * glm::dot(n, c) / cl;  // n . (R_{k+1} x R_k) = -n . c
+  }
+  return sum / (2.0 * kPi);
+}
+
+// Gauss-Legendre nodes and weights on [0, 1], orders 1..kMaxQuadratureOrder, built once.
+struct GaussRule {
+  std::vector<double> x, w;
+};
+
+const GaussRule& gaussRule(int n) {
+  static const std::vector<GaussRule> rules = [] {
+    std::vector<GaussRule> r(kMaxQuadratureOrder + 1);
+    for (int order = 1; order <= kMaxQuadratureOrder; ++order) {
+      GaussRule& g = r[order];
+      g.x.resize(order);
+      g.w.resize(order);
+      for (int i = 0; i < (order + 1) / 2; ++i) {
+        // Newton on P_n from the Chebyshev-like guess; converges to machine precision.
+        double z = std::cos(kPi * (i + 0.75) / (order + 0.5));
+        double dp = 1.0;
+        for (int it = 0; it < 100; ++it) {
+          double p0 = 1.0, p1 = 0.0;
+          for (int j = 1; j <= order; ++j) {
+            double p2 = p1;
+            p1 = p0;
+            p0 = ((2.0 * j - 1.0) * z * p1 - (j - 1.0) * p2) / j;
+          }
+          dp = order * (z * p0 - p1) / (z * z - 1.0);
+          double dz = p0 / dp;
+          z -= dz;
+          if (std::abs(dz) < 1e-16) {
+            // One more evaluation of the derivative at the converged node.
+            p0 = 1.0;
+            p1 = 0.0;
+            for (int j = 1; j <= order; ++j) {
+              double p2 = p1;
+              p1 = p0;
+              p0 = ((2.0 * j - 1.0) * z * p1 - (j - 1.0) * p2) / j;
+            }
+            dp = order * (z * p0 - p1) / (z * z - 1.0);
+            break;
+          }
+        }
+        double weight = 2.0 / ((1.0 - z * z) * dp * dp);
+        // Map [-1, 1] -> [0, 1]; z > 0 here, so node i is near 1 and its mirror near 0.
+        g.x[i] = 0.5 * (1.0 - z);
+        g.x[order - 1 - i] = 0.5 * (1.0 + z);
+        g.w[i] = g.w[order - 1 - i] = 0.5 * weight;
+      }
+      if (order % 2 == 1) g.x[order / 2] = 0.5;
+    }
+    return r;
+  }();
+  return rules[std::clamp(n, 1, kMaxQuadratureOrder)];
+}
+
+// An integration cell: bilinear map of four corners, (0,0) (1,0) (1,1) (0,1). A triangle with
+// apex a is the collapsed cell (a, b, c, a) (Duffy).
+struct Cell {
+  std::array<glm::dvec3, 4> q;
+  glm::dvec3 at(double u, double v) const {
+    return (1.0 - u) * (1.0 - v) * q[0] + u * (1.0 - v) * q[1] + u * v * q[2] +
+           (1.0 - u) * v * q[3];
+  }
+  double jacobian(double u, double v) const {
+    glm::dvec3 du = (1.0 - v) * (q[1] - q[0]) + v * (q[2] - q[3]);
+    glm::dvec3 dv = (1.0 - u) * (q[3] - q[0]) + u * (q[2] - q[1]);
+    return glm::length(glm::cross(du, dv));
+  }
+  Cell sub(double u0, double u1, double v0, double v1) const {
+    return Cell{{at(u0, v0), at(u1, v0), at(u1, v1), at(u0, v1)}};
+  }
+};
+
+struct Target {
+  const glm::dvec3* v;
+  std::size_t count;
+};
+
+// \int_{cell} F(dA_x -> to) dA_x with an nu x nv tensor Gauss-Legendre rule.
+double integrateCell(const Cell& cell, const glm::dvec3& normal, const Target& to, int nu, int nv) {
+  const GaussRule& gu = gaussRule(nu);
+  const GaussRule& gv = gaussRule(nv);
+  double sum = 0.0;
+  for (int i = 0; i < nu; ++i) {
+    double row = 0.0;
+    for (int j = 0; j < nv; ++j) {
+      double u = gu.x[i], v = gv.x[j];
+      double f = pointToPolygonFormFactor(cell.at(u, v), normal, to.v, to.count);
+      row += gv.w[j] * cell.jacobian(u, v) * f;
+    }
+    sum += gu.w[i] * row;
+  }
+  return sum;
+}
+
+// The cells of the reference's fixed rules: quad -> itself, triangle -> collapsed at v0,
+// n-gon -> fan of collapsed triangles from the vertex centroid.
+std::vector<Cell> initialCells(const std::vector<glm::dvec3>& v) {
+  std::vector<Cell> cells;
+  if (v.size() == 3) {
+    cells.push_back(Cell{{v[0], v[1], v[2], v[0]}});
+  } else if (v.size() == 4) {
+    cells.push_back(Cell{{v[0], v[1], v[2], v[3]}});
+  } else if (v.size() > 4) {
+    glm::dvec3 c(0.0);
+    for (const auto& x : v) c += x;
+    c /= double(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      cells.push_back(Cell{{c, v[k], v[(k + 1) % v.size()], c}});
+    }
+  }
+  return cells;
+}
+
+double diameter(const std::vector<glm::dvec3>& v) {
+  double d = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    for (std::size_t j = i + 1; j < v.size(); ++j) d = std::max(d, glm::length(v[i] - v[j]));
+  }
+  return d;
+}
+
+// True if no part of `to` can be seen from `from`: every vertex of `from` is on or behind
+// `to`'s plane, or every vertex of `to` is on or behind `from`'s plane, up to a relative
+// rounding tolerance (kPlaneTolerance times the diameter). Catches coplanar pairs (including a
+// polygon with itself), whose point factors are pure rounding noise.
+constexpr double kPlaneTolerance = 1e-12;
+
+bool facesAway(const std::vector<glm::dvec3>& from, const glm::dvec3& fromNormal,
+               const std::vector<glm::dvec3>& to, const glm::dvec3& toNormal, double scale) {
+  double eps = kPlaneTolerance * scale;
+  bool fromInFront = false, toInFront = false;
+  for (const auto& x : from) fromInFront |= glm::dot(toNormal, x - to[0]) > eps;
+  for (const auto& x : to) toInFront |= glm::dot(fromNormal, x - from[0]) > eps;
+  return !fromInFront || !toInFront;
+}
+
+glm::dvec3 vertexCentroid(const std::vector<glm::dvec3>& v) {
+  glm::dvec3 c(0.0);
+  for (const auto& x : v) c += x;
+  return v.empty() ? c : c / double(v.size());
+}
+
+}  // namespace
+
+glm::dvec3 polygonNormal(const glm::dvec3* v, std::size_t count) {
+  glm::dvec3 a(0.0);
+  for (std::size_t i = 1; i + 1 < count; ++i) a += glm::cross(v[i] - v[0], v[i + 1] - v[0]);
+  double len = glm::length(a);
+  return len > 0.0 && std::isfinite(len) ? a / len : glm::dvec3(0.0);
+}
+
+double polygonArea(const glm::dvec3* v, std::size_t count) {
+  glm::dvec3 a(0.0);
+  for (std::size_t i = 1; i + 1 < count; ++i) a += glm::cross(v[i] - v[0], v[i + 1] - v[0]);
+  return 0.5 * glm::length(a);
+}
+
+std::vector<glm::dvec3> polygonVertices(const Polygon& poly) {
+  return std::vector<glm::dvec3>(poly.v.begin(), poly.v.begin() + std::clamp(poly.count, 0, 4));
+}
+
+double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& nIn, const glm::dvec3* v,
+                                std::size_t count) {
+  if (count < 3) return 0.0;
+  double nl = glm::length(nIn);
+  if (!(nl > 0.0) || !std::isfinite(nl)) return 0.0;
+  glm::dvec3 n = nIn / nl;
+  glm::dvec3 m = polygonNormal(v, count);
+  if (m == glm::dvec3(0.0)) return 0.0;
+  // One-sided: only an element strictly in front of the polygon's plane sees its front.
+  if (!(glm::dot(m, p - v[0]) > 0.0)) return 0.0;
+
+  // Horizon clipping to n . (x - p) >= 0 (Sutherland-Hodgman against one plane).
+  bool anyIn = false, anyOut = false;
+  for (std::size_t k = 0; k < count; ++k) {
+    double d = glm::dot(n, v[k] - p);
+    anyIn |= d > 0.0;
+    anyOut |= d < 0.0;
+  }
+  if (!anyIn) return 0.0;
+  double f;
+  if (!anyOut) {
+    f = contourSum(p, n, v, count);
+  } else {
+    VertexBuffer w(count + 2);
+    for (std::size_t k = 0; k < count; ++k) {
+      const glm::dvec3& a = v[k];
+      const glm::dvec3& b = v[(k + 1) % count];
+      double da = glm::dot(n, a - p);
+      double db = glm::dot(n, b - p);
+      if (da >= 0.0) w.push(a);
+      if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) {
+        double t = da / (da - db);  // in (0, 1)
+        w.push(a + t * (b - a));
+      }
+    }
+    if (w.size() < 3) return 0.0;
+    f = contourSum(p, n, w.data(), w.size());
+  }
+  if (!(f > 0.0)) return 0.0;  // also maps a NaN from non-finite input to 0
+  return std::min(f, 1.0);
+}
+
+double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& n,
+                                const std::vector<glm::dvec3>& v) {
+  return pointToPolygonFormFactor(p, n, v.data(), v.size());
+}
+
+double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& n, const Polygon& poly) {
+  return pointToPolygonFormFactor(p, n, poly.v.data(),
+                                  static_cast<std::size_t>(std::clamp(poly.count, 0, 4)));
+}
+
+int autoQuadratureOrder(const std::vector<glm::dvec3>& from, const std::vector<glm::dvec3>& to) {
+  double s = std::max(diameter(from), diameter(to));
+  double d = glm::length(vertexCentroid(from) - vertexCentroid(to));
+  if (!(s > 0.0)) return 1;
+  double r = d / s;
+  if (r >= 20.0) return 2;
+  if (r >= 5.0) return 4;
+  if (r >= 2.0) return 6;
+  if (r >= 1.0) return 8;
+  if (r >= 0.5) return 12;
+  return 16;
+}
+
+int autoQuadratureOrder(const Polygon& from, const Polygon& to) {
+  return autoQuadratureOrder(polygonVertices(from), polygonVertices(to));
+}
+
+double polygonToPolygonFormFactor(const std::vector<glm::dvec3>& from,
+                                  const std::vector<glm::dvec3>& to, int order) {
+  if (from.size() < 3 || to.size() < 3) return 0.0;
+  double area = polygonArea(from.data(), from.size());
+  glm::dvec3 normal = polygonNormal(from.data(), from.size());
+  if (!(area > 0.0) || normal == glm::dvec3(0.0)) return 0.0;
+  glm::dvec3 toNormal = polygonNormal(to.data(), to.size());
+  if (toNormal == glm::dvec3(0.0)) return 0.0;
+  if (facesAway(from, normal, to, toNormal, std::max(diameter(from), diameter(to)))) return 0.0;
+  if (order <= 0) order = autoQuadratureOrder(from, to);
+  order = std::clamp(order, 1, kMaxQuadratureOrder);
+  Target target{to.data(), to.size()};
+  double sum = 0.0;
+  for (const Cell& cell : initialCells(from))
+    sum += integrateCell(cell, normal, target, order, order);
+  double f = sum / area;
+  return std::isfinite(f) ? std::clamp(f, 0.0, 1.0) : 0.0;
+}
+
+double polygonToPolygonFormFactor(const Polygon& from, const Polygon& to, int order) {
+  return polygonToPolygonFormFactor(polygonVertices(from), polygonVertices(to), order);
+}
+
+AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const std::vector<glm::dvec3>& from,
+                                                      const std::vector<glm::dvec3>& to,
+                                                      double relTol, double absTol, int maxCells) {
+  AdaptiveFormFactor result;
+  if (from.size() < 3 || to.size() < 3) return result;
+  double area = polygonArea(from.data(), from.size());
+  glm::dvec3 normal = polygonNormal(from.data(), from.size());
+  if (!(area > 0.0) || normal == glm::dvec3(0.0)) return result;
+  glm::dvec3 toNormal = polygonNormal(to.data(), to.size());
+  if (toNormal == glm::dvec3(0.0) ||
+      facesAway(from, normal, to, toNormal, std::max(diameter(from), diameter(to)))) {
+    result.converged = true;
+    return result;
+  }
+  Target target{to.data(), to.size()};
+
+  constexpr int kHigh = 8, kLow = 5;
+  // Absolute error in F below which refining only chases rounding noise.
+  constexpr double kAdaptiveNoiseFloor = 1e-18;
+  struct Scored {
+    Cell cell;
+    double value, errU, errV;
+    double err() const { return errU + errV; }
+    bool operator<(const Scored& o) const { return err() < o.err(); }
+  };
+  auto score = [&](const Cell& c) {
+    double hh = integrateCell(c, normal, target, kHigh, kHigh);
+    double lh = integrateCell(c, normal, target, kLow, kHigh);
+    double hl = integrateCell(c, normal, target, kHigh, kLow);
+    return Scored{c, hh, std::abs(lh - hh), std::abs(hl - hh)};
+  };
+
+  // Sums are over \int F dA (not yet divided by the area); tolerances scale accordingly.
+  std::priority_queue<Scored> heap;
+  double total = 0.0, totalErr = 0.0;
+  for (const Cell& c : initialCells(from)) {
+    Scored s = score(c);
+    total += s.value;
+    totalErr += s.err();
+    heap.push(s);
+  }
+  auto done = [&] {
+    return totalErr <=
+           std::max(std::max(absTol, kAdaptiveNoiseFloor) * area, relTol * std::abs(total));
+  };
+  int cells = static_cast<int>(heap.size());
+  int sinceResum = 0;
+  while (!done() && cells < maxCells && !heap.empty()) {
+    Scored worst = heap.top();
+    heap.pop();
+    total -= worst.value;
+    totalErr -= worst.err();
+    std::array<Cell, 4> children;
+    int childCount = 0;
+    const Cell& c = worst.cell;
+    // Split across the parametric direction(s) that carry the error.
+    bool splitU = worst.errU >= 0.25 * worst.errV;
+    bool splitV = worst.errV >= 0.25 * worst.errU;
+    if (splitU && splitV) {
+      children = {c.sub(0, 0.5, 0, 0.5), c.sub(0.5, 1, 0, 0.5), c.sub(0.5, 1, 0.5, 1),
+                  c.sub(0, 0.5, 0.5, 1)};
+      childCount = 4;
+    } else if (splitU) {
+      children[0] = c.sub(0, 0.5, 0, 1);
+      children[1] = c.sub(0.5, 1, 0, 1);
+      childCount = 2;
+    } else {
+      children[0] = c.sub(0, 1, 0, 0.5);
+      children[1] = c.sub(0, 1, 0.5, 1);
+      childCount = 2;
+    }
+    for (int i = 0; i < childCount; ++i) {
+      Scored s = score(children[i]);
+      total += s.value;
+      totalErr += s.err();
+      heap.push(s);
+    }
+    cells += childCount - 1;
+    if (++sinceResum == 1024) {
+      // Recompute the running sums to stop drift from the repeated add/subtract.
+      sinceResum = 0;
+      auto copy = heap;
+      total = totalErr = 0.0;
+      while (!copy.empty()) {
+        total += copy.top().value;
+        totalErr += copy.top().err();
+        copy.pop();
+      }
+    }
+  }
+  // Final sum, smallest contributions first.
+  std::vector<double> values, errors;
+  while (!heap.empty()) {
+    values.push_back(heap.top().value);
+    errors.push_back(heap.top().err());
+    heap.pop();
+  }
+  std::sort(values.begin(), values.end(),
+            [](double a, double b) { return std::abs(a) < std::abs(b); });
+  total = totalErr = 0.0;
+  for (double x : values) total += x;
+  for (double e : errors) totalErr += e;
+  result.cells = cells;
+  result.converged = done();
+  double f = total / area;
+  result.value = std::isfinite(f) ? std::clamp(f, 0.0, 1.0) : 0.0;
+  result.errorEstimate = totalErr / area;
+  return result;
+}
+
+AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const Polygon& from, const Polygon& to,
+                                                      double relTol, double absTol, int maxCells) {
+  return polygonToPolygonFormFactorAdaptive(polygonVertices(from), polygonVertices(to), relTol,
+                                            absTol, maxCells);
+}
+
+double formFactorEstimate(const Polygon& from, const Polygon& to) {
+  return pointToPolygonFormFactor(from.centroid(), from.normal(), to);
+}
+
+double formFactorSpread(const Polygon& from, const Polygon& to, double atCentroid) {
+  glm::dvec3 n = from.normal();
+  double lo = atCentroid, hi = atCentroid;
+  for (int i = 0; i < from.count; ++i) {
+    double f = pointToPolygonFormFactor(from.v[size_t(i)], n, to);
+    lo = std::min(lo, f);
+    hi = std::max(hi, f);
+  }
+  return hi - lo;
+}
+
+}  // namespace rad

@@ -1,0 +1,101 @@
+// The space-time global solution rad-global computes and the second pass reads (paper §3.1,
+// §4.2; DESIGN.md §6): the union over all key times of the patch hierarchy, the links with
+// their activity intervals and F·V samples, the radiosity of every node at every key time, and
+// what rad-movies needs per receiver: the good-link irradiance as vertex values over the union
+// leaves (Gouraud) and the bad (receiver top, shooter top) pairs.
+//
+// Good and bad (paper §3.1): a link p <- q is *bad* when the pair (top of p, top of q) is in
+// badPairs; everything else is good. The good-link irradiance excludes every link of a bad
+// pair at every key time, so  H(x, t) = goodIrradiance(x, t) + sum over bad shooters S of the
+// receiver top of  B_S(t) F(x -> S(t)) T(x, S, t)  with nothing counted twice.
+//
+// Times: values are given at key times; between two key times everything is linear in t, and
+// before the first / after the last key the end value is held.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcommon/scene/patch_hierarchy.h"
+
+namespace rad {
+
+struct GlobalLink {
+  uint32_t receiver = 0;  // dense node index (gathers)
+  uint32_t shooter = 0;   // dense node index (shoots)
+  uint32_t firstKey = 0;  // activity interval [firstKey, lastKey] in key indices
+  uint32_t lastKey = 0;
+  uint32_t sampleOffset = 0;  // into linkSampleKeys / linkSampleValues
+  uint32_t sampleCount = 0;   // >= 1; a link whose F·V never changes keeps one sample
+  uint8_t flags = 0;          // kLinkBad | kLinkVisibilityEvent | kLinkRefined
+};
+constexpr uint8_t kLinkBad = 1;              // belongs to a bad pair
+constexpr uint8_t kLinkVisibilityEvent = 2;  // its F·V changed because visibility changed
+constexpr uint8_t kLinkRefined = 4;          // refined (kept for the hierarchy; not gathered)
+
+class GlobalSolution {
+ public:
+  // --- content (public so the writer and reader are plain; invariants checked by validate())
+  std::vector<double> keyTimes;  // K >= 1, strictly increasing, seconds
+  // Union hierarchy over all key times: node i has id nodeIds[i]; nodes 0..topCount-1 are the
+  // top-level patches in Scene::inputPolygons() order; parents come before children.
+  PatchHierarchy hierarchy;
+  // Radiosity B (W/m^2, RGB) of node i at key k: nodeRadiosity[i * K + k]. Interior nodes hold
+  // the area average of their children (push-pull), so a top's value is its mean radiosity.
+  std::vector<glm::vec3> nodeRadiosity;
+  // Good-link irradiance H_good (W/m^2) at the vertices of every union leaf, per key:
+  // leafVertexGoodIrradiance[(leafRow[i] * K + k) * 4 + c] for corner c of node i
+  // (triangles use c = 0..2). leafRow[i] = -1 for interior nodes.
+  std::vector<int32_t> leafRow;
+  std::vector<glm::vec3> leafVertexGoodIrradiance;
+  // Links (one row per activity interval) and their F·V samples: piecewise linear in key
+  // index through (linkSampleKeys[j], linkSampleValues[j]), held outside.
+  std::vector<GlobalLink> links;
+  std::vector<uint32_t> linkSampleKeys;
+  std::vector<float> linkSampleValues;
+  // Bad (receiver top, shooter top) pairs, sorted, unique.
+  std::vector<std::pair<uint32_t, uint32_t>> badPairs;
+
+  int keyCount() const { return int(keyTimes.size()); }
+  // Fractional key position of time t: k0, k1 and weight w of k1 (held outside the range).
+  void keyWeights(double t, int& k0, int& k1, double& w) const;
+
+  // B of node i at time t (linear between keys).
+  glm::dvec3 radiosity(int node, double t) const;
+  glm::dvec3 radiosityAtKey(int node, int key) const {
+    return nodeRadiosity[size_t(node) * keyCount() + key];
+  }
+  // H_good at the point of top-level patch `top` with top-level (u,v) `uv`, at key k:
+  // Gouraud-interpolated over the union leaf that contains the point.
+  glm::dvec3 goodIrradianceAtKey(int top, glm::dvec2 uv, int key) const;
+  glm::dvec3 goodIrradiance(int top, glm::dvec2 uv, double t) const;
+  // Shooter tops of the bad pairs whose receiver is `receiverTop`, ascending.
+  std::vector<uint32_t> badShooters(uint32_t receiverTop) const;
+  bool isBadPair(uint32_t receiverTop, uint32_t shooterTop) const;
+
+  // Throws rad::inputError(where, ...) when sizes or indices are inconsistent.
+  void validate(const std::string& where) const;
+  // The part of validate() that covers keyTimes, hierarchy, nodeRadiosity and leafRow only:
+  // all a solution read without its links and good irradiance (rad-compose) must satisfy.
+  void validateRadiosity(const std::string& where) const;
+};
+
+// Where a point of a node lies in its top-level patch's (u,v) square, and back: subdivision
+// is exact in parameter space (quads: quarter squares; triangles: midpoint split of the half
+// square, child 3 inverted).
+glm::dvec2 topUvFromNodeUv(PatchId node, glm::dvec2 nodeUv, bool triangle);
+glm::dvec2 nodeUvFromTopUv(PatchId node, glm::dvec2 topUv, bool triangle);
+// (u,v) clamped into a node's parameter domain ([0,1]^2, or the half square u+v <= 1).
+glm::dvec2 clampToParameterDomain(glm::dvec2 uv, bool triangle);
+// One step down the quadtree: the child (0..3) whose domain contains the node-local point uv,
+// with uv rewritten in that child's own (u,v) (clamped into its domain).
+int descendToChild(glm::dvec2& uv, bool triangle);
+// The deepest existing node of `hierarchy` under top-level patch `top` whose parameter domain
+// contains topUv (points outside the domain are clamped into it).
+int leafAtTopUv(const PatchHierarchy& hierarchy, int top, glm::dvec2 topUv);
+
+}  // namespace rad

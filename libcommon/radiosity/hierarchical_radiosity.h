@@ -1,0 +1,187 @@
+// Hierarchical radiosity at one time (Hanrahan, Salzman, Aupperle 1991, "A rapid hierarchical
+// radiosity algorithm") and the pieces rad-global's space-time solve is made of (paper §3.1,
+// §4.2; DESIGN.md §6).
+//
+// One key-time solve:
+//  * top-level links p <- q between every mutually facing pair of top-level patches (a pair
+//    where one lies wholly on or behind the other's plane is never linked);
+//  * brightness-weighted refinement (HSA'91 §4, "BF refinement"): a link p <- q is refined
+//    while  max_c B_q,c * F~_pq * V_pq * A_p > eps * Phi  (Phi = largest emitted power over
+//    the colour channels, so eps is relative and the scene's units do not matter) and the
+//    larger of the two patches has area > minArea; the larger patch is subdivided. F~ is the
+//    cheap estimate (formFactorEstimate, both directions), V the link's visibility. Refined
+//    links are kept (flag refined) but not gathered;
+//  * leaf links get the accurate unoccluded F (polygonToPolygonFormFactor) and V from k
+//    stratified shadow-ray pairs (VisibilityScene), seeded from (receiver id, shooter id);
+//  * gather + push-pull (HSA'91 §5), Gauss-Seidel over the top-level patches, until the
+//    relative change of B is below tol * (1 - rho_max) (the stop rule of the furnace
+//    reference: a change below tol alone leaves an error of tol / (1 - rho));
+//  * refine again with the new B and re-solve, until a round refines nothing.
+//
+// Every key time works on one shared PatchHierarchy (the union over key times): a key's own
+// tree is the set of nodes it split (KeySolution::split). Node indices are dense indices of
+// that hierarchy; patch ids (PatchId) are what stays the same from key to key.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcommon/radiosity/form_factor.h"
+#include "libcommon/scene/patch_hierarchy.h"
+#include "libcommon/scene/scene.h"
+#include "libcommon/radiosity/visibility.h"
+
+namespace rad {
+
+// What the refinement oracle weighs (see the top of this file).
+enum class RefinementOracle {
+  kPower,  // HSA'91 "BF refinement": the power B_q F_pq V A_p the link carries
+  kError,  // the power it may carry wrongly: B_q V max(A_p dF_p, A_q dF_q), dF = formFactorSpread
+  kBoth,   // either one over eps
+};
+
+struct RadiosityOptions {
+  RefinementOracle oracle = RefinementOracle::kPower;
+  double eps = 1e-3;           // refinement threshold relative to the largest emitted power
+  double minArea = 0.0;        // m^2: a link whose larger patch is not larger than this stays
+  bool refine = true;          // false: top-level links only (discrete system of the input patches)
+  int rays = 16;               // shadow-ray pairs per link
+  double tol = 1e-4;           // relative change, scaled by (1 - rho_max)
+  int maxIterations = 200000;  // Gauss-Seidel sweeps per solve (a safety net)
+  int maxRefineRounds = 8;     // refine / solve rounds
+  int quadratureOrder = kAutoOrder;  // of polygonToPolygonFormFactor; kAutoOrder = per pair
+  // Relative tolerance of the adaptive near-contact form factor. 1e-5 instead of 1e-7 halves
+  // rad-global's time on the table scene and moves no radiosity by more than 3e-7 relative.
+  double formFactorTolerance = 1e-5;
+};
+
+// Diffuse reflectance and emitted radiosity B_e = pi L_e (W/m^2) of one top-level patch.
+struct SurfaceProperties {
+  glm::dvec3 reflectance{0.0};
+  glm::dvec3 emission{0.0};
+  bool isEmitter() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
+};
+// From the scene's materials (reflectance clamped to [0, 1]; the glTF default material is
+// white).
+std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
+                                                   const PatchHierarchy& hierarchy);
+
+// One link of a key-time solve.
+struct SolverLink {
+  int receiver = 0;             // dense node index (gathers)
+  int shooter = 0;              // dense node index (shoots)
+  double formFactor = 0;        // unoccluded F(receiver -> shooter); the estimate until `accurate`
+  double visibility = 0;        // V in [0, 1]
+  double estimate = 0;          // F~ of the oracle
+  double spreadArea = 0;        // max(A_p dF(p -> q), A_q dF(q -> p)) of the error oracle (m^2)
+  bool refined = false;         // kept for the hierarchy, not gathered
+  bool accurate = false;        // formFactor is the quadrature value
+  bool reused = false;          // F and V taken from the previous key time (coherence)
+  bool visibilityOnly = false;  // F taken over, V recomputed (the shaft met a moving object)
+  double knownFormFactor = -1;  // the accurate F when the previous key computed it, else < 0
+  double fv() const { return formFactor * visibility; }
+};
+
+// Link values that a key-time solve may take over instead of recomputing (paper §4.2): keyed
+// by (receiver id, shooter id). Only values are taken over, never decisions: the solve refines
+// and iterates exactly as without them, so a coherent key solve is bit-identical to an
+// independent one whenever the cached values are what recomputing would give.
+struct CachedLink {
+  double estimate = 0, spreadArea = 0;  // geometry only: valid while both ends are static
+  double formFactor = -1;               // accurate unoccluded F, or < 0 when never computed
+  double visibility = 0;
+  bool visibilityValid = false;  // false: a moving object's swept bound met the link's shaft
+};
+struct LinkKeyHash {
+  size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {
+    return size_t(splitMix64(k.first ^ splitMix64(k.second)));
+  }
+};
+using LinkCache = std::unordered_map<std::pair<uint64_t, uint64_t>, CachedLink, LinkKeyHash>;
+
+struct KeySolveInput {
+  std::vector<glm::dmat4> topToWorld;           // per top-level patch: its node's world transform
+  const VisibilityScene* visibility = nullptr;  // null: every link fully visible
+  uint32_t keyIndex = 0;                        // for reports only (seeds ignore it)
+  const LinkCache* reuse = nullptr;             // coherence: values to take over
+};
+
+struct KeySolution {
+  std::vector<SolverLink> links;
+  std::vector<char> split;             // per dense node: subdivided in this key's tree
+  std::vector<glm::dvec3> radiosity;   // per dense node of this key's tree (area average)
+  std::vector<glm::dvec3> irradiance;  // per dense node: H gathered at it and its ancestors
+  std::vector<Polygon> world;          // per dense node: world polygon at this key
+  std::vector<double> area;            // per dense node: world area
+  int iterations = 0;                  // Gauss-Seidel sweeps, all rounds
+  int refineRounds = 0;
+  size_t linksComputed = 0;        // links whose F or V was computed here
+  size_t linksReused = 0;          // links whose F and V came from `reuse`
+  size_t linksVisibilityOnly = 0;  // of linksComputed: F from `reuse`, V computed
+  double lastChange = 0;           // relative change of the last sweep
+  double secondsLinks = 0, secondsSolve = 0;
+
+  bool inTree(int node, const PatchHierarchy& h) const {
+    int parent = h.node(node).parent;
+    return parent < 0 || (size_t(parent) < split.size() && split[size_t(parent)]);
+  }
+  // Power absorbed (sum over leaves of A (1 - rho) H) and emitted (sum A B_e), per channel.
+  glm::dvec3 absorbedPower(const PatchHierarchy& h,
+                           const std::vector<SurfaceProperties>& surfaces) const;
+  glm::dvec3 emittedPower(const PatchHierarchy& h,
+                          const std::vector<SurfaceProperties>& surfaces) const;
+};
+
+// One key-time solve (see the top of this file). Subdivides `hierarchy` as needed.
+KeySolution solveKeyTime(PatchHierarchy& hierarchy, const std::vector<SurfaceProperties>& surfaces,
+                         const KeySolveInput& input, const RadiosityOptions& options);
+
+// Unoccluded F(p -> q) of a leaf link. kAutoOrder: integrated over the smaller of the two
+// with reciprocity (A_p F_pq = A_q F_qp), adaptively near contact (centroid distance below
+// the larger diameter, to relative tolerance relTol), else polygonToPolygonFormFactor's
+// automatic order; any other order: polygonToPolygonFormFactor(p, q, order) (one rule per
+// receiver: exact row sums).
+double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relTol = 1e-5);
+
+// True when the top-level patches p and q can exchange energy at all: some vertex of each lies
+// strictly in front of the other's plane.
+bool mutuallyFacing(const Polygon& p, const Polygon& q);
+
+// Seed of the shadow rays of link (receiver <- shooter). It does not depend on the key time:
+// a link whose ends and blockers did not move gets bit-identical visibility whether it is
+// reused (coherent) or recomputed (--no-coherence), and its shadow does not shimmer in time.
+uint64_t linkSeed(PatchId receiver, PatchId shooter);
+
+// The scene's triangles for visibility: mesh nodes static over [t0, t1] in the static BVH in
+// world space, each dynamic mesh node an instance whose transform setTime() updates. Every
+// triangle's surface id is its top-level patch index.
+class SceneVisibility {
+ public:
+  SceneVisibility(const Scene& scene, const PatchHierarchy& hierarchy, double t0, double t1);
+  void setTime(double t);  // sets the instance transforms and commits
+  const VisibilityScene& visibility() const { return *vis_; }
+  int dynamicNodeCount() const { return int(instances_.size()); }
+
+ private:
+  const Scene& scene_;
+  std::unique_ptr<VisibilityScene> vis_;
+  std::vector<std::pair<int, int>> instances_;  // (mesh node, instance id)
+};
+
+// World transform of every top-level patch's node at time t.
+std::vector<glm::dmat4> topTransforms(const Scene& scene, const PatchHierarchy& hierarchy,
+                                      double t);
+
+// Shaft culling (Haines & Wallace 1994, "Shaft culling for efficient ray-cast radiosity"):
+// true when the axis-aligned box [lo, hi] may meet the convex hull of the two polygons. The
+// shaft used is the hull's bounding box intersected with the prisms over the hull's three
+// axis-aligned projections (a 2D convex hull each), which contains the hull: a `false` is
+// exact, a `true` may be conservative.
+bool shaftMeetsBox(const Polygon& a, const Polygon& b, const glm::dvec3& lo, const glm::dvec3& hi);
+
+}  // namespace rad

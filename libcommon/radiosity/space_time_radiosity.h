@@ -1,0 +1,69 @@
+// Space-time hierarchical radiosity (paper §3.1, §4.2; DESIGN.md §6 "rad-global"): one
+// hierarchical solve per key time on a shared (union) patch hierarchy, with temporal
+// coherence between consecutive key times, merged into a GlobalSolution.
+//
+// Coherence (§4.2): between key times t_{k-1} and t_k a link keeps its F and V when both its
+// end patches are static over [t_{k-1}, t_k] and its shaft (Haines & Wallace 1994; see
+// shaftMeetsBox) meets no swept bound of a node that moves in that interval. Such a link's
+// shadow rays would hit exactly what they hit before (same seeds, same static blockers, no
+// dynamic one inside the shaft), so the values taken over are the ones recomputing would give
+// and, since the solve makes the same decisions from them, the coherent solution is
+// bit-identical to independent per-key solves. Without coherence every key time is an
+// independent solve (the baseline of the speed-up, and of the tests).
+//
+// Memory: each key time's links are folded into the links' activity intervals as soon as the
+// key is solved (a run whose F·V does not change keeps one value), so the peak is one key's
+// solve plus the compact result, not key times x links.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "libcommon/radiosity/global_solution.h"
+#include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/scene/scene.h"
+
+namespace rad {
+
+enum class BadLinkRule { kLights, kPartial, kAll, kNone };
+BadLinkRule parseBadLinkRule(const std::string& s);  // lights|partial|all|none; usage Error
+const char* badLinkRuleName(BadLinkRule r);
+
+struct SpaceTimeOptions {
+  RadiosityOptions radiosity;
+  BadLinkRule badLinks = BadLinkRule::kLights;
+  // partial: a pair is also bad when one of its gathered links has partialThreshold < V < 1.
+  double partialThreshold = 0.0;
+  bool coherence = true;
+  std::function<void()> onKeySolved;  // called after each key time's solve (progress)
+};
+
+struct KeyTimeReport {
+  double time = 0;
+  size_t links = 0;           // all links of the key (refined ones included)
+  size_t recomputed = 0;      // F / V computed at this key
+  size_t reused = 0;          // F and V taken over from the previous key
+  size_t visibilityOnly = 0;  // of recomputed: F taken over, only V computed
+  size_t nodes = 0;           // nodes of this key's tree
+  int iterations = 0;         // Gauss-Seidel sweeps
+  int refineRounds = 0;
+  double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
+};
+
+struct SpaceTimeReport {
+  std::vector<KeyTimeReport> keys;
+  double secondsSetup = 0, secondsMerge = 0;
+  size_t unionNodes = 0, linkRows = 0, badPairs = 0;
+};
+
+// Link values of `previous` (solved at t0 on `hierarchy`) that stay valid until t1: F, its
+// estimate and spread while both ends are static; V too unless the shaft meets a swept bound.
+LinkCache reusableLinks(const KeySolution& previous, const PatchHierarchy& hierarchy,
+                        const Scene& scene, double t0, double t1);
+
+// The whole first pass: key times must be strictly increasing.
+GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
+                              const SpaceTimeOptions& options, SpaceTimeReport* report = nullptr);
+
+}  // namespace rad

@@ -1,0 +1,329 @@
+// Shadow-ray visibility with Embree 3 (Wald et al. 2014); stratified ray pairs after Hanrahan,
+// Salzman, Aupperle 1991; splitmix64 from Steele, Lea, Flood 2014.
+#include "libcommon/radiosity/visibility.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <mutex>
+#include <numeric>
+#include <string>
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "libcommon/core/error.h"
+
+namespace rad {
+
+std::uint64_t splitMix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+double uniformOpen01(std::uint64_t seed, std::uint64_t counter) {
+  std::uint64_t r = splitMix64(splitMix64(seed) ^ splitMix64(counter + 0x632BE59BD9B4E019ull));
+  return (static_cast<double>(r >> 11) + 0.5) * 0x1.0p-53;
+}
+
+namespace {
+
+const char* embreeErrorName(RTCError e) {
+  switch (e) {
+    case RTC_ERROR_NONE:
+      return "no error";
+    case RTC_ERROR_UNKNOWN:
+      return "unknown error";
+    case RTC_ERROR_INVALID_ARGUMENT:
+      return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION:
+      return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY:
+      return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+      return "unsupported CPU";
+    case RTC_ERROR_CANCELLED:
+      return "cancelled";
+  }
+  return "unknown error";
+}
+
+// Intersection context extended with the surfaces a query ignores (Embree's documented way
+// of passing per-ray data to filter functions).
+struct FilterContext {
+  RTCIntersectContext context;
+  std::uint32_t ignoreA;
+  std::uint32_t ignoreB;
+};
+
+void ignoreEndSurfaces(const RTCFilterFunctionNArguments* args) {
+  const auto* fc = reinterpret_cast<const FilterContext*>(args->context);
+  const auto* surfaces = static_cast<const std::uint32_t*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    std::uint32_t s = surfaces[RTCHitN_primID(args->hit, args->N, i)];
+    if (s == fc->ignoreA || s == fc->ignoreB) args->valid[i] = 0;
+  }
+}
+
+// Random-number streams of one query.
+enum Stream : std::uint64_t { kJitterA = 1, kJitterB = 2, kPermuteA = 3, kPermuteB = 4, kPair = 5 };
+
+std::uint64_t streamSeed(std::uint64_t seed, Stream s) {
+  return splitMix64(seed ^ (0xD1B54A32D192ED03ull * static_cast<std::uint64_t>(s)));
+}
+
+// Uniformly random permutation of 0..k-1 (Fisher-Yates, counter-based).
+std::vector<int> permutation(int k, std::uint64_t seed) {
+  std::vector<int> p(k);
+  std::iota(p.begin(), p.end(), 0);
+  for (int i = k - 1; i > 0; --i) {
+    int j = std::min(i, static_cast<int>(uniformOpen01(seed, i) * (i + 1)));
+    std::swap(p[i], p[j]);
+  }
+  return p;
+}
+
+// k stratified points in the open unit square.
+std::vector<glm::dvec2> stratified(int k, std::uint64_t jitterSeed, std::uint64_t permSeed) {
+  std::vector<glm::dvec2> pts(k);
+  int m = static_cast<int>(std::lround(std::sqrt(static_cast<double>(k))));
+  if (m * m == k) {
+    for (int i = 0; i < k; ++i) {
+      pts[i] = {(i % m + uniformOpen01(jitterSeed, 2 * i)) / m,
+                (i / m + uniformOpen01(jitterSeed, 2 * i + 1)) / m};
+    }
+  } else {
+    std::vector<int> py = permutation(k, permSeed);
+    for (int i = 0; i < k; ++i) {
+      pts[i] = {(i + uniformOpen01(jitterSeed, 2 * i)) / k,
+                (py[i] + uniformOpen01(jitterSeed, 2 * i + 1)) / k};
+    }
+  }
+  return pts;
+}
+
+// Area-uniform map of the unit square onto a triangle or a convex quad (split along v0-v2,
+// u chooses the half in proportion to its area, so strata stay strata).
+glm::dvec3 onPolygon(const Polygon& p, glm::dvec2 s) {
+  auto onTriangle = [](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, double u,
+                       double v) {
+    double su = std::sqrt(u);
+    return (1.0 - su) * a + su * (1.0 - v) * b + su * v * c;
+  };
+  if (p.count == 3) return onTriangle(p.v[0], p.v[1], p.v[2], s.x, s.y);
+  double a0 = glm::length(glm::cross(p.v[1] - p.v[0], p.v[2] - p.v[0]));
+  double a1 = glm::length(glm::cross(p.v[2] - p.v[0], p.v[3] - p.v[0]));
+  double w = a0 + a1 > 0.0 ? a0 / (a0 + a1) : 0.5;
+  if (s.x < w) return onTriangle(p.v[0], p.v[1], p.v[2], s.x / w, s.y);
+  return onTriangle(p.v[0], p.v[2], p.v[3], std::min((s.x - w) / (1.0 - w), 1.0), s.y);
+}
+
+}  // namespace
+
+struct VisibilityScene::Impl {
+  RTCDevice device = nullptr;
+  RTCScene top = nullptr;
+  std::vector<RTCScene> children;                   // [0] static, then one per dynamic object
+  std::vector<RTCGeometry> instances;               // dynamic instances, by instance id
+  std::deque<std::vector<std::uint32_t>> surfaces;  // stable addresses for the filter
+  std::mutex errorMutex;
+  std::string lastError;
+
+  ~Impl() {
+    for (RTCGeometry g : instances) rtcReleaseGeometry(g);
+    if (top) rtcReleaseScene(top);
+    for (RTCScene s : children) rtcReleaseScene(s);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  void check(const char* what) {
+    RTCError e = rtcGetDeviceError(device);
+    if (e == RTC_ERROR_NONE) return;
+    std::string msg;
+    {
+      std::lock_guard<std::mutex> lock(errorMutex);
+      msg = lastError;
+    }
+    throw Error(
+        ExitCode::kEnvironment, "embree",
+        std::string(what) + ": " + embreeErrorName(e) + (msg.empty() ? "" : " (" + msg + ")"));
+  }
+
+  static void onError(void* user, RTCError, const char* str) {
+    auto* self = static_cast<Impl*>(user);
+    std::lock_guard<std::mutex> lock(self->errorMutex);
+    self->lastError = str ? str : "";
+  }
+
+  RTCScene buildMesh(const std::vector<VisibilityTriangle>& tris) {
+    RTCScene scene = rtcNewScene(device);
+    check("rtcNewScene");
+    children.push_back(scene);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    if (!tris.empty()) {
+      RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      check("rtcNewGeometry(triangle)");
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * tris.size()));
+      auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tris.size()));
+      if (!vb || !ib) {
+        rtcReleaseGeometry(g);
+        check("rtcSetNewGeometryBuffer");
+        throw Error(ExitCode::kEnvironment, "embree", "rtcSetNewGeometryBuffer failed");
+      }
+      surfaces.emplace_back();
+      std::vector<std::uint32_t>& ids = surfaces.back();
+      ids.reserve(tris.size());
+      for (std::size_t t = 0; t < tris.size(); ++t) {
+        for (int c = 0; c < 3; ++c) {
+          for (int d = 0; d < 3; ++d) vb[9 * t + 3 * c + d] = static_cast<float>(tris[t].v[c][d]);
+          ib[3 * t + c] = static_cast<unsigned>(3 * t + c);
+        }
+        ids.push_back(tris[t].surface);
+      }
+      rtcSetGeometryUserData(g, ids.data());
+      rtcSetGeometryOccludedFilterFunction(g, ignoreEndSurfaces);
+      rtcCommitGeometry(g);
+      rtcAttachGeometry(scene, g);
+      rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(scene);
+    check("building a triangle BVH");
+    return scene;
+  }
+
+  RTCGeometry instance(RTCScene child, const glm::dmat4& m) {
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+    check("rtcNewGeometry(instance)");
+    rtcSetGeometryInstancedScene(g, child);
+    rtcSetGeometryTimeStepCount(g, 1);
+    setTransform(g, m);
+    rtcAttachGeometry(top, g);
+    check("attaching an instance");
+    return g;
+  }
+
+  static void setTransform(RTCGeometry g, const glm::dmat4& m) {
+    float xfm[12];  // 3x4, column-major: columns 0..3 of the affine part
+    for (int c = 0; c < 4; ++c) {
+      for (int r = 0; r < 3; ++r) xfm[3 * c + r] = static_cast<float>(m[c][r]);
+    }
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    rtcCommitGeometry(g);
+  }
+};
+
+VisibilityScene::VisibilityScene(const std::vector<VisibilityTriangle>& staticTriangles)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->device = rtcNewDevice(nullptr);
+  if (!impl_->device) {
+    throw Error(ExitCode::kEnvironment, "embree",
+                std::string("rtcNewDevice: ") + embreeErrorName(rtcGetDeviceError(nullptr)));
+  }
+  rtcSetDeviceErrorFunction(impl_->device, &Impl::onError, impl_.get());
+  if (!rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED)) {
+    throw Error(ExitCode::kEnvironment, "embree",
+                "this Embree build has no filter-function support (needed to ignore end patches)");
+  }
+  impl_->top = rtcNewScene(impl_->device);
+  impl_->check("rtcNewScene");
+  rtcSetSceneFlags(impl_->top, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(impl_->top, RTC_BUILD_QUALITY_LOW);
+  RTCScene statics = impl_->buildMesh(staticTriangles);
+  RTCGeometry g = impl_->instance(statics, glm::dmat4(1.0));
+  rtcReleaseGeometry(g);  // never moves; the top scene keeps it alive
+  commit();
+}
+
+VisibilityScene::~VisibilityScene() = default;
+VisibilityScene::VisibilityScene(VisibilityScene&&) noexcept = default;
+VisibilityScene& VisibilityScene::operator=(VisibilityScene&&) noexcept = default;
+
+int VisibilityScene::addInstance(const std::vector<VisibilityTriangle>& localTriangles,
+                                 const glm::dmat4& objectToWorld) {
+  RTCScene child = impl_->buildMesh(localTriangles);
+  impl_->instances.push_back(impl_->instance(child, objectToWorld));
+  return static_cast<int>(impl_->instances.size()) - 1;
+}
+
+void VisibilityScene::setInstanceTransform(int id, const glm::dmat4& objectToWorld) {
+  if (id < 0 || id >= instanceCount()) {
+    throw Error(
+        ExitCode::kInternal, "VisibilityScene",
+        "no instance " + std::to_string(id) + " (have " + std::to_string(instanceCount()) + ")");
+  }
+  Impl::setTransform(impl_->instances[id], objectToWorld);
+  impl_->check("rtcSetGeometryTransform");
+}
+
+void VisibilityScene::commit() {
+  rtcCommitScene(impl_->top);
+  impl_->check("building the instance BVH");
+}
+
+int VisibilityScene::instanceCount() const {
+  return static_cast<int>(impl_->instances.size());
+}
+
+bool VisibilityScene::occluded(const glm::dvec3& from, const glm::dvec3& to, std::uint32_t ignoreA,
+                               std::uint32_t ignoreB) const {
+  glm::dvec3 d = to - from;
+  RTCRay ray;
+  ray.org_x = static_cast<float>(from.x);
+  ray.org_y = static_cast<float>(from.y);
+  ray.org_z = static_cast<float>(from.z);
+  ray.dir_x = static_cast<float>(d.x);
+  ray.dir_y = static_cast<float>(d.y);
+  ray.dir_z = static_cast<float>(d.z);
+  ray.tnear = static_cast<float>(kSegmentEpsilon);
+  ray.tfar = static_cast<float>(1.0 - kSegmentEpsilon);
+  ray.time = 0.0f;
+  ray.mask = 0xffffffffu;
+  ray.id = 0;
+  ray.flags = 0;
+  if (!(ray.dir_x != 0.0f || ray.dir_y != 0.0f || ray.dir_z != 0.0f)) return false;
+  FilterContext fc;
+  rtcInitIntersectContext(&fc.context);
+  fc.ignoreA = ignoreA;
+  fc.ignoreB = ignoreB;
+  rtcOccluded1(impl_->top, &fc.context, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+double VisibilityScene::visibility(const Polygon& a, const Polygon& b, int k, std::uint64_t seed,
+                                   std::uint32_t ignoreA, std::uint32_t ignoreB) const {
+  k = std::max(k, 1);
+  std::vector<glm::dvec2> sa =
+      stratified(k, streamSeed(seed, kJitterA), streamSeed(seed, kPermuteA));
+  std::vector<glm::dvec2> sb =
+      stratified(k, streamSeed(seed, kJitterB), streamSeed(seed, kPermuteB));
+  std::vector<int> pair = permutation(k, streamSeed(seed, kPair));
+  int unoccluded = 0;
+  for (int i = 0; i < k; ++i) {
+    glm::dvec3 pa = onPolygon(a, sa[i]);
+    glm::dvec3 pb = onPolygon(b, sb[pair[i]]);
+    if (!occluded(pa, pb, ignoreA, ignoreB)) ++unoccluded;
+  }
+  return static_cast<double>(unoccluded) / k;
+}
+
+std::vector<double> VisibilityScene::visibilityBatch(const std::vector<VisibilityQuery>& queries,
+                                                     int k) const {
+  std::vector<double> out(queries.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const VisibilityQuery& q = queries[i];
+                        out[i] = visibility(q.a, q.b, k, q.seed, q.ignoreA, q.ignoreB);
+                      }
+                    });
+  return out;
+}
+
+}  // namespace rad

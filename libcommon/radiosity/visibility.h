@@ -1,0 +1,97 @@
+// Shadow-ray visibility between patches with Embree 3 (Wald et al. 2014, "Embree: a kernel
+// framework for efficient CPU ray tracing"); stratified pair estimator as in Hanrahan,
+// Salzman, Aupperle 1991 (visibility of a link from k jittered ray pairs).
+//
+// Scene layout: all static triangles (world space) live in one child scene whose BVH is built
+// once (high quality) and instanced with the identity transform; each dynamic rigid object is
+// its own child scene (built once, in its local frame) instanced with a transform that the
+// caller sets per key time. Only the small top-level BVH over the instances is rebuilt by
+// commit(). Embree works in single precision: blockers closer than ~1e-6 of the scene's
+// coordinate magnitude to a ray end are below its resolution.
+//
+// End polygons are never blockers. Two mechanisms, both always on:
+//  * every triangle carries a caller-defined `surface` id (e.g. the top-level patch it belongs
+//    to); a query may name the surfaces of its two end polygons, and hits on triangles with
+//    those ids are ignored (an Embree occlusion filter). This is the robust way: it also
+//    ignores the sub-patch's parent surface and is immune to float self-intersection;
+//  * each ray is the open segment between its two sample points, shortened at both ends by
+//    kSegmentEpsilon of its length (tnear / tfar), so surfaces touching an end polygon along
+//    an edge (a wall meeting the floor) do not block rays that start next to that edge.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcommon/scene/geometry.h"
+
+namespace rad {
+
+struct VisibilityTriangle {
+  glm::dvec3 v[3];
+  std::uint32_t surface = 0;  // caller's patch id; queries name the ids of their end patches
+};
+
+struct VisibilityQuery {
+  Polygon a, b;
+  std::uint64_t seed = 0;  // derive from the link (e.g. hash of both patch ids, key time)
+  std::uint32_t ignoreA = 0xffffffffu;  // surface id of a (kNoSurface: none)
+  std::uint32_t ignoreB = 0xffffffffu;  // surface id of b
+};
+
+class VisibilityScene {
+ public:
+  static constexpr std::uint32_t kNoSurface = 0xffffffffu;
+  // Relative shortening of every shadow segment at both ends.
+  static constexpr double kSegmentEpsilon = 1e-4;
+
+  // Creates the Embree device and the static BVH (built here, once). Throws
+  // rad::Error(ExitCode::kEnvironment) if Embree fails.
+  explicit VisibilityScene(const std::vector<VisibilityTriangle>& staticTriangles);
+  ~VisibilityScene();
+  VisibilityScene(const VisibilityScene&) = delete;
+  VisibilityScene& operator=(const VisibilityScene&) = delete;
+  VisibilityScene(VisibilityScene&&) noexcept;
+  VisibilityScene& operator=(VisibilityScene&&) noexcept;
+
+  // Adds a rigid dynamic object (triangles in its local frame); returns its instance id
+  // (0, 1, ...). Its BVH is built here, once. Call commit() before the next query.
+  int addInstance(const std::vector<VisibilityTriangle>& localTriangles,
+                  const glm::dmat4& objectToWorld = glm::dmat4(1.0));
+  // Sets an instance's local-to-world transform (affine). Call commit() before the next query.
+  void setInstanceTransform(int id, const glm::dmat4& objectToWorld);
+  // Rebuilds the top-level BVH over the instances. Not thread-safe with queries.
+  void commit();
+
+  // True if the open segment from -> to (shortened by kSegmentEpsilon at both ends) hits a
+  // triangle whose surface is neither ignoreA nor ignoreB.
+  bool occluded(const glm::dvec3& from, const glm::dvec3& to, std::uint32_t ignoreA = kNoSurface,
+                std::uint32_t ignoreB = kNoSurface) const;
+
+  // Fraction in [0, 1] of k ray pairs that are unoccluded. Sample points: stratified on a and
+  // on b (jittered m x m grid if k = m^2, otherwise Latin hypercube with k strata per axis),
+  // area-uniform on each polygon, the b strata randomly permuted against the a strata. All
+  // randomness is counter-based from `seed` (splitmix64), so the result depends only on the
+  // arguments and the scene: not on threads or call order. Thread-safe after commit().
+  // Estimator: E = V (unbiased); the standard deviation is at most 1/(2 sqrt(k)).
+  double visibility(const Polygon& a, const Polygon& b, int k, std::uint64_t seed,
+                    std::uint32_t ignoreA = kNoSurface, std::uint32_t ignoreB = kNoSurface) const;
+  // Many queries in parallel (TBB); results in input order, identical to calling visibility()
+  // on each query in turn.
+  std::vector<double> visibilityBatch(const std::vector<VisibilityQuery>& queries, int k) const;
+
+  int instanceCount() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Counter-based random numbers (Steele, Lea, Flood 2014, splitmix64 finaliser).
+std::uint64_t splitMix64(std::uint64_t x);
+// Uniform double in the open interval (0, 1) from (seed, counter).
+double uniformOpen01(std::uint64_t seed, std::uint64_t counter);
+
+}  // namespace rad

@@ -1,0 +1,162 @@
+// The scene model: what the toolchain sees of an animated glTF 2.0 scene (DESIGN.md §4).
+//
+// Units are metres and seconds; time is double everywhere. Geometry is kept in each mesh
+// node's local frame so rigid motion never changes a patch's shape or id; world positions at
+// time t are worldTransform(node, t) applied to the local polygons.
+//
+// Animation follows the glTF 2.0 specification exactly (§3.11 "Animations"): TRS channels,
+// STEP / LINEAR / CUBICSPLINE samplers, shortest-arc normalised slerp for rotations, the
+// first key's value held before it and the last key's after it, all animations playing
+// together on one clock.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "libcommon/scene/geometry.h"
+
+namespace rad {
+
+struct Texture {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // linear RGB, row-major, 3 floats per texel (sRGB decoded)
+  glm::dvec3 mean{1.0};    // mean linear RGB over the texture
+};
+
+struct Material {
+  std::string name;
+  // Diffuse reflectance rho = baseColorFactor.rgb x mean(baseColorTexture), each in [0, 1].
+  glm::dvec3 reflectance{1.0};
+  // Exitant radiance L_e = emissiveFactor x KHR_materials_emissive_strength, W/(m^2 sr).
+  // Emitted radiosity is B_e = pi L_e.
+  glm::dvec3 emission{0.0};
+  bool doubleSided = false;
+  int baseColorTexture = -1;  // index into Scene::textures or -1
+  int baseColorTexCoord = 0;
+
+  bool isEmitter() const { return emission.x > 0.0 || emission.y > 0.0 || emission.z > 0.0; }
+};
+
+// One triangle of a mesh in its node's local frame, CCW about the front face.
+struct MeshTriangle {
+  std::array<glm::dvec3, 3> p{};
+  std::array<glm::dvec2, 3> uv{};  // TEXCOORD_n of the material's base colour, or zero
+  int material = -1;               // index into Scene::materials (-1 = glTF default material)
+};
+
+struct Mesh {
+  std::string name;
+  std::vector<MeshTriangle> triangles;  // degenerate (zero-area) triangles already dropped
+};
+
+struct Camera {
+  std::string name;
+  bool perspective = true;
+  double yfov = 0.8;              // radians (perspective)
+  double aspectRatio = 0.0;       // 0 = take the image's aspect ratio
+  double xmag = 1.0, ymag = 1.0;  // orthographic half extents
+  double znear = 0.01;
+  double zfar = 0.0;  // 0 = infinite (perspective only)
+};
+
+struct Node {
+  std::string name;
+  int parent = -1;
+  std::vector<int> children;
+  int mesh = -1;    // index into Scene::meshes or -1
+  int camera = -1;  // index into Scene::cameras or -1
+  // Rest pose (used where no channel animates a property).
+  glm::dvec3 translation{0.0};
+  glm::dquat rotation{1.0, 0.0, 0.0, 0.0};  // glm order (w, x, y, z)
+  glm::dvec3 scale{1.0};
+};
+
+enum class AnimationPath { kTranslation, kRotation, kScale };
+enum class Interpolation { kStep, kLinear, kCubicSpline };
+
+struct AnimationChannel {
+  std::string animation;  // name of the glTF animation it came from
+  int node = -1;
+  AnimationPath path = AnimationPath::kTranslation;
+  Interpolation interpolation = Interpolation::kLinear;
+  std::vector<double> times;  // strictly increasing key times, seconds
+  // Output values, flattened: 3 (T, S) or 4 (R, x y z w as in glTF) doubles per element;
+  // CUBICSPLINE has 3 elements per key: in-tangent, value, out-tangent.
+  std::vector<double> values;
+};
+
+// A camera placed in the world at some time.
+struct CameraView {
+  Camera lens;
+  glm::dmat4 worldFromCamera{1.0};  // rigid (scale removed); camera looks down its -Z, +Y up
+  glm::dvec3 eye() const { return glm::dvec3(worldFromCamera[3]); }
+};
+
+// A top-level patch: an input polygon in its mesh node's local frame.
+struct InputPolygon {
+  Polygon local;
+  std::array<glm::dvec2, 4> uv{};  // texture coordinates at the vertices
+  int node = -1;                   // mesh node that places it in the world
+  int material = -1;
+  bool backFace = false;  // the reversed copy made for a doubleSided material
+};
+
+class Scene {
+ public:
+  std::string path;  // file it was read from (for messages)
+  std::vector<Node> nodes;
+  std::vector<int> roots;  // root nodes of the displayed scene (empty: every parentless node)
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Camera> cameras;
+  std::vector<AnimationChannel> channels;
+  std::vector<std::string> warnings;  // e.g. "dropped 3 zero-area triangles"
+
+  // Local transform of a node at time t with glTF semantics (T * R * S).
+  glm::dmat4 localTransform(int node, double t) const;
+  // World transform: product of local transforms from the root down.
+  glm::dmat4 worldTransform(int node, double t) const;
+
+  // Time range covered by the animation keys; both 0 for a static scene.
+  double startTime() const;
+  double endTime() const;
+  double duration() const { return endTime() - startTime(); }
+
+  // Nodes reachable from roots (or from every parentless node when roots is empty),
+  // in ascending index order.
+  std::vector<int> reachableNodes() const;
+  // Nodes that carry a mesh and are reachable from roots, in ascending index order.
+  std::vector<int> meshNodes() const;
+  // True when the node's world transform changes somewhere in [t0, t1].
+  bool isDynamic(int node, double t0, double t1) const;
+  // World-space axis-aligned bounds swept by a mesh node's geometry over [t0, t1]:
+  // {min, max}. Conservative (exact for static nodes).
+  // Static nodes: bounds of the transformed vertices. Dynamic nodes: the 8 corners of the
+  // local box at sampleTimes(node, t0, t1, 32), padded by the largest distance a corner moves
+  // between consecutive samples (conservative while the path between two samples is at most
+  // twice as long as its chord, which dense sampling of glTF curves guarantees in practice).
+  std::array<glm::dvec3, 2> sweptBounds(int node, double t0, double t1) const;
+  // Sorted distinct times in [t0, t1]: 65 uniform samples, plus perSegment + 1 samples over
+  // every key segment of the channels animating the node or its ancestors (and the instant
+  // before each key, where STEP jumps).
+  std::vector<double> sampleTimes(int node, double t0, double t1, int perSegment) const;
+
+  // Top-level patches of all mesh nodes: triangles, with coplanar adjacent pairs that form a
+  // convex quad merged; doubleSided materials add a reversed copy. Deterministic order:
+  // by mesh node, then triangle order.
+  std::vector<InputPolygon> inputPolygons() const;
+
+  // Camera nodes reachable from roots, in ascending index order. cameraNode("") is the first;
+  // cameraNode(name) matches a node name first, then a camera name; -1 if none.
+  std::vector<int> cameraNodes() const;
+  int cameraNode(const std::string& name) const;
+  CameraView cameraAt(int node, double t) const;
+};
+
+}  // namespace rad

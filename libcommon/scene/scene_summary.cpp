@@ -1,0 +1,113 @@
+#include "libcommon/scene/scene_summary.h"
+
+#include <sstream>
+
+namespace rad {
+
+namespace {
+nlohmann::json vec3(const glm::dvec3& v) {
+  return {v.x, v.y, v.z};
+}
+}  // namespace
+
+glm::dvec3 emittedPower(const Scene& scene, const InputPolygon& polygon, double t) {
+  if (polygon.material < 0) return glm::dvec3(0.0);
+  const Material& m = scene.materials[polygon.material];
+  double area = polygon.local.transformed(scene.worldTransform(polygon.node, t)).area();
+  return glm::pi<double>() * m.emission * area;
+}
+
+nlohmann::json summarizeScene(const Scene& scene) {
+  nlohmann::json s;
+  double t0 = scene.startTime(), t1 = scene.endTime();
+  std::vector<InputPolygon> polygons = scene.inputPolygons();
+  size_t triangles = 0;
+  for (int n : scene.meshNodes()) triangles += scene.meshes[scene.nodes[n].mesh].triangles.size();
+  s["path"] = scene.path;
+  s["time_range"] = {t0, t1};
+  s["mesh_nodes"] = scene.meshNodes().size();
+  s["triangles"] = triangles;
+  s["patches"] = polygons.size();
+  size_t quads = 0;
+  double area = 0.0;
+  for (const InputPolygon& p : polygons) {
+    quads += p.local.count == 4;
+    area += p.local.transformed(scene.worldTransform(p.node, t0)).area();
+  }
+  s["quads"] = quads;
+  s["total_area_m2"] = area;
+
+  // Emitters grouped by mesh node.
+  nlohmann::json emitters = nlohmann::json::array();
+  for (int n : scene.meshNodes()) {
+    glm::dvec3 power(0.0);
+    size_t count = 0;
+    for (const InputPolygon& p : polygons) {
+      if (p.node != n || p.material < 0 || !scene.materials[p.material].isEmitter()) continue;
+      power += emittedPower(scene, p, t0);
+      ++count;
+    }
+    if (count == 0) continue;
+    emitters.push_back({{"node", n},
+                        {"name", scene.nodes[n].name},
+                        {"patches", count},
+                        {"power_w", vec3(power)},
+                        {"dynamic", scene.isDynamic(n, t0, t1)}});
+  }
+  s["emitters"] = emitters;
+
+  nlohmann::json dynamic = nlohmann::json::array();
+  for (int n : scene.meshNodes()) {
+    if (!scene.isDynamic(n, t0, t1)) continue;
+    auto b = scene.sweptBounds(n, t0, t1);
+    dynamic.push_back(
+        {{"node", n}, {"name", scene.nodes[n].name}, {"swept_bounds", {vec3(b[0]), vec3(b[1])}}});
+  }
+  s["dynamic_nodes"] = dynamic;
+
+  nlohmann::json cameras = nlohmann::json::array();
+  for (int n : scene.cameraNodes()) {
+    const Camera& c = scene.cameras[scene.nodes[n].camera];
+    CameraView v0 = scene.cameraAt(n, t0);
+    cameras.push_back({{"node", n},
+                       {"name", scene.nodes[n].name},
+                       {"type", c.perspective ? "perspective" : "orthographic"},
+                       {"yfov", c.yfov},
+                       {"eye_at_start", vec3(v0.eye())},
+                       {"animated", scene.isDynamic(n, t0, t1)}});
+  }
+  s["cameras"] = cameras;
+
+  nlohmann::json warnings = scene.warnings;
+  if (cameras.empty()) warnings.push_back("no camera: rad-intervals and rad-compose need one");
+  if (emitters.empty()) warnings.push_back("no emitter: rad-global needs one");
+  s["warnings"] = warnings;
+  return s;
+}
+
+std::string sceneSummaryText(const nlohmann::json& s) {
+  std::ostringstream os;
+  os << s["path"].get<std::string>() << ": glTF scene\n";
+  os << "  time range     " << s["time_range"][0] << " .. " << s["time_range"][1] << " s\n";
+  os << "  patches        " << s["patches"] << " (" << s["quads"] << " quads) from "
+     << s["triangles"] << " triangles in " << s["mesh_nodes"] << " mesh nodes, "
+     << s["total_area_m2"] << " m^2\n";
+  for (const auto& e : s["emitters"]) {
+    os << "  emitter        " << e["name"].get<std::string>() << " (node " << e["node"] << "), "
+       << e["patches"] << " patches, power " << e["power_w"].dump() << " W"
+       << (e["dynamic"].get<bool>() ? ", moving" : "") << "\n";
+  }
+  for (const auto& d : s["dynamic_nodes"]) {
+    os << "  dynamic        " << d["name"].get<std::string>() << " (node " << d["node"]
+       << "), swept bounds " << d["swept_bounds"].dump() << "\n";
+  }
+  for (const auto& c : s["cameras"]) {
+    os << "  camera         " << c["name"].get<std::string>() << " (node " << c["node"] << "), "
+       << c["type"].get<std::string>() << ", yfov " << c["yfov"]
+       << (c["animated"].get<bool>() ? ", animated" : ", static") << "\n";
+  }
+  for (const auto& w : s["warnings"]) os << "  warning        " << w.get<std::string>() << "\n";
+  return os.str();
+}
+
+}  // namespace rad
