@@ -31,21 +31,27 @@ INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) $(INTERVALS_FLAG
 MOVIES_ARGS    = $(MOVIES_FLAGS)
 COMPOSE_ARGS   = --frames $(FRAMES) $(COMPOSE_FLAGS)
 
-STAGES = rad-global rad-intervals rad-movies rad-compose
-MISSING = $(strip $(foreach t,$(STAGES),$(if $(wildcard $(BIN)/$(t)),,$(t))))
+# The stage command lines, written once: the rules below run them, `make -f animation.mk
+# stage-commands` prints them (one `STAGE<TAB>command` line each) for bench.py and tradeoff.py,
+# which time each stage themselves.
+GLOBAL_CMD    = $(strip $(BIN)/rad-global $(SCENE) -o $(OUT)/global.rlh $(GLOBAL_ARGS) \
+                  --report $(OUT)/global-report.json)
+INTERVALS_CMD = $(strip $(BIN)/rad-intervals $(SCENE) -o $(OUT)/intervals.rti $(INTERVALS_ARGS) \
+                  --report $(OUT)/intervals-report.json)
+MOVIES_CMD    = $(strip $(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti -o $(OUT)/movies \
+                  $(MOVIES_ARGS) --report $(OUT)/movies-report.json)
+COMPOSE_CMD   = $(strip $(BIN)/rad-compose $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies \
+                  -o $(OUT)/frames $(COMPOSE_ARGS) --report $(OUT)/compose-report.json)
 
-.PHONY: all frames clean
+.PHONY: all frames clean stage-commands
 .DELETE_ON_ERROR:
 
-ifeq ($(MISSING),)
 all: $(OUT)/movie.mp4 $(OUT)/contact-sheet.png
 	@echo "animation.mk: frames in $(OUT)/frames, $(OUT)/movie.mp4, $(OUT)/contact-sheet.png" >&2
-else
-# Run what exists and say what is still missing.
-all: $(OUT)/scene.json $(if $(filter rad-global,$(MISSING)),,$(OUT)/global.rlh) \
-     $(if $(filter rad-intervals,$(MISSING)),,$(OUT)/intervals.rti)
-	@echo "animation.mk: not built yet: $(MISSING); frames and movie.mp4 need them" >&2
-endif
+
+# A stage binary that is not built is an error, not a stage quietly left out.
+$(BIN)/rad-%:
+	@echo "animation.mk: $@ is not built; run pipelines/bootstrap.sh first" >&2; exit 1
 
 frames: $(OUT)/frames/.done
 
@@ -55,7 +61,7 @@ frames: $(OUT)/frames/.done
 update-params = $(shell mkdir -p $(OUT) && printf '%s\n' '$(2)' > $(OUT)/$(1).params.new && \
   { cmp -s $(OUT)/$(1).params.new $(OUT)/$(1).params && rm -f $(OUT)/$(1).params.new || \
     mv -f $(OUT)/$(1).params.new $(OUT)/$(1).params; })
-ifeq ($(filter clean,$(MAKECMDGOALS)),)
+ifeq ($(filter clean stage-commands,$(MAKECMDGOALS)),)
 $(call update-params,global,$(GLOBAL_ARGS))
 $(call update-params,intervals,$(INTERVALS_ARGS))
 $(call update-params,movies,$(MOVIES_ARGS))
@@ -68,23 +74,21 @@ $(OUT)/scene.json: $(SCENE) $(BIN)/rad-inspect
 	$(BIN)/rad-inspect --json $(SCENE) > $@.tmp && mv -f $@.tmp $@
 
 $(OUT)/global.rlh: $(SCENE) $(OUT)/global.params $(BIN)/rad-global
-	$(BIN)/rad-global $(SCENE) -o $@ $(GLOBAL_ARGS) --report $(OUT)/global-report.json
+	$(GLOBAL_CMD)
 
 $(OUT)/intervals.rti: $(SCENE) $(OUT)/intervals.params $(BIN)/rad-intervals
-	$(BIN)/rad-intervals $(SCENE) -o $@ $(INTERVALS_ARGS) --report $(OUT)/intervals-report.json
+	$(INTERVALS_CMD)
 
 # The folder is emptied first: movies of an earlier run (another intervals.rti) must not linger.
 $(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
 	@rm -rf $(OUT)/movies
-	$(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti -o $(OUT)/movies $(MOVIES_ARGS) \
-	  --report $(OUT)/movies-report.json
+	$(MOVIES_CMD)
 	@touch $@
 
 $(OUT)/frames/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
 	@rm -rf $(OUT)/frames
-	$(BIN)/rad-compose $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies -o $(OUT)/frames \
-	  $(COMPOSE_ARGS)
+	$(COMPOSE_CMD)
 	@touch $@
 
 $(OUT)/movie.mp4: $(OUT)/frames/.done
@@ -100,4 +104,12 @@ $(OUT)/contact-sheet.png: $(OUT)/frames/.done
 
 clean:
 	rm -rf $(OUT)
+
+# $(info) prints the text as Make expanded it, with no shell in between to eat quotes.
+stage-commands:
+	$(info global	$(GLOBAL_CMD))
+	$(info intervals	$(INTERVALS_CMD))
+	$(info movies	$(MOVIES_CMD))
+	$(info compose	$(COMPOSE_CMD))
+	@:
 

@@ -34,6 +34,7 @@ import csv
 import json
 import math
 import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -67,26 +68,28 @@ SCRATCH_FLAGS = {"global": ["--no-coherence"], "intervals": ["--max-length", "1"
                  "movies": ["--no-coherence"], "compose": []}
 
 
+def stage_commands(bin_dir, scene, out, frames, size, flags):
+    """The four stages' command lines as animation.mk writes them (its `stage-commands` target),
+    so the pipeline measured here is the one the README runs; flags: stage -> extra arguments,
+    passed as the Makefile's STAGE_FLAGS. Returns [(stage, argv)] in pipeline order."""
+    fr = frames if isinstance(frames, str) else "0-%d" % (frames - 1)
+    make = ["make", "-s", "--no-print-directory", "-C", ROOT, "-f",
+            os.path.join(HERE, "animation.mk"), "stage-commands", "BIN=" + os.path.abspath(bin_dir),
+            "SCENE=" + os.path.abspath(scene), "OUT=" + os.path.abspath(out), "FRAMES=" + fr, "FPS=24", "SIZE=" + size]
+    make += ["%s_FLAGS=%s" % (stage.upper(), shlex.join(args)) for stage, args in flags.items()]
+    printed = subprocess.run(make, capture_output=True, text=True, check=True).stdout
+    commands = [line.split("\t", 1) for line in printed.splitlines() if "\t" in line]
+    return [(stage, shlex.split(command)) for stage, command in commands]
+
+
 def pipeline(bin_dir, scene, out, frames, size, flags, log):
     """Runs the four stages into out/; flags: stage name -> extra arguments. Returns per-stage
     (seconds, peak MiB, CPU seconds), total seconds and CPU seconds, and overall peak MiB."""
     os.makedirs(out, exist_ok=True)
-    fr = frames if isinstance(frames, str) else "0-%d" % (frames - 1)
-    g, i, m, c = (os.path.join(bin_dir, t) for t in
-                  ("rad-global", "rad-intervals", "rad-movies", "rad-compose"))
-    f = lambda k: list(flags.get(k, []))
-    stages = {}
-    stages["global"] = run([g, scene, "-o", out + "/global.rlh", "--frames", fr, "--fps", "24",
-                            "--report", out + "/global-report.json"] + f("global"), log)
-    stages["intervals"] = run([i, scene, "-o", out + "/intervals.rti", "--frames", fr, "--fps",
-                               "24", "--size", size, "--report", out + "/intervals-report.json"]
-                              + f("intervals"), log)
-    stages["movies"] = run([m, scene, out + "/global.rlh", out + "/intervals.rti", "-o",
-                            out + "/movies", "--report", out + "/movies-report.json"] + f("movies"),
-                           log)
-    stages["compose"] = run([c, scene, out + "/global.rlh", out + "/intervals.rti",
-                             out + "/movies", "-o", out + "/frames", "--frames", fr, "--no-png"]
-                            + f("compose"), log)
+    flags = {k: list(v) for k, v in flags.items()}
+    flags["compose"] = flags.get("compose", []) + ["--no-png"]  # timed: EXR frames only
+    stages = {stage: run(argv, log)
+              for stage, argv in stage_commands(bin_dir, scene, out, frames, size, flags)}
     total = sum(s[0] for s in stages.values())
     peak = max(s[1] for s in stages.values())
     cpu = sum(s[2] for s in stages.values())

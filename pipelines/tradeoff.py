@@ -29,16 +29,36 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import bench  # noqa: E402
 
-# knob name -> (stage, flag, the tool's default, the other values swept). The default setting is
-# run once (row "default") and belongs to every knob's curve.
+# knob name -> (stage, flag, the other values swept). The default setting is run once (row
+# "default") and belongs to every knob's curve; its value comes from the tool itself
+# (`--print-defaults`), not from a copy here.
 KNOBS = [
-    ("eps", "global", "--eps", "0.001", ["0.5", "0.1", "0.02", "0.005", "0.0005"]),
-    ("key-step", "global", "--key-step", "8", ["16", "12", "4", "2"]),
-    ("bad-links", "global", "--bad-links", "lights", ["none", "partial", "all"]),
-    ("texel-density", "intervals", "--texel-density", "1", ["0.25", "0.5", "2"]),
-    ("movie-key-step", "movies", "--key-step", "6", ["24", "12", "3", "1"]),
-    ("max-samples", "movies", "--max-samples", "64", ["4", "8", "16", "32"]),
+    ("eps", "global", "--eps", ["0.5", "0.1", "0.02", "0.005", "0.0005"]),
+    ("key-step", "global", "--key-step", ["16", "12", "4", "2"]),
+    ("bad-links", "global", "--bad-links", ["none", "partial", "all"]),
+    ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "2"]),
+    ("movie-key-step", "movies", "--movie-key-step", ["24", "12", "3", "1"]),
+    ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32"]),
 ]
+TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
+         "compose": "rad-compose"}
+
+
+def knob_defaults(bin_dir):
+    """knob -> the default value its tool reports (`TOOL --print-defaults`, one JSON object keyed
+    by long option name), as the label of the default on each knob's curve; "default" for a tool
+    that cannot be asked (e.g. --replot without binaries)."""
+    asked = {}
+    for stage in {s for _, s, _, _ in KNOBS}:
+        try:
+            p = subprocess.run([os.path.join(bin_dir, TOOLS[stage]), "--print-defaults"],
+                               capture_output=True, text=True, check=True)
+            asked[stage] = json.loads(p.stdout)
+        except (OSError, subprocess.CalledProcessError, ValueError):
+            asked[stage] = {}
+    label = lambda v: "%g" % v if isinstance(v, float) else str(v)
+    return {k: label(asked[s][f.lstrip("-")]) if f.lstrip("-") in asked[s] else "default"
+            for k, s, f, _ in KNOBS}
 
 
 # What counts as a real difference. Timing: the least CPU time of three runs still varies by
@@ -92,14 +112,19 @@ def main():
     ap.add_argument("--repeat", type=int, default=3, help="timed runs per setting (fastest kept)")
     ap.add_argument("--self-test", action="store_true",
                     help="check the Pareto front's dominance rule and exit (ctest runs this)")
+    ap.add_argument("--check-knobs", action="store_true",
+                    help="check that every swept flag is one of its tool's options, run nothing")
     ap.add_argument("--replot", action="store_true",
                     help="recompute the front and the plot from OUT/tradeoff.csv, run nothing")
     a = ap.parse_args()
     if a.self_test:
         self_test()
         return
+    if a.check_knobs:
+        check_knobs(a.bin)
+        return
     if a.replot:
-        replot(a.out)
+        replot(a.out, knob_defaults(a.bin))
         return
     os.makedirs(a.out, exist_ok=True)
     log = os.path.join(a.out, "tradeoff.log")
@@ -127,7 +152,7 @@ def main():
     # The default is timed first and again last (its least CPU time over both is kept): the
     # machine's speed drifts over a 10-minute sweep (another job ending on the other core made
     # later settings 7 % faster than the same computation timed first).
-    runs = ([("default", None, None, "-")] + [(k, s, f, v) for k, s, f, _, vs in KNOBS for v in vs]
+    runs = ([("default", None, None, "-")] + [(k, s, f, v) for k, s, f, vs in KNOBS for v in vs]
             + [("default", None, None, "-")])
     # One untimed run first: the first run pays for cold caches (binaries, scene, references).
     bench.pipeline(a.bin, a.scene, os.path.join(a.out, "runs", "warm-up"), a.frames, a.size, {},
@@ -163,20 +188,30 @@ def main():
         row.update({"seconds_per_frame": min(t) / nframes,
                     "seconds_spread": (max(t) - min(t)) / min(t),
                     "wall_seconds_per_frame": min(w) / nframes})
-    report(a.out, rows)
+    report(a.out, rows, knob_defaults(a.bin))
 
 
-def replot(out):
+def check_knobs(bin_dir):
+    """Fails when a swept flag is not an option of its tool (a renamed flag would otherwise make
+    every run of that knob fail and drop out of the sweep)."""
+    unknown = [k for k, d in knob_defaults(bin_dir).items() if d == "default"]
+    if unknown:
+        sys.exit("tradeoff.py: %s: not an option of the tool that --print-defaults reports"
+                 % ", ".join(unknown))
+    print("tradeoff.py: every knob is an option of its tool")
+
+
+def replot(out, defaults):
     with open(os.path.join(out, "tradeoff.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
     for r in rows:
         for k in ("seconds_per_frame", "seconds_spread", "wall_seconds_per_frame", "rmse",
                   "relative_l2", "raw_relative_l2", "peak_mib"):
             r[k] = float(r[k])
-    report(out, rows)
+    report(out, rows, defaults)
 
 
-def report(out, rows):
+def report(out, rows, defaults):
     """Marks the Pareto front, writes the CSV, prints the table and draws the plot."""
     front = pareto([(r["seconds_per_frame"], r["rmse"]) for r in rows])
     for i, r in enumerate(rows):
@@ -197,17 +232,17 @@ def report(out, rows):
             100 * r["relative_l2"], 100 * r["raw_relative_l2"], "*" if r["pareto"] else ""))
     print("pareto: not dominated by a setting %.0f %% faster at no more error, or %.0f %% more "
           "accurate at no more time" % (100 * TIME_TOLERANCE, 100 * ERROR_TOLERANCE))
-    write_plot(out, rows, front)
+    write_plot(out, rows, front, defaults)
 
 
-def write_plot(out, rows, front):
+def write_plot(out, rows, front, defaults):
     dat = os.path.join(out, "tradeoff.dat")
     with open(dat, "w") as f:
         default = [r for r in rows if r["knob"] == "default"]
-        knobs = [k for k, _, _, _, _ in KNOBS if any(r["knob"] == k for r in rows)]
+        knobs = [k for k, _, _, _ in KNOBS if any(r["knob"] == k for r in rows)]
         for k in knobs:
             # Each knob's curve passes through the default setting, labelled with its value.
-            dv = next(d for name, _, _, d, _ in KNOBS if name == k)
+            dv = defaults[k]
             pts = [(r["seconds_per_frame"], r["rmse"], r["value"]) for r in rows if r["knob"] == k]
             pts += [(r["seconds_per_frame"], r["rmse"], dv) for r in default]
             f.write("# %s\n" % k)
