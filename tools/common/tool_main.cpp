@@ -12,6 +12,8 @@
 
 #include <tbb/global_control.h>
 
+#include "formats/build_info.h"
+
 namespace rad {
 
 namespace {
@@ -68,7 +70,7 @@ nlohmann::json optionDefaults(CLI::App& app) {
 
 void setUpApp(CLI::App& app, const std::string& tool, const std::string& example) {
   app.name(tool);
-  app.set_version_flag("--version", std::string(tool) + " " RAD_VERSION " (" RAD_GIT_REVISION ")");
+  app.set_version_flag("--version", std::string(tool) + " " RAD_VERSION " (" + gitRevision() + ")");
   app.footer(std::string("Example:\n  ") + example + "\n\n" + exitCodeHelp());
   app.get_formatter()->column_width(34);
   // Results never depend on it (work is split by item, not by thread, and every sample seed
