@@ -1,7 +1,9 @@
 // rad-compose: final frames from the texture movies (paper §3.1 last step; DESIGN.md §6
 // "rad-compose"). Reads the scene, the global solution, the intervals and the movies; writes
-// FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The work is in
-// libcommon/compose/frame_composer.h and formats/frame_sequence.h.
+// FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The options are
+// libcommon/compose/compose_options.h; the work is in libcommon/compose/frame_composer.h and
+// formats/frame_sequence.h (the frame loop). This main parses, checks the inputs agree, fills
+// in the defaults they give, calls the loop and reports.
 #include <unistd.h>
 
 #include <cstdio>

@@ -1,6 +1,7 @@
 // rad-intervals: texture-movie extents from per-frame item buffers (paper §4.1, §4.3;
-// DESIGN.md §6 rad-intervals). The algorithm is libcommon/intervals/texture_intervals_builder.h;
-// this main parses, reads the scene, runs the frames, writes intervals.rti and reports.
+// DESIGN.md §6 rad-intervals). The options are libcommon/intervals/intervals_options.h, the
+// algorithm libcommon/intervals/texture_intervals_builder.h, the frame loop
+// formats/interval_sequence.h; this main parses, calls them, writes intervals.rti and reports.
 #include <cstdio>
 #include <vector>
 
