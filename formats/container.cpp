@@ -347,6 +347,15 @@ bool ContainerReader::looksLikeContainer(const std::string& path) {
 }
 
 void ContainerReader::validate() {
+  const uint64_t headerLength = validatePreamble();
+  validateHeader(headerLength);
+  const uint64_t dataEnd = validateArrayTable();
+  validateFileSize(dataEnd);
+  validatePadding(headerLength);
+  validateChecksums();
+}
+
+uint64_t ContainerReader::validatePreamble() {
   const std::string& p = path_;
   const uint64_t size = bytes_.size();
   const uint8_t* b = bytes_.data();
@@ -385,7 +394,12 @@ void ContainerReader::validate() {
   if (sum != storedSum)
     throw inputError(p, "header checksum mismatch: preamble or header corrupted");
   dataStart_ = alignUp(kPreambleSize + headerLength);
+  return headerLength;
+}
 
+void ContainerReader::validateHeader(uint64_t headerLength) {
+  const std::string& p = path_;
+  const uint8_t* b = bytes_.data();
   // JSON header.
   if (jsonDepth(b + kPreambleSize, headerLength) > kMaxJsonDepth) {
     throw inputError(p, "header nests deeper than " + std::to_string(kMaxJsonDepth) + " levels");
@@ -412,63 +426,74 @@ void ContainerReader::validate() {
     throw inputError(p, "header: \"metadata\" is not an object");
   const auto& prov = field(header_, "provenance");
   if (!prov.is_null()) provenance_ = Provenance::fromJson(prov, p + ": provenance");
+}
 
-  // Array table.
+uint64_t ContainerReader::validateArrayTable() {
   const auto& table = field(header_, "arrays");
-  if (!table.is_array()) throw inputError(p, "header: \"arrays\" is not a list");
+  if (!table.is_array()) throw inputError(path_, "header: \"arrays\" is not a list");
   uint64_t dataEnd = 0;
   for (std::size_t i = 0; i < table.size(); ++i) {
-    const auto& e = table[i];
-    const std::string at = "array #" + std::to_string(i);
-    if (!e.is_object()) throw inputError(p, at + " is not an object");
-    ArrayInfo a;
-    const auto& name = field(e, "name");
-    if (!name.is_string() || name.get_ref<const std::string&>().empty() ||
-        hasControlCharacter(name.get_ref<const std::string&>())) {
-      throw inputError(p, at + ": missing, empty or unprintable name");
-    }
-    a.name = name.get<std::string>();
-    const std::string an = "array '" + a.name + "'";
-    if (find(a.name)) throw inputError(p, "duplicate " + an);
-    const auto& dt = field(e, "dtype");
-    if (!dt.is_string() || !parseDType(dt.get<std::string>(), a.dtype)) {
-      throw inputError(p, an + ": unknown dtype " + dt.dump());
-    }
-    const auto& shape = field(e, "shape");
-    if (!shape.is_array() || shape.size() > kMaxDims) throw inputError(p, an + ": bad shape");
-    uint64_t n = dtypeSize(a.dtype);
-    bool overflow = false;
-    for (const auto& d : shape) {
-      if (!isUnsigned(d)) throw inputError(p, an + ": bad shape " + shape.dump());
-      const uint64_t dim = d.get<uint64_t>();
-      a.shape.push_back(dim);
-      if (dim != 0 && n > std::numeric_limits<uint64_t>::max() / dim) overflow = true;
-      n *= dim;
-    }
-    if (!isUnsigned(field(e, "offset")) || !isUnsigned(field(e, "nbytes"))) {
-      throw inputError(p, an + ": missing offset or nbytes");
-    }
-    a.offset = field(e, "offset").get<uint64_t>();
-    a.nbytes = field(e, "nbytes").get<uint64_t>();
-    if (overflow || n != a.nbytes) {
-      throw inputError(p, an + ": " + std::to_string(a.nbytes) + " bytes do not match " +
-                              dtypeName(a.dtype) + " shape " + shape.dump());
-    }
-    if (a.offset % kContainerAlignment != 0) {
-      throw inputError(p, an + ": offset " + std::to_string(a.offset) + " is not " +
-                              std::to_string(kContainerAlignment) + "-byte aligned");
-    }
-    if (a.offset > std::numeric_limits<uint64_t>::max() - a.nbytes - kContainerAlignment ||
-        dataStart_ + a.offset + a.nbytes < dataStart_) {
-      throw inputError(p, an + ": extends past end of file");
-    }
-    const auto& hash = field(e, "hash");
-    if (!hash.is_string()) throw inputError(p, an + ": missing hash");
-    a.hash = hash.get<std::string>();
+    ArrayInfo a = arrayEntry(table[i], i);
     dataEnd = std::max(dataEnd, a.offset + a.nbytes);
     arrays_.push_back(std::move(a));
   }
+  return dataEnd;
+}
 
+ArrayInfo ContainerReader::arrayEntry(const nlohmann::json& e, std::size_t i) const {
+  const std::string& p = path_;
+  const std::string at = "array #" + std::to_string(i);
+  if (!e.is_object()) throw inputError(p, at + " is not an object");
+  ArrayInfo a;
+  const auto& name = field(e, "name");
+  if (!name.is_string() || name.get_ref<const std::string&>().empty() ||
+      hasControlCharacter(name.get_ref<const std::string&>())) {
+    throw inputError(p, at + ": missing, empty or unprintable name");
+  }
+  a.name = name.get<std::string>();
+  const std::string an = "array '" + a.name + "'";
+  if (find(a.name)) throw inputError(p, "duplicate " + an);
+  const auto& dt = field(e, "dtype");
+  if (!dt.is_string() || !parseDType(dt.get<std::string>(), a.dtype)) {
+    throw inputError(p, an + ": unknown dtype " + dt.dump());
+  }
+  const auto& shape = field(e, "shape");
+  if (!shape.is_array() || shape.size() > kMaxDims) throw inputError(p, an + ": bad shape");
+  uint64_t n = dtypeSize(a.dtype);
+  bool overflow = false;
+  for (const auto& d : shape) {
+    if (!isUnsigned(d)) throw inputError(p, an + ": bad shape " + shape.dump());
+    const uint64_t dim = d.get<uint64_t>();
+    a.shape.push_back(dim);
+    if (dim != 0 && n > std::numeric_limits<uint64_t>::max() / dim) overflow = true;
+    n *= dim;
+  }
+  if (!isUnsigned(field(e, "offset")) || !isUnsigned(field(e, "nbytes"))) {
+    throw inputError(p, an + ": missing offset or nbytes");
+  }
+  a.offset = field(e, "offset").get<uint64_t>();
+  a.nbytes = field(e, "nbytes").get<uint64_t>();
+  if (overflow || n != a.nbytes) {
+    throw inputError(p, an + ": " + std::to_string(a.nbytes) + " bytes do not match " +
+                            dtypeName(a.dtype) + " shape " + shape.dump());
+  }
+  if (a.offset % kContainerAlignment != 0) {
+    throw inputError(p, an + ": offset " + std::to_string(a.offset) + " is not " +
+                            std::to_string(kContainerAlignment) + "-byte aligned");
+  }
+  if (a.offset > std::numeric_limits<uint64_t>::max() - a.nbytes - kContainerAlignment ||
+      dataStart_ + a.offset + a.nbytes < dataStart_) {
+    throw inputError(p, an + ": extends past end of file");
+  }
+  const auto& hash = field(e, "hash");
+  if (!hash.is_string()) throw inputError(p, an + ": missing hash");
+  a.hash = hash.get<std::string>();
+  return a;
+}
+
+void ContainerReader::validateFileSize(uint64_t dataEnd) const {
+  const std::string& p = path_;
+  const uint64_t size = bytes_.size();
   // Total size: the header determines it exactly, which catches truncation and appended bytes.
   const uint64_t dataLength = alignUp(dataEnd);
   if (dataLength > std::numeric_limits<uint64_t>::max() - dataStart_) {
@@ -483,7 +508,12 @@ void ContainerReader::validate() {
     throw inputError(p, "trailing data: header says " + std::to_string(expected) +
                             " bytes, file has " + std::to_string(size));
   }
+}
 
+void ContainerReader::validatePadding(uint64_t headerLength) const {
+  const std::string& p = path_;
+  const uint64_t size = bytes_.size();
+  const uint8_t* b = bytes_.data();
   // Overlaps and padding: every byte not in an array must be zero, so a flipped padding byte is
   // noticed too (the checksums cover everything else).
   std::vector<const ArrayInfo*> order;
@@ -505,7 +535,11 @@ void ContainerReader::validate() {
     cursor = begin + a->nbytes;
   }
   checkZero(cursor, size);
+}
 
+void ContainerReader::validateChecksums() const {
+  const std::string& p = path_;
+  const uint8_t* b = bytes_.data();
   for (const auto& a : arrays_) {
     const std::string actual = formatFnv1a64(fnv1a64(b + dataStart_ + a.offset, a.nbytes));
     if (actual != a.hash) {
@@ -566,6 +600,25 @@ std::string ContainerReader::summary() const {
     s << "] " << a.nbytes << " bytes " << a.hash << "\n";
   }
   return s.str();
+}
+
+void addInput(Provenance& provenance, const std::string& path) {
+  if (ContainerReader::looksLikeContainer(path)) {
+    addInput(provenance, ContainerReader::open(path));
+    return;
+  }
+  provenance.inputs.push_back({path, hashFile(path), nullptr});
+}
+
+InputRecord inputRecordOf(const ContainerReader& input) {
+  InputRecord r{input.path(), input.fileHash(), nullptr};
+  const auto& prov = input.header().find("provenance");
+  if (prov != input.header().end() && prov->is_object()) r.history = *prov;
+  return r;
+}
+
+void addInput(Provenance& provenance, const ContainerReader& input) {
+  provenance.inputs.push_back(inputRecordOf(input));
 }
 
 }  // namespace rad

@@ -179,7 +179,15 @@ class ContainerReader {
 
  private:
   ContainerReader() = default;
+  // validate() is these steps, in this order (a newer version is reported before "corrupt"):
   void validate();
+  uint64_t validatePreamble();                 // magic, version, header length and checksum
+  void validateHeader(uint64_t headerLength);  // JSON, kind, kind_version, metadata, provenance
+  uint64_t validateArrayTable();               // every entry; returns the data section's end
+  ArrayInfo arrayEntry(const nlohmann::json& entry, std::size_t index) const;
+  void validateFileSize(uint64_t dataEnd) const;      // truncation, trailing bytes
+  void validatePadding(uint64_t headerLength) const;  // overlaps, nonzero padding
+  void validateChecksums() const;                     // every array's hash
   const ArrayInfo* find(const std::string& name) const;
   const ArrayInfo& checkedInfo(const std::string& name, DType dtype) const;
 
@@ -193,5 +201,15 @@ class ContainerReader {
   Provenance provenance_;
   std::vector<ArrayInfo> arrays_;
 };
+
+// Appends an InputRecord for `path`: its hash, and if it is a rad container its provenance as
+// history. A file that starts with the container magic but does not open is an error (the
+// caller would fail to read it anyway); any other file gets a null history.
+void addInput(Provenance& provenance, const std::string& path);
+// Same for a container already open: no second read of the file.
+void addInput(Provenance& provenance, const ContainerReader& input);
+// The record addInput appends for a container, for a caller that must release the reader
+// before the provenance exists (rad-compose drops global.rlh's bytes once read).
+InputRecord inputRecordOf(const ContainerReader& input);
 
 }  // namespace rad

@@ -10,8 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "formats/build_info.h"
 #include "formats/checksum.h"
-#include "formats/container.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -140,11 +140,7 @@ Provenance makeProvenance(const std::string& tool, int argc, const char* const* 
 #else
   p.version = "unknown";
 #endif
-#ifdef RAD_GIT_REVISION
-  p.gitRevision = RAD_GIT_REVISION;
-#else
-  p.gitRevision = "unknown";
-#endif
+  p.gitRevision = gitRevision();
   for (int i = 0; i < argc; ++i) {
     if (i) p.commandLine += ' ';
     p.commandLine += shellQuote(argv[i] ? argv[i] : "");
@@ -182,25 +178,6 @@ std::string hashFile(const std::string& path) {
   }
   ::close(fd);
   return formatFnv1a64(h);
-}
-
-void addInput(Provenance& provenance, const std::string& path) {
-  if (ContainerReader::looksLikeContainer(path)) {
-    addInput(provenance, ContainerReader::open(path));
-    return;
-  }
-  provenance.inputs.push_back({path, hashFile(path), nullptr});
-}
-
-InputRecord inputRecordOf(const ContainerReader& input) {
-  InputRecord r{input.path(), input.fileHash(), nullptr};
-  const auto& prov = input.header().find("provenance");
-  if (prov != input.header().end() && prov->is_object()) r.history = *prov;
-  return r;
-}
-
-void addInput(Provenance& provenance, const ContainerReader& input) {
-  provenance.inputs.push_back(inputRecordOf(input));
 }
 
 std::vector<std::string> parameterMismatch(const nlohmann::json& built,

@@ -12,8 +12,9 @@
 
 namespace rad {
 
-class ContainerReader;
-
+// The record of one input (provenance.inputs). The container-aware ways of making one (addInput,
+// inputRecordOf) are in formats/container.h: the container stores a provenance, so it builds
+// on this file, never the reverse.
 struct InputRecord {
   std::string path;  // as given on the command line (not made absolute: files move)
   std::string hash;  // "fnv1a64:<16 hex>" of the whole file's bytes
@@ -24,7 +25,7 @@ struct InputRecord {
 struct Provenance {
   std::string tool;         // e.g. "rad-global"
   std::string version;      // RAD_VERSION of the build, e.g. "0.1.0"
-  std::string gitRevision;  // RAD_GIT_REVISION of the build, or "unknown"
+  std::string gitRevision;  // gitRevision() of the build (formats/build_info.h), or "unknown"
   std::string commandLine;  // argv, shell-quoted so it can be pasted back into a shell
   // Every parameter in effect, defaults included; keys are long option names without "--".
   nlohmann::json parameters = nlohmann::json::object();
@@ -40,7 +41,7 @@ struct Provenance {
   std::string toText() const;
 };
 
-// tool, RAD_VERSION, RAD_GIT_REVISION, the quoted command line and `parameters` (must be an
+// tool, RAD_VERSION, gitRevision(), the quoted command line and `parameters` (must be an
 // object; null is taken as {}).
 Provenance makeProvenance(const std::string& tool, int argc, const char* const* argv,
                           const nlohmann::json& parameters);
@@ -52,16 +53,6 @@ std::string shellQuote(const std::string& word);
 // Content hash of a whole file, "fnv1a64:<16 hex>". Streams in 1 MiB chunks (~0.15 s per
 // 100 MB). Throws rad::inputError(path, ...) if it cannot be read.
 std::string hashFile(const std::string& path);
-
-// Appends an InputRecord for `path`: its hash, and if it is a rad container its provenance as
-// history. A file that starts with the container magic but does not open is an error (the
-// caller would fail to read it anyway); any other file gets a null history.
-void addInput(Provenance& provenance, const std::string& path);
-// Same for a container already open: no second read of the file.
-void addInput(Provenance& provenance, const ContainerReader& input);
-// The record addInput appends for a container, for a caller that must release the reader
-// before the provenance exists (rad-compose drops global.rlh's bytes once read).
-InputRecord inputRecordOf(const ContainerReader& input);
 
 // Compares the parameters a file was built with against those this run needs, for each of
 // `keys`. Returns one message per difference, e.g. "built with --eps 0.02; this run expects

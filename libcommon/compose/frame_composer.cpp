@@ -110,6 +110,90 @@ class PatchIndex {
   int shift_ = 60;
 };
 
+// The visible top-level patches' world polygons at the frame's time, with their normals and
+// (u,v) maps, set up once per frame, not per pixel. Affine maps keep the (u,v)
+// parameterisation, so the hit's (u,v) in the world polygon is its top-level (u,v).
+struct VisibleTops {
+  std::vector<Polygon> world;
+  std::vector<glm::dvec3> normals;
+  std::vector<PolygonUvMap> uvMaps;
+};
+
+// Active movies per top, by patch id; the deepest level per top bounds the descent.
+struct ActiveMovies {
+  PatchIndex movieOf;
+  std::vector<int> deepest;
+};
+
+ActiveMovies indexMovies(const std::vector<MovieTexture>& movies, int topCount) {
+  ActiveMovies a{PatchIndex(movies.size()), std::vector<int>(topCount, -1)};
+  for (size_t k = 0; k < movies.size(); ++k) {
+    const MovieTexture& mt = movies[k];
+    if (mt.patch.top >= uint32_t(topCount) || !mt.irradiance || mt.width < 1 || mt.height < 1)
+      throw Error(ExitCode::kInternal, "compose",
+                  "movie of patch " + mt.patch.toString() + " is invalid for this scene");
+    a.movieOf.insert(mt.patch.packed(), k);
+    a.deepest[mt.patch.top] = std::max(a.deepest[mt.patch.top], mt.patch.level());
+  }
+  return a;
+}
+
+// Top-level (u,v) of the hit point of pixel (col, row)'s centre ray with the patch's plane. (A
+// ray parallel to the plane cannot hit it; its centroid stands in.)
+glm::dvec2 topUvOfPixel(const PrimaryRays& rays, int col, int row, const Polygon& poly,
+                        const glm::dvec3& nrm, const PolygonUvMap& uvMap) {
+  glm::dvec3 origin, direction;  // direction not unit length: its scale cancels in s
+  rays.line(glm::dvec2(col + 0.5, row + 0.5), origin, direction);
+  const double denom = glm::dot(nrm, direction);
+  bool onPlane = false;
+  glm::dvec3 hit;
+  if (std::abs(denom) > 1e-300) {
+    double s = glm::dot(nrm, poly.v[0] - origin) / denom;
+    if (std::isfinite(s)) {
+      hit = origin + s * direction;
+      onPlane = true;
+    }
+  }
+  if (!onPlane) hit = poly.centroid();
+  return clampToParameterDomain(uvMap.uvAt(hit), poly.count == 3);
+}
+
+// Base colour texture factor tex(x) / mean(tex) (Material::reflectance already holds the
+// mean) into `texFactor`; false (and 1) without a usable texture.
+bool textureFactorAt(const Scene& scene, const Material& mat, const InputPolygon& top,
+                     int cornerCount, glm::dvec2 topUv, glm::dvec3& texFactor) {
+  texFactor = glm::dvec3(1.0);
+  if (mat.baseColorTexture < 0 || mat.baseColorTexture >= int(scene.textures.size())) return false;
+  const Texture& tex = scene.textures[mat.baseColorTexture];
+  if (!(tex.width > 0 && tex.height > 0 && tex.rgb.size() == size_t(tex.width) * tex.height * 3))
+    return false;
+  glm::dvec2 texUv = interpolateCorners(top.uv, cornerCount, topUv);
+  glm::dvec3 c = sampleRepeat(tex, texUv);
+  for (int a = 0; a < 3; ++a) texFactor[a] = tex.mean[a] > 0.0 ? c[a] / tex.mean[a] : 0.0;
+  return true;
+}
+
+// The deepest active movie whose patch contains top-level (u,v) `topUv` of `top`, and the
+// point's (u,v) in that movie's patch; -1 when none does.
+int deepestMovieAt(const ActiveMovies& active, int top, glm::dvec2 topUv, bool triangle,
+                   glm::dvec2& foundUv) {
+  int found = -1;
+  foundUv = glm::dvec2(0.0);
+  if (active.deepest[top] < 0) return found;
+  PatchId node{uint32_t(top), 1u};
+  glm::dvec2 uv = topUv;
+  for (int level = 0;; ++level) {
+    const long k = active.movieOf.find(node.packed());
+    if (k >= 0) {
+      found = int(k);
+      foundUv = uv;
+    }
+    if (level >= active.deepest[top]) break;
+    node = node.child(descendToChild(uv, triangle));
+  }
+  return found;
+}
+
 }  // namespace
 
 struct FrameComposer::Impl {
@@ -123,6 +207,13 @@ struct FrameComposer::Impl {
   std::vector<Material> materials;     // per top (default material where -1)
   ItemBufferRenderer renderer;
   ItemBuffer items;
+
+  // The named steps of FrameComposer::compose, in order.
+  CameraView renderItems(double t);
+  void placeVisibleTops(VisibleTops& visible) const;
+  PixelSource shadePixel(double t, const std::vector<MovieTexture>& movies,
+                         const VisibleTops& visible, const ActiveMovies& active,
+                         const PrimaryRays& rays, int col, int row, int top, float* rgb) const;
 
   Impl(const Scene& s, const GlobalSolution& g, ImageSize sz, int cam)
       : scene(s), solution(g), size(sz), cameraNode(cam), tops(s.inputPolygons()), renderer(sz) {
@@ -168,46 +259,40 @@ ComposedFrame FrameComposer::compose(double t, const std::vector<MovieTexture>& 
   return out;
 }
 
+// Visibility: the item buffer at time t, the object transforms left in `transforms`.
+CameraView FrameComposer::Impl::renderItems(double t) {
+  CameraView view = scene.cameraAt(cameraNode, t);
+  for (size_t k = 0; k < objectNodes.size(); ++k)
+    transforms[k] = scene.worldTransform(objectNodes[k], t);
+  renderer.render(view, transforms, items);
+  return view;
+}
+
+void FrameComposer::Impl::placeVisibleTops(VisibleTops& v) const {
+  const int topCount = int(tops.size());
+  v.world.assign(topCount, Polygon{});
+  v.normals.assign(topCount, glm::dvec3(0.0));
+  v.uvMaps.assign(topCount, PolygonUvMap{});
+  std::vector<char> seen(topCount, 0);
+  for (uint32_t id : items.id)
+    if (id != kNoItem) seen[id - 1] = 1;
+  std::unordered_map<int, size_t> objectOfNode;
+  for (size_t k = 0; k < objectNodes.size(); ++k) objectOfNode[objectNodes[k]] = k;
+  for (int i = 0; i < topCount; ++i)
+    if (seen[i]) {
+      v.world[i] = tops[i].local.transformed(transforms[objectOfNode[tops[i].node]]);
+      v.normals[i] = v.world[i].normal();
+      v.uvMaps[i] = PolygonUvMap(v.world[i]);
+    }
+}
+
 void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, ComposedFrame& out) {
   Impl& m = *impl_;
   const ImageSize size = m.size;
-  const int topCount = int(m.tops.size());
-
-  // Visibility: the item buffer at time t.
-  CameraView view = m.scene.cameraAt(m.cameraNode, t);
-  for (size_t k = 0; k < m.objectNodes.size(); ++k)
-    m.transforms[k] = m.scene.worldTransform(m.objectNodes[k], t);
-  m.renderer.render(view, m.transforms, m.items);
-
-  // World polygons at t (affine maps keep the (u,v) parameterisation, so the hit's (u,v) in
-  // the world polygon is its top-level (u,v)).
-  // Their normals and (u,v) maps are set up once per frame here, not per pixel.
-  std::vector<Polygon> world(topCount);
-  std::vector<glm::dvec3> normals(topCount);
-  std::vector<PolygonUvMap> uvMaps(topCount);
-  std::vector<char> seen(topCount, 0);
-  for (uint32_t id : m.items.id)
-    if (id != kNoItem) seen[id - 1] = 1;
-  std::unordered_map<int, size_t> objectOfNode;
-  for (size_t k = 0; k < m.objectNodes.size(); ++k) objectOfNode[m.objectNodes[k]] = k;
-  for (int i = 0; i < topCount; ++i)
-    if (seen[i]) {
-      world[i] = m.tops[i].local.transformed(m.transforms[objectOfNode[m.tops[i].node]]);
-      normals[i] = world[i].normal();
-      uvMaps[i] = PolygonUvMap(world[i]);
-    }
-
-  // Active movies per top, by patch id; the deepest level per top bounds the descent.
-  PatchIndex movieOf(movies.size());
-  std::vector<int> deepest(topCount, -1);
-  for (size_t k = 0; k < movies.size(); ++k) {
-    const MovieTexture& mt = movies[k];
-    if (mt.patch.top >= uint32_t(topCount) || !mt.irradiance || mt.width < 1 || mt.height < 1)
-      throw Error(ExitCode::kInternal, "compose",
-                  "movie of patch " + mt.patch.toString() + " is invalid for this scene");
-    movieOf.insert(mt.patch.packed(), k);
-    deepest[mt.patch.top] = std::max(deepest[mt.patch.top], mt.patch.level());
-  }
+  const CameraView view = m.renderItems(t);
+  VisibleTops visible;
+  m.placeVisibleTops(visible);
+  const ActiveMovies active = indexMovies(movies, int(m.tops.size()));
 
   // The frame's primary rays (the lens is validated here, once).
   const PrimaryRays rays(view, size);
@@ -226,83 +311,10 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
         uint32_t id = m.items.id[p];
         if (id == kNoItem) continue;
         ++rowCovered[row];
-        int top = int(id - 1);
-        const Polygon& poly = world[top];
-        const bool triangle = poly.count == 3;
-        const Material& mat = m.materials[top];
-
-        // Hit point of the pixel-centre ray with the patch's plane.
-        // (A ray parallel to the plane cannot hit it; its centroid stands in.)
-        glm::dvec3 origin, direction;  // direction not unit length: its scale cancels in s
-        rays.line(glm::dvec2(col + 0.5, row + 0.5), origin, direction);
-        const glm::dvec3& nrm = normals[size_t(top)];
-        const double denom = glm::dot(nrm, direction);
-        bool onPlane = false;
-        glm::dvec3 hit;
-        if (std::abs(denom) > 1e-300) {
-          double s = glm::dot(nrm, poly.v[0] - origin) / denom;
-          if (std::isfinite(s)) {
-            hit = origin + s * direction;
-            onPlane = true;
-          }
-        }
-        if (!onPlane) hit = poly.centroid();
-        glm::dvec2 topUv = clampToParameterDomain(uvMaps[size_t(top)].uvAt(hit), triangle);
-
-        // Base colour texture factor tex(x) / mean(tex) (Material::reflectance already holds
-        // the mean), 1 without a texture.
-        glm::dvec3 texFactor(1.0);
-        bool textured = false;
-        if (mat.baseColorTexture >= 0 && mat.baseColorTexture < int(m.scene.textures.size())) {
-          const Texture& tex = m.scene.textures[mat.baseColorTexture];
-          if (tex.width > 0 && tex.height > 0 &&
-              tex.rgb.size() == size_t(tex.width) * tex.height * 3) {
-            glm::dvec2 texUv = interpolateCorners(m.tops[top].uv, poly.count, topUv);
-            glm::dvec3 c = sampleRepeat(tex, texUv);
-            for (int a = 0; a < 3; ++a) texFactor[a] = tex.mean[a] > 0.0 ? c[a] / tex.mean[a] : 0.0;
-            textured = true;
-          }
-        }
-
-        // The deepest active movie whose patch contains the point.
-        int found = -1;
-        glm::dvec2 foundUv(0.0);
-        if (deepest[top] >= 0) {
-          PatchId node{uint32_t(top), 1u};
-          glm::dvec2 uv = topUv;
-          for (int level = 0;; ++level) {
-            const long k = movieOf.find(node.packed());
-            if (k >= 0) {
-              found = int(k);
-              foundUv = uv;
-            }
-            if (level >= deepest[top]) break;
-            node = node.child(descendToChild(uv, triangle));
-          }
-        }
-
-        glm::dvec3 L;
-        if (found >= 0) {
-          // $L = L_e + \frac{\rho(x)}{\pi} H(x)$
-          const MovieTexture& mt = movies[size_t(found)];
-          glm::dvec3 H = sampleClamped(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width,
-                                       mt.height, foundUv);
-          L = mat.emission + (mat.reflectance * texFactor / kPi) * H;
-          out.source[p] = PixelSource::kMovie;
-          ++rowMovie[row];
-        } else {
-          // Fallback: the union leaf's radiosity, $L = B / \pi$.
-          int leaf = leafAtTopUv(m.solution.hierarchy, top, topUv);
-          glm::dvec3 B = m.solution.radiosity(leaf, t);
-          if (textured)
-            L = mat.emission + texFactor * glm::max(B / kPi - mat.emission, glm::dvec3(0.0));
-          else
-            L = B / kPi;
-          out.source[p] = PixelSource::kFallback;
-          ++rowFallback[row];
-        }
-        for (int a = 0; a < 3; ++a)
-          out.rgb[p * 3 + a] = std::isfinite(L[a]) ? float(std::max(L[a], 0.0)) : 0.0f;
+        const PixelSource source =
+            m.shadePixel(t, movies, visible, active, rays, col, row, int(id - 1), &out.rgb[p * 3]);
+        out.source[p] = source;
+        ++(source == PixelSource::kMovie ? rowMovie : rowFallback)[row];
       }
     }
   });
@@ -312,6 +324,45 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
     out.moviePixels += rowMovie[row];
     out.fallbackPixels += rowFallback[row];
   }
+}
+
+// One covered pixel of top-level patch `top`: its radiance into rgb[0..2], from the deepest
+// active movie containing the point, else from the global solution.
+PixelSource FrameComposer::Impl::shadePixel(double t, const std::vector<MovieTexture>& movies,
+                                            const VisibleTops& visible, const ActiveMovies& active,
+                                            const PrimaryRays& rays, int col, int row, int top,
+                                            float* rgb) const {
+  const Polygon& poly = visible.world[top];
+  const bool triangle = poly.count == 3;
+  const Material& mat = materials[top];
+  const glm::dvec2 topUv =
+      topUvOfPixel(rays, col, row, poly, visible.normals[size_t(top)], visible.uvMaps[size_t(top)]);
+  glm::dvec3 texFactor;
+  const bool textured = textureFactorAt(scene, mat, tops[top], poly.count, topUv, texFactor);
+  glm::dvec2 foundUv;
+  const int found = deepestMovieAt(active, top, topUv, triangle, foundUv);
+
+  glm::dvec3 L;
+  PixelSource source;
+  if (found >= 0) {
+    // $L = L_e + \frac{\rho(x)}{\pi} H(x)$
+    const MovieTexture& mt = movies[size_t(found)];
+    glm::dvec3 H =
+        sampleClamped(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width, mt.height, foundUv);
+    L = mat.emission + (mat.reflectance * texFactor / kPi) * H;
+    source = PixelSource::kMovie;
+  } else {
+    // Fallback: the union leaf's radiosity, $L = B / \pi$.
+    int leaf = leafAtTopUv(solution.hierarchy, top, topUv);
+    glm::dvec3 B = solution.radiosity(leaf, t);
+    if (textured)
+      L = mat.emission + texFactor * glm::max(B / kPi - mat.emission, glm::dvec3(0.0));
+    else
+      L = B / kPi;
+    source = PixelSource::kFallback;
+  }
+  for (int a = 0; a < 3; ++a) rgb[a] = std::isfinite(L[a]) ? float(std::max(L[a], 0.0)) : 0.0f;
+  return source;
 }
 
 double srgbEncode(double x) {

@@ -298,5 +298,34 @@ TEST_F(RadCompose, MissingMovieAndFramesOutsideTheWindow) {
   EXPECT_NE(r.err.find("outside the intervals' window 0-3"), std::string::npos) << r.err;
 }
 
+// rad-compose refuses a global solution whose key times do not span the intervals' frames
+// (here one key time, t = 0, for frames 0-23), with one line naming both files and both ranges,
+// before it reads a movie or writes a frame.
+TEST(RadComposeWindow, RefusesAGlobalSolutionThatDoesNotCoverTheIntervals) {
+  const fs::path d =
+      fs::temp_directory_path() / ("rad_compose_window_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d / "movies");
+  const std::string scene = RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
+  const std::string global = (d / "global.rlh").string(), iv = (d / "intervals.rti").string();
+  CommandResult g =
+      runCommand(tool("rad-global") + " " + scene + " -o " + global + " --frames 0-0 --eps 0.05");
+  ASSERT_EQ(g.exitCode, 0) << g.err;
+  CommandResult i =
+      runCommand(tool("rad-intervals") + " " + scene + " -o " + iv + " --frames 0-23 --size 44x30");
+  ASSERT_EQ(i.exitCode, 0) << i.err;
+  const std::string frames = (d / "frames").string();
+  CommandResult r = runCommand(tool("rad-compose") + " " + scene + " " + global + " " + iv + " " +
+                               (d / "movies").string() + " -o " + frames);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("rad-compose: " + global + ": ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(iv), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("frames 0-0 "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("frames 0-23 "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(frames));
+  if (!std::getenv("RAD_KEEP_TEST_DIR")) fs::remove_all(d);
+}
+
 }  // namespace
 }  // namespace rad::test

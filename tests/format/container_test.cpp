@@ -12,6 +12,7 @@
 #include <random>
 
 #include "formats/atomic_file.h"
+#include "formats/build_info.h"
 #include "formats/checksum.h"
 #include "formats/container.h"
 #include "formats/provenance.h"
@@ -222,7 +223,7 @@ TEST_F(ContainerTest, MetadataAndProvenanceRoundTrip) {
   const Provenance& p = r.provenance();
   EXPECT_EQ(p.tool, "rad-global");
   EXPECT_EQ(p.version, RAD_VERSION);
-  EXPECT_EQ(p.gitRevision, RAD_GIT_REVISION);
+  EXPECT_EQ(p.gitRevision, gitRevision());
   EXPECT_EQ(p.commandLine, "rad-global --eps 0.01 -o 'out dir/global.rlh' scene.gltf");
   EXPECT_EQ(p.parameters, json({{"eps", 0.01}, {"levels", 6}, {"mode", "fast"}}));
   EXPECT_EQ(p.toJson(), sampleProvenance().toJson());
@@ -268,7 +269,8 @@ TEST_F(ContainerTest, NestedHistoryRoundTripsAndPrintsOldestFirst) {
   EXPECT_EQ(inner.inputs[0].path, scene);
 
   const std::string text = back.toText();
-  const auto gPos = text.find("rad-global " RAD_VERSION " (git " RAD_GIT_REVISION "): rad-global");
+  const auto gPos =
+      text.find(std::string("rad-global " RAD_VERSION " (git ") + gitRevision() + "): rad-global");
   const auto mPos = text.find("rad-movies " RAD_VERSION);
   EXPECT_NE(gPos, std::string::npos) << text;
   EXPECT_NE(mPos, std::string::npos) << text;

@@ -12,16 +12,65 @@
 
 #include <tbb/global_control.h>
 
+#include "formats/build_info.h"
+
 namespace rad {
 
 namespace {
 int gThreads = 0;  // --threads; 0: every core this process may use (TBB's default)
 std::unique_ptr<tbb::global_control> gThreadLimit;
+
+constexpr const char* kPrintDefaults = "--print-defaults";
+
+// Thrown by --print-defaults' callback, which CLI11 runs before it checks required options
+// (like --help), so `rad-global --print-defaults` needs no scene.
+class CallForDefaults : public CLI::Success {
+ public:
+  CallForDefaults()
+      : CLI::Success("CallForDefaults", "print the defaults and exit", CLI::ExitCodes::Success) {}
+};
+
+bool isNumberType(const std::string& typeName) {
+  const std::string base = typeName.substr(0, typeName.find(':'));  // "FLOAT:POSITIVE"
+  return base == "INT" || base == "UINT" || base == "FLOAT" || base == "NUMBER";
+}
+
+// The default CLI11 would show in --help if it were captured: the bound variable's value now,
+// read without changing what --help shows.
+std::string boundDefault(CLI::Option& opt) {
+  const std::string shown = opt.get_default_str();
+  opt.capture_default_str();
+  const std::string value = opt.get_default_str();
+  opt.default_str(shown);
+  return value;
+}
+
+nlohmann::json defaultValue(CLI::Option& opt) {
+  const std::string text = boundDefault(opt);
+  if (opt.get_items_expected_max() == 0) return text == "true" || text == "1";  // a flag
+  if (text.empty()) return nullptr;
+  if (isNumberType(opt.get_type_name())) {
+    nlohmann::json number = nlohmann::json::parse(text, nullptr, false);
+    if (number.is_number()) return number;
+  }
+  return text;
+}
 }  // namespace
+
+nlohmann::json optionDefaults(CLI::App& app) {
+  nlohmann::json out = nlohmann::json::object();
+  for (CLI::Option* opt : app.get_options()) {
+    if (opt == app.get_help_ptr() || opt == app.get_version_ptr()) continue;
+    const std::vector<std::string>& names = opt->get_lnames();
+    if (names.empty() || "--" + names.front() == kPrintDefaults) continue;  // positionals too
+    out[names.front()] = defaultValue(*opt);
+  }
+  return out;
+}
 
 void setUpApp(CLI::App& app, const std::string& tool, const std::string& example) {
   app.name(tool);
-  app.set_version_flag("--version", std::string(tool) + " " RAD_VERSION " (" RAD_GIT_REVISION ")");
+  app.set_version_flag("--version", std::string(tool) + " " RAD_VERSION " (" + gitRevision() + ")");
   app.footer(std::string("Example:\n  ") + example + "\n\n" + exitCodeHelp());
   app.get_formatter()->column_width(34);
   // Results never depend on it (work is split by item, not by thread, and every sample seed
@@ -29,11 +78,18 @@ void setUpApp(CLI::App& app, const std::string& tool, const std::string& example
   app.add_option("--threads", gThreads, "worker threads; 0: all cores")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  app.add_flag_callback(
+      kPrintDefaults, [] { throw CallForDefaults(); },
+      "print every option's default as one JSON object on stdout and exit");
 }
 
 int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** argv) {
+  const nlohmann::json defaults = optionDefaults(app);  // before parsing changes the values
   try {
     app.parse(argc, argv);
+  } catch (const CallForDefaults&) {
+    std::cout << defaults.dump(1) << "\n";
+    return 0;
   } catch (const CLI::CallForHelp&) {
     std::cout << app.help();
     return 0;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "libcommon/core/error.h"
 
@@ -18,13 +19,21 @@ inline const char* exitCodeHelp() {
          "            4 environment (no GL context, out of memory); 5 internal error.";
 }
 
-// Creates the CLI11 app with --version, --threads and the exit-code footer. `example` is one
-// command line.
+// Creates the CLI11 app with --version, --threads, --print-defaults and the exit-code footer.
+// `example` is one command line.
 void setUpApp(CLI::App& app, const std::string& tool, const std::string& example);
 
 // Parses the command line; returns -1 to go on, otherwise the exit code to return
-// (0 after --help / --version, 2 after a usage error, which is printed as one line).
+// (0 after --help / --version / --print-defaults, 2 after a usage error, which is printed as
+// one line).
 int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** argv);
+
+// Every option's default as one JSON object, for --print-defaults (Radiance's print_rdefaults):
+// keys are the long names without "--" ("eps", "key-step"), values the defaults the options
+// were bound with: numbers as JSON numbers, flags false, other values as strings, an option
+// with no default (empty string, unset std::optional) null. Positionals, --help, --version and
+// --print-defaults are left out. Call it before parsing (it reads the bound variables).
+nlohmann::json optionDefaults(CLI::App& app);
 
 // Runs body, mapping rad::Error and other exceptions to `tool: message` on stderr and the
 // documented exit code.

@@ -1,7 +1,9 @@
 // rad-compose: final frames from the texture movies (paper §3.1 last step; DESIGN.md §6
 // "rad-compose"). Reads the scene, the global solution, the intervals and the movies; writes
-// FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The work is in
-// libcommon/compose/frame_composer.h and formats/frame_sequence.h.
+// FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The options are
+// libcommon/compose/compose_options.h; the work is in libcommon/compose/frame_composer.h and
+// formats/frame_sequence.h (the frame loop). This main parses, checks the inputs agree, fills
+// in the defaults they give, calls the loop and reports.
 #include <unistd.h>
 
 #include <cstdio>
@@ -13,32 +15,78 @@
 #include "formats/container.h"
 #include "formats/frame_image.h"
 #include "formats/frame_sequence.h"
+#include "formats/frame_window.h"
 #include "formats/gltf_scene.h"
 #include "formats/link_hierarchy.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
+#include "libcommon/compose/compose_options.h"
 #include "tools/common/tool_main.h"
 
 namespace {
 
 constexpr const char* kTool = "rad-compose";
 
-struct Options {
-  std::string scene, global, intervals, movies;
-  std::string output;
-  std::string frames;  // empty: the intervals' window
-  std::optional<double> fps;
-  std::string size;  // empty: the intervals' image size
-  std::string camera;
-  std::optional<double> exposure;
-  bool autoExposure = false;
-  bool half = false;
-  std::string compression = "none";
-  bool noPng = false;
-  std::string report;
-};
+// The loop's options for `o`, after filling in `o`'s defaults from the inputs so that
+// o.toJson() records every value in effect: frames = the intervals' window, fps and size = the
+// intervals', camera = the camera node's name.
+rad::ComposeSequenceOptions resolve(rad::ComposeOptions& o, const rad::Scene& scene,
+                                    const rad::TextureIntervals& intervals) {
+  rad::ComposeSequenceOptions c;
+  c.moviesDir = o.movies;
+  c.framesDir = o.output;
+  if (o.frames.empty()) {
+    for (int f = intervals.firstFrame; f <= intervals.lastFrame; ++f) c.frames.push_back(f);
+    o.frames = std::to_string(c.frames.front()) + "-" + std::to_string(c.frames.back());
+  } else {
+    c.frames = rad::parseFrameRange(o.frames);
+  }
+  c.fps = o.fps.value_or(intervals.fps);
+  if (!(c.fps > 0.0)) throw rad::Error(rad::ExitCode::kUsage, "", "--fps must be positive");
+  o.fps = c.fps;
+  if (o.size.empty()) {
+    c.size = {intervals.imageWidth, intervals.imageHeight};
+  } else {
+    auto [w, h] = rad::parseImageSize(o.size);
+    c.size = {w, h};
+  }
+  if (c.size.width < 1 || c.size.height < 1)
+    throw rad::inputError(o.intervals, "no image size; pass --size");
+  o.size = std::to_string(c.size.width) + "x" + std::to_string(c.size.height);
+  c.cameraNode = scene.cameraNode(o.camera);
+  if (c.cameraNode < 0)
+    throw rad::inputError(o.scene,
+                          o.camera.empty() ? "no camera" : "no camera named '" + o.camera + "'");
+  o.camera = scene.nodes[c.cameraNode].name;
+  c.autoExposure = o.autoExposure;
+  c.exposureEV = o.exposure.value_or(0.0);
+  c.half = o.half;
+  c.compression = rad::frameCompressionOf(o.compression);
+  c.png = !o.noPng;
+  return c;
+}
 
-int run(const Options& o, int argc, char** argv) {
+// The movies were sized and timed for the intervals' image, fps and camera: say so when this
+// run differs (still allowed: a quick preview at another size is legitimate).
+void warnAboutDifferences(const rad::ComposeSequenceOptions& c, const std::string& givenCamera,
+                          const std::string& intervalsPath, const rad::ContainerReader& reader,
+                          const rad::TextureIntervals& intervals) {
+  if (c.size != rad::ImageSize{intervals.imageWidth, intervals.imageHeight})
+    std::cerr << kTool << ": warning: composing at " << c.size.width << "x" << c.size.height << "; "
+              << intervalsPath << " sized the movies for " << intervals.imageWidth << "x"
+              << intervals.imageHeight << "\n";
+  if (c.fps != intervals.fps)
+    std::cerr << kTool << ": warning: --fps " << c.fps << "; " << intervalsPath
+              << " was built with " << intervals.fps << " fps\n";
+  const nlohmann::json& built = reader.provenance().parameters;
+  if (!givenCamera.empty() && built.contains("camera"))
+    for (const std::string& m :
+         rad::parameterMismatch(built, {{"camera", givenCamera}}, {"camera"}))
+      std::cerr << kTool << ": warning: " << intervalsPath << ": " << m << "\n";
+}
+
+int run(const rad::ComposeOptions& given, int argc, char** argv) {
+  rad::ComposeOptions o = given;
   rad::Scene scene = rad::readGltfScene(o.scene);
   // Of global.rlh only the radiosity (fallback pixels, auto exposure) is kept, and the file's
   // bytes are released once read. On the 32-cube scene the file (49 MB) and a copy of its links
@@ -52,67 +100,15 @@ int run(const Options& o, int argc, char** argv) {
   }
   rad::ContainerReader intervalsReader = rad::ContainerReader::open(o.intervals);
   rad::TextureIntervals intervals = rad::readTextureIntervals(intervalsReader);
+  rad::requireGlobalCoversIntervals(o.global, solution, o.intervals, intervals);
 
-  rad::ComposeSequenceOptions c;
-  c.moviesDir = o.movies;
-  c.framesDir = o.output;
-  if (o.frames.empty()) {
-    for (int f = intervals.firstFrame; f <= intervals.lastFrame; ++f) c.frames.push_back(f);
-  } else {
-    c.frames = rad::parseFrameRange(o.frames);
-  }
-  c.fps = o.fps.value_or(intervals.fps);
-  if (!(c.fps > 0.0)) throw rad::Error(rad::ExitCode::kUsage, "", "--fps must be positive");
-  if (o.size.empty()) {
-    c.size = {intervals.imageWidth, intervals.imageHeight};
-  } else {
-    auto [w, h] = rad::parseImageSize(o.size);
-    c.size = {w, h};
-  }
-  if (c.size.width < 1 || c.size.height < 1)
-    throw rad::inputError(o.intervals, "no image size; pass --size");
-  c.cameraNode = scene.cameraNode(o.camera);
-  if (c.cameraNode < 0)
-    throw rad::inputError(o.scene,
-                          o.camera.empty() ? "no camera" : "no camera named '" + o.camera + "'");
-  c.autoExposure = o.autoExposure;
-  c.exposureEV = o.exposure.value_or(0.0);
-  c.half = o.half;
-  c.compression = rad::frameCompressionOf(o.compression);
-  c.png = !o.noPng;
-
-  nlohmann::json parameters = {
-      {"output", o.output},
-      {"frames", o.frames.empty()
-                     ? std::to_string(c.frames.front()) + "-" + std::to_string(c.frames.back())
-                     : o.frames},
-      {"fps", c.fps},
-      {"size", std::to_string(c.size.width) + "x" + std::to_string(c.size.height)},
-      {"camera", scene.nodes[c.cameraNode].name},
-      {"exposure", c.exposureEV},
-      {"auto-exposure", c.autoExposure},
-      {"half", c.half},
-      {"compression", o.compression},
-      {"no-png", o.noPng}};
-  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
+  const rad::ComposeSequenceOptions c = resolve(o, scene, intervals);
+  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, o.toJson());
   rad::addInput(provenance, o.scene);
   provenance.inputs.push_back(std::move(globalInput));
   rad::addInput(provenance, intervalsReader);
   rad::addMoviesInput(provenance, intervals, o.movies, c.frames);
-
-  // The movies were sized and timed for the intervals' image, fps and camera: say so when this
-  // run differs (still allowed: a quick preview at another size is legitimate).
-  if (c.size != rad::ImageSize{intervals.imageWidth, intervals.imageHeight})
-    std::cerr << kTool << ": warning: composing at " << c.size.width << "x" << c.size.height << "; "
-              << o.intervals << " sized the movies for " << intervals.imageWidth << "x"
-              << intervals.imageHeight << "\n";
-  if (c.fps != intervals.fps)
-    std::cerr << kTool << ": warning: --fps " << c.fps << "; " << o.intervals << " was built with "
-              << intervals.fps << " fps\n";
-  const nlohmann::json& built = intervalsReader.provenance().parameters;
-  if (!o.camera.empty() && built.contains("camera"))
-    for (const std::string& m : rad::parameterMismatch(built, {{"camera", o.camera}}, {"camera"}))
-      std::cerr << kTool << ": warning: " << o.intervals << ": " << m << "\n";
+  warnAboutDifferences(c, given.camera, o.intervals, intervalsReader, intervals);
 
   rad::Progress progress(kTool, long(c.frames.size()));
   auto warn = [&](const std::string& message) {
@@ -140,7 +136,7 @@ int main(int argc, char** argv) {
       "irradiance H at the frame's time, L = Le + rho/pi H (paper §3.1); pixels no movie\n"
       "covers fall back to the global solution (counted in a warning). Writes FRAMES_DIR/\n"
       "NNNN.exr (linear radiance, W/(m^2 sr)) and NNNN.png (sRGB, exposure applied)."};
-  Options o;
+  rad::ComposeOptions o;
   rad::setUpApp(app, kTool,
                 "rad-compose scene.gltf out/global.rlh out/intervals.rti out/movies -o out/frames "
                 "--frames 0-95 --auto-exposure");

@@ -1,64 +1,46 @@
 // rad-intervals: texture-movie extents from per-frame item buffers (paper §4.1, §4.3;
-// DESIGN.md §6 rad-intervals). The algorithm is libcommon/intervals/texture_intervals_builder.h; this
-// main parses, reads the scene, runs the frames, writes intervals.rti and reports.
-#include <algorithm>
-#include <chrono>
-#include <cmath>
+// DESIGN.md §6 rad-intervals). The options are libcommon/intervals/intervals_options.h, the
+// algorithm libcommon/intervals/texture_intervals_builder.h, the frame loop
+// formats/interval_sequence.h; this main parses, calls them, writes intervals.rti and reports.
 #include <cstdio>
-#include <filesystem>
-#include <iostream>
+#include <vector>
 
 #include "formats/atomic_file.h"
 #include "formats/container.h"
 #include "formats/gltf_scene.h"
-#include "formats/item_buffer_exr.h"
+#include "formats/interval_sequence.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
-#include "libcommon/intervals/texture_intervals_builder.h"
+#include "libcommon/intervals/intervals_options.h"
+#include "libcommon/scene/frame_range.h"
 #include "tools/common/tool_main.h"
 
 namespace {
 
 constexpr const char* kTool = "rad-intervals";
 
-struct Options {
-  std::string scene;
-  std::string output;
-  std::string frames;  // empty: 0 .. the animation's end at --fps
-  std::string size = "352x240";
-  std::string camera;
-  std::string itemBuffers;
-  std::string report;
-  rad::TextureIntervalsOptions build;
-};
-
-static_assert(int(rad::MovieEnd::kLeftFrustum) == int(rad::CloseReason::kLeftFrustum) &&
-                  int(rad::MovieEnd::kHidden) == int(rad::CloseReason::kHidden) &&
-                  int(rad::MovieEnd::kLevelChange) == int(rad::CloseReason::kLevelChange) &&
-                  int(rad::MovieEnd::kResize) == int(rad::CloseReason::kResize) &&
-                  int(rad::MovieEnd::kMaxLength) == int(rad::CloseReason::kMaxLength) &&
-                  int(rad::MovieEnd::kWindow) == int(rad::CloseReason::kWindow),
-              "MovieEnd and CloseReason codes must agree");
-
-nlohmann::json parametersOf(const Options& o, const std::string& frames) {
-  const rad::TextureIntervalsOptions& b = o.build;
-  return {{"frames", frames},
-          {"fps", b.fps},
-          {"size", o.size},
-          {"camera", o.camera},
-          {"item-buffers", o.itemBuffers},
-          {"max-level", b.maxLevel},
-          {"min-visible-fraction", b.minVisibleFraction},
-          {"level-hysteresis", b.levelHysteresis},
-          {"texel-density", b.texelDensity},
-          {"min-size", b.minSize},
-          {"max-size", b.maxSize},
-          {"resize-tolerance", b.resizeTolerance},
-          {"max-length", b.maxLength}};
+// --frames as strictly increasing frame numbers (the builder's contract).
+std::vector<int> increasingFrames(const std::string& spec) {
+  std::vector<int> frames = rad::parseFrameRange(spec);
+  if (frames.empty()) throw rad::Error(rad::ExitCode::kUsage, "", "--frames: no frames");
+  for (size_t i = 1; i < frames.size(); ++i)
+    if (frames[i] <= frames[i - 1])
+      throw rad::Error(rad::ExitCode::kUsage, "", "--frames: frames must increase");
+  return frames;
 }
 
-int run(const Options& given, int argc, char** argv) {
-  Options o = given;
+void printSummary(const nlohmann::json& report, size_t movies) {
+  std::fprintf(stderr,
+               "%s: %d frames, %zu movies, mean length %.1f frames, %.0f texels/frame, "
+               "item buffer %.2f ms/frame (median %.2f), %.2f ms/frame total\n",
+               kTool, report["frames"].get<int>(), movies,
+               report["mean_length_frames"].get<double>(), report["texels_per_frame"].get<double>(),
+               report["item_buffer_ms_per_frame"].get<double>(),
+               report["item_buffer_ms_median"].get<double>(), report["ms_per_frame"].get<double>());
+}
+
+int run(const rad::IntervalsOptions& given, int argc, char** argv) {
+  rad::IntervalsOptions o = given;
   auto [w, h] = rad::parseImageSize(o.size);
   o.build.imageSize = {w, h};
   o.build.validate();
@@ -67,96 +49,22 @@ int run(const Options& given, int argc, char** argv) {
   if (camera < 0)
     throw rad::inputError(o.scene,
                           o.camera.empty() ? "no camera" : "no camera named '" + o.camera + "'");
-  std::string frameSpec = o.frames;
-  if (frameSpec.empty())
-    frameSpec = "0-" + std::to_string(std::max(0L, std::lround(scene.endTime() * o.build.fps)));
-  std::vector<int> frames = rad::parseFrameRange(frameSpec);
-  if (frames.empty()) throw rad::Error(rad::ExitCode::kUsage, "", "--frames: no frames");
-  for (size_t i = 1; i < frames.size(); ++i)
-    if (frames[i] <= frames[i - 1])
-      throw rad::Error(rad::ExitCode::kUsage, "", "--frames: frames must increase");
+  if (o.frames.empty()) o.frames = rad::animationFrames(scene, o.build.fps).toString();
+  const std::vector<int> frames = increasingFrames(o.frames);
 
-  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parametersOf(o, frameSpec));
+  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, o.toJson());
   rad::addInput(provenance, o.scene);
-  std::string provenanceJson = provenance.toJson().dump();
-  if (!o.itemBuffers.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.itemBuffers, ec);
-    if (ec) throw rad::outputError(o.itemBuffers, ec.message());
-  }
-
-  auto start = std::chrono::steady_clock::now();
-  rad::TextureIntervalsBuilder builder(scene, camera, o.build);
-  double setupSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::vector<double> itemSeconds;
   rad::Progress progress(kTool, long(frames.size()));
-  for (int f : frames) {
-    builder.addFrame(f, [&](const rad::IntervalFrame& fr) {
-      itemSeconds.push_back(fr.itemBufferSeconds);
-      if (o.itemBuffers.empty()) return;
-      char name[32];
-      std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
-      rad::writeItemBufferExr(o.itemBuffers + name, *fr.itemBuffer, fr.frame, fr.time,
-                              provenanceJson);
-    });
-    progress.advance();
-  }
+  rad::IntervalSequence sequence =
+      rad::computeIntervalSequence(scene, camera, frames, o.build, o.itemBuffers,
+                                   provenance.toJson().dump(), [&]() { progress.advance(); });
   progress.done();
-  std::vector<rad::MovieExtent> extents = builder.finish();
-  double totalSeconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  rad::TextureIntervals iv;
-  iv.firstFrame = frames.front();
-  iv.lastFrame = frames.back();
-  iv.fps = o.build.fps;
-  iv.imageWidth = w;
-  iv.imageHeight = h;
-  for (size_t i = 0; i < extents.size(); ++i) {
-    const rad::MovieExtent& e = extents[i];
-    rad::TextureInterval m;
-    m.movie = uint32_t(i);
-    m.patch = e.patch;
-    m.firstFrame = e.firstFrame;
-    m.lastFrame = e.lastFrame;
-    m.width = e.width;
-    m.height = e.height;
-    m.reason = rad::CloseReason(int(e.end));
-    iv.movies.push_back(m);
-  }
-  const rad::PatchHierarchy& ph = builder.hierarchy();
-  nlohmann::json metadata = {{"top_patches", ph.topCount()},
-                             {"patch_nodes", ph.size()},
-                             {"max_level", o.build.maxLevel},
-                             {"camera", scene.nodes[camera].name},
-                             {"frame_step", frames.size() > 1 ? frames[1] - frames[0] : 1}};
-  rad::writeTextureIntervals(o.output, iv, provenance, metadata);
+  rad::writeTextureIntervals(o.output, sequence.intervals, provenance, sequence.metadata);
 
   // The report summarises what was written (read back: also checks the file).
-  nlohmann::json report = rad::summarizeTextureIntervals(rad::ContainerReader::open(o.output));
-  int n = builder.framesAdded();
-  report["output"] = o.output;
-  report["frames"] = n;
-  report["image_size"] = {w, h};
-  report["top_patches"] = ph.topCount();
-  report["patch_nodes"] = ph.size();
-  report["item_buffer_ms_per_frame"] = 1e3 * builder.itemBufferSeconds() / n;
-  // The first frame pays for shader compilation and driver warm-up: the median is the figure.
-  std::sort(itemSeconds.begin(), itemSeconds.end());
-  report["item_buffer_ms_median"] = 1e3 * itemSeconds[itemSeconds.size() / 2];
-  report["item_buffer_ms_max"] = 1e3 * itemSeconds.back();
-  report["setup_seconds"] = setupSeconds;
-  report["total_seconds"] = totalSeconds;
-  report["ms_per_frame"] = 1e3 * (totalSeconds - setupSeconds) / n;
+  const nlohmann::json report = rad::intervalSequenceReport(sequence, o.output);
   if (!o.report.empty()) rad::writeTextFile(o.report, report.dump(1) + "\n");
-  std::fprintf(stderr,
-               "%s: %d frames, %zu movies, mean length %.1f frames, %.0f texels/frame, "
-               "item buffer %.2f ms/frame (median %.2f), %.2f ms/frame total\n",
-               kTool, n, extents.size(), report["mean_length_frames"].get<double>(),
-               report["texels_per_frame"].get<double>(),
-               report["item_buffer_ms_per_frame"].get<double>(),
-               report["item_buffer_ms_median"].get<double>(), report["ms_per_frame"].get<double>());
+  printSummary(report, sequence.intervals.movies.size());
   return 0;
 }
 
@@ -166,13 +74,14 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Computes texture-movie extents (which patch node gets a movie, from which frame "
       "to which, at what size) from per-frame item buffers (paper §4.1, §4.3)."};
-  Options o;
+  rad::IntervalsOptions o;
   rad::setUpApp(app, kTool,
                 "rad-intervals scene.gltf -o intervals.rti --frames 0-95 --fps 24 --size 352x240");
   app.add_option("SCENE", o.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
   app.add_option("-o,--output", o.output, "output intervals file (.rti)")->required();
-  app.add_option("--frames", o.frames,
-                 "frame range a-b or a-bxstep (default: 0 to the animation's end)");
+  app.add_option(
+      "--frames", o.frames,
+      "frame range a-b or a-bxstep (default: the whole animation, 0 to ceil(end x fps))");
   app.add_option("--fps", o.build.fps, "frames per second; frame f is at time f/fps")
       ->capture_default_str();
   app.add_option("--size", o.size, "item buffer size WxH (the final frame size)")

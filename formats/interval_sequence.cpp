@@ -1,0 +1,117 @@
+#include "formats/interval_sequence.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "formats/container.h"
+#include "formats/item_buffer_exr.h"
+#include "libcommon/core/error.h"
+
+namespace rad {
+
+namespace {
+
+static_assert(int(MovieEnd::kLeftFrustum) == int(CloseReason::kLeftFrustum) &&
+                  int(MovieEnd::kHidden) == int(CloseReason::kHidden) &&
+                  int(MovieEnd::kLevelChange) == int(CloseReason::kLevelChange) &&
+                  int(MovieEnd::kResize) == int(CloseReason::kResize) &&
+                  int(MovieEnd::kMaxLength) == int(CloseReason::kMaxLength) &&
+                  int(MovieEnd::kWindow) == int(CloseReason::kWindow),
+              "MovieEnd and CloseReason codes must agree");
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+TextureIntervals intervalsRecord(const std::vector<MovieExtent>& extents,
+                                 const std::vector<int>& frames,
+                                 const TextureIntervalsOptions& options) {
+  TextureIntervals iv;
+  iv.firstFrame = frames.front();
+  iv.lastFrame = frames.back();
+  iv.fps = options.fps;
+  iv.imageWidth = options.imageSize.width;
+  iv.imageHeight = options.imageSize.height;
+  for (size_t i = 0; i < extents.size(); ++i) {
+    const MovieExtent& e = extents[i];
+    TextureInterval m;
+    m.movie = uint32_t(i);
+    m.patch = e.patch;
+    m.firstFrame = e.firstFrame;
+    m.lastFrame = e.lastFrame;
+    m.width = e.width;
+    m.height = e.height;
+    m.reason = CloseReason(int(e.end));
+    iv.movies.push_back(m);
+  }
+  return iv;
+}
+
+}  // namespace
+
+IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
+                                         const std::vector<int>& frames,
+                                         const TextureIntervalsOptions& options,
+                                         const std::string& itemBuffersDir,
+                                         const std::string& provenanceJson,
+                                         const std::function<void()>& frameDone) {
+  if (!itemBuffersDir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(itemBuffersDir, ec);
+    if (ec) throw outputError(itemBuffersDir, ec.message());
+  }
+
+  IntervalSequence run;
+  const auto start = std::chrono::steady_clock::now();
+  TextureIntervalsBuilder builder(scene, cameraNode, options);
+  run.setupSeconds = secondsSince(start);
+  for (int f : frames) {
+    builder.addFrame(f, [&](const IntervalFrame& fr) {
+      run.itemSeconds.push_back(fr.itemBufferSeconds);
+      if (itemBuffersDir.empty()) return;
+      char name[32];
+      std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
+      writeItemBufferExr(itemBuffersDir + name, *fr.itemBuffer, fr.frame, fr.time, provenanceJson);
+    });
+    if (frameDone) frameDone();
+  }
+  const std::vector<MovieExtent> extents = builder.finish();
+  run.totalSeconds = secondsSince(start);
+
+  run.intervals = intervalsRecord(extents, frames, options);
+  const PatchHierarchy& ph = builder.hierarchy();
+  run.metadata = {{"top_patches", ph.topCount()},
+                  {"patch_nodes", ph.size()},
+                  {"max_level", options.maxLevel},
+                  {"camera", scene.nodes[cameraNode].name},
+                  {"frame_step", frames.size() > 1 ? frames[1] - frames[0] : 1}};
+  run.frames = builder.framesAdded();
+  run.topPatches = ph.topCount();
+  run.patchNodes = ph.size();
+  run.itemBufferSeconds = builder.itemBufferSeconds();
+  return run;
+}
+
+nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::string& output) {
+  nlohmann::json report = summarizeTextureIntervals(ContainerReader::open(output));
+  const int n = run.frames;
+  report["output"] = output;
+  report["frames"] = n;
+  report["image_size"] = {run.intervals.imageWidth, run.intervals.imageHeight};
+  report["top_patches"] = run.topPatches;
+  report["patch_nodes"] = run.patchNodes;
+  report["item_buffer_ms_per_frame"] = 1e3 * run.itemBufferSeconds / n;
+  // The first frame pays for shader compilation and driver warm-up: the median is the figure.
+  std::vector<double> itemSeconds = run.itemSeconds;
+  std::sort(itemSeconds.begin(), itemSeconds.end());
+  report["item_buffer_ms_median"] = 1e3 * itemSeconds[itemSeconds.size() / 2];
+  report["item_buffer_ms_max"] = 1e3 * itemSeconds.back();
+  report["setup_seconds"] = run.setupSeconds;
+  report["total_seconds"] = run.totalSeconds;
+  report["ms_per_frame"] = 1e3 * (run.totalSeconds - run.setupSeconds) / n;
+  return report;
+}
+
+}  // namespace rad

@@ -1,0 +1,47 @@
+// rad-intervals' frame loop (paper §4.1, §4.3; DESIGN.md §6 rad-intervals), next to
+// frame_sequence (rad-compose's): every frame through one TextureIntervalsBuilder
+// (libcommon/intervals/texture_intervals_builder.h), optionally writing each frame's item
+// buffer as DIR/NNNN.exr, then the extents as the intervals.rti record.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "formats/texture_intervals.h"
+#include "libcommon/intervals/texture_intervals_builder.h"
+#include "libcommon/scene/scene.h"
+
+namespace rad {
+
+struct IntervalSequence {
+  TextureIntervals intervals;  // what intervals.rti stores: the window, fps, size, movies
+  nlohmann::json metadata;     // its metadata: top_patches, patch_nodes, max_level, camera,
+                               // frame_step
+  // For the report.
+  int frames = 0;  // frames added
+  int topPatches = 0;
+  int patchNodes = 0;
+  double itemBufferSeconds = 0.0;   // total render + readback
+  std::vector<double> itemSeconds;  // per frame, in frame order
+  double setupSeconds = 0.0;        // builder set-up (GL context, hierarchy)
+  double totalSeconds = 0.0;        // set-up and every frame
+};
+
+// Runs `frames` (strictly increasing) from camera node `cameraNode`. With a non-empty
+// `itemBuffersDir` (created; rad::outputError if it cannot be) each frame's item buffer is
+// written there as NNNN.exr carrying `provenanceJson`. `frameDone` is called after each frame.
+IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
+                                         const std::vector<int>& frames,
+                                         const TextureIntervalsOptions& options,
+                                         const std::string& itemBuffersDir,
+                                         const std::string& provenanceJson,
+                                         const std::function<void()>& frameDone = {});
+
+// rad-intervals' --report: summarizeTextureIntervals of the file written at `output` (read
+// back, which also checks it) plus the run's counts and times.
+nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::string& output);
+
+}  // namespace rad

@@ -1,0 +1,39 @@
+// rad-compose's options (paper §3.1 last step; DESIGN.md §6 "rad-compose"): the command line
+// binds each flag to a field here, and toJson() is the provenance parameters of every frame,
+// so a flag's name is written once (CONVENTIONS.md "Stages with one shape"). The defaults that
+// come from the inputs (the intervals' window, fps and size, the scene's first camera) are
+// filled in by the tool once the inputs are read, before toJson(), so the provenance records
+// every value in effect. The frame loop is formats/frame_sequence.h.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace rad {
+
+struct ComposeOptions {
+  std::string scene;               // glTF scene
+  std::string global;              // global.rlh (rad-global)
+  std::string intervals;           // intervals.rti (rad-intervals)
+  std::string movies;              // MOVIES_DIR (rad-movies)
+  std::string output;              // FRAMES_DIR for NNNN.exr / NNNN.png
+  std::string frames;              // FIRST-LAST[xSTEP]; empty: the intervals' window
+  std::optional<double> fps;       // frame f at f / fps; empty: the intervals'
+  std::string size;                // WIDTHxHEIGHT; empty: the intervals'
+  std::string camera;              // node or camera name; empty: the first camera
+  std::optional<double> exposure;  // PNG exposure in EV; empty: 0 (or --auto-exposure)
+  bool autoExposure = false;
+  bool half = false;  // HALF EXR channels
+  std::string compression = "none";
+  bool noPng = false;
+  std::string report;  // JSON report file; empty: none
+
+  // Provenance parameters; keys are the long option names without "--": output, frames, fps,
+  // size, camera, exposure, auto-exposure, half, compression, no-png. An unset fps is null and
+  // an unset exposure 0.
+  nlohmann::json toJson() const;
+};
+
+}  // namespace rad

@@ -1,0 +1,33 @@
+// rad-intervals' options (paper §4.1, §4.3; DESIGN.md §6 rad-intervals): the command line binds
+// each flag to a field here (the algorithm's own in `build`), and toJson() is the provenance
+// parameters of intervals.rti, so a flag's name and default are written once (CONVENTIONS.md
+// "Stages with one shape"). The frame loop is formats/interval_sequence.h.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "libcommon/intervals/texture_intervals_builder.h"
+
+namespace rad {
+
+struct IntervalsOptions {
+  std::string scene;   // glTF scene
+  std::string output;  // intervals.rti
+  // FIRST-LAST[xSTEP]; empty: the scene's whole animation at build.fps (animationFrames),
+  // filled in by the tool before toJson() so the provenance records the frames in effect.
+  std::string frames;
+  std::string size = "352x240";  // item buffer size WxH, parsed into build.imageSize
+  std::string camera;            // node or camera name; empty: the first camera
+  std::string itemBuffers;       // also write each frame's item buffer here; empty: no
+  std::string report;            // JSON report file; empty: none
+  TextureIntervalsOptions build;
+
+  // Provenance parameters; keys are the long option names without "--": frames, fps, size,
+  // camera, item-buffers, max-level, min-visible-fraction, level-hysteresis, texel-density,
+  // min-size, max-size, resize-tolerance, max-length.
+  nlohmann::json toJson() const;
+};
+
+}  // namespace rad

@@ -1,0 +1,38 @@
+// rad-reference's options (DESIGN.md §8 "error vs converged reference"): the command line binds
+// each flag to a field here, and toJson() is the provenance parameters of every frame it
+// writes, so a flag's name and default are written once (CONVENTIONS.md "Stages with one
+// shape").
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "libcommon/reference/path_tracer.h"
+
+namespace rad {
+
+struct ReferenceOptions {
+  std::string scene;   // glTF scene
+  std::string output;  // directory for NNNN.exr
+  // FIRST-LAST[xSTEP]; empty: the scene's whole animation (animationFrames), filled in by the
+  // tool before toJson() so the provenance records the frames in effect.
+  std::string frames;
+  double fps = 24.0;  // frame f is at time f / fps
+  std::string size = "352x240";
+  std::string camera;  // node or camera name; empty: the first camera
+  int spp = 256;       // samples per pixel
+  int maxDepth = 64;   // reflections per path
+  std::uint64_t seed = 0;
+  bool decorrelateFrames = false;
+  bool pixelCentres = false;
+
+  // The path tracer's options (samples, depth, seed, decorrelation, pixel centres).
+  PathTracerOptions pathTracer() const;
+  // Provenance parameters; keys are the long option names without "--": frames, fps, size,
+  // spp, camera, max-depth, seed, decorrelate-frames, pixel-centres.
+  nlohmann::json toJson() const;
+};
+
+}  // namespace rad
