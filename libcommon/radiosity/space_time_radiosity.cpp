@@ -251,7 +251,6 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
     KeySolveInput in;
     in.topToWorld = topTransforms(scene, h, t);
     in.visibility = &vis.visibility();
-    in.keyIndex = uint32_t(k);
     KeyTimeReport kr;
     kr.time = t;
     LinkCache cache;
