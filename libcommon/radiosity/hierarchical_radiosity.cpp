@@ -66,6 +66,26 @@ std::vector<glm::dvec2> convexHull2d(std::vector<glm::dvec2> p) {
 
 }  // namespace
 
+RefinementOracle parseRefinementOracle(const std::string& name) {
+  if (name == "power") return RefinementOracle::kPower;
+  if (name == "error") return RefinementOracle::kError;
+  if (name == "both") return RefinementOracle::kBoth;
+  throw Error(ExitCode::kUsage, "",
+              "refinement oracle '" + name + "'; expected power, error or both");
+}
+
+const char* refinementOracleName(RefinementOracle oracle) {
+  switch (oracle) {
+    case RefinementOracle::kPower:
+      return "power";
+    case RefinementOracle::kError:
+      return "error";
+    case RefinementOracle::kBoth:
+      return "both";
+  }
+  return "?";
+}
+
 double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relTol) {
   if (order != kAutoOrder) return polygonToPolygonFormFactor(p, q, order);
   // Integrate over the smaller patch and use reciprocity: a Gauss rule on the larger one misses

@@ -29,6 +29,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -47,6 +48,9 @@ enum class RefinementOracle {
   kError,  // the power it may carry wrongly: B_q V max(A_p dF_p, A_q dF_q), dF = formFactorSpread
   kBoth,   // either one over eps
 };
+// "power", "error", "both"; anything else is a usage Error naming the value.
+RefinementOracle parseRefinementOracle(const std::string& name);
+const char* refinementOracleName(RefinementOracle oracle);
 
 struct RadiosityOptions {
   RefinementOracle oracle = RefinementOracle::kPower;

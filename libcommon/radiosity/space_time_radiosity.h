@@ -54,7 +54,7 @@ struct KeyTimeReport {
 struct SpaceTimeReport {
   std::vector<KeyTimeReport> keys;
   double secondsSetup = 0, secondsMerge = 0;
-  size_t unionNodes = 0, linkRows = 0, badPairs = 0;
+  size_t topPatches = 0, unionNodes = 0, linkRows = 0, badPairs = 0;
 };
 
 // Link values of `previous` (solved at t0 on `hierarchy`) that stay valid until t1: F, its
