@@ -1,6 +1,7 @@
 // rad-global as a user runs it on the bundled scene: the link hierarchy and its report, the
 // coherent file equal to the --no-coherence one, the same bytes on one core and on all, and
-// one-line usage errors for out-of-range parameters (issue 3 items 7-9).
+// one-line usage errors for out-of-range parameters (issue 3 items 7-9); without --frames, the
+// whole animation (issue 14).
 #include <filesystem>
 #include <fstream>
 #include <thread>
