@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <memory>
 
 #include <tbb/parallel_for.h>
@@ -67,6 +66,26 @@ std::vector<glm::dvec2> convexHull2d(std::vector<glm::dvec2> p) {
 
 }  // namespace
 
+RefinementOracle parseRefinementOracle(const std::string& name) {
+  if (name == "power") return RefinementOracle::kPower;
+  if (name == "error") return RefinementOracle::kError;
+  if (name == "both") return RefinementOracle::kBoth;
+  throw Error(ExitCode::kUsage, "",
+              "refinement oracle '" + name + "'; expected power, error or both");
+}
+
+const char* refinementOracleName(RefinementOracle oracle) {
+  switch (oracle) {
+    case RefinementOracle::kPower:
+      return "power";
+    case RefinementOracle::kError:
+      return "error";
+    case RefinementOracle::kBoth:
+      return "both";
+  }
+  return "?";
+}
+
 double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relTol) {
   if (order != kAutoOrder) return polygonToPolygonFormFactor(p, q, order);
   // Integrate over the smaller patch and use reciprocity: a Gauss rule on the larger one misses
@@ -128,241 +147,312 @@ glm::dvec3 KeySolution::emittedPower(const PatchHierarchy& h,
   return sum;
 }
 
-KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>& surfaces,
-                         const KeySolveInput& input, const RadiosityOptions& opt) {
-  const int T = h.topCount();
-  if (int(surfaces.size()) != T || int(input.topToWorld.size()) != T)
-    throw Error(ExitCode::kInternal, "", "solveKeyTime: per-top arrays have the wrong size");
-  KeySolution s;
-  std::vector<glm::dvec3> B;
-  // World geometry of every node of the union hierarchy (nodes made here are appended).
-  auto ensureNodes = [&]() {
-    for (int i = int(s.world.size()); i < h.size(); ++i) {
-      const PatchNode& n = h.node(i);
-      s.world.push_back(n.local.transformed(input.topToWorld[n.id.top]));
-      s.area.push_back(s.world.back().area());
-      s.split.push_back(0);
-      B.push_back(n.parent >= 0 ? B[size_t(n.parent)] : surfaces[n.id.top].emission);
-    }
-  };
-  ensureNodes();
-
-  // Absolute refinement threshold: eps times the largest emitted power over the channels.
-  glm::dvec3 emitted(0.0);
-  double rhoMax = 0.0;
-  for (int t = 0; t < T; ++t) {
-    emitted += s.area[size_t(t)] * surfaces[size_t(t)].emission;
-    rhoMax = std::max(rhoMax, maxComponent(surfaces[size_t(t)].reflectance));
-  }
-  const double epsAbs = opt.eps * maxComponent(emitted);
-  const bool refineOn = opt.refine && epsAbs > 0.0;
-
-  auto t0 = std::chrono::steady_clock::now();
-  // Top-level links between every mutually facing pair.
-  for (int p = 0; p < T; ++p)
-    for (int q = 0; q < T; ++q)
-      if (p != q && s.area[size_t(p)] > 0 && s.area[size_t(q)] > 0 &&
-          mutuallyFacing(s.world[size_t(p)], s.world[size_t(q)])) {
+std::vector<SolverLink> linkTopLevel(const std::vector<Polygon>& world,
+                                     const std::vector<double>& area, int topCount) {
+  std::vector<SolverLink> links;
+  for (int p = 0; p < topCount; ++p)
+    for (int q = 0; q < topCount; ++q)
+      if (p != q && area[size_t(p)] > 0 && area[size_t(q)] > 0 &&
+          mutuallyFacing(world[size_t(p)], world[size_t(q)])) {
         SolverLink l;
         l.receiver = p;
         l.shooter = q;
-        s.links.push_back(l);
+        links.push_back(l);
       }
+  return links;
+}
 
-  size_t evaluated = 0;  // links [0, evaluated) have their estimate and visibility
-  auto evaluateNew = [&]() {
-    size_t begin = evaluated, end = s.links.size();
-    tbb::parallel_for(begin, end, [&](size_t li) {
-      SolverLink& l = s.links[li];
-      const PatchNode& r = h.node(l.receiver);
-      const PatchNode& q = h.node(l.shooter);
-      const Polygon& P = s.world[size_t(l.receiver)];
-      const Polygon& Q = s.world[size_t(l.shooter)];
-      auto shadowRays = [&] {
-        return input.visibility ? input.visibility->visibility(P, Q, opt.rays, linkSeed(r.id, q.id),
-                                                               r.id.top, q.id.top)
-                                : 1.0;
-      };
-      if (input.reuse) {
-        auto it = input.reuse->find({r.id.packed(), q.id.packed()});
-        if (it != input.reuse->end()) {
-          // The values, never a decision: F starts as the estimate as in a fresh evaluation,
-          // and computeAccurate takes the known accurate F instead of integrating again.
-          const CachedLink& c = it->second;
-          l.estimate = c.estimate;
-          l.spreadArea = c.spreadArea;
-          l.formFactor = l.estimate;
-          l.knownFormFactor = c.formFactor;
-          if (c.visibilityValid) {
-            l.visibility = c.visibility;
-            l.reused = true;
-          } else {
-            l.visibility = shadowRays();
-            l.visibilityOnly = true;
-          }
-          return;
-        }
+namespace {
+
+// One key-time solve as its named passes (see the header): link top level, then rounds of
+// evaluate + refine, accurate pass, gather + push-pull, until a round refines nothing. The
+// passes share the solution being built, the radiosity B of every node and the thresholds.
+class KeyTimeSolver {
+ public:
+  KeyTimeSolver(PatchHierarchy& h, const std::vector<SurfaceProperties>& surfaces,
+                const KeySolveInput& input, const RadiosityOptions& opt)
+      : h_(h), surfaces_(surfaces), input_(input), opt_(opt) {
+    addNewNodes();
+    setThresholds();
+  }
+
+  KeySolution run() {
+    s_.links = linkTopLevel(s_.world, s_.area, h_.topCount());
+    for (int round = 0;; ++round) {
+      auto tl = std::chrono::steady_clock::now();
+      size_t refined = 0;
+      if (refineOn_)
+        refined = refine(unrefinedLinks());
+      else
+        evaluateNewLinks();
+      if (round > 0 && refined == 0) {
+        s_.secondsLinks += secondsSince(tl);
+        break;
       }
-      double ap = s.area[size_t(l.receiver)], aq = s.area[size_t(l.shooter)];
-      // Both directions: the centroid estimate alone can miss a near-contact pair.
-      const double fpq = formFactorEstimate(P, Q), fqp = formFactorEstimate(Q, P);
-      l.estimate = std::min(1.0, std::max(fpq, fqp * aq / ap));
-      l.formFactor = l.estimate;
-      if (opt.oracle != RefinementOracle::kPower)
-        l.spreadArea = std::max(ap * formFactorSpread(P, Q, fpq), aq * formFactorSpread(Q, P, fqp));
-      l.visibility = shadowRays();
-    });
-    evaluated = end;
-  };
+      computeAccurateFormFactors();
+      s_.secondsLinks += secondsSince(tl);
+      auto ts = std::chrono::steady_clock::now();
+      solve();
+      s_.secondsSolve += secondsSince(ts);
+      s_.refineRounds = round + 1;
+      if (!refineOn_ || round + 1 >= opt_.maxRefineRounds) break;
+    }
+    return finish();
+  }
+
+ private:
+  // World geometry and starting radiosity of the nodes of the union hierarchy this solve has
+  // not seen yet (the ones made before it, then the ones each subdivision appends). A node
+  // starts with its parent's B, a top-level patch with its emission.
+  void addNewNodes() {
+    for (int i = int(s_.world.size()); i < h_.size(); ++i) {
+      const PatchNode& n = h_.node(i);
+      s_.world.push_back(n.local.transformed(input_.topToWorld[n.id.top]));
+      s_.area.push_back(s_.world.back().area());
+      s_.split.push_back(0);
+      B_.push_back(n.parent >= 0 ? B_[size_t(n.parent)] : surfaces_[n.id.top].emission);
+    }
+  }
+
+  // The absolute refinement threshold eps * Phi (Phi = largest emitted power over the colour
+  // channels) and the stop rule tol * (1 - rho_max) of the Gauss-Seidel sweeps.
+  void setThresholds() {
+    glm::dvec3 emitted(0.0);
+    double rhoMax = 0.0;
+    for (int t = 0; t < h_.topCount(); ++t) {
+      emitted += s_.area[size_t(t)] * surfaces_[size_t(t)].emission;
+      rhoMax = std::max(rhoMax, maxComponent(surfaces_[size_t(t)].reflectance));
+    }
+    epsAbs_ = opt_.eps * maxComponent(emitted);
+    refineOn_ = opt_.refine && epsAbs_ > 0.0;
+    stopChange_ = opt_.tol * std::max(1.0 - rhoMax, 1e-6);
+  }
+
+  // Evaluate: the oracle's estimate F~ (and spread) and the visibility V of every link made
+  // since the last call, in parallel (each link writes only itself).
+  void evaluateNewLinks() {
+    size_t begin = evaluated_, end = s_.links.size();
+    tbb::parallel_for(begin, end, [&](size_t li) { evaluateLink(s_.links[li]); });
+    evaluated_ = end;
+  }
+
+  void evaluateLink(SolverLink& l) const {
+    const PatchNode& r = h_.node(l.receiver);
+    const PatchNode& q = h_.node(l.shooter);
+    const Polygon& P = s_.world[size_t(l.receiver)];
+    const Polygon& Q = s_.world[size_t(l.shooter)];
+    auto shadowRays = [&] {
+      return input_.visibility ? input_.visibility->visibility(
+                                     P, Q, opt_.rays, linkSeed(r.id, q.id), r.id.top, q.id.top)
+                               : 1.0;
+    };
+    if (input_.reuse) {
+      auto it = input_.reuse->find({r.id.packed(), q.id.packed()});
+      if (it != input_.reuse->end()) {
+        // The values, never a decision: F starts as the estimate as in a fresh evaluation,
+        // and the accurate pass takes the known accurate F instead of integrating again.
+        const CachedLink& c = it->second;
+        l.estimate = c.estimate;
+        l.spreadArea = c.spreadArea;
+        l.formFactor = l.estimate;
+        l.knownFormFactor = c.formFactor;
+        if (c.visibilityValid) {
+          l.visibility = c.visibility;
+          l.reused = true;
+        } else {
+          l.visibility = shadowRays();
+          l.visibilityOnly = true;
+        }
+        return;
+      }
+    }
+    double ap = s_.area[size_t(l.receiver)], aq = s_.area[size_t(l.shooter)];
+    // Both directions: the centroid estimate alone can miss a near-contact pair.
+    const double fpq = formFactorEstimate(P, Q), fqp = formFactorEstimate(Q, P);
+    l.estimate = std::min(1.0, std::max(fpq, fqp * aq / ap));
+    l.formFactor = l.estimate;
+    if (opt_.oracle != RefinementOracle::kPower)
+      l.spreadArea = std::max(ap * formFactorSpread(P, Q, fpq), aq * formFactorSpread(Q, P, fqp));
+    l.visibility = shadowRays();
+  }
+
+  // The refinement oracle (header): power max_c B_q F~ V A_p, error max_c B_q V spreadArea,
+  // either one, against eps * Phi.
+  bool oracleWantsRefinement(const SolverLink& l) const {
+    double bv = maxComponent(B_[size_t(l.shooter)]) * l.visibility;
+    bool power = bv * l.estimate * s_.area[size_t(l.receiver)] > epsAbs_;
+    bool error = bv * l.spreadArea > epsAbs_;
+    return opt_.oracle == RefinementOracle::kPower   ? power
+           : opt_.oracle == RefinementOracle::kError ? error
+                                                     : power || error;
+  }
 
   // Which node a link would split, or -1 (HSA'91: the larger one, if above minArea).
-  auto nodeToSplit = [&](const SolverLink& l) {
+  int nodeToSplit(const SolverLink& l) const {
     int a = l.receiver, b = l.shooter;
-    if (s.area[size_t(b)] > s.area[size_t(a)]) std::swap(a, b);
+    if (s_.area[size_t(b)] > s_.area[size_t(a)]) std::swap(a, b);
     for (int n : {a, b})
-      if (s.area[size_t(n)] > opt.minArea && h.node(n).id.level() < PatchId::kMaxLevel) return n;
+      if (s_.area[size_t(n)] > opt_.minArea && h_.node(n).id.level() < PatchId::kMaxLevel) return n;
     return -1;
-  };
-  // Refines the links of `work` (and the links that makes) until the oracle is satisfied.
-  auto refinePass = [&](std::vector<size_t> work) {
+  }
+
+  // Subdivides `node` (one end of link li) and replaces the link by its four children's links,
+  // whose indices go to `next`.
+  void splitLink(size_t li, int node, std::vector<size_t>& next) {
+    const SolverLink l = s_.links[li];  // a copy: push_back below may move the links
+    bool fresh = !s_.split[size_t(node)];
+    int first = h_.subdivide(node);
+    addNewNodes();
+    s_.split[size_t(node)] = 1;
+    if (fresh)  // children enter this key's tree with their parent's radiosity
+      for (int c = 0; c < 4; ++c) B_[size_t(first + c)] = B_[size_t(node)];
+    s_.links[li].refined = true;
+    for (int c = 0; c < 4; ++c) {
+      SolverLink child;
+      child.receiver = node == l.receiver ? first + c : l.receiver;
+      child.shooter = node == l.receiver ? l.shooter : first + c;
+      next.push_back(s_.links.size());
+      s_.links.push_back(child);
+    }
+  }
+
+  // Refine: the links of `work`, and the links that makes, until the oracle is satisfied
+  // (each generation evaluated first). Returns the number of links refined.
+  size_t refine(std::vector<size_t> work) {
     size_t count = 0;
     while (!work.empty()) {
-      evaluateNew();
+      evaluateNewLinks();
       std::vector<size_t> next;
       for (size_t li : work) {
-        if (s.links[li].refined) continue;
-        SolverLink l = s.links[li];
-        double bv = maxComponent(B[size_t(l.shooter)]) * l.visibility;
-        bool power = bv * l.estimate * s.area[size_t(l.receiver)] > epsAbs;
-        bool error = bv * l.spreadArea > epsAbs;
-        bool want = (opt.oracle == RefinementOracle::kPower   ? power
-                     : opt.oracle == RefinementOracle::kError ? error
-                                                              : power || error);
-        if (!want) continue;
-        int node = nodeToSplit(l);
+        if (s_.links[li].refined || !oracleWantsRefinement(s_.links[li])) continue;
+        int node = nodeToSplit(s_.links[li]);
         if (node < 0) continue;
-        bool fresh = !s.split[size_t(node)];
-        int first = h.subdivide(node);
-        ensureNodes();
-        s.split[size_t(node)] = 1;
-        if (fresh)  // children enter this key's tree with their parent's radiosity
-          for (int c = 0; c < 4; ++c) B[size_t(first + c)] = B[size_t(node)];
-        s.links[li].refined = true;
-        for (int c = 0; c < 4; ++c) {
-          SolverLink child;
-          child.receiver = node == l.receiver ? first + c : l.receiver;
-          child.shooter = node == l.receiver ? l.shooter : first + c;
-          next.push_back(s.links.size());
-          s.links.push_back(child);
-        }
+        splitLink(li, node, next);
         ++count;
       }
       work.swap(next);
     }
     return count;
-  };
+  }
 
-  auto computeAccurate = [&]() {
-    tbb::parallel_for(size_t(0), s.links.size(), [&](size_t li) {
-      SolverLink& l = s.links[li];
+  std::vector<size_t> unrefinedLinks() const {
+    std::vector<size_t> work;
+    for (size_t i = 0; i < s_.links.size(); ++i)
+      if (!s_.links[i].refined) work.push_back(i);
+    return work;
+  }
+
+  // Accurate pass: the quadrature F (linkFormFactor) of every visible leaf link not yet
+  // computed, or the accurate F the previous key time already computed (coherence).
+  void computeAccurateFormFactors() {
+    tbb::parallel_for(size_t(0), s_.links.size(), [&](size_t li) {
+      SolverLink& l = s_.links[li];
       if (l.refined || l.accurate) return;
       if (l.visibility > 0.0) {
         if (l.knownFormFactor >= 0.0) {
           l.formFactor = l.knownFormFactor;
         } else {
-          l.formFactor = linkFormFactor(s.world[size_t(l.receiver)], s.world[size_t(l.shooter)],
-                                        opt.quadratureOrder, opt.formFactorTolerance);
+          l.formFactor = linkFormFactor(s_.world[size_t(l.receiver)], s_.world[size_t(l.shooter)],
+                                        opt_.quadratureOrder, opt_.formFactorTolerance);
           l.reused = false;  // computed here after all
           l.visibilityOnly = false;
         }
       }
       l.accurate = true;
     });
-  };
+  }
 
-  // Gather + push-pull (HSA'91 §5), Gauss-Seidel over the top-level patches.
-  std::vector<size_t> adjStart, adj;
-  std::vector<glm::dvec3> irr;
-  double maxDelta = 0, maxB = 0;
-  std::function<glm::dvec3(int, const glm::dvec3&)> pushPull = [&](int i, const glm::dvec3& down) {
+  // Per receiving node, its gathered (unrefined) links in link order: adj_[adjStart_[i] ..
+  // adjStart_[i + 1]).
+  void buildGatherLists() {
+    size_t N = size_t(h_.size());
+    adjStart_.assign(N + 1, 0);
+    for (const SolverLink& l : s_.links)
+      if (!l.refined) ++adjStart_[size_t(l.receiver) + 1];
+    for (size_t i = 0; i < N; ++i) adjStart_[i + 1] += adjStart_[i];
+    adj_.assign(adjStart_[N], 0);
+    std::vector<size_t> fill(adjStart_.begin(), adjStart_.end() - 1);
+    for (size_t li = 0; li < s_.links.size(); ++li)
+      if (!s_.links[li].refined) adj_[fill[size_t(s_.links[li].receiver)]++] = li;
+  }
+
+  // Gather + push-pull at node i (HSA'91 §5): $H_i = H_{down} + \sum_j F_{ij} V_{ij} B_j$ over
+  // its links, pushed down to the children; a leaf sets $B_i = E_i + \rho_i H_i$, a parent
+  // pulls up the area average of its children. Returns $B_i A_i$.
+  glm::dvec3 gatherPushPull(int i, const glm::dvec3& down) {
     glm::dvec3 H = down;
-    for (size_t k = adjStart[size_t(i)]; k < adjStart[size_t(i) + 1]; ++k) {
-      const SolverLink& l = s.links[adj[k]];
-      H += double(l.fv()) * B[size_t(l.shooter)];
+    for (size_t k = adjStart_[size_t(i)]; k < adjStart_[size_t(i) + 1]; ++k) {
+      const SolverLink& l = s_.links[adj_[k]];
+      H += double(l.fv()) * B_[size_t(l.shooter)];
     }
-    irr[size_t(i)] = H;
-    if (!s.split[size_t(i)]) {
-      const SurfaceProperties& sp = surfaces[h.node(i).id.top];
+    irr_[size_t(i)] = H;
+    if (!s_.split[size_t(i)]) {
+      const SurfaceProperties& sp = surfaces_[h_.node(i).id.top];
       glm::dvec3 b = sp.emission + sp.reflectance * H;
-      maxDelta = std::max(maxDelta, maxComponent(glm::abs(b - B[size_t(i)])));
-      maxB = std::max(maxB, maxComponent(glm::abs(b)));
-      B[size_t(i)] = b;
-      return b * s.area[size_t(i)];
+      maxDelta_ = std::max(maxDelta_, maxComponent(glm::abs(b - B_[size_t(i)])));
+      maxB_ = std::max(maxB_, maxComponent(glm::abs(b)));
+      B_[size_t(i)] = b;
+      return b * s_.area[size_t(i)];
     }
-    int first = h.node(i).firstChild;
+    int first = h_.node(i).firstChild;
     glm::dvec3 sum(0.0);
     double areaSum = 0;
     for (int c = 0; c < 4; ++c) {
-      sum += pushPull(first + c, H);
-      areaSum += s.area[size_t(first + c)];
+      sum += gatherPushPull(first + c, H);
+      areaSum += s_.area[size_t(first + c)];
     }
-    B[size_t(i)] = areaSum > 0 ? sum / areaSum : B[size_t(first)];
-    return B[size_t(i)] * s.area[size_t(i)];
-  };
-  const double stopChange = opt.tol * std::max(1.0 - rhoMax, 1e-6);
-  auto solve = [&]() {
-    size_t N = size_t(h.size());
-    adjStart.assign(N + 1, 0);
-    for (const SolverLink& l : s.links)
-      if (!l.refined) ++adjStart[size_t(l.receiver) + 1];
-    for (size_t i = 0; i < N; ++i) adjStart[i + 1] += adjStart[i];
-    adj.assign(adjStart[N], 0);
-    std::vector<size_t> fill(adjStart.begin(), adjStart.end() - 1);
-    for (size_t li = 0; li < s.links.size(); ++li)
-      if (!s.links[li].refined) adj[fill[size_t(s.links[li].receiver)]++] = li;
-    irr.assign(N, glm::dvec3(0.0));
-    for (int it = 0; it < opt.maxIterations; ++it) {
-      maxDelta = maxB = 0;
-      for (int t = 0; t < T; ++t) pushPull(t, glm::dvec3(0.0));
-      ++s.iterations;
-      s.lastChange = maxB > 0 ? maxDelta / maxB : 0.0;
-      if (s.lastChange < stopChange) break;
-    }
-  };
+    B_[size_t(i)] = areaSum > 0 ? sum / areaSum : B_[size_t(first)];
+    return B_[size_t(i)] * s_.area[size_t(i)];
+  }
 
-  std::vector<size_t> work(s.links.size());
-  for (size_t i = 0; i < work.size(); ++i) work[i] = i;
-  for (int round = 0;; ++round) {
-    auto tl = std::chrono::steady_clock::now();
-    size_t refined = 0;
-    if (refineOn)
-      refined = refinePass(work);
-    else
-      evaluateNew();
-    if (round > 0 && refined == 0) {
-      s.secondsLinks += secondsSince(tl);
-      break;
+  // Gauss-Seidel sweeps of gather + push-pull over the top-level patches until the relative
+  // change of B is below the stop rule (or maxIterations).
+  void solve() {
+    buildGatherLists();
+    irr_.assign(size_t(h_.size()), glm::dvec3(0.0));
+    for (int it = 0; it < opt_.maxIterations; ++it) {
+      maxDelta_ = maxB_ = 0;
+      for (int t = 0; t < h_.topCount(); ++t) gatherPushPull(t, glm::dvec3(0.0));
+      ++s_.iterations;
+      s_.lastChange = maxB_ > 0 ? maxDelta_ / maxB_ : 0.0;
+      if (s_.lastChange < stopChange_) break;
     }
-    computeAccurate();
-    s.secondsLinks += secondsSince(tl);
-    auto ts = std::chrono::steady_clock::now();
-    solve();
-    s.secondsSolve += secondsSince(ts);
-    s.refineRounds = round + 1;
-    if (!refineOn || round + 1 >= opt.maxRefineRounds) break;
-    work.clear();
-    for (size_t i = 0; i < s.links.size(); ++i)
-      if (!s.links[i].refined) work.push_back(i);
   }
-  (void)t0;
-  for (const SolverLink& l : s.links) {
-    (l.reused ? s.linksReused : s.linksComputed)++;
-    s.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
+
+  KeySolution finish() {
+    for (const SolverLink& l : s_.links) {
+      (l.reused ? s_.linksReused : s_.linksComputed)++;
+      s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
+    }
+    s_.radiosity = std::move(B_);
+    s_.irradiance = std::move(irr_);
+    s_.irradiance.resize(size_t(h_.size()), glm::dvec3(0.0));
+    return std::move(s_);
   }
-  s.radiosity = std::move(B);
-  s.irradiance = std::move(irr);
-  s.irradiance.resize(size_t(h.size()), glm::dvec3(0.0));
-  return s;
+
+  PatchHierarchy& h_;
+  const std::vector<SurfaceProperties>& surfaces_;
+  const KeySolveInput& input_;
+  const RadiosityOptions& opt_;
+  KeySolution s_;
+  std::vector<glm::dvec3> B_;  // per dense node: radiosity (W/m^2), area average of a parent
+  size_t evaluated_ = 0;       // links [0, evaluated_) have their estimate and visibility
+  double epsAbs_ = 0;          // eps * Phi
+  bool refineOn_ = false;
+  double stopChange_ = 0;  // tol * (1 - rho_max)
+  std::vector<size_t> adjStart_, adj_;
+  std::vector<glm::dvec3> irr_;     // per dense node: H gathered at it and its ancestors
+  double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
+};
+
+}  // namespace
+
+KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>& surfaces,
+                         const KeySolveInput& input, const RadiosityOptions& opt) {
+  const int T = h.topCount();
+  if (int(surfaces.size()) != T || int(input.topToWorld.size()) != T)
+    throw Error(ExitCode::kInternal, "", "solveKeyTime: per-top arrays have the wrong size");
+  return KeyTimeSolver(h, surfaces, input, opt).run();
 }
 
 std::vector<glm::dmat4> topTransforms(const Scene& scene, const PatchHierarchy& hierarchy,

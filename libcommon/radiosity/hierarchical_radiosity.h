@@ -2,17 +2,20 @@
 // radiosity algorithm") and the pieces rad-global's space-time solve is made of (paper §3.1,
 // §4.2; DESIGN.md §6).
 //
-// One key-time solve:
-//  * top-level links p <- q between every mutually facing pair of top-level patches (a pair
-//    where one lies wholly on or behind the other's plane is never linked);
-//  * brightness-weighted refinement (HSA'91 §4, "BF refinement"): a link p <- q is refined
-//    while  max_c B_q,c * F~_pq * V_pq * A_p > eps * Phi  (Phi = largest emitted power over
-//    the colour channels, so eps is relative and the scene's units do not matter) and the
-//    larger of the two patches has area > minArea; the larger patch is subdivided. F~ is the
-//    cheap estimate (formFactorEstimate, both directions), V the link's visibility. Refined
-//    links are kept (flag refined) but not gathered;
-//  * leaf links get the accurate unoccluded F (polygonToPolygonFormFactor) and V from k
-//    stratified shadow-ray pairs (VisibilityScene), seeded from (receiver id, shooter id);
+// One key-time solve, as named passes (solveKeyTime runs them in this order):
+//  * link top level (linkTopLevel): links p <- q between every mutually facing pair of
+//    top-level patches (a pair where one lies wholly on or behind the other's plane is never
+//    linked). All pairs today; the step a clustering method replaces;
+//  * evaluate: every new link gets the cheap estimate F~ (formFactorEstimate, both
+//    directions) and its visibility V from k stratified shadow-ray pairs (VisibilityScene),
+//    seeded from (receiver id, shooter id);
+//  * refine, brightness-weighted (HSA'91 §4, "BF refinement"): a link p <- q is refined while
+//    max_c B_q,c * F~_pq * V_pq * A_p > eps * Phi  (Phi = largest emitted power over the
+//    colour channels, so eps is relative and the scene's units do not matter) and the larger
+//    of the two patches has area > minArea; the larger patch is subdivided and its four
+//    children's links are evaluated and refined in turn. Refined links are kept (flag
+//    refined) but not gathered;
+//  * accurate pass: leaf links get the accurate unoccluded F (polygonToPolygonFormFactor);
 //  * gather + push-pull (HSA'91 §5), Gauss-Seidel over the top-level patches, until the
 //    relative change of B is below tol * (1 - rho_max) (the stop rule of the furnace
 //    reference: a change below tol alone leaves an error of tol / (1 - rho));
@@ -26,15 +29,16 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/radiosity/visibility.h"
 #include "libcommon/scene/patch_hierarchy.h"
 #include "libcommon/scene/scene.h"
-#include "libcommon/radiosity/visibility.h"
 
 namespace rad {
 
@@ -44,6 +48,9 @@ enum class RefinementOracle {
   kError,  // the power it may carry wrongly: B_q V max(A_p dF_p, A_q dF_q), dF = formFactorSpread
   kBoth,   // either one over eps
 };
+// "power", "error", "both"; anything else is a usage Error naming the value.
+RefinementOracle parseRefinementOracle(const std::string& name);
+const char* refinementOracleName(RefinementOracle oracle);
 
 struct RadiosityOptions {
   RefinementOracle oracle = RefinementOracle::kPower;
@@ -107,7 +114,6 @@ using LinkCache = std::unordered_map<std::pair<uint64_t, uint64_t>, CachedLink, 
 struct KeySolveInput {
   std::vector<glm::dmat4> topToWorld;           // per top-level patch: its node's world transform
   const VisibilityScene* visibility = nullptr;  // null: every link fully visible
-  uint32_t keyIndex = 0;                        // for reports only (seeds ignore it)
   const LinkCache* reuse = nullptr;             // coherence: values to take over
 };
 
@@ -140,6 +146,14 @@ struct KeySolution {
 // One key-time solve (see the top of this file). Subdivides `hierarchy` as needed.
 KeySolution solveKeyTime(PatchHierarchy& hierarchy, const std::vector<SurfaceProperties>& surfaces,
                          const KeySolveInput& input, const RadiosityOptions& options);
+
+// The top-level links of a key-time solve (first pass above): receiver p <- shooter q for
+// every ordered pair of distinct top-level patches p, q < topCount with positive area that are
+// mutuallyFacing, in (p, q) order. `world` and `area` are per dense node (the top-level patches
+// first). O(topCount^2): the door for clustering (Smits, Arvo, Greenberg 1994), which would
+// link clusters here and leave the other passes as they are.
+std::vector<SolverLink> linkTopLevel(const std::vector<Polygon>& world,
+                                     const std::vector<double>& area, int topCount);
 
 // Unoccluded F(p -> q) of a leaf link. kAutoOrder: integrated over the smaller of the two
 // with reciprocity (A_p F_pq = A_q F_qp), adaptively near contact (centroid distance below

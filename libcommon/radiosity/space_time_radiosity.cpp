@@ -166,8 +166,8 @@ BadLinkRule parseBadLinkRule(const std::string& s) {
   if (s == "partial") return BadLinkRule::kPartial;
   if (s == "all") return BadLinkRule::kAll;
   if (s == "none") return BadLinkRule::kNone;
-  throw Error(ExitCode::kUsage, "--bad-links",
-              "expected lights, partial, all or none, got '" + s + "'");
+  throw Error(ExitCode::kUsage, "",
+              "bad link rule '" + s + "'; expected lights, partial, all or none");
 }
 
 const char* badLinkRuleName(BadLinkRule r) {
@@ -225,89 +225,136 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
   return cache;
 }
 
-GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
-                              const SpaceTimeOptions& opt, SpaceTimeReport* report) {
-  SpaceTimeReport localReport;
-  SpaceTimeReport& rep = report ? *report : localReport;
-  const size_t K = keyTimes.size();
-  if (K == 0) throw Error(ExitCode::kUsage, "", "no key times");
-  auto tSetup = std::chrono::steady_clock::now();
-  PatchHierarchy h(scene.inputPolygons());
-  if (h.topCount() == 0) throw inputError(scene.path, "has no polygons");
-  const int T = h.topCount();
-  std::vector<SurfaceProperties> surfaces = surfacePropertiesOf(scene, h);
-  SceneVisibility vis(scene, h, keyTimes.front(), keyTimes.back());
-  rep.secondsSetup = secondsSince(tSetup);
+namespace {
 
-  std::vector<KeyRecord> records(K);
-  // Per link (receiver << 32 | shooter): its activity intervals so far, compacted as each key
-  // time finishes (memory: the compact result, not every key's links).
-  LinkIntervals intervals;
-  std::vector<char> badPair(size_t(T) * size_t(T), 0);  // paper §3.1, over all key times
-  KeySolution prev;
-  for (size_t k = 0; k < K; ++k) {
-    double t = keyTimes[k];
-    vis.setTime(t);
-    KeySolveInput in;
-    in.topToWorld = topTransforms(scene, h, t);
-    in.visibility = &vis.visibility();
-    in.keyIndex = uint32_t(k);
-    KeyTimeReport kr;
-    kr.time = t;
-    LinkCache cache;
-    if (opt.coherence && k > 0) {
-      auto tc = std::chrono::steady_clock::now();
-      cache = reusableLinks(prev, h, scene, keyTimes[k - 1], t);
-      in.reuse = &cache;
-      kr.secondsCoherence = secondsSince(tc);
-    }
-    KeySolution s = solveKeyTime(h, surfaces, in, opt.radiosity);
-    kr.links = s.links.size();
-    kr.recomputed = s.linksComputed;
-    kr.reused = s.linksReused;
-    kr.visibilityOnly = s.linksVisibilityOnly;
-    kr.iterations = s.iterations;
-    kr.refineRounds = s.refineRounds;
-    kr.secondsLinks = s.secondsLinks;
-    kr.secondsSolve = s.secondsSolve;
-    for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
-    rep.keys.push_back(kr);
-    if (opt.onKeySolved) opt.onKeySolved();
+// Paper §3.1: the second pass recomputes a (receiver, shooter) pair of top-level patches per
+// texel when it is bad. Marks the pair of link l under `rule`, over all key times (a pair once
+// bad stays bad).
+void markBadPair(char& bad, BadLinkRule rule, const SolverLink& l, bool shooterEmits,
+                 double partialThreshold) {
+  switch (rule) {
+    case BadLinkRule::kNone:
+      break;
+    case BadLinkRule::kAll:
+      bad = 1;
+      break;
+    case BadLinkRule::kLights:
+      bad |= shooterEmits;
+      break;
+    case BadLinkRule::kPartial:
+      bad |= shooterEmits ||
+             (!l.refined && float(l.visibility) > partialThreshold && float(l.visibility) < 1.0f);
+      break;
+  }
+}
 
-    KeyRecord& rec = records[k];
-    for (const SolverLink& l : s.links) {
-      intervals.add((uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter), uint32_t(k),
-                    float(l.fv()), float(l.visibility), l.refined);
-      // Bad pairs: by shooter top (and partial visibility).
-      uint32_t rt = h.node(l.receiver).id.top, st = h.node(l.shooter).id.top;
-      char& bad = badPair[size_t(rt) * size_t(T) + st];
-      switch (opt.badLinks) {
-        case BadLinkRule::kNone:
-          break;
-        case BadLinkRule::kAll:
-          bad = 1;
-          break;
-        case BadLinkRule::kLights:
-          bad |= surfaces[st].isEmitter();
-          break;
-        case BadLinkRule::kPartial:
-          bad |= surfaces[st].isEmitter() ||
-                 (!l.refined && float(l.visibility) > opt.partialThreshold &&
-                  float(l.visibility) < 1.0f);
-          break;
-      }
-    }
-    std::vector<glm::dvec3> b = pushedDown(s, h);
-    rec.radiosity.assign(b.begin(), b.end());
-    prev = std::move(s);
+KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, double time,
+                              double secondsCoherence) {
+  KeyTimeReport kr;
+  kr.time = time;
+  kr.secondsCoherence = secondsCoherence;
+  kr.links = s.links.size();
+  kr.recomputed = s.linksComputed;
+  kr.reused = s.linksReused;
+  kr.visibilityOnly = s.linksVisibilityOnly;
+  kr.iterations = s.iterations;
+  kr.refineRounds = s.refineRounds;
+  kr.secondsLinks = s.secondsLinks;
+  kr.secondsSolve = s.secondsSolve;
+  for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
+  return kr;
+}
+
+// The key-time pass (paper §4.2): one hierarchical solve per key time on the shared union
+// hierarchy, each taking over what stays valid of the previous key's links (coherence), and
+// folded into the links' activity intervals, the bad pairs and the per-key radiosity as soon
+// as it is solved.
+class KeyTimePass {
+ public:
+  KeyTimePass(const Scene& scene, const std::vector<double>& keyTimes, const SpaceTimeOptions& opt,
+              SpaceTimeReport& rep)
+      : scene_(scene), keyTimes_(keyTimes), opt_(opt), rep_(rep) {
+    auto tSetup = std::chrono::steady_clock::now();
+    h_ = PatchHierarchy(scene.inputPolygons());
+    if (h_.topCount() == 0) throw inputError(scene.path, "has no polygons");
+    T_ = size_t(h_.topCount());
+    surfaces_ = surfacePropertiesOf(scene, h_);
+    vis_ = std::make_unique<SceneVisibility>(scene, h_, keyTimes.front(), keyTimes.back());
+    rep_.secondsSetup = secondsSince(tSetup);
+    rep_.topPatches = T_;
+    records_.resize(keyTimes.size());
+    badPair_.assign(T_ * T_, 0);
   }
 
-  // ---- merge into the union hierarchy
-  auto tMerge = std::chrono::steady_clock::now();
-  const size_t N = size_t(h.size());
-  GlobalSolution g;
-  g.keyTimes = keyTimes;
-  // Radiosity per node and key; nodes created after key k take their ancestor's value there.
+  void run() {
+    KeySolution prev;
+    for (size_t k = 0; k < keyTimes_.size(); ++k) {
+      KeySolution s = solveKey(k, prev);
+      foldLinks(s, uint32_t(k));
+      std::vector<glm::dvec3> b = pushedDown(s, h_);
+      records_[k].radiosity.assign(b.begin(), b.end());
+      prev = std::move(s);
+    }
+  }
+
+  PatchHierarchy& hierarchy() { return h_; }
+  LinkIntervals& intervals() { return intervals_; }
+  const std::vector<char>& badPairs() const { return badPair_; }  // T x T, receiver-major
+  const std::vector<KeyRecord>& records() const { return records_; }
+
+ private:
+  KeySolution solveKey(size_t k, const KeySolution& prev) {
+    double t = keyTimes_[k];
+    vis_->setTime(t);
+    KeySolveInput in;
+    in.topToWorld = topTransforms(scene_, h_, t);
+    in.visibility = &vis_->visibility();
+    LinkCache cache;
+    double secondsCoherence = 0;
+    if (opt_.coherence && k > 0) {
+      auto tc = std::chrono::steady_clock::now();
+      cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
+      in.reuse = &cache;
+      secondsCoherence = secondsSince(tc);
+    }
+    KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);
+    rep_.keys.push_back(keyTimeReportOf(s, h_, t, secondsCoherence));
+    if (opt_.onKeySolved) opt_.onKeySolved();
+    return s;
+  }
+
+  // Per link (receiver << 32 | shooter): its value at key k into the activity intervals, and
+  // its (receiver top, shooter top) pair into the bad pairs.
+  void foldLinks(const KeySolution& s, uint32_t k) {
+    for (const SolverLink& l : s.links) {
+      intervals_.add((uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter), k, float(l.fv()),
+                     float(l.visibility), l.refined);
+      uint32_t rt = h_.node(l.receiver).id.top, st = h_.node(l.shooter).id.top;
+      markBadPair(badPair_[size_t(rt) * T_ + st], opt_.badLinks, l, surfaces_[st].isEmitter(),
+                  opt_.partialThreshold);
+    }
+  }
+
+  const Scene& scene_;
+  const std::vector<double>& keyTimes_;
+  const SpaceTimeOptions& opt_;
+  SpaceTimeReport& rep_;
+  PatchHierarchy h_;
+  size_t T_ = 0;
+  std::vector<SurfaceProperties> surfaces_;
+  std::unique_ptr<SceneVisibility> vis_;
+  std::vector<KeyRecord> records_;
+  // The activity intervals so far, compacted as each key time finishes (memory: the compact
+  // result, not every key's links).
+  LinkIntervals intervals_;
+  std::vector<char> badPair_;
+};
+
+// Merge: radiosity per node and key; nodes created after key k take their ancestor's value
+// there (a parent's index is below its children's, so it is filled first).
+void mergeNodeRadiosity(const std::vector<KeyRecord>& records, const PatchHierarchy& h,
+                        GlobalSolution& g) {
+  const size_t N = size_t(h.size()), K = records.size();
   g.nodeRadiosity.assign(N * K, glm::vec3(0.0f));
   for (size_t k = 0; k < K; ++k) {
     const KeyRecord& rec = records[k];
@@ -318,59 +365,109 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
       g.nodeRadiosity[i * K + k] = b;
     }
   }
+}
 
+void mergeBadPairs(const std::vector<char>& badPair, size_t T, GlobalSolution& g) {
   for (uint32_t r = 0; r < uint32_t(T); ++r)
     for (uint32_t s = 0; s < uint32_t(T); ++s)
-      if (badPair[size_t(r) * size_t(T) + s]) g.badPairs.emplace_back(r, s);
+      if (badPair[size_t(r) * T + s]) g.badPairs.emplace_back(r, s);
+}
 
-  // Links: one row per activity interval (maximal run of consecutive keys, same refined flag),
-  // in ascending (receiver, shooter) order, rows in key order. Good-link irradiance gathered at
-  // each node at each key, summed in that link order (the same whatever the thread count or
-  // the coherence).
+// One activity interval as a GlobalLink, its samples appended to g.linkSample*.
+GlobalLink globalLinkOf(const LinkIntervals& intervals, const LinkIntervals::Row& r, uint32_t rcv,
+                        uint32_t sh, bool bad, GlobalSolution& g) {
+  GlobalLink gl;
+  gl.receiver = rcv;
+  gl.shooter = sh;
+  gl.firstKey = r.firstKey;
+  gl.lastKey = r.lastKey;
+  gl.sampleOffset = uint32_t(g.linkSampleKeys.size());
+  if (r.constant) {
+    g.linkSampleKeys.push_back(r.firstKey);
+    g.linkSampleValues.push_back(r.firstFv);
+  } else {
+    intervals.forEachKey(r, [&](uint32_t k, float fv) {
+      g.linkSampleKeys.push_back(k);
+      g.linkSampleValues.push_back(fv);
+    });
+  }
+  gl.sampleCount = uint32_t(g.linkSampleKeys.size()) - gl.sampleOffset;
+  gl.flags = uint8_t((bad ? kLinkBad : 0) | (r.visibilityChanged ? kLinkVisibilityEvent : 0) |
+                     (r.refined ? kLinkRefined : 0));
+  return gl;
+}
+
+// Merge: the links, one row per activity interval (maximal run of consecutive keys, same
+// refined flag), in ascending (receiver, shooter) order, rows in key order. Returns the
+// good-link irradiance $H_i = \sum_j F_{ij} V_{ij} B_j$ gathered at each node i at each key
+// (N x K, key-major), summed in that link order (the same whatever the thread count or the
+// coherence). Ends the adding of `intervals`.
+std::vector<glm::dvec3> mergeLinks(LinkIntervals& intervals, const std::vector<char>& badPair,
+                                   const std::vector<KeyRecord>& records, const PatchHierarchy& h,
+                                   GlobalSolution& g) {
+  const size_t N = size_t(h.size()), K = records.size(), T = size_t(h.topCount());
   std::vector<glm::dvec3> goodH(N * K, glm::dvec3(0.0));
-  {
-    const std::vector<std::pair<uint64_t, uint32_t>> linkKeys = intervals.takeSortedLinks();
-    size_t sampleTotal = 0;
-    for (uint32_t i = 0; i < uint32_t(intervals.rowCount()); ++i)
-      sampleTotal += LinkIntervals::sampleCount(intervals.row(i));
-    g.links.reserve(intervals.rowCount());
-    g.linkSampleKeys.reserve(sampleTotal);
-    g.linkSampleValues.reserve(sampleTotal);
-    for (const auto& [key, firstRow] : linkKeys) {
-      uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
-      bool bad = badPair[size_t(h.node(int(rcv)).id.top) * size_t(T) + h.node(int(sh)).id.top];
-      for (uint32_t ri = firstRow; ri != LinkIntervals::kNone; ri = intervals.row(ri).nextRow) {
-        const LinkIntervals::Row& r = intervals.row(ri);
-        if (!bad && !r.refined)
-          intervals.forEachKey(r, [&](uint32_t k, float fv) {
-            goodH[k * N + rcv] += double(fv) * glm::dvec3(records[k].radiosity[sh]);
-          });
-        GlobalLink gl;
-        gl.receiver = rcv;
-        gl.shooter = sh;
-        gl.firstKey = r.firstKey;
-        gl.lastKey = r.lastKey;
-        gl.sampleOffset = uint32_t(g.linkSampleKeys.size());
-        if (r.constant) {
-          g.linkSampleKeys.push_back(r.firstKey);
-          g.linkSampleValues.push_back(r.firstFv);
-        } else {
-          intervals.forEachKey(r, [&](uint32_t k, float fv) {
-            g.linkSampleKeys.push_back(k);
-            g.linkSampleValues.push_back(fv);
-          });
-        }
-        gl.sampleCount = uint32_t(g.linkSampleKeys.size()) - gl.sampleOffset;
-        gl.flags = uint8_t((bad ? kLinkBad : 0) | (r.visibilityChanged ? kLinkVisibilityEvent : 0) |
-                           (r.refined ? kLinkRefined : 0));
-        g.links.push_back(gl);
-      }
+  const std::vector<std::pair<uint64_t, uint32_t>> linkKeys = intervals.takeSortedLinks();
+  size_t sampleTotal = 0;
+  for (uint32_t i = 0; i < uint32_t(intervals.rowCount()); ++i)
+    sampleTotal += LinkIntervals::sampleCount(intervals.row(i));
+  g.links.reserve(intervals.rowCount());
+  g.linkSampleKeys.reserve(sampleTotal);
+  g.linkSampleValues.reserve(sampleTotal);
+  for (const auto& [key, firstRow] : linkKeys) {
+    uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
+    bool bad = badPair[size_t(h.node(int(rcv)).id.top) * T + h.node(int(sh)).id.top];
+    for (uint32_t ri = firstRow; ri != LinkIntervals::kNone; ri = intervals.row(ri).nextRow) {
+      const LinkIntervals::Row& r = intervals.row(ri);
+      if (!bad && !r.refined)
+        intervals.forEachKey(r, [&](uint32_t k, float fv) {
+          goodH[k * N + rcv] += double(fv) * glm::dvec3(records[k].radiosity[sh]);
+        });
+      g.links.push_back(globalLinkOf(intervals, r, rcv, sh, bad, g));
     }
   }
-  intervals = LinkIntervals();  // its memory back before the leaf arrays
+  return goodH;
+}
 
-  // Good-link irradiance at the union leaves' vertices (Gouraud: averaged over the leaves of
-  // the same top-level patch that share the vertex, in exact dyadic top-level (u,v)).
+// The union leaves' shared vertices: per leaf and corner, the index of its vertex among the
+// distinct exact dyadic top-level (u,v) of the same top-level patch (a triangle's fourth corner
+// repeats its first), and per vertex the number of leaf corners at it.
+struct LeafVertices {
+  std::vector<std::array<int, 4>> leafVertex;
+  std::vector<int> vertexCount;
+};
+
+LeafVertices leafVerticesOf(const PatchHierarchy& h, const std::vector<int>& leaves) {
+  LeafVertices out;
+  out.leafVertex.resize(leaves.size());
+  std::vector<std::map<std::pair<double, double>, int>> perTop(size_t(h.topCount()));
+  for (size_t li = 0; li < leaves.size(); ++li) {
+    const PatchNode& n = h.node(leaves[li]);
+    bool tri = n.local.count == 3;
+    const glm::dvec2 corners[4] = {
+        {0, 0}, {1, 0}, tri ? glm::dvec2(0, 1) : glm::dvec2(1, 1), {0, 1}};
+    for (int c = 0; c < 4; ++c) {
+      if (tri && c == 3) {
+        out.leafVertex[li][3] = out.leafVertex[li][0];
+        continue;
+      }
+      glm::dvec2 uv = topUvFromNodeUv(n.id, corners[c], tri);
+      auto [it, fresh] =
+          perTop[n.id.top].emplace(std::make_pair(uv.x, uv.y), int(out.vertexCount.size()));
+      if (fresh) out.vertexCount.push_back(0);
+      out.leafVertex[li][size_t(c)] = it->second;
+      out.vertexCount[size_t(it->second)]++;
+    }
+  }
+  return out;
+}
+
+// Merge: good-link irradiance at the union leaves' vertices (Gouraud: a leaf's H is the sum of
+// goodH over it and its ancestors, averaged at each vertex over the leaves of the same
+// top-level patch that share it), per leaf, key and corner. Also sets g.leafRow.
+void mergeLeafVertexIrradiance(const std::vector<glm::dvec3>& goodH, const PatchHierarchy& h,
+                               size_t K, GlobalSolution& g) {
+  const size_t N = size_t(h.size());
   g.leafRow.assign(N, -1);
   std::vector<int> leaves;
   for (size_t i = 0; i < N; ++i)
@@ -379,53 +476,51 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
       leaves.push_back(int(i));
     }
   const size_t L = leaves.size();
-  std::vector<std::array<int, 4>> leafVertex(L);  // vertex index per corner
-  std::vector<int> vertexCount;
-  {
-    std::vector<std::map<std::pair<double, double>, int>> perTop(static_cast<size_t>(T));
-    for (size_t li = 0; li < L; ++li) {
-      const PatchNode& n = h.node(leaves[li]);
-      bool tri = n.local.count == 3;
-      const glm::dvec2 corners[4] = {
-          {0, 0}, {1, 0}, tri ? glm::dvec2(0, 1) : glm::dvec2(1, 1), {0, 1}};
-      for (int c = 0; c < 4; ++c) {
-        if (tri && c == 3) {
-          leafVertex[li][3] = leafVertex[li][0];
-          continue;
-        }
-        glm::dvec2 uv = topUvFromNodeUv(n.id, corners[c], tri);
-        auto [it, fresh] =
-            perTop[n.id.top].emplace(std::make_pair(uv.x, uv.y), int(vertexCount.size()));
-        if (fresh) vertexCount.push_back(0);
-        leafVertex[li][size_t(c)] = it->second;
-        vertexCount[size_t(it->second)]++;
-      }
-    }
-  }
+  const LeafVertices lv = leafVerticesOf(h, leaves);
   g.leafVertexGoodIrradiance.assign(L * K * 4, glm::vec3(0.0f));
-  std::vector<glm::dvec3> leafH(L), vertexSum(vertexCount.size());
+  std::vector<glm::dvec3> vertexSum(lv.vertexCount.size());
   for (size_t k = 0; k < K; ++k) {
     const glm::dvec3* nodeH = &goodH[k * N];
     std::fill(vertexSum.begin(), vertexSum.end(), glm::dvec3(0.0));
     for (size_t li = 0; li < L; ++li) {
       glm::dvec3 H(0.0);
       for (int a = leaves[li]; a >= 0; a = h.node(a).parent) H += nodeH[size_t(a)];
-      leafH[li] = H;
       const PatchNode& n = h.node(leaves[li]);
       for (int c = 0; c < (n.local.count == 3 ? 3 : 4); ++c)
-        vertexSum[size_t(leafVertex[li][size_t(c)])] += H;
+        vertexSum[size_t(lv.leafVertex[li][size_t(c)])] += H;
     }
     for (size_t li = 0; li < L; ++li)
       for (int c = 0; c < 4; ++c) {
-        int v = leafVertex[li][size_t(c)];
+        int v = lv.leafVertex[li][size_t(c)];
         g.leafVertexGoodIrradiance[(li * K + k) * 4 + size_t(c)] =
-            glm::vec3(vertexSum[size_t(v)] / double(vertexCount[size_t(v)]));
+            glm::vec3(vertexSum[size_t(v)] / double(lv.vertexCount[size_t(v)]));
       }
   }
-  g.hierarchy = std::move(h);
+}
+
+}  // namespace
+
+GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
+                              const SpaceTimeOptions& opt, SpaceTimeReport* report) {
+  SpaceTimeReport localReport;
+  SpaceTimeReport& rep = report ? *report : localReport;
+  if (keyTimes.empty()) throw Error(ExitCode::kUsage, "", "no key times");
+  KeyTimePass pass(scene, keyTimes, opt, rep);
+  pass.run();
+
+  auto tMerge = std::chrono::steady_clock::now();
+  GlobalSolution g;
+  g.keyTimes = keyTimes;
+  mergeNodeRadiosity(pass.records(), pass.hierarchy(), g);
+  mergeBadPairs(pass.badPairs(), size_t(pass.hierarchy().topCount()), g);
+  std::vector<glm::dvec3> goodH =
+      mergeLinks(pass.intervals(), pass.badPairs(), pass.records(), pass.hierarchy(), g);
+  pass.intervals() = LinkIntervals();  // its memory back before the leaf arrays
+  mergeLeafVertexIrradiance(goodH, pass.hierarchy(), keyTimes.size(), g);
+  rep.unionNodes = size_t(pass.hierarchy().size());
+  g.hierarchy = std::move(pass.hierarchy());
   g.validate("rad-global");
   rep.secondsMerge = secondsSince(tMerge);
-  rep.unionNodes = N;
   rep.linkRows = g.links.size();
   rep.badPairs = g.badPairs.size();
   return g;

@@ -54,7 +54,7 @@ struct KeyTimeReport {
 struct SpaceTimeReport {
   std::vector<KeyTimeReport> keys;
   double secondsSetup = 0, secondsMerge = 0;
-  size_t unionNodes = 0, linkRows = 0, badPairs = 0;
+  size_t topPatches = 0, unionNodes = 0, linkRows = 0, badPairs = 0;
 };
 
 // Link values of `previous` (solved at t0 on `hierarchy`) that stay valid until t1: F, its
@@ -62,7 +62,11 @@ struct SpaceTimeReport {
 LinkCache reusableLinks(const KeySolution& previous, const PatchHierarchy& hierarchy,
                         const Scene& scene, double t0, double t1);
 
-// The whole first pass: key times must be strictly increasing.
+// The whole first pass: key times must be strictly increasing. Two passes: the key-time pass
+// (per key: the visibility scene at t, the links coherence keeps from the previous key,
+// solveKeyTime, its links folded into activity intervals and bad pairs), then the merge into
+// the union hierarchy (node radiosity per key, bad pairs, link rows with their F·V samples,
+// good-link irradiance at the leaves' vertices).
 GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
                               const SpaceTimeOptions& options, SpaceTimeReport* report = nullptr);
 

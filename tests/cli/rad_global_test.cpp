@@ -1,6 +1,7 @@
 // rad-global as a user runs it on the bundled scene: the link hierarchy and its report, the
 // coherent file equal to the --no-coherence one, the same bytes on one core and on all, and
-// one-line usage errors for out-of-range parameters (issue 3 items 7-9).
+// one-line usage errors for out-of-range parameters (issue 3 items 7-9); without --frames, the
+// whole animation (issue 14).
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
+#include "formats/container.h"
 #include "formats/gltf_scene.h"
 #include "formats/link_hierarchy.h"
 
@@ -31,8 +33,8 @@ fs::path scratchDir() {
 
 TEST(RadGlobal, BundledSceneLinksReportAndInspect) {
   fs::path d = scratchDir();
-  auto r = runCommand(tool("rad-global") + " " + kScene + " -o " + (d / "g.rlh").string() +
-                      kFlags + " --report " + (d / "report.json").string());
+  auto r = runCommand(tool("rad-global") + " " + kScene + " -o " + (d / "g.rlh").string() + kFlags +
+                      " --report " + (d / "report.json").string());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.err.find("recomputed"), std::string::npos) << r.err;
   nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "report.json").string()));
@@ -82,10 +84,30 @@ TEST(RadGlobal, SameBytesOnOneCoreAndOnAll) {
   fs::remove_all(d);
 }
 
+// Without --frames rad-global covers the scene's whole animation (frame_range.h
+// animationFrames): the bundled scene lasts 4 s, so at 24 fps its frames are 0-96. (Before issue
+// 14 the default was 0-0, one key time at t = 0.)
+TEST(RadGlobal, WithoutFramesCoversTheWholeAnimation) {
+  fs::path d = scratchDir();
+  const std::string out = (d / "whole.rlh").string();
+  auto r =
+      runCommand(tool("rad-global") + " " + kScene + " -o " + out +
+                 " --fps 24 --key-step 48 --eps 3e-3 --report " + (d / "report.json").string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json meta = ContainerReader::open(out).metadata();
+  EXPECT_EQ(meta.at("first_frame"), 0) << meta.dump();
+  EXPECT_EQ(meta.at("last_frame"), 96) << meta.dump();
+  EXPECT_EQ(meta.at("parameters").at("frames"), "0-96") << meta.dump();
+  nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "report.json").string()));
+  ASSERT_EQ(rep["key_times"].size(), 3u);  // frames 0, 48, 96
+  EXPECT_DOUBLE_EQ(rep["key_times"][2]["time"].get<double>(), 4.0);
+  fs::remove_all(d);
+}
+
 TEST(RadGlobal, OutOfRangeParametersAreUsageErrors) {
-  for (const char* bad : {"--eps -1", "--key-step 0", "--rays 0", "--tol 0", "--oracle fast",
-                          "--bad-links some", "--partial-threshold 2", "--threads -1",
-                          "--frames 9-x"}) {
+  for (const char* bad :
+       {"--eps -1", "--key-step 0", "--rays 0", "--tol 0", "--oracle fast", "--bad-links some",
+        "--partial-threshold 2", "--threads -1", "--frames 9-x"}) {
     auto r = runCommand(tool("rad-global") + " " + kScene + " -o /tmp/never.rlh " + bad);
     EXPECT_EQ(r.exitCode, 2) << bad << ": " << r.err;
     EXPECT_EQ(test::countLines(r.err), 1) << bad << ": " << r.err;

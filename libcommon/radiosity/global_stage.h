@@ -1,0 +1,62 @@
+// rad-global as a stage (paper §3.1, §4.2; DESIGN.md §6 "rad-global"): the options its command
+// line binds and records as provenance, the key-time schedule and the min-area default derived
+// from them, and the run report. The algorithm itself is solveSpaceTime
+// (space_time_radiosity.h); the tool parses, calls the functions here and writes global.rlh.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "libcommon/radiosity/space_time_radiosity.h"
+#include "libcommon/scene/frame_range.h"
+#include "libcommon/scene/scene.h"
+
+namespace rad {
+
+// Every parameter of rad-global's solve, defaults written here once.
+struct GlobalOptions {
+  // The frames as given, oiiotool style FIRST-LAST[xSTEP]; empty: the scene's whole animation
+  // (animationFrames). The key times span the first to the last frame named.
+  std::string frames;
+  double fps = 24.0;  // frame f is at time f / fps
+  // Frames between key times (>= 1; the last frame is always one). 8, not 4: on four scenes
+  // (the bundled one, 8 cubes, the table with moving lights, static and following camera; 48
+  // frames, tradeoff.py) 8 gave the same error against the path-traced reference to 0.03 % and
+  // 17-28 % less CPU time; the good links' indirect light between keys is smooth, and the
+  // lights' (bad) links are re-evaluated per movie key anyway.
+  int keyStep = 8;
+  // radiosity.minArea 0 (the default): resolveMinArea's 1e-4 of the largest top-level patch.
+  SpaceTimeOptions spaceTime;
+
+  // The provenance parameters: every parameter under its flag's name ("frames", "fps",
+  // "key-step", "eps", "oracle", "min-area", "rays", "tol", "bad-links", "partial-threshold",
+  // "no-coherence"). Call it once frames and min-area are resolved, so the record says what ran.
+  nlohmann::json toJson() const;
+};
+
+// The key times of frames first..last: keyFrames(first, last, keyStep) (the one key schedule,
+// frame_range.h), frame f at time f / fps (s).
+std::vector<double> keyTimesOf(const FrameRange& frames, int keyStep, double fps);
+
+// minArea when it is > 0; else 1e-4 of the world area (m^2) of the largest top-level patch at
+// time t (rad-global: the first key time), so the subdivision depth does not depend on the
+// scene's units.
+double resolveMinArea(const Scene& scene, double minArea, double t);
+
+// rad-global's run report: the solver's, plus what the tool measures around it.
+struct GlobalReport {
+  SpaceTimeReport solve;
+  double secondsRead = 0, secondsWrite = 0, secondsTotal = 0;  // scene read, file write, all
+  double peakMemoryMb = 0;                                     // of the process (getrusage)
+  bool coherence = true;
+
+  // The --report JSON: key_times[], totals, seconds, peak_memory_mb, coherence
+  // (pipelines/bench.py and the CLI tests read these keys).
+  nlohmann::json toJson() const;
+  // The stderr table: a header line naming `tool`, one row per key time, two total lines.
+  std::string table(const std::string& tool) const;
+};
+
+}  // namespace rad
