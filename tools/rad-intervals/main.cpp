@@ -32,14 +32,6 @@ struct Options {
   rad::TextureIntervalsOptions build;
 };
 
-static_assert(int(rad::MovieEnd::kLeftFrustum) == int(rad::CloseReason::kLeftFrustum) &&
-                  int(rad::MovieEnd::kHidden) == int(rad::CloseReason::kHidden) &&
-                  int(rad::MovieEnd::kLevelChange) == int(rad::CloseReason::kLevelChange) &&
-                  int(rad::MovieEnd::kResize) == int(rad::CloseReason::kResize) &&
-                  int(rad::MovieEnd::kMaxLength) == int(rad::CloseReason::kMaxLength) &&
-                  int(rad::MovieEnd::kWindow) == int(rad::CloseReason::kWindow),
-              "MovieEnd and CloseReason codes must agree");
-
 nlohmann::json parametersOf(const Options& o, const std::string& frames) {
   const rad::TextureIntervalsOptions& b = o.build;
   return {{"frames", frames},
@@ -113,18 +105,7 @@ int run(const Options& given, int argc, char** argv) {
   iv.fps = o.build.fps;
   iv.imageWidth = w;
   iv.imageHeight = h;
-  for (size_t i = 0; i < extents.size(); ++i) {
-    const rad::MovieExtent& e = extents[i];
-    rad::TextureInterval m;
-    m.movie = uint32_t(i);
-    m.patch = e.patch;
-    m.firstFrame = e.firstFrame;
-    m.lastFrame = e.lastFrame;
-    m.width = e.width;
-    m.height = e.height;
-    m.reason = rad::CloseReason(int(e.end));
-    iv.movies.push_back(m);
-  }
+  iv.movies = extents;  // one record: finish() numbers them 0..n-1
   const rad::PatchHierarchy& ph = builder.hierarchy();
   nlohmann::json metadata = {{"top_patches", ph.topCount()},
                              {"patch_nodes", ph.size()},
