@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "formats/form_factor_scratch_file.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/scene/frame_range.h"
@@ -384,6 +385,47 @@ TEST(TextureMovieBaker, SinkGetsTheKeysInOrderBitEqualToTheInMemoryBake) {
   for (size_t k = 0; k < rec.keys.size(); ++k)
     EXPECT_EQ(0, std::memcmp(rec.keys[k].data(), whole.keys[k].data(), rec.keys[k].size() * 4));
   EXPECT_EQ(baker.stats().keys, long(rec.keys.size()));
+}
+
+// The doors (TextureMovieBakerBackends): the mask renderer handed in is the one every render
+// goes through, and parking a moving pair's form factors in the scratch file (as rad-movies
+// does) gives the same movie, bit for bit, as recomputing them.
+TEST(TextureMovieBaker, BackendsAreTheOnesUsedAndTheSpillChangesNoBit) {
+  TestScene t = makeScene(true, false);
+  translate(t.scene, t.lightNode, {-0.3, 0, 0}, {0.3, 0, 0.2}, 0.0, 1.0);
+  struct CountingRenderer : OcclusionMaskRenderer {
+    TransmittanceRenderer gl;
+    long* calls = nullptr;
+    void render(const Polygon& receiver, int width, int height,
+                const std::vector<glm::dvec3>& samples,
+                const std::vector<BlockerTriangle>& blockers,
+                std::vector<SampleMask>& out) override {
+      ++*calls;
+      gl.render(receiver, width, height, samples, blockers, out);
+    }
+    long passes() const override { return gl.passes(); }
+    long samplePasses() const override { return gl.samplePasses(); }
+    std::string rendererName() const override { return "counting " + gl.rendererName(); }
+  };
+  long calls = 0;
+  TextureMovieBakerBackends backends;
+  backends.maskRenderer = [&calls] {
+    auto r = std::make_unique<CountingRenderer>();
+    r->calls = &calls;
+    return r;
+  };
+  backends.formFactorSpill = formFactorScratchFiles();
+  const MovieRequest r = request(t, 16, 12, 0, 24);
+  BakedMovie recomputed = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
+  TextureMovieBaker baker(t.scene, t.solution, kFps, {}, backends);
+  BakedMovie spilled = baker.bake(r);
+  EXPECT_EQ(calls, 5) << "one render per key of the moving pair";
+  EXPECT_EQ(baker.rendererName().rfind("counting ", 0), 0u) << baker.rendererName();
+  ASSERT_EQ(spilled.keys.size(), recomputed.keys.size());
+  for (size_t k = 0; k < spilled.keys.size(); ++k)
+    EXPECT_EQ(0, std::memcmp(spilled.keys[k].data(), recomputed.keys[k].data(),
+                             spilled.keys[k].size() * sizeof(float)))
+        << k;
 }
 
 TEST(TextureMovieBaker, BadRequestsAreInputErrors) {
