@@ -24,7 +24,13 @@
 // computed first; then each key's irradiance is accumulated (good layer, then the bad shooters
 // in badShooters order: the same arithmetic and order as shooter-major) and handed to a
 // BakedKeySink before the next key starts. The working memory is then
-// texels x (per-key buffers + per coherent pair buffers), whatever the number of keys.
+// texels x (per-key buffers + per coherent pair buffers), whatever the number of keys. A moving
+// pair's form factors, scanned ahead of the keys for their largest value, are parked in a
+// FormFactorSpill (form_factor_spill.h) until their key, or recomputed then.
+//
+// Doors (TextureMovieBakerBackends): the occlusion masks come from an OcclusionMaskRenderer
+// (occlusion_mask_renderer.h; OSMesa projective shadows by default) and the spill from a
+// factory, so a new shadow method or scratch store is a new class, not an edit of bake().
 #pragma once
 
 #include <cstdint>
@@ -125,7 +131,8 @@ struct TextureMovieBakerStats {
 class TextureMovieBaker {
  public:
   // scene and solution must outlive the baker; fps converts frames to times (t = frame / fps).
-  // Throws a usage Error for inconsistent options.
+  // Throws a usage Error for inconsistent options. Key frames of a movie: rad::keyFrames(first,
+  // last, options.keyStep) (libcommon/scene/frame_range.h).
   TextureMovieBaker(const Scene& scene, const GlobalSolution& solution, double fps,
                     TextureMovieBakerOptions options, TextureMovieBakerBackends backends = {});
   ~TextureMovieBaker();

@@ -105,7 +105,8 @@ int main(int argc, char** argv) {
          },
          "deprecated name of --movie-key-step")
       ->check(CLI::PositiveNumber)
-      ->excludes(keyStep);
+      ->excludes(keyStep)
+      ->group("Deprecated");
   app.add_option("--min-samples", b.minSamples, "shooter samples per bad link, at least")
       ->capture_default_str();
   app.add_option("--max-samples", b.maxSamples, "shooter samples per bad link, at most (<= 64)")
