@@ -13,14 +13,6 @@ namespace rad {
 
 namespace {
 
-static_assert(int(MovieEnd::kLeftFrustum) == int(CloseReason::kLeftFrustum) &&
-                  int(MovieEnd::kHidden) == int(CloseReason::kHidden) &&
-                  int(MovieEnd::kLevelChange) == int(CloseReason::kLevelChange) &&
-                  int(MovieEnd::kResize) == int(CloseReason::kResize) &&
-                  int(MovieEnd::kMaxLength) == int(CloseReason::kMaxLength) &&
-                  int(MovieEnd::kWindow) == int(CloseReason::kWindow),
-              "MovieEnd and CloseReason codes must agree");
-
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -34,18 +26,7 @@ TextureIntervals intervalsRecord(const std::vector<MovieExtent>& extents,
   iv.fps = options.fps;
   iv.imageWidth = options.imageSize.width;
   iv.imageHeight = options.imageSize.height;
-  for (size_t i = 0; i < extents.size(); ++i) {
-    const MovieExtent& e = extents[i];
-    TextureInterval m;
-    m.movie = uint32_t(i);
-    m.patch = e.patch;
-    m.firstFrame = e.firstFrame;
-    m.lastFrame = e.lastFrame;
-    m.width = e.width;
-    m.height = e.height;
-    m.reason = CloseReason(int(e.end));
-    iv.movies.push_back(m);
-  }
+  iv.movies = extents;  // one record (MovieExtent): finish() numbers them 0..n-1
   return iv;
 }
 

@@ -4,24 +4,6 @@
 
 namespace rad {
 
-const char* closeReasonName(CloseReason r) {
-  switch (r) {
-    case CloseReason::kLeftFrustum:
-      return "left_frustum";
-    case CloseReason::kHidden:
-      return "hidden";
-    case CloseReason::kLevelChange:
-      return "level_change";
-    case CloseReason::kResize:
-      return "resize";
-    case CloseReason::kMaxLength:
-      return "max_length";
-    case CloseReason::kWindow:
-      return "window";
-  }
-  return "unknown";
-}
-
 void writeTextureIntervals(const std::string& path, const TextureIntervals& iv,
                            const Provenance& provenance, const nlohmann::json& metadata) {
   ContainerWriter w(kTextureIntervalsKind, kTextureIntervalsMajor, kTextureIntervalsMinor);
@@ -39,14 +21,14 @@ void writeTextureIntervals(const std::string& path, const TextureIntervals& iv,
   std::vector<int32_t> frames(n * 2), size(n * 2);
   std::vector<uint8_t> reason(n);
   for (size_t i = 0; i < n; ++i) {
-    const TextureInterval& m = iv.movies[i];
+    const MovieExtent& m = iv.movies[i];
     if (m.movie != i) throw Error(ExitCode::kInternal, path, "movie ids are not 0..n-1 in order");
     patch[i] = m.patch.packed();
     frames[2 * i] = m.firstFrame;
     frames[2 * i + 1] = m.lastFrame;
     size[2 * i] = m.width;
     size[2 * i + 1] = m.height;
-    reason[i] = uint8_t(m.reason);
+    reason[i] = uint8_t(m.end);
   }
   w.addArray("movie_patch", patch);
   w.addArray("movie_frames", frames, {n, 2});
@@ -80,7 +62,7 @@ TextureIntervals readTextureIntervals(const ContainerReader& r) {
     throw inputError(where, "movie arrays differ in length");
   iv.movies.resize(n);
   for (size_t i = 0; i < n; ++i) {
-    TextureInterval& m = iv.movies[i];
+    MovieExtent& m = iv.movies[i];
     m.movie = uint32_t(i);
     m.patch = PatchId::fromPacked(patch[i]);
     if (m.patch.path == 0 || m.patch.level() > PatchId::kMaxLevel)
@@ -93,9 +75,9 @@ TextureIntervals readTextureIntervals(const ContainerReader& r) {
       throw inputError(where, "movie " + std::to_string(i) + ": frames outside the window");
     if (m.width < 1 || m.height < 1 || m.width > 16384 || m.height > 16384)
       throw inputError(where, "movie " + std::to_string(i) + ": invalid texture size");
-    if (reason[i] >= kCloseReasonCount)
+    if (reason[i] >= kMovieEndCount)
       throw inputError(where, "movie " + std::to_string(i) + ": unknown close reason");
-    m.reason = CloseReason(reason[i]);
+    m.end = MovieEnd(reason[i]);
   }
   return iv;
 }
@@ -110,12 +92,12 @@ nlohmann::json summarizeTextureIntervals(const ContainerReader& r) {
   size_t n = iv.movies.size();
   double frames = 0, texels = 0;
   std::map<int, int> levels;
-  int reasons[kCloseReasonCount] = {};
-  for (const TextureInterval& m : iv.movies) {
+  int reasons[kMovieEndCount] = {};
+  for (const MovieExtent& m : iv.movies) {
     frames += m.frameCount();
     texels += double(m.width) * m.height * m.frameCount();
     levels[m.level()]++;
-    reasons[int(m.reason)]++;
+    reasons[int(m.end)]++;
   }
   int window = iv.lastFrame - iv.firstFrame + 1;
   j["window"] = {{"first_frame", iv.firstFrame}, {"last_frame", iv.lastFrame}, {"fps", iv.fps}};
@@ -126,7 +108,7 @@ nlohmann::json summarizeTextureIntervals(const ContainerReader& r) {
   for (auto& [l, c] : levels) lv[std::to_string(l)] = c;
   j["movies_per_level"] = lv;
   nlohmann::json rs = nlohmann::json::object();
-  for (int k = 0; k < kCloseReasonCount; ++k) rs[closeReasonName(CloseReason(k))] = reasons[k];
+  for (int k = 0; k < kMovieEndCount; ++k) rs[movieEndName(MovieEnd(k))] = reasons[k];
   j["close_reasons"] = rs;
   return j;
 }

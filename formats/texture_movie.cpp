@@ -73,6 +73,18 @@ void TextureMovie::textureAt(double t, std::vector<float>& out) const {
   for (size_t i = 0; i < n; ++i) out[i] = (1.0f - w) * a[i] + w * b[i];
 }
 
+TextureMovie textureMovieOf(const MovieExtent& extent, std::string provenanceJson) {
+  TextureMovie m;
+  m.movie = extent.movie;
+  m.patch = extent.patch;
+  m.firstFrame = extent.firstFrame;
+  m.lastFrame = extent.lastFrame;
+  m.width = extent.width;
+  m.height = extent.height;
+  m.provenanceJson = std::move(provenanceJson);
+  return m;
+}
+
 std::string textureMoviePath(const std::string& dir, uint32_t id) {
   char name[32];
   std::snprintf(name, sizeof name, "/%06u.exr", id);

@@ -12,6 +12,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/provenance.h"
+#include "libcommon/intervals/movie_extent.h"
 #include "libcommon/scene/patch_hierarchy.h"
 
 namespace rad {
@@ -43,6 +44,10 @@ struct TextureMovie {
     return float((t - keyTimes[k0]) / (keyTimes[k1] - keyTimes[k0]));
   }
 };
+
+// The metadata of the movie baked for one intervals.rti record: its id, patch, frames and size,
+// and the baking tool's provenance (keyFrames, keyTimes and keys empty).
+TextureMovie textureMovieOf(const MovieExtent& extent, std::string provenanceJson);
 
 // Path of movie `id` in `dir`: dir/000042.exr.
 std::string textureMoviePath(const std::string& dir, uint32_t id);

@@ -347,6 +347,7 @@ std::vector<MovieExtent> TextureIntervalsBuilder::finish() {
     if (a.firstFrame != b.firstFrame) return a.firstFrame < b.firstFrame;
     return a.patch.packed() < b.patch.packed();
   });
+  for (size_t i = 0; i < out.size(); ++i) out[i].movie = uint32_t(i);
   return out;
 }
 

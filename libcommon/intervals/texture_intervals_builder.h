@@ -45,8 +45,9 @@
 #include <string>
 #include <vector>
 
-#include "libcommon/scene/camera_projection.h"
 #include "libcommon/gl/item_buffer.h"
+#include "libcommon/intervals/movie_extent.h"
+#include "libcommon/scene/camera_projection.h"
 #include "libcommon/scene/patch_hierarchy.h"
 #include "libcommon/scene/scene.h"
 
@@ -66,28 +67,6 @@ struct TextureIntervalsOptions {
 
   // Throws rad::Error(kUsage) naming the flag of the first invalid value.
   void validate() const;
-};
-
-// Why a movie ended. The codes are those of formats/texture_intervals.h's CloseReason (and of
-// the file format); libcommon does not include formats/, so the tool converts by value.
-enum class MovieEnd : uint8_t {
-  kLeftFrustum = 0,
-  kHidden = 1,
-  kLevelChange = 2,
-  kResize = 3,
-  kMaxLength = 4,
-  kWindow = 5,
-};
-
-struct MovieExtent {
-  PatchId patch;
-  int firstFrame = 0, lastFrame = 0;  // inclusive
-  int width = 1, height = 1;
-  MovieEnd end = MovieEnd::kWindow;
-  bool operator==(const MovieExtent& o) const {
-    return patch == o.patch && firstFrame == o.firstFrame && lastFrame == o.lastFrame &&
-           width == o.width && height == o.height && end == o.end;
-  }
 };
 
 // What one frame looked like (for reports, tests and --item-buffers).
@@ -128,11 +107,11 @@ class TextureIntervalsBuilder {
   // `observer` (may be empty) sees the frame before the next one is rendered.
   void addFrame(int frame, const std::function<void(const IntervalFrame&)>& observer = {});
   // Closes the movies still open (kWindow) and returns all, in id order: sorted by
-  // (firstFrame, patch.packed()).
+  // (firstFrame, patch.packed()), MovieExtent::movie = the index (intervals.rti's ids).
   std::vector<MovieExtent> finish();
 
   // Movies so far (open ones have end == kWindow and lastFrame = the last frame added), in
-  // creation order.
+  // creation order; their ids (MovieExtent::movie) are given by finish() and are 0 here.
   const std::vector<MovieExtent>& movies() const;
   double itemBufferSeconds() const;  // total over the frames added
   int framesAdded() const;

@@ -1,22 +1,32 @@
 // Texture-movie baking (paper §3.1 and §5). Sources and the formula in texture_movie_baker.h.
+//
+// One movie is baked in two parts (MovieBake below):
+//  * planning, once per movie (MovieBake::plan): the texel points and the receiver at every
+//    key (MovieGeometry), then per bad pair its shooter, its form factors (once for a static
+//    pair; a moving pair's are scanned for their largest value and spilled), its samples and
+//    its blockers: a static pair's static blockers are rendered once into a sample mask, its
+//    dynamic ones listed for the keys (§5);
+//  * baking, key by key (MovieBake::bakeKey): the good layer, then per pair in badShooters
+//    order the key's occlusion mask (OcclusionMaskRenderer), merged with the static mask
+//    (mergeOcclusion), times B_S F added to the irradiance (combine), and the clamped key
+//    texture handed to the sink.
 #include "libcommon/movies/texture_movie_baker.h"
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <unordered_map>
-
-#include <unistd.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/scene/frame_range.h"
 
 namespace rad {
 namespace {
@@ -73,71 +83,425 @@ void parallelRows(int height, F&& body) {
   });
 }
 
-// A moving pair's per-key form factors, computed ahead of the keys to find their largest value,
-// are spilled to an unlinked temporary file and read back when their key is baked: the page
-// cache holds them (the kernel writes them out under memory pressure), not the process, and
-// reading them back costs far less than recomputing. Any failure (no temporary directory, a
-// full disk) only means the set is recomputed: same values, bit for bit.
-class FormFactorSpill {
+// A bad pair's per-movie data, computed before the first key (paper §5: what the coherence
+// makes per-movie instead of per-key).
+struct Pair {
+  uint32_t shooter = 0;
+  bool coherent = false;
+  std::vector<Polygon> shooterWorld;       // per key
+  int samples = 0;                         // N
+  std::vector<glm::dvec2> unitSamples;     // fixed in the shooter's frame
+  std::vector<int> candidates;             // non-coherent: every possible blocker
+  std::vector<int> dynamicList;            // coherent: moving blockers in the swept shaft
+  std::vector<glm::dvec3> keyZeroSamples;  // coherent: the samples (the pair does not move)
+  SampleMask valid = 0;                    // coherent
+  std::vector<double> formFactor;          // coherent: F(x -> S), once per movie
+  std::vector<SampleMask> staticMask;      // coherent: static blockers; empty = none (all 0)
+  std::vector<long long> spilled;          // moving: key k's form factors in the spill, or -1
+};
+
+// The receiver of one movie at its key times, and what the blocker tests ask of the scene
+// over the movie (each node's answer computed once).
+class MovieGeometry {
  public:
-  FormFactorSpill() = default;
-  FormFactorSpill(const FormFactorSpill&) = delete;
-  FormFactorSpill& operator=(const FormFactorSpill&) = delete;
-  ~FormFactorSpill() {
-    if (file_) std::fclose(file_);
-  }
-  // Offset of the stored set, or -1 when it could not be stored.
-  long long put(const std::vector<double>& f) {
-    if (failed_) return -1;
-    if (!file_ && !(file_ = std::tmpfile())) {
-      failed_ = true;
-      return -1;
+  MovieGeometry(const Scene& scene, const std::vector<InputPolygon>& tops, const MovieRequest& req,
+                const std::vector<double>& keyTimes)
+      : scene_(scene),
+        tops_(tops),
+        receiverTop_(tops[req.patch.top]),
+        keyTimes_(keyTimes),
+        w_(req.width),
+        h_(req.height),
+        t0_(keyTimes.front()),
+        t1_(keyTimes.back()),
+        nodeMoves_(scene.nodes.size(), -1) {
+    texelPoints(req.patch);
+    receiverDynamic_ = movesDuringMovie(receiverTop_.node);
+    const size_t K = keyTimes_.size();
+    receiverWorld_.resize(K);
+    receiverTransform_.resize(K);
+    for (size_t k = 0; k < K; ++k) {
+      receiverTransform_[k] = scene_.worldTransform(receiverTop_.node, keyTimes_[k]);
+      receiverWorld_[k] = nodeWorldPolygon(scene_, receiverTop_, req.patch, keyTimes_[k]);
     }
-    const char* p = reinterpret_cast<const char*>(f.data());
-    size_t left = f.size() * sizeof(double);
-    long long at = size_;
-    off_t offset = off_t(size_);
-    while (left > 0) {
-      ssize_t n = ::pwrite(fileno(file_), p, left, offset);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        failed_ = true;
-        return -1;
+    receiverNormalLocal_ = receiverTop_.local.normal();
+  }
+
+  int width() const { return w_; }
+  int height() const { return h_; }
+  size_t texels() const { return size_t(w_) * h_; }
+  int keys() const { return int(keyTimes_.size()); }
+  double keyTime(int k) const { return keyTimes_[size_t(k)]; }
+  const Scene& scene() const { return scene_; }
+  const glm::dvec2& topUv(size_t x) const { return topUv_[x]; }
+  const Polygon& receiverWorld(int k) const { return receiverWorld_[size_t(k)]; }
+  bool receiverDynamic() const { return receiverDynamic_; }
+
+  // Whether a node moves during the movie, and its swept bounds, are asked for every blocker
+  // candidate of every bad pair (with 32 moving cubes that was over half of rad-movies' time,
+  // recomputing the same answers); each node's answer over [t0, t1] is computed once.
+  bool movesDuringMovie(int node) {
+    if (node < 0 || node >= int(nodeMoves_.size())) return scene_.isDynamic(node, t0_, t1_);
+    signed char& m = nodeMoves_[size_t(node)];
+    if (m < 0) m = scene_.isDynamic(node, t0_, t1_) ? 1 : 0;
+    return m == 1;
+  }
+  const std::array<glm::dvec3, 2>& sweptDuringMovie(int node) {
+    auto it = nodeSwept_.find(node);
+    if (it == nodeSwept_.end())
+      it = nodeSwept_.emplace(node, scene_.sweptBounds(node, t0_, t1_)).first;
+    return it->second;
+  }
+
+  // Unoccluded form factors F(x -> S) per texel at key k.
+  void formFactorsAt(const Pair& p, int k, std::vector<double>& f) const {
+    f.resize(texels());
+    const glm::dmat4& m = receiverTransform_[size_t(k)];
+    glm::dvec3 n = glm::normalize(
+        glm::dvec3(glm::transpose(glm::inverse(m)) * glm::dvec4(receiverNormalLocal_, 0.0)));
+    const Polygon& sw = p.shooterWorld[size_t(k)];
+    parallelRows(h_, [&](int j) {
+      for (int i = 0; i < w_; ++i) {
+        size_t x = size_t(j) * w_ + i;
+        glm::dvec3 pt(m * glm::dvec4(localPoint_[x], 1.0));
+        f[x] = pointToPolygonFormFactor(pt, n, sw);
       }
-      p += n;
-      left -= size_t(n);
-      offset += n;
-    }
-    size_ += (long long)(f.size() * sizeof(double));
-    return at;
+    });
   }
-  // Reads a stored set of f.size() values; false on failure.
-  bool get(long long at, std::vector<double>& f) const {
-    if (!file_ || at < 0) return false;
-    char* p = reinterpret_cast<char*>(f.data());
-    size_t left = f.size() * sizeof(double);
-    off_t offset = off_t(at);
-    while (left > 0) {
-      ssize_t n = ::pread(fileno(file_), p, left, offset);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) return false;
-      p += n;
-      left -= size_t(n);
-      offset += n;
+  std::vector<glm::dvec3> samplesAt(const Pair& p, int k) const {
+    std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
+    for (int i = 0; i < p.samples; ++i)
+      s[size_t(i)] = samplePointOnPolygon(p.shooterWorld[size_t(k)], p.unitSamples[size_t(i)]);
+    return s;
+  }
+  Box shaftAt(const Pair& p, int k) const {
+    Box box;
+    box.grow(receiverWorld_[size_t(k)]);
+    box.grow(p.shooterWorld[size_t(k)]);
+    return box;
+  }
+  // World polygon of top-level patch b at key k. The node's world transform is computed once
+  // per movie and key: the blockers of every pair at every key are placed with it, several
+  // polygons per node.
+  Polygon worldPolygon(int b, int k) {
+    const int node = tops_[size_t(b)].node;
+    const long long key = (long long)k * (long long)(scene_.nodes.size() + 1) + (node + 1);
+    auto it = nodeWorldAtKey_.find(key);
+    if (it == nodeWorldAtKey_.end())
+      it = nodeWorldAtKey_.emplace(key, scene_.worldTransform(node, keyTimes_[size_t(k)])).first;
+    return tops_[size_t(b)].local.transformed(it->second);
+  }
+  // Blockers of candidate list `list` in the pair's shaft at key k, as world triangles.
+  std::vector<BlockerTriangle> blockersAt(const Pair& p, const std::vector<int>& list, int k) {
+    Box shaft = shaftAt(p, k);
+    std::vector<BlockerTriangle> tris;
+    for (int b : list) {
+      Polygon poly = worldPolygon(b, k);
+      Box pb;
+      pb.grow(poly);
+      if (pb.overlaps(shaft)) appendTriangles(poly, tris);
     }
-    return true;
+    return tris;
   }
 
  private:
-  std::FILE* file_ = nullptr;
-  long long size_ = 0;
-  bool failed_ = false;
+  // Texel centres: node (u,v) -> top (u,v) -> local point.
+  void texelPoints(PatchId patch) {
+    const bool triangle = receiverTop_.local.count == 3;
+    topUv_.resize(texels());
+    localPoint_.resize(texels());
+    for (int j = 0; j < h_; ++j)
+      for (int i = 0; i < w_; ++i) {
+        size_t x = size_t(j) * w_ + i;
+        topUv_[x] = topUvFromNodeUv(patch, {(i + 0.5) / w_, (j + 0.5) / h_}, triangle);
+        localPoint_[x] = polygonPointAt(receiverTop_.local, topUv_[x]);
+      }
+  }
+
+  const Scene& scene_;
+  const std::vector<InputPolygon>& tops_;
+  const InputPolygon& receiverTop_;
+  const std::vector<double>& keyTimes_;
+  const int w_, h_;
+  const double t0_, t1_;
+  std::vector<glm::dvec2> topUv_;
+  std::vector<glm::dvec3> localPoint_;
+  std::vector<signed char> nodeMoves_;
+  std::unordered_map<int, std::array<glm::dvec3, 2>> nodeSwept_;
+  bool receiverDynamic_ = false;
+  std::vector<Polygon> receiverWorld_;
+  std::vector<glm::dmat4> receiverTransform_;
+  glm::dvec3 receiverNormalLocal_{0.0};
+  std::unordered_map<long long, glm::dmat4> nodeWorldAtKey_;
 };
+
+// Merge (paper §5): a coherent pair's transmittance at one key from its static-blocker mask
+// (empty: no static blocker) and the key's dynamic-blocker mask. kExact ORs the masks (the
+// same bits as rendering all blockers together); the others merge the two transmittances.
+void mergeOcclusion(MergeMode merge, const std::vector<SampleMask>& staticMask,
+                    const std::vector<SampleMask>& keyMask, SampleMask valid,
+                    std::vector<float>& transmittance) {
+  const size_t texels = transmittance.size();
+  const bool noStatic = staticMask.empty();
+  if (merge == MergeMode::kExact) {
+    for (size_t x = 0; x < texels; ++x)
+      transmittance[x] = float(
+          transmittanceFromMask((noStatic ? SampleMask(0) : staticMask[x]) | keyMask[x], valid));
+  } else {
+    for (size_t x = 0; x < texels; ++x)
+      transmittance[x] = float(mergeTransmittance(
+          merge, transmittanceFromMask(noStatic ? SampleMask(0) : staticMask[x], valid),
+          transmittanceFromMask(keyMask[x], valid)));
+  }
+}
+
+// One movie's bake: plan() once, then bakeKey(k) for k = 0 .. K-1.
+class MovieBake {
+ public:
+  MovieBake(const GlobalSolution& solution, const std::vector<InputPolygon>& tops,
+            const TextureMovieBakerOptions& options, TextureMovieBakerStats& stats,
+            const std::function<OcclusionMaskRenderer&()>& renderer, FormFactorSpill& spill,
+            const MovieRequest& req, MovieGeometry& geometry)
+      : solution_(solution),
+        tops_(tops),
+        options_(options),
+        stats_(stats),
+        renderer_(renderer),
+        spill_(spill),
+        req_(req),
+        geo_(geometry),
+        texels_(geometry.texels()),
+        acc_(texels_),
+        transmittance_(texels_),
+        texture_(texels_ * 3) {}
+
+  // Planning: the per-movie part of every bad pair, in badShooters order.
+  void plan(const std::vector<uint32_t>& badShooters) {
+    saturatedSamples_ = transmittanceSampleCount(std::numeric_limits<double>::infinity(),
+                                                 options_.samplesPerFormFactor, options_.minSamples,
+                                                 options_.maxSamples);
+    for (uint32_t S : badShooters) {
+      Pair p;
+      if (planPair(S, p)) pairs_.push_back(std::move(p));
+    }
+  }
+
+  // Key k: H = G + sum over the pairs, in badShooters order, of B_S F T (the same arithmetic
+  // and per-texel order as accumulating pair by pair over all keys), into the sink.
+  void bakeKey(int k, double t, BakedKeySink& sink) {
+    goodLayer(t);
+    for (const Pair& p : pairs_) {
+      OcclusionMaskRenderer& gl = renderer_();
+      const std::vector<double>& f =
+          p.coherent ? coherentTransmittance(gl, p, k) : movingTransmittance(gl, p, k);
+      combine(p, t, f);
+    }
+    auto clock = Clock::now();
+    for (size_t x = 0; x < texels_; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double v = acc_[x][c];
+        // Irradiance is never negative or NaN (DESIGN.md §9); clamp rounding only.
+        texture_[3 * x + size_t(c)] = std::isfinite(v) ? float(std::max(v, 0.0)) : 0.0f;
+      }
+    stats_.secondsCombine += secondsSince(clock);
+    sink.key(size_t(k), texture_);
+  }
+
+ private:
+  bool planPair(uint32_t S, Pair& p);
+  double scanFormFactors(Pair& p);
+  std::vector<int> blockerCandidates(uint32_t S) const;
+  void planCoherentBlockers(Pair& p, const std::vector<int>& candidates);
+
+  // Good layer (paper §3.1: Gouraud over the patch from the global solution).
+  void goodLayer(double t) {
+    auto clock = Clock::now();
+    const int R = int(req_.patch.top), w = geo_.width();
+    parallelRows(geo_.height(), [&](int j) {
+      for (int i = 0; i < w; ++i) {
+        size_t x = size_t(j) * w + i;
+        acc_[x] = solution_.goodIrradiance(R, geo_.topUv(x), t);
+      }
+    });
+    stats_.secondsGood += secondsSince(clock);
+  }
+
+  // A static pair at key k: its dynamic blockers rendered from the movie's samples, merged
+  // with the static mask. Returns the pair's form factors (once per movie).
+  const std::vector<double>& coherentTransmittance(OcclusionMaskRenderer& gl, const Pair& p,
+                                                   int k) {
+    auto clock = Clock::now();
+    std::vector<BlockerTriangle> dynamicTris = p.dynamicList.empty()
+                                                   ? std::vector<BlockerTriangle>()
+                                                   : geo_.blockersAt(p, p.dynamicList, k);
+    gl.render(geo_.receiverWorld(0), geo_.width(), geo_.height(), p.keyZeroSamples, dynamicTris,
+              keyMask_);
+    mergeOcclusion(options_.merge, p.staticMask, keyMask_, p.valid, transmittance_);
+    stats_.secondsTransmittance += secondsSince(clock);
+    return p.formFactor;
+  }
+
+  // A moving pair (or the baseline) at key k: every blocker in the key's shaft rendered from
+  // the key's samples; the key's form factors read back from the spill or recomputed.
+  const std::vector<double>& movingTransmittance(OcclusionMaskRenderer& gl, const Pair& p, int k) {
+    auto clock = Clock::now();
+    const std::vector<glm::dvec3> samples = geo_.samplesAt(p, k);
+    const SampleMask valid = frontSampleMask(geo_.receiverWorld(k), samples);
+    gl.render(geo_.receiverWorld(k), geo_.width(), geo_.height(), samples,
+              geo_.blockersAt(p, p.candidates, k), keyMask_);
+    for (size_t x = 0; x < texels_; ++x)
+      transmittance_[x] = float(transmittanceFromMask(keyMask_[x], valid));
+    stats_.secondsTransmittance += secondsSince(clock);
+    clock = Clock::now();
+    keyFormFactor_.resize(texels_);
+    if (!spill_.get(p.spilled[size_t(k)], keyFormFactor_)) geo_.formFactorsAt(p, k, keyFormFactor_);
+    stats_.secondsFormFactor += secondsSince(clock);
+    return keyFormFactor_;
+  }
+
+  // Combine: the bad layer B_S(t) F T added to the irradiance.
+  void combine(const Pair& p, double t, const std::vector<double>& f) {
+    auto clock = Clock::now();
+    const glm::dvec3 B = solution_.radiosity(int(p.shooter), t);
+    for (size_t x = 0; x < texels_; ++x) acc_[x] += B * (f[x] * double(transmittance_[x]));
+    stats_.secondsCombine += secondsSince(clock);
+  }
+
+  const GlobalSolution& solution_;
+  const std::vector<InputPolygon>& tops_;
+  const TextureMovieBakerOptions& options_;
+  TextureMovieBakerStats& stats_;
+  const std::function<OcclusionMaskRenderer&()>& renderer_;
+  FormFactorSpill& spill_;
+  const MovieRequest& req_;
+  MovieGeometry& geo_;
+  const size_t texels_;
+  int saturatedSamples_ = 0;
+  std::vector<Pair> pairs_;
+  // Per-key buffers (movieWorkingBytes counts them).
+  std::vector<glm::dvec3> acc_;
+  std::vector<float> transmittance_, texture_;
+  std::vector<SampleMask> keyMask_;
+  std::vector<double> keyFormFactor_;  // also the scan's scratch
+};
+
+// One bad pair's per-movie part; false when the shooter cannot reach the patch.
+bool MovieBake::planPair(uint32_t S, Pair& p) {
+  if (S >= tops_.size()) return false;
+  const InputPolygon& shooterTop = tops_[S];
+  ++stats_.badPairs;
+  const bool shooterDynamic = geo_.movesDuringMovie(shooterTop.node);
+  const bool pairStatic = !geo_.receiverDynamic() && !shooterDynamic;
+  (pairStatic ? stats_.staticPairs : stats_.dynamicPairs) += 1;
+  p.shooter = S;
+  p.coherent = options_.coherence && pairStatic;
+  const int K = geo_.keys();
+  p.shooterWorld.resize(static_cast<size_t>(K));
+  for (int k = 0; k < K; ++k)
+    p.shooterWorld[size_t(k)] =
+        shooterTop.local.transformed(geo_.scene().worldTransform(shooterTop.node, geo_.keyTime(k)));
+
+  const double maxF = scanFormFactors(p);
+  if (!(maxF > 0.0)) return false;  // the shooter cannot reach this patch during the movie
+
+  // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie.
+  auto clock = Clock::now();
+  p.samples = transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
+                                       options_.maxSamples);
+  stats_.samples += p.samples;
+  const uint32_t seed = mix32(req_.patch.packed() * 0x9e3779b97f4a7c15ull ^ S);
+  p.unitSamples = multiJitteredPoints(p.samples, seed);
+
+  std::vector<int> candidates = blockerCandidates(S);
+  if (p.coherent) {
+    planCoherentBlockers(p, candidates);
+  } else {
+    // A moving end (or the baseline): every blocker in the key's shaft at every key.
+    for (int b : candidates) {
+      bool dyn = geo_.movesDuringMovie(tops_[size_t(b)].node);
+      (dyn ? stats_.dynamicBlockers : stats_.staticBlockers) += 1;
+    }
+    p.candidates = std::move(candidates);
+  }
+  stats_.secondsTransmittance += secondsSince(clock);
+  return true;
+}
+
+// The largest form factor over the movie fixes N (and whether the pair matters at all). A
+// coherent pair keeps its one set; a moving pair's sets are spilled as they are scanned and the
+// scan stops once N has reached its maximum (more keys cannot change it; their sets are
+// computed when their key is baked).
+double MovieBake::scanFormFactors(Pair& p) {
+  auto clock = Clock::now();
+  double maxF = 0.0;
+  if (p.coherent) {
+    geo_.formFactorsAt(p, 0, p.formFactor);
+    for (double v : p.formFactor) maxF = std::max(maxF, v);
+    stats_.secondsFormFactor += secondsSince(clock);
+    return maxF;
+  }
+  const int K = geo_.keys();
+  p.spilled.assign(static_cast<size_t>(K), -1);
+  for (int k = 0; k < K; ++k) {
+    geo_.formFactorsAt(p, k, keyFormFactor_);
+    for (double v : keyFormFactor_) maxF = std::max(maxF, v);
+    p.spilled[size_t(k)] = spill_.put(keyFormFactor_);
+    if (maxF > 0.0 &&
+        transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
+                                 options_.maxSamples) == saturatedSamples_)
+      break;
+  }
+  stats_.secondsFormFactorScan += secondsSince(clock);
+  return maxF;
+}
+
+// Blocker candidates: every top-level patch but the two ends (and their reversed copies).
+std::vector<int> MovieBake::blockerCandidates(uint32_t S) const {
+  const uint32_t R = req_.patch.top;
+  const InputPolygon &receiverTop = tops_[R], &shooterTop = tops_[S];
+  std::vector<int> candidates;
+  for (size_t b = 0; b < tops_.size(); ++b) {
+    if (b == R || b == S || sameSurface(tops_[b], receiverTop) || sameSurface(tops_[b], shooterTop))
+      continue;
+    candidates.push_back(int(b));
+  }
+  return candidates;
+}
+
+// §5: a static pair's shaft blockers split into static ones, rendered here once per movie into
+// the pair's static mask, and dynamic ones (in the shaft swept over the movie), rendered per key.
+void MovieBake::planCoherentBlockers(Pair& p, const std::vector<int>& candidates) {
+  Box shaft = geo_.shaftAt(p, 0);
+  std::vector<int> staticList;
+  for (int b : candidates) {
+    int node = tops_[size_t(b)].node;
+    if (!geo_.movesDuringMovie(node)) {
+      Box pb;
+      pb.grow(geo_.worldPolygon(b, 0));  // t0 is key 0's time
+      if (pb.overlaps(shaft)) staticList.push_back(b);
+    } else {
+      const std::array<glm::dvec3, 2>& sb = geo_.sweptDuringMovie(node);
+      Box swept{sb[0], sb[1]};
+      if (swept.overlaps(shaft)) p.dynamicList.push_back(b);
+    }
+  }
+  stats_.staticBlockers += long(staticList.size());
+  stats_.dynamicBlockers += long(p.dynamicList.size());
+  p.keyZeroSamples = geo_.samplesAt(p, 0);
+  p.valid = frontSampleMask(geo_.receiverWorld(0), p.keyZeroSamples);
+  std::vector<BlockerTriangle> staticTris = geo_.blockersAt(p, staticList, 0);
+  renderer_().render(geo_.receiverWorld(0), geo_.width(), geo_.height(), p.keyZeroSamples,
+                     staticTris, p.staticMask);
+  if (!staticTris.empty())
+    stats_.passesSavedByCoherence += geo_.keys() - 1;
+  else
+    std::vector<SampleMask>().swap(p.staticMask);  // all zero: not kept
+}
 
 }  // namespace
 
 nlohmann::json TextureMovieBakerOptions::toJson() const {
-  return {{"key-step", keyStep},
+  return {{"movie-key-step", keyStep},
           {"min-samples", minSamples},
           {"max-samples", maxSamples},
           {"samples-per-form-factor", samplesPerFormFactor},
@@ -160,7 +524,6 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"render_passes", passes},
           {"sample_passes", samplePasses},
           {"render_passes_saved_by_coherence", passesSavedByCoherence},
-          {"key_step_raised", keyStepRaised},
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
@@ -170,12 +533,15 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"warnings", warnings}};
 }
 
-std::vector<int> movieKeyFrames(int firstFrame, int lastFrame, int step) {
-  step = std::max(step, 1);
-  std::vector<int> frames;
-  for (long f = firstFrame; f < lastFrame; f += step) frames.push_back(int(f));
-  frames.push_back(lastFrame);
-  return frames;
+MovieRequest movieRequestOf(const MovieExtent& extent) {
+  MovieRequest r;
+  r.movie = extent.movie;
+  r.patch = extent.patch;
+  r.firstFrame = extent.firstFrame;
+  r.lastFrame = extent.lastFrame;
+  r.width = extent.width;
+  r.height = extent.height;
+  return r;
 }
 
 Polygon nodeWorldPolygon(const Scene& scene, const InputPolygon& top, PatchId node, double t) {
@@ -191,13 +557,15 @@ Polygon nodeWorldPolygon(const Scene& scene, const InputPolygon& top, PatchId no
 }
 
 TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& solution, double fps,
-                                     TextureMovieBakerOptions options)
+                                     TextureMovieBakerOptions options,
+                                     TextureMovieBakerBackends backends)
     : scene_(scene),
       solution_(solution),
       fps_(fps),
       options_(options),
+      backends_(std::move(backends)),
       tops_(solution.hierarchy.tops()) {
-  if (options_.keyStep < 1) throw Error(ExitCode::kUsage, "--key-step", "must be >= 1");
+  if (options_.keyStep < 1) throw Error(ExitCode::kUsage, "--movie-key-step", "must be >= 1");
   if (options_.maxSamples < 1 || options_.maxSamples > kMaxTransmittanceSamples)
     throw Error(ExitCode::kUsage, "--max-samples", "must be in 1..64");
   if (options_.minSamples < 1 || options_.minSamples > options_.maxSamples)
@@ -208,12 +576,16 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
     throw Error(ExitCode::kUsage, "--max-texture-memory", "must be > 0");
   if (!(fps_ > 0.0) || !std::isfinite(fps_))
     throw Error(ExitCode::kBadInput, "", "frames per second must be positive");
+  if (!backends_.maskRenderer)
+    backends_.maskRenderer = [] { return std::make_unique<TransmittanceRenderer>(); };
+  if (!backends_.formFactorSpill)
+    backends_.formFactorSpill = [] { return std::make_unique<NoFormFactorSpill>(); };
 }
 
 TextureMovieBaker::~TextureMovieBaker() = default;
 
-TransmittanceRenderer& TextureMovieBaker::renderer() {
-  if (!renderer_) renderer_ = std::make_unique<TransmittanceRenderer>();
+OcclusionMaskRenderer& TextureMovieBaker::renderer() {
+  if (!renderer_) renderer_ = backends_.maskRenderer();
   return *renderer_;
 }
 
@@ -229,23 +601,6 @@ double TextureMovieBaker::movieWorkingBytes(int width, int height, size_t badSho
   const double perTexel = 16 + 24 + 24 + 12 + 12 + 4 + 8 + 8 + 16.0 * double(badShooters);
   return double(width) * double(height) * perTexel;
 }
-
-// A bad pair's per-movie data, computed before the first key (paper §5: what the coherence
-// makes per-movie instead of per-key).
-struct TextureMovieBaker::Pair {
-  uint32_t shooter = 0;
-  bool coherent = false;
-  std::vector<Polygon> shooterWorld;       // per key
-  int samples = 0;                         // N
-  std::vector<glm::dvec2> unitSamples;     // fixed in the shooter's frame
-  std::vector<int> candidates;             // non-coherent: every possible blocker
-  std::vector<int> dynamicList;            // coherent: moving blockers in the swept shaft
-  std::vector<glm::dvec3> keyZeroSamples;  // coherent: the samples (the pair does not move)
-  SampleMask valid = 0;                    // coherent
-  std::vector<double> formFactor;          // coherent: F(x -> S), once per movie
-  std::vector<SampleMask> staticMask;      // coherent: static blockers; empty = none (all 0)
-  std::vector<long long> spilled;          // moving: key k's form factors in the spill, or -1
-};
 
 BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
   // Collects the keys; a movie whose keys all agree keeps one (coherence on).
@@ -270,6 +625,23 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
   return movie;
 }
 
+void TextureMovieBaker::checkRequest(const MovieRequest& req, size_t badShooters) const {
+  const std::string where = "movie " + std::to_string(req.movie);
+  const int w = req.width, h = req.height;
+  // Working memory: one key's buffers and the per-pair ones, whatever the number of keys.
+  const double bytes = movieWorkingBytes(w, h, badShooters);
+  const double budget = options_.maxTextureMemoryMiB * 1024.0 * 1024.0;
+  if (bytes > budget) {
+    char budgetText[32];
+    std::snprintf(budgetText, sizeof budgetText, "%g", options_.maxTextureMemoryMiB);
+    throw Error(ExitCode::kEnvironment, where,
+                "texture " + std::to_string(w) + "x" + std::to_string(h) + " with " +
+                    std::to_string(badShooters) + " bad shooter(s) needs " +
+                    std::to_string(int(std::ceil(bytes / 1048576.0))) +
+                    " MiB of working memory; --max-texture-memory is " + budgetText + " MiB");
+  }
+}
+
 BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) {
   const std::string where = "movie " + std::to_string(req.movie);
   if (req.patch.top >= tops_.size())
@@ -282,294 +654,24 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
     throw inputError(where, "texture " + std::to_string(req.width) + "x" +
                                 std::to_string(req.height) + "; expected 1..16384 each way");
   if (req.firstFrame > req.lastFrame) throw inputError(where, "first frame after last frame");
-
-  const uint32_t R = req.patch.top;
-  const InputPolygon& receiverTop = tops_[R];
-  const bool triangle = receiverTop.local.count == 3;
-  const int w = req.width, h = req.height;
-  const size_t texels = size_t(w) * h;
-  const std::vector<uint32_t> badShooters = solution_.badShooters(R);
-
-  // Working memory: one key's buffers and the per-pair ones, whatever the number of keys.
-  const double bytes = movieWorkingBytes(w, h, badShooters.size());
-  const double budget = options_.maxTextureMemoryMiB * 1024.0 * 1024.0;
-  if (bytes > budget) {
-    char budgetText[32];
-    std::snprintf(budgetText, sizeof budgetText, "%g", options_.maxTextureMemoryMiB);
-    throw Error(ExitCode::kEnvironment, where,
-                "texture " + std::to_string(w) + "x" + std::to_string(h) + " with " +
-                    std::to_string(badShooters.size()) + " bad shooter(s) needs " +
-                    std::to_string(int(std::ceil(bytes / 1048576.0))) +
-                    " MiB of working memory; --max-texture-memory is " + budgetText + " MiB");
-  }
+  const std::vector<uint32_t> badShooters = solution_.badShooters(req.patch.top);
+  checkRequest(req, badShooters.size());
 
   BakedMovie movie;
   movie.keyStep = options_.keyStep;
-  movie.keyFrames = movieKeyFrames(req.firstFrame, req.lastFrame, movie.keyStep);
-  const int K = int(movie.keyFrames.size());
+  movie.keyFrames = keyFrames(req.firstFrame, req.lastFrame, movie.keyStep);
   for (int f : movie.keyFrames) movie.keyTimes.push_back(f / fps_);
-  const double t0 = movie.keyTimes.front(), t1 = movie.keyTimes.back();
 
-  // Texel centres: node (u,v) -> top (u,v) -> local point.
-  std::vector<glm::dvec2> topUv(texels);
-  std::vector<glm::dvec3> localPoint(texels);
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      size_t x = size_t(j) * w + i;
-      topUv[x] = topUvFromNodeUv(req.patch, {(i + 0.5) / w, (j + 0.5) / h}, triangle);
-      localPoint[x] = polygonPointAt(receiverTop.local, topUv[x]);
-    }
-
-  // Whether a node moves during the movie, and its swept bounds, are asked for every blocker
-  // candidate of every bad pair (with 32 moving cubes that was over half of rad-movies' time,
-  // recomputing the same answers); each node's answer over [t0, t1] is computed once.
-  std::vector<signed char> nodeMoves(scene_.nodes.size(), -1);
-  auto movesDuringMovie = [&](int node) {
-    if (node < 0 || node >= int(nodeMoves.size())) return scene_.isDynamic(node, t0, t1);
-    signed char& m = nodeMoves[size_t(node)];
-    if (m < 0) m = scene_.isDynamic(node, t0, t1) ? 1 : 0;
-    return m == 1;
+  // Planning (everything that does not depend on the key), then the keys one by one.
+  MovieGeometry geometry(scene_, tops_, req, movie.keyTimes);
+  std::unique_ptr<FormFactorSpill> spill = backends_.formFactorSpill();
+  const std::function<OcclusionMaskRenderer&()> gl = [this]() -> OcclusionMaskRenderer& {
+    return renderer();
   };
-  std::unordered_map<int, std::array<glm::dvec3, 2>> nodeSwept;
-  auto sweptDuringMovie = [&](int node) -> const std::array<glm::dvec3, 2>& {
-    auto it = nodeSwept.find(node);
-    if (it == nodeSwept.end()) it = nodeSwept.emplace(node, scene_.sweptBounds(node, t0, t1)).first;
-    return it->second;
-  };
-  const bool receiverDynamic = movesDuringMovie(receiverTop.node);
-  std::vector<Polygon> receiverWorld(static_cast<size_t>(K));
-  std::vector<glm::dmat4> receiverTransform(static_cast<size_t>(K));
-  for (int k = 0; k < K; ++k) {
-    receiverTransform[size_t(k)] =
-        scene_.worldTransform(receiverTop.node, movie.keyTimes[size_t(k)]);
-    receiverWorld[size_t(k)] =
-        nodeWorldPolygon(scene_, receiverTop, req.patch, movie.keyTimes[size_t(k)]);
-  }
-  const glm::dvec3 receiverNormalLocal = receiverTop.local.normal();
-
-  // Unoccluded form factors F(x -> S) per texel at key k.
-  auto formFactorsAt = [&](const Pair& p, int k, std::vector<double>& f) {
-    f.resize(texels);
-    const glm::dmat4& m = receiverTransform[size_t(k)];
-    glm::dvec3 n = glm::normalize(
-        glm::dvec3(glm::transpose(glm::inverse(m)) * glm::dvec4(receiverNormalLocal, 0.0)));
-    const Polygon& sw = p.shooterWorld[size_t(k)];
-    parallelRows(h, [&](int j) {
-      for (int i = 0; i < w; ++i) {
-        size_t x = size_t(j) * w + i;
-        glm::dvec3 pt(m * glm::dvec4(localPoint[x], 1.0));
-        f[x] = pointToPolygonFormFactor(pt, n, sw);
-      }
-    });
-  };
-  auto samplesAt = [&](const Pair& p, int k) {
-    std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
-    for (int i = 0; i < p.samples; ++i)
-      s[size_t(i)] = samplePointOnPolygon(p.shooterWorld[size_t(k)], p.unitSamples[size_t(i)]);
-    return s;
-  };
-  auto shaftAt = [&](const Pair& p, int k) {
-    Box box;
-    box.grow(receiverWorld[size_t(k)]);
-    box.grow(p.shooterWorld[size_t(k)]);
-    return box;
-  };
-  // World transform of a node at key k, once per movie: the blockers of every pair at every
-  // key are placed with it, several polygons per node.
-  std::unordered_map<long long, glm::dmat4> nodeWorldAtKey;
-  auto worldPolygon = [&](int b, int k) {
-    const int node = tops_[size_t(b)].node;
-    const long long key = (long long)k * (long long)(scene_.nodes.size() + 1) + (node + 1);
-    auto it = nodeWorldAtKey.find(key);
-    if (it == nodeWorldAtKey.end())
-      it =
-          nodeWorldAtKey.emplace(key, scene_.worldTransform(node, movie.keyTimes[size_t(k)])).first;
-    return tops_[size_t(b)].local.transformed(it->second);
-  };
-  // Blockers of candidate list `list` in the pair's shaft at key k, as world triangles.
-  auto blockersAt = [&](const Pair& p, const std::vector<int>& list, int k) {
-    Box shaft = shaftAt(p, k);
-    std::vector<BlockerTriangle> tris;
-    for (int b : list) {
-      Polygon poly = worldPolygon(b, k);
-      Box pb;
-      pb.grow(poly);
-      if (pb.overlaps(shaft)) appendTriangles(poly, tris);
-    }
-    return tris;
-  };
-
-  // Per-movie part of every bad pair, in badShooters order.
-  const int saturatedSamples = transmittanceSampleCount(std::numeric_limits<double>::infinity(),
-                                                        options_.samplesPerFormFactor,
-                                                        options_.minSamples, options_.maxSamples);
-  std::vector<Pair> pairs;
-  std::vector<double> keyFormFactor;
-  FormFactorSpill spill;
-  for (uint32_t S : badShooters) {
-    if (S >= tops_.size()) continue;
-    const InputPolygon& shooterTop = tops_[S];
-    ++stats_.badPairs;
-    const bool shooterDynamic = movesDuringMovie(shooterTop.node);
-    const bool pairStatic = !receiverDynamic && !shooterDynamic;
-    (pairStatic ? stats_.staticPairs : stats_.dynamicPairs) += 1;
-    Pair p;
-    p.shooter = S;
-    p.coherent = options_.coherence && pairStatic;
-    p.shooterWorld.resize(static_cast<size_t>(K));
-    for (int k = 0; k < K; ++k)
-      p.shooterWorld[size_t(k)] = shooterTop.local.transformed(
-          scene_.worldTransform(shooterTop.node, movie.keyTimes[size_t(k)]));
-
-    // The largest form factor over the movie fixes N (and whether the pair matters at all).
-    // A coherent pair keeps its one set; a moving pair's sets are spilled as they are scanned
-    // (FormFactorSpill) and the scan stops once N has reached its maximum (more keys cannot
-    // change it; their sets are computed when their key is baked).
-    auto clock = Clock::now();
-    double maxF = 0.0;
-    if (p.coherent) {
-      formFactorsAt(p, 0, p.formFactor);
-      for (double v : p.formFactor) maxF = std::max(maxF, v);
-      stats_.secondsFormFactor += secondsSince(clock);
-    } else {
-      p.spilled.assign(static_cast<size_t>(K), -1);
-      for (int k = 0; k < K; ++k) {
-        formFactorsAt(p, k, keyFormFactor);
-        for (double v : keyFormFactor) maxF = std::max(maxF, v);
-        p.spilled[size_t(k)] = spill.put(keyFormFactor);
-        if (maxF > 0.0 &&
-            transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
-                                     options_.maxSamples) == saturatedSamples)
-          break;
-      }
-      stats_.secondsFormFactorScan += secondsSince(clock);
-    }
-    if (!(maxF > 0.0)) continue;  // the shooter cannot reach this patch during the movie
-
-    // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie.
-    clock = Clock::now();
-    p.samples = transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
-                                         options_.maxSamples);
-    stats_.samples += p.samples;
-    const uint32_t seed = mix32(req.patch.packed() * 0x9e3779b97f4a7c15ull ^ S);
-    p.unitSamples = multiJitteredPoints(p.samples, seed);
-
-    // Blocker candidates: every top-level patch but the two ends (and their reversed copies).
-    std::vector<int> candidates;
-    for (size_t b = 0; b < tops_.size(); ++b) {
-      if (b == R || b == S || sameSurface(tops_[b], receiverTop) ||
-          sameSurface(tops_[b], shooterTop))
-        continue;
-      candidates.push_back(int(b));
-    }
-    if (p.coherent) {
-      // §5: split the shaft's blockers into static ones (once per movie) and dynamic ones.
-      Box shaft = shaftAt(p, 0);
-      std::vector<int> staticList;
-      for (int b : candidates) {
-        int node = tops_[size_t(b)].node;
-        if (!movesDuringMovie(node)) {
-          Box pb;
-          pb.grow(worldPolygon(b, 0));  // t0 is key 0's time
-          if (pb.overlaps(shaft)) staticList.push_back(b);
-        } else {
-          const std::array<glm::dvec3, 2>& sb = sweptDuringMovie(node);
-          Box swept{sb[0], sb[1]};
-          if (swept.overlaps(shaft)) p.dynamicList.push_back(b);
-        }
-      }
-      stats_.staticBlockers += long(staticList.size());
-      stats_.dynamicBlockers += long(p.dynamicList.size());
-      p.keyZeroSamples = samplesAt(p, 0);
-      p.valid = frontSampleMask(receiverWorld[0], p.keyZeroSamples);
-      std::vector<BlockerTriangle> staticTris = blockersAt(p, staticList, 0);
-      renderer().render(receiverWorld[0], w, h, p.keyZeroSamples, staticTris, p.staticMask);
-      if (!staticTris.empty())
-        stats_.passesSavedByCoherence += K - 1;
-      else
-        std::vector<SampleMask>().swap(p.staticMask);  // all zero: not kept
-    } else {
-      // A moving end (or the baseline): every blocker in the key's shaft at every key.
-      for (int b : candidates) {
-        bool dyn = movesDuringMovie(tops_[size_t(b)].node);
-        (dyn ? stats_.dynamicBlockers : stats_.staticBlockers) += 1;
-      }
-      p.candidates = std::move(candidates);
-    }
-    stats_.secondsTransmittance += secondsSince(clock);
-    pairs.push_back(std::move(p));
-  }
-
-  // Key by key: H = G + sum over the pairs, in badShooters order, of B_S F T (the same
-  // arithmetic and per-texel order as accumulating pair by pair over all keys).
+  MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry);
+  bake.plan(badShooters);
   sink.begin(movie);
-  std::vector<glm::dvec3> acc(texels);
-  std::vector<float> transmittance(texels), texture(texels * 3);
-  std::vector<SampleMask> keyMask;
-  for (int k = 0; k < K; ++k) {
-    const double t = movie.keyTimes[size_t(k)];
-    // Good layer (paper §3.1: Gouraud over the patch from the global solution).
-    auto clock = Clock::now();
-    parallelRows(h, [&](int j) {
-      for (int i = 0; i < w; ++i) {
-        size_t x = size_t(j) * w + i;
-        acc[x] = solution_.goodIrradiance(int(R), topUv[x], t);
-      }
-    });
-    stats_.secondsGood += secondsSince(clock);
-
-    for (const Pair& p : pairs) {
-      TransmittanceRenderer& gl = renderer();
-      clock = Clock::now();
-      if (p.coherent) {
-        std::vector<BlockerTriangle> dynamicTris = p.dynamicList.empty()
-                                                       ? std::vector<BlockerTriangle>()
-                                                       : blockersAt(p, p.dynamicList, k);
-        gl.render(receiverWorld[0], w, h, p.keyZeroSamples, dynamicTris, keyMask);
-        const bool noStatic = p.staticMask.empty();
-        if (options_.merge == MergeMode::kExact) {
-          for (size_t x = 0; x < texels; ++x)
-            transmittance[x] = float(transmittanceFromMask(
-                (noStatic ? SampleMask(0) : p.staticMask[x]) | keyMask[x], p.valid));
-        } else {
-          for (size_t x = 0; x < texels; ++x)
-            transmittance[x] = float(mergeTransmittance(
-                options_.merge,
-                transmittanceFromMask(noStatic ? SampleMask(0) : p.staticMask[x], p.valid),
-                transmittanceFromMask(keyMask[x], p.valid)));
-        }
-        stats_.secondsTransmittance += secondsSince(clock);
-      } else {
-        const std::vector<glm::dvec3> samples = samplesAt(p, k);
-        const SampleMask valid = frontSampleMask(receiverWorld[size_t(k)], samples);
-        gl.render(receiverWorld[size_t(k)], w, h, samples, blockersAt(p, p.candidates, k), keyMask);
-        for (size_t x = 0; x < texels; ++x)
-          transmittance[x] = float(transmittanceFromMask(keyMask[x], valid));
-        stats_.secondsTransmittance += secondsSince(clock);
-        clock = Clock::now();
-        keyFormFactor.resize(texels);
-        if (!spill.get(p.spilled[size_t(k)], keyFormFactor)) formFactorsAt(p, k, keyFormFactor);
-        stats_.secondsFormFactor += secondsSince(clock);
-      }
-
-      // Bad layer: B_S(t) F T.
-      clock = Clock::now();
-      const glm::dvec3 B = solution_.radiosity(int(p.shooter), t);
-      const std::vector<double>& f = p.coherent ? p.formFactor : keyFormFactor;
-      for (size_t x = 0; x < texels; ++x) acc[x] += B * (f[x] * double(transmittance[x]));
-      stats_.secondsCombine += secondsSince(clock);
-    }
-
-    clock = Clock::now();
-    for (size_t x = 0; x < texels; ++x)
-      for (int c = 0; c < 3; ++c) {
-        double v = acc[x][c];
-        // Irradiance is never negative or NaN (DESIGN.md §9); clamp rounding only.
-        texture[3 * x + size_t(c)] = std::isfinite(v) ? float(std::max(v, 0.0)) : 0.0f;
-      }
-    stats_.secondsCombine += secondsSince(clock);
-    sink.key(size_t(k), texture);
-  }
+  for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);
   const size_t stored = sink.finish();
 
   if (renderer_) {
@@ -579,7 +681,7 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) 
   ++stats_.movies;
   if (stored == 1) ++stats_.constantMovies;
   stats_.keys += long(stored);
-  stats_.texels += long(texels * stored);
+  stats_.texels += long(size_t(req.width) * req.height * stored);
   return movie;
 }
 

@@ -24,7 +24,13 @@
 // computed first; then each key's irradiance is accumulated (good layer, then the bad shooters
 // in badShooters order: the same arithmetic and order as shooter-major) and handed to a
 // BakedKeySink before the next key starts. The working memory is then
-// texels x (per-key buffers + per coherent pair buffers), whatever the number of keys.
+// texels x (per-key buffers + per coherent pair buffers), whatever the number of keys. A moving
+// pair's form factors, scanned ahead of the keys for their largest value, are parked in a
+// FormFactorSpill (form_factor_spill.h) until their key, or recomputed then.
+//
+// Doors (TextureMovieBakerBackends): the occlusion masks come from an OcclusionMaskRenderer
+// (occlusion_mask_renderer.h; OSMesa projective shadows by default) and the spill from a
+// factory, so a new shadow method or scratch store is a new class, not an edit of bake().
 #pragma once
 
 #include <cstdint>
@@ -35,15 +41,20 @@
 
 #include <nlohmann/json.hpp>
 
+#include "libcommon/intervals/movie_extent.h"
+#include "libcommon/movies/form_factor_spill.h"
+#include "libcommon/movies/occlusion_mask_renderer.h"
+#include "libcommon/movies/transmittance.h"
 #include "libcommon/radiosity/global_solution.h"
 #include "libcommon/scene/patch_hierarchy.h"
 #include "libcommon/scene/scene.h"
-#include "libcommon/movies/transmittance.h"
 
 namespace rad {
 
+// rad-movies binds its flags to these fields; toJson() is the provenance parameters, keyed by
+// the flag names.
 struct TextureMovieBakerOptions {
-  int keyStep = 6;                      // frames between key textures (>= 1)
+  int keyStep = 6;                      // --movie-key-step: frames between key textures (>= 1)
   int minSamples = 4;                   // shooter samples per bad link, lower bound
   int maxSamples = 64;                  // upper bound (<= 64)
   double samplesPerFormFactor = 256.0;  // N = ceil(this * max texel form factor), then clamped
@@ -55,6 +66,17 @@ struct TextureMovieBakerOptions {
   nlohmann::json toJson() const;
 };
 
+// The parts of the bake a new method replaces without editing it (the doors). Empty members
+// take the defaults.
+struct TextureMovieBakerBackends {
+  // The occlusion masks (default: TransmittanceRenderer, OSMesa projective shadows), made on
+  // the first render the baker needs.
+  OcclusionMaskRendererFactory maskRenderer;
+  // One store per movie for moving pairs' scanned form factors (default: NoFormFactorSpill,
+  // every set recomputed; rad-movies passes formats/form_factor_scratch_file.h's).
+  FormFactorSpillFactory formFactorSpill;
+};
+
 // What to bake: one interval of intervals.rti (formats/texture_intervals.h).
 struct MovieRequest {
   uint32_t movie = 0;
@@ -62,6 +84,8 @@ struct MovieRequest {
   int firstFrame = 0, lastFrame = 0;
   int width = 1, height = 1;
 };
+// The request for one movie record (its id, patch, frames and size).
+MovieRequest movieRequestOf(const MovieExtent& extent);
 
 // The result, as formats/texture_movie.h stores it: keys[k] has width * height * 3 floats
 // (RGB irradiance, W/m^2), row j = 0 at v = 0, texel (i, j) at node (u,v) = ((i+.5)/w, (j+.5)/h).
@@ -96,7 +120,6 @@ struct TextureMovieBakerStats {
   long staticBlockers = 0, dynamicBlockers = 0;  // per pair, in the pair's (swept) shaft
   long passes = 0, samplePasses = 0;             // transmittance renders
   long passesSavedByCoherence = 0;               // static-blocker renders not repeated
-  long keyStepRaised = 0;  // always 0: the key step no longer depends on the memory budget
   double secondsGood = 0, secondsFormFactor = 0, secondsTransmittance = 0, secondsCombine = 0;
   // Moving pairs' form factors computed ahead of the keys only to find their largest value
   // (which fixes N): the price of baking key by key without every key's form factors held.
@@ -108,9 +131,10 @@ struct TextureMovieBakerStats {
 class TextureMovieBaker {
  public:
   // scene and solution must outlive the baker; fps converts frames to times (t = frame / fps).
-  // Throws a usage Error for inconsistent options.
+  // Throws a usage Error for inconsistent options. Key frames of a movie: rad::keyFrames(first,
+  // last, options.keyStep) (libcommon/scene/frame_range.h).
   TextureMovieBaker(const Scene& scene, const GlobalSolution& solution, double fps,
-                    TextureMovieBakerOptions options);
+                    TextureMovieBakerOptions options, TextureMovieBakerBackends backends = {});
   ~TextureMovieBaker();
 
   // Bakes one movie, streaming its keys to `sink`. Throws rad::inputError("movie N", ...) when
@@ -132,20 +156,19 @@ class TextureMovieBaker {
   std::string rendererName() const;
 
  private:
-  struct Pair;
   const Scene& scene_;
   const GlobalSolution& solution_;
   double fps_;
   TextureMovieBakerOptions options_;
+  TextureMovieBakerBackends backends_;
   std::vector<InputPolygon> tops_;
-  std::unique_ptr<TransmittanceRenderer> renderer_;
+  std::unique_ptr<OcclusionMaskRenderer> renderer_;
   TextureMovieBakerStats stats_;
 
-  TransmittanceRenderer& renderer();
+  OcclusionMaskRenderer& renderer();
+  // Throws for a request bake() cannot do (see bake).
+  void checkRequest(const MovieRequest& request, size_t badShooters) const;
 };
-
-// Key frames of [f0, f1] every `step` frames, f1 always included.
-std::vector<int> movieKeyFrames(int firstFrame, int lastFrame, int step);
 
 // Texel centres of a node: world points at time t via the top polygon's (u,v) map.
 // out[j * w + i]; also the node's world polygon (corners in the patch (u,v) order).

@@ -32,15 +32,10 @@
 
 #include <glm/glm.hpp>
 
+#include "libcommon/movies/occlusion_mask_renderer.h"
 #include "libcommon/scene/geometry.h"
 
 namespace rad {
-
-// One bit per shooter sample; sample s is bit s.
-using SampleMask = uint64_t;
-constexpr int kMaxTransmittanceSamples = 64;
-
-using BlockerTriangle = std::array<glm::dvec3, 3>;
 
 // Number of shooter samples for a bad link (paper §3.1: "proportional to the maximum form
 // factor between the shooter and the texels"): ceil(samplesPerFormFactor * maxFormFactor)
@@ -83,31 +78,29 @@ glm::dmat4 projectiveShadowMatrix(const Polygon& receiver, const glm::dvec3& sam
 // (u,v) of a point of the receiver's plane under the render's homography.
 glm::dvec2 receiverPlaneUv(const Polygon& receiver, const glm::dvec3& pointOnPlane);
 
-// OSMesa renderer of occlusion masks. Owns its GL context (gl_context.h threading rules: one
-// renderer per thread).
-class TransmittanceRenderer {
+// OSMesa renderer of occlusion masks (projective shadows, see above): the baker's default
+// OcclusionMaskRenderer. Owns its GL context (gl_context.h threading rules: one renderer per
+// thread).
+class TransmittanceRenderer final : public OcclusionMaskRenderer {
  public:
   // Throws rad::Error(kEnvironment) when no GL context can be made.
   TransmittanceRenderer();
-  ~TransmittanceRenderer();
+  ~TransmittanceRenderer() override;
   TransmittanceRenderer(const TransmittanceRenderer&) = delete;
   TransmittanceRenderer& operator=(const TransmittanceRenderer&) = delete;
 
-  // Occlusion masks of a w x h receiver texture (world-space receiver polygon, vertices in
-  // the patch_hierarchy.h (u,v) order): out[j * w + i] gets bit s when a blocker triangle
-  // (world space, either side) crosses the segment from samples[s] to texel (i, j)'s point on
-  // the receiver plane, strictly in front of the plane. Samples behind the plane get no bits.
-  // samples.size() in 1..64; an empty blocker list gives all-zero masks without rendering.
+  // OcclusionMaskRenderer::render; an empty blocker list (or no sample in front of the
+  // receiver) gives all-zero masks without rendering.
   void render(const Polygon& receiver, int width, int height,
               const std::vector<glm::dvec3>& samples, const std::vector<BlockerTriangle>& blockers,
-              std::vector<SampleMask>& out);
+              std::vector<SampleMask>& out) override;
 
   // Render passes so far (one per render() call that drew) and sample-passes (passes x
   // samples): the cost figures of the report.
-  long passes() const;
-  long samplePasses() const;
-  long trianglesDrawn() const;  // blocker triangles x samples
-  std::string rendererName() const;
+  long passes() const override;
+  long samplePasses() const override;
+  long trianglesDrawn() const;                // blocker triangles x samples
+  std::string rendererName() const override;  // GL_RENDERER
 
  private:
   struct Impl;

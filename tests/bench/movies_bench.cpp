@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "formats/form_factor_scratch_file.h"
 #include "libcommon/movies/texture_movie_baker.h"
 
 using namespace rad;
@@ -135,7 +136,9 @@ int main(int argc, char** argv) {
     TextureMovieBakerOptions o;
     o.coherence = mode == 0;
     if (mode == 1) o.keyStep = baselineKeyStep;
-    TextureMovieBaker baker(s, g, fps, o);
+    TextureMovieBakerBackends backends;
+    backends.formFactorSpill = formFactorScratchFiles();  // as rad-movies bakes
+    TextureMovieBaker baker(s, g, fps, o, backends);
     auto t = std::chrono::steady_clock::now();
     for (const MovieRequest& r : requests) out[mode].push_back(baker.bake(r));
     seconds[mode] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();

@@ -1,7 +1,7 @@
 // rad-movies end to end on the Cornell box (tests/data/external/cornell_box): a global solution
-// and intervals written here (one key time, every surface a bad receiver of the light), the
-// tool run as a user runs it; movies read back; shards, the baseline, determinism, report and
-// errors checked.
+// and intervals written here (constant key times over the window, every surface a bad receiver
+// of the light), the tool run as a user runs it; movies read back; shards, the baseline,
+// determinism, report, errors, the frame-window check and the key-step flags checked.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,6 +13,7 @@
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
 #include "formats/texture_movie.h"
+#include "libcommon/scene/frame_range.h"
 #include "tests/cli/cli_util.h"
 
 namespace fs = std::filesystem;
@@ -31,7 +32,11 @@ class RadMoviesCli : public ::testing::Test {
     fs::create_directories(*dir_);
     Scene scene = readGltfScene(kScene);
     GlobalSolution g;
-    g.keyTimes = {0.0};
+    // A key time at every frame of the intervals' window 0-11 (as rad-global --frames 0-11
+    // --key-step 1 writes them), all with the same values: the window is covered and every
+    // movie key is at a global key time.
+    const int K = 12;
+    for (int f = 0; f < K; ++f) g.keyTimes.push_back(f / 24.0);
     g.hierarchy = PatchHierarchy(scene.inputPolygons());
     const int n = g.hierarchy.topCount();
     std::vector<int> emitters, receivers;
@@ -39,10 +44,11 @@ class RadMoviesCli : public ::testing::Test {
       int mat = g.hierarchy.top(i).material;
       bool emits = mat >= 0 && scene.materials[size_t(mat)].isEmitter();
       (emits ? emitters : receivers).push_back(i);
-      g.nodeRadiosity.push_back(emits ? glm::vec3(scene.materials[size_t(mat)].emission * 3.14159)
-                                      : glm::vec3(0.2f));
+      for (int k = 0; k < K; ++k)
+        g.nodeRadiosity.push_back(emits ? glm::vec3(scene.materials[size_t(mat)].emission * 3.14159)
+                                        : glm::vec3(0.2f));
       g.leafRow.push_back(i);
-      for (int c = 0; c < 4; ++c) g.leafVertexGoodIrradiance.push_back(glm::vec3(0.3f));
+      for (int c = 0; c < 4 * K; ++c) g.leafVertexGoodIrradiance.push_back(glm::vec3(0.3f));
     }
     ASSERT_FALSE(emitters.empty());
     for (int r : receivers)
@@ -167,6 +173,50 @@ TEST_F(RadMoviesCli, MovieBeyondTheMemoryBudgetIsRefusedAndLeavesNoFile) {
   int files = 0;
   for (const auto& e : fs::directory_iterator(path("tiny"))) files += !e.path().empty();
   EXPECT_EQ(files, 0) << "no movie and no temporary left behind";
+}
+
+// A global solution whose key times stop before the intervals' last frame would be read outside
+// the times it was solved for: refused before any movie is baked, naming both files and ranges.
+TEST_F(RadMoviesCli, GlobalSolutionNotCoveringTheIntervalsIsRefused) {
+  CommandResult g = runCommand(tool("rad-global") + " " + kScene + " -o " + path("global00.rlh") +
+                               " --frames 0-0 --threads 1");
+  ASSERT_EQ(g.exitCode, 0) << g.err;
+  TextureIntervals iv = readTextureIntervals(path("intervals.rti"));
+  iv.lastFrame = 23;
+  for (TextureInterval& m : iv.movies) m.lastFrame = 23;
+  Provenance p = makeProvenance("test", 0, nullptr, nlohmann::json::object());
+  writeTextureIntervals(path("intervals23.rti"), iv, p, nlohmann::json::object());
+  CommandResult r = runCommand(tool("rad-movies") + " " + kScene + " " + path("global00.rlh") +
+                               " " + path("intervals23.rti") + " -o " + path("window"));
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("global00.rlh"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("intervals23.rti"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("0-23"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("0-0"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(textureMoviePath(path("window"), 0))) << "no movie baked";
+}
+
+// --movie-key-step sets the frames between key textures; --key-step, its old name, still does
+// and warns once.
+TEST_F(RadMoviesCli, KeyStepIsADeprecatedNameOfMovieKeyStep) {
+  CommandResult a = runCommand(command("step-new", "--movie-key-step 3 --no-coherence"));
+  ASSERT_EQ(a.exitCode, 0) << a.err;
+  EXPECT_TRUE(a.err.empty()) << a.err;
+  CommandResult b = runCommand(command("step-old", "--key-step 3 --no-coherence"));
+  ASSERT_EQ(b.exitCode, 0) << b.err;
+  EXPECT_EQ(b.err, "rad-movies: warning: --key-step is deprecated; use --movie-key-step\n");
+  for (int id = 0; id < movieCount_; ++id) {
+    TextureMovie x = readTextureMovie(textureMoviePath(path("step-new"), uint32_t(id)));
+    TextureMovie y = readTextureMovie(textureMoviePath(path("step-old"), uint32_t(id)));
+    EXPECT_EQ(x.keyFrames, keyFrames(x.firstFrame, x.lastFrame, 3)) << id;
+    EXPECT_EQ(y.keyFrames, x.keyFrames) << id;
+    EXPECT_EQ(y.keys, x.keys) << id;
+  }
+  TextureMovie first = readTextureMovie(textureMoviePath(path("step-new"), 0));
+  EXPECT_EQ(first.keyFrames, (std::vector<int>{0, 3, 6, 9, 11}));
+  CommandResult both = runCommand(command("step-both", "--key-step 3 --movie-key-step 3"));
+  EXPECT_EQ(both.exitCode, 2) << both.err;
 }
 
 }  // namespace

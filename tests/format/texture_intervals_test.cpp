@@ -21,10 +21,10 @@ TextureIntervals sample() {
   iv.imageWidth = 352;
   iv.imageHeight = 240;
   PatchId a{3, 1}, b = PatchId{7, 1}.child(2).child(1);
-  iv.movies = {{0, a, 10, 20, 64, 64, CloseReason::kResize},
-               {1, b, 10, 40, 4, 8, CloseReason::kWindow},
-               {2, a, 21, 25, 128, 128, CloseReason::kHidden},
-               {3, PatchId{0, 1}.child(3), 30, 30, 1, 1, CloseReason::kMaxLength}};
+  iv.movies = {{0, a, 10, 20, 64, 64, MovieEnd::kResize},
+               {1, b, 10, 40, 4, 8, MovieEnd::kWindow},
+               {2, a, 21, 25, 128, 128, MovieEnd::kHidden},
+               {3, PatchId{0, 1}.child(3), 30, 30, 1, 1, MovieEnd::kMaxLength}};
   return iv;
 }
 
@@ -67,7 +67,7 @@ TEST(TextureIntervalsFormat, RoundTrip) {
     EXPECT_EQ(b.lastFrame, a.lastFrame);
     EXPECT_EQ(b.width, a.width);
     EXPECT_EQ(b.height, a.height);
-    EXPECT_EQ(b.reason, a.reason);
+    EXPECT_EQ(b.end, a.end);
   }
   EXPECT_EQ(r.movies[1].level(), 2);
   ContainerReader reader = ContainerReader::open(path);
@@ -144,12 +144,12 @@ TEST(TextureIntervalsFormat, InconsistentContentIsRejected) {
 }
 
 TEST(TextureIntervalsFormat, CloseReasonNames) {
-  EXPECT_STREQ(closeReasonName(CloseReason::kLeftFrustum), "left_frustum");
-  EXPECT_STREQ(closeReasonName(CloseReason::kHidden), "hidden");
-  EXPECT_STREQ(closeReasonName(CloseReason::kLevelChange), "level_change");
-  EXPECT_STREQ(closeReasonName(CloseReason::kResize), "resize");
-  EXPECT_STREQ(closeReasonName(CloseReason::kMaxLength), "max_length");
-  EXPECT_STREQ(closeReasonName(CloseReason::kWindow), "window");
+  EXPECT_STREQ(movieEndName(MovieEnd::kLeftFrustum), "left_frustum");
+  EXPECT_STREQ(movieEndName(MovieEnd::kHidden), "hidden");
+  EXPECT_STREQ(movieEndName(MovieEnd::kLevelChange), "level_change");
+  EXPECT_STREQ(movieEndName(MovieEnd::kResize), "resize");
+  EXPECT_STREQ(movieEndName(MovieEnd::kMaxLength), "max_length");
+  EXPECT_STREQ(movieEndName(MovieEnd::kWindow), "window");
 }
 
 }  // namespace

@@ -507,17 +507,7 @@ TEST(TextureIntervalsBuilder, BitIdenticalAcrossRuns) {
     iv.lastFrame = 23;
     iv.imageWidth = kSize.width;
     iv.imageHeight = kSize.height;
-    for (size_t i = 0; i < ms.size(); ++i) {
-      TextureInterval m;
-      m.movie = uint32_t(i);
-      m.patch = ms[i].patch;
-      m.firstFrame = ms[i].firstFrame;
-      m.lastFrame = ms[i].lastFrame;
-      m.width = ms[i].width;
-      m.height = ms[i].height;
-      m.reason = CloseReason(int(ms[i].end));
-      iv.movies.push_back(m);
-    }
+    iv.movies = ms;  // the builder's records are the file's
     const char* argv[] = {"rad-intervals", "cornell-moving.gltf"};
     writeTextureIntervals(path, iv, makeProvenance("rad-intervals", 2, argv, {}), {});
     std::ifstream in(path, std::ios::binary);
