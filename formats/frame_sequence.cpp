@@ -28,7 +28,7 @@ class MovieCache {
   TextureMovieStream& get(size_t index) {
     auto it = loaded_.find(index);
     if (it != loaded_.end()) return *it->second;
-    const TextureInterval& iv = intervals_.movies[index];
+    const MovieExtent& iv = intervals_.movies[index];
     std::string path = textureMoviePath(dir_, iv.movie);
     auto stream = std::make_unique<TextureMovieStream>(path);
     const TextureMovie* movie = &stream->movie();
@@ -140,7 +140,7 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
     const double t = f / options.fps;
     active.clear();
     for (size_t i = 0; i < intervals.movies.size(); ++i) {
-      const TextureInterval& iv = intervals.movies[i];
+      const MovieExtent& iv = intervals.movies[i];
       if (iv.firstFrame > f || iv.lastFrame < f) continue;
       TextureMovieStream& stream = cache.get(i);
       const TextureMovie& movie = stream.movie();
@@ -194,7 +194,7 @@ void addMoviesInput(Provenance& provenance, const TextureIntervals& intervals,
   uint64_t h = kFnv1a64Offset;
   InputRecord record;
   record.path = moviesDir;
-  for (const TextureInterval& iv : intervals.movies) {
+  for (const MovieExtent& iv : intervals.movies) {
     if (iv.lastFrame < *lo || iv.firstFrame > *hi) continue;
     std::string path = textureMoviePath(moviesDir, iv.movie);
     std::string fileHash = hashFile(path);

@@ -18,8 +18,7 @@ constexpr int kTextureIntervalsMajor = 1;
 constexpr int kTextureIntervalsMinor = 0;
 
 // intervals.rti stores libcommon's movie record (libcommon/intervals/movie_extent.h: patch,
-// frames, size, MovieEnd) as it is; TextureInterval is the file's name for it.
-using TextureInterval = MovieExtent;
+// frames, size, MovieEnd) as it is.
 
 struct TextureIntervals {
   int firstFrame = 0, lastFrame = 0;  // the window computed

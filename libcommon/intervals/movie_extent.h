@@ -2,7 +2,7 @@
 // why it ended (Martín, Pueyo, Tost, "Frame rate independent texture movies for animated
 // radiosity", §4.1 events, §4.3 representation). The one record of the pipeline's second
 // half: rad-intervals' builder makes it (texture_intervals_builder.h), intervals.rti stores it
-// (formats/texture_intervals.h, whose name TextureInterval is this struct), rad-movies bakes it
+// (formats/texture_intervals.h stores it as it is), rad-movies bakes it
 // (movieRequestOf in libcommon/movies/texture_movie_baker.h) and rad-compose plays it.
 #pragma once
 

@@ -253,8 +253,8 @@ const char* mergeModeName(MergeMode m) {
 MergeMode parseMergeMode(const std::string& name) {
   for (MergeMode m : {MergeMode::kExact, MergeMode::kMax, MergeMode::kSum, MergeMode::kIndependent})
     if (name == mergeModeName(m)) return m;
-  throw Error(ExitCode::kUsage, "--merge",
-              "unknown merge '" + name + "'; expected exact, max, sum or independent");
+  throw Error(ExitCode::kUsage, "",
+              "merge mode '" + name + "'; expected exact, max, sum or independent");
 }
 
 double mergeTransmittance(MergeMode mode, double ts, double td) {

@@ -72,7 +72,7 @@ class RadCompose : public ::testing::Test {
     iv.imageWidth = kSize.width;
     iv.imageHeight = kSize.height;
     auto add = [&](uint32_t id, int top, int first, int last) {
-      TextureInterval t;
+      MovieExtent t;
       t.movie = id;
       t.patch = PatchId{uint32_t(top), 1};
       t.firstFrame = first;

@@ -63,7 +63,7 @@ class RadMoviesCli : public ::testing::Test {
     iv.fps = 24.0;
     iv.imageWidth = iv.imageHeight = 64;
     for (int r : receivers) {
-      TextureInterval t;
+      MovieExtent t;
       t.movie = uint32_t(iv.movies.size());
       t.patch = PatchId{uint32_t(r), 1u};
       t.firstFrame = 0;
@@ -72,7 +72,7 @@ class RadMoviesCli : public ::testing::Test {
       t.height = 6;
       iv.movies.push_back(t);
     }
-    TextureInterval child = iv.movies.front();
+    MovieExtent child = iv.movies.front();
     child.movie = uint32_t(iv.movies.size());
     child.patch = child.patch.child(2);
     child.firstFrame = 3;
@@ -183,7 +183,7 @@ TEST_F(RadMoviesCli, GlobalSolutionNotCoveringTheIntervalsIsRefused) {
   ASSERT_EQ(g.exitCode, 0) << g.err;
   TextureIntervals iv = readTextureIntervals(path("intervals.rti"));
   iv.lastFrame = 23;
-  for (TextureInterval& m : iv.movies) m.lastFrame = 23;
+  for (MovieExtent& m : iv.movies) m.lastFrame = 23;
   Provenance p = makeProvenance("test", 0, nullptr, nlohmann::json::object());
   writeTextureIntervals(path("intervals23.rti"), iv, p, nlohmann::json::object());
   CommandResult r = runCommand(tool("rad-movies") + " " + kScene + " " + path("global00.rlh") +

@@ -60,7 +60,7 @@ TEST(TextureIntervalsFormat, RoundTrip) {
   EXPECT_EQ(r.imageHeight, 240);
   ASSERT_EQ(r.movies.size(), iv.movies.size());
   for (size_t i = 0; i < iv.movies.size(); ++i) {
-    const TextureInterval &a = iv.movies[i], &b = r.movies[i];
+    const MovieExtent &a = iv.movies[i], &b = r.movies[i];
     EXPECT_EQ(b.movie, i);
     EXPECT_EQ(b.patch, a.patch);
     EXPECT_EQ(b.firstFrame, a.firstFrame);

@@ -117,7 +117,8 @@ int main(int argc, char** argv) {
   app.add_option("--merge", o.merge,
                  "static/dynamic occlusion merge: exact (bit masks ORed), or the approximate "
                  "max, sum, independent")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::IsMember({"exact", "max", "sum", "independent"}));
   app.add_flag_callback(
       "--no-coherence", [&b] { b.coherence = false; },
       "re-render every blocker and recompute every form factor at every key, store every "
