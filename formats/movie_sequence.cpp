@@ -95,7 +95,7 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
   for (const MovieExtent* m : shardMovies(intervals, options.shard)) {
     sink.start(textureMovieOf(*m, provenanceJson), textureMoviePath(options.moviesDir, m->movie));
     try {
-      baker.bake(movieRequestOf(*m), sink);
+      baker.bake(*m, sink);
     } catch (const Error& e) {
       sink.discard();
       // Name the file the bad movie came from.

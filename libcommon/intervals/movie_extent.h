@@ -3,7 +3,7 @@
 // radiosity", §4.1 events, §4.3 representation). The one record of the pipeline's second
 // half: rad-intervals' builder makes it (texture_intervals_builder.h), intervals.rti stores it
 // (formats/texture_intervals.h stores it as it is), rad-movies bakes it
-// (movieRequestOf in libcommon/movies/texture_movie_baker.h) and rad-compose plays it.
+// (TextureMovieBaker::bake in libcommon/movies/texture_movie_baker.h) and rad-compose plays it.
 #pragma once
 
 #include <cstdint>

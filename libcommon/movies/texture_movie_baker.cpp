@@ -104,7 +104,7 @@ struct Pair {
 // over the movie (each node's answer computed once).
 class MovieGeometry {
  public:
-  MovieGeometry(const Scene& scene, const std::vector<InputPolygon>& tops, const MovieRequest& req,
+  MovieGeometry(const Scene& scene, const std::vector<InputPolygon>& tops, const MovieExtent& req,
                 const std::vector<double>& keyTimes)
       : scene_(scene),
         tops_(tops),
@@ -261,7 +261,7 @@ class MovieBake {
   MovieBake(const GlobalSolution& solution, const std::vector<InputPolygon>& tops,
             const TextureMovieBakerOptions& options, TextureMovieBakerStats& stats,
             const std::function<OcclusionMaskRenderer&()>& renderer, FormFactorSpill& spill,
-            const MovieRequest& req, MovieGeometry& geometry)
+            const MovieExtent& req, MovieGeometry& geometry)
       : solution_(solution),
         tops_(tops),
         options_(options),
@@ -373,7 +373,7 @@ class MovieBake {
   TextureMovieBakerStats& stats_;
   const std::function<OcclusionMaskRenderer&()>& renderer_;
   FormFactorSpill& spill_;
-  const MovieRequest& req_;
+  const MovieExtent& req_;
   MovieGeometry& geo_;
   const size_t texels_;
   int saturatedSamples_ = 0;
@@ -533,17 +533,6 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"warnings", warnings}};
 }
 
-MovieRequest movieRequestOf(const MovieExtent& extent) {
-  MovieRequest r;
-  r.movie = extent.movie;
-  r.patch = extent.patch;
-  r.firstFrame = extent.firstFrame;
-  r.lastFrame = extent.lastFrame;
-  r.width = extent.width;
-  r.height = extent.height;
-  return r;
-}
-
 Polygon nodeWorldPolygon(const Scene& scene, const InputPolygon& top, PatchId node, double t) {
   const bool triangle = top.local.count == 3;
   static const glm::dvec2 quadCorners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
@@ -602,7 +591,7 @@ double TextureMovieBaker::movieWorkingBytes(int width, int height, size_t badSho
   return double(width) * double(height) * perTexel;
 }
 
-BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
+BakedMovie TextureMovieBaker::bake(const MovieExtent& req) {
   // Collects the keys; a movie whose keys all agree keeps one (coherence on).
   struct Collector : BakedKeySink {
     bool collapse = false;
@@ -625,7 +614,7 @@ BakedMovie TextureMovieBaker::bake(const MovieRequest& req) {
   return movie;
 }
 
-void TextureMovieBaker::checkRequest(const MovieRequest& req, size_t badShooters) const {
+void TextureMovieBaker::checkRequest(const MovieExtent& req, size_t badShooters) const {
   const std::string where = "movie " + std::to_string(req.movie);
   const int w = req.width, h = req.height;
   // Working memory: one key's buffers and the per-pair ones, whatever the number of keys.
@@ -642,7 +631,7 @@ void TextureMovieBaker::checkRequest(const MovieRequest& req, size_t badShooters
   }
 }
 
-BakedMovie TextureMovieBaker::bake(const MovieRequest& req, BakedKeySink& sink) {
+BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
   const std::string where = "movie " + std::to_string(req.movie);
   if (req.patch.top >= tops_.size())
     throw inputError(where, "patch " + req.patch.toString() + " names top-level patch " +

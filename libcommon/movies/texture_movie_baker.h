@@ -77,16 +77,6 @@ struct TextureMovieBakerBackends {
   FormFactorSpillFactory formFactorSpill;
 };
 
-// What to bake: one interval of intervals.rti (formats/texture_intervals.h).
-struct MovieRequest {
-  uint32_t movie = 0;
-  PatchId patch;
-  int firstFrame = 0, lastFrame = 0;
-  int width = 1, height = 1;
-};
-// The request for one movie record (its id, patch, frames and size).
-MovieRequest movieRequestOf(const MovieExtent& extent);
-
 // The result, as formats/texture_movie.h stores it: keys[k] has width * height * 3 floats
 // (RGB irradiance, W/m^2), row j = 0 at v = 0, texel (i, j) at node (u,v) = ((i+.5)/w, (j+.5)/h).
 // bake(request, sink) fills in keyFrames, keyTimes and keyStep only (the keys went to the sink).
@@ -141,10 +131,10 @@ class TextureMovieBaker {
   // the request names a patch outside the scene or a bad size, an environment Error when the
   // movie's working memory exceeds maxTextureMemoryMiB. Creates the GL context on first need
   // (a scene without bad pairs never touches GL).
-  BakedMovie bake(const MovieRequest& request, BakedKeySink& sink);
+  BakedMovie bake(const MovieExtent& request, BakedKeySink& sink);
   // The same with the keys collected in memory (K keys alive; for tests and small movies). A
   // movie whose keys are all bit-equal keeps one key when coherence is on.
-  BakedMovie bake(const MovieRequest& request);
+  BakedMovie bake(const MovieExtent& request);
 
   // Bytes bake() holds for a w x h movie of a receiver with `badShooters` bad shooters: one
   // key's buffers plus the per-pair ones, independent of the number of keys.
@@ -167,7 +157,7 @@ class TextureMovieBaker {
 
   OcclusionMaskRenderer& renderer();
   // Throws for a request bake() cannot do (see bake).
-  void checkRequest(const MovieRequest& request, size_t badShooters) const;
+  void checkRequest(const MovieExtent& request, size_t badShooters) const;
 };
 
 // Texel centres of a node: world points at time t via the top polygon's (u,v) map.

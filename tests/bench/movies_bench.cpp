@@ -111,12 +111,12 @@ int main(int argc, char** argv) {
     g.leafRow.push_back(i);
     for (int c = 0; c < 4; ++c) g.leafVertexGoodIrradiance.push_back(glm::vec3(0.4f));
   }
-  std::vector<MovieRequest> requests;
+  std::vector<MovieExtent> requests;
   for (int i = 0; i < n; ++i) {
     int node = g.hierarchy.top(i).node;
     if (std::find(floorNodes.begin(), floorNodes.end(), node) == floorNodes.end()) continue;
     g.badPairs.push_back({uint32_t(i), uint32_t(lightTop)});
-    MovieRequest r;
+    MovieExtent r;
     r.movie = uint32_t(requests.size());
     r.patch = PatchId{uint32_t(i), 1u};
     r.firstFrame = 0;
@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
     backends.formFactorSpill = formFactorScratchFiles();  // as rad-movies bakes
     TextureMovieBaker baker(s, g, fps, o, backends);
     auto t = std::chrono::steady_clock::now();
-    for (const MovieRequest& r : requests) out[mode].push_back(baker.bake(r));
+    for (const MovieExtent& r : requests) out[mode].push_back(baker.bake(r));
     seconds[mode] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
     stats[mode] = baker.stats();
     std::printf(

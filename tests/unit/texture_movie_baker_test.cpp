@@ -92,8 +92,8 @@ TestScene makeScene(bool wall, bool mover) {
   return t;
 }
 
-MovieRequest request(const TestScene& t, int w, int h, int f0 = 0, int f1 = 24) {
-  MovieRequest r;
+MovieExtent request(const TestScene& t, int w, int h, int f0 = 0, int f1 = 24) {
+  MovieExtent r;
   r.movie = 3;
   r.patch = PatchId{uint32_t(t.floorTop), 1u};
   r.firstFrame = f0;
@@ -192,7 +192,7 @@ TEST(TextureMovieBaker, CoherentEqualsTheBaselineAndSavesRenders) {
   baselineOptions.coherence = false;
   TextureMovieBaker coherent(t.scene, t.solution, kFps, coherentOptions);
   TextureMovieBaker baseline(t.scene, t.solution, kFps, baselineOptions);
-  MovieRequest r = request(t, 20, 16, 0, 24);
+  MovieExtent r = request(t, 20, 16, 0, 24);
   BakedMovie a = coherent.bake(r), b = baseline.bake(r);
   ASSERT_EQ(a.keys.size(), 5u) << "a moving occluder: every key stored";
   ASSERT_EQ(b.keys.size(), 5u);
@@ -214,7 +214,7 @@ TEST(TextureMovieBaker, CoherentEqualsTheBaselineAndSavesRenders) {
 
 TEST(TextureMovieBaker, ApproximateMergesDifferFromExactOnlyWhereLayersOverlap) {
   TestScene t = makeScene(true, true);
-  MovieRequest r = request(t, 20, 16, 0, 24);
+  MovieExtent r = request(t, 20, 16, 0, 24);
   TextureMovieBakerOptions o;
   BakedMovie exact = TextureMovieBaker(t.scene, t.solution, kFps, o).bake(r);
   for (MergeMode mode : {MergeMode::kMax, MergeMode::kSum, MergeMode::kIndependent}) {
@@ -230,7 +230,7 @@ TEST(TextureMovieBaker, ApproximateMergesDifferFromExactOnlyWhereLayersOverlap) 
 
 TEST(TextureMovieBaker, StaticShadowsMakeAConstantMovieUnlessCoherenceIsOff) {
   TestScene t = makeScene(true, false);
-  MovieRequest r = request(t, 8, 8, 0, 30);
+  MovieExtent r = request(t, 8, 8, 0, 30);
   TextureMovieBaker coherent(t.scene, t.solution, kFps, {});
   BakedMovie a = coherent.bake(r);
   EXPECT_EQ(a.keys.size(), 1u);
@@ -256,7 +256,7 @@ TEST(TextureMovieBaker, MovingLightOrReceiverRendersEveryBlockerPerKey) {
     TextureMovieBaker coherent(t.scene, t.solution, kFps, o);
     o.coherence = false;
     TextureMovieBaker baseline(t.scene, t.solution, kFps, o);
-    MovieRequest r = request(t, 16, 12, 0, 24);
+    MovieExtent r = request(t, 16, 12, 0, 24);
     BakedMovie a = coherent.bake(r), b = baseline.bake(r);
     ASSERT_EQ(a.keys.size(), 5u) << moveLight;
     EXPECT_NE(a.keys.front(), a.keys.back()) << "the shadow moves";
@@ -302,7 +302,7 @@ TEST(TextureMovieBaker, OneTexelMovie) {
 
 TEST(TextureMovieBaker, BitIdenticalAcrossRuns) {
   TestScene t = makeScene(true, true);
-  MovieRequest r = request(t, 17, 11, 2, 20);
+  MovieExtent r = request(t, 17, 11, 2, 20);
   BakedMovie a = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
   BakedMovie b = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
   ASSERT_EQ(a.keys.size(), b.keys.size());
@@ -316,7 +316,7 @@ TEST(TextureMovieBaker, ChildPatchTexelsAreTheTopsTexelsAtTheSamePoints) {
   TestScene t = makeScene(true, false);
   TextureMovieBaker baker(t.scene, t.solution, kFps, {});
   BakedMovie top = baker.bake(request(t, 8, 8, 0, 0));
-  MovieRequest child = request(t, 4, 4, 0, 0);
+  MovieExtent child = request(t, 4, 4, 0, 0);
   child.patch = child.patch.child(0);
   BakedMovie sub = baker.bake(child);
   double worst = 0.0;
@@ -355,7 +355,7 @@ TEST(TextureMovieBaker, MemoryBudgetBoundsOneKeyNotTheMovieLength) {
 // The streaming bake hands the keys over in order, one at a time, equal to the in-memory bake.
 TEST(TextureMovieBaker, SinkGetsTheKeysInOrderBitEqualToTheInMemoryBake) {
   TestScene t = makeScene(true, true);
-  MovieRequest r = request(t, 17, 11, 2, 20);
+  MovieExtent r = request(t, 17, 11, 2, 20);
   BakedMovie whole = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
   struct Recorder : BakedKeySink {
     std::vector<int> frames;
@@ -415,7 +415,7 @@ TEST(TextureMovieBaker, BackendsAreTheOnesUsedAndTheSpillChangesNoBit) {
     return r;
   };
   backends.formFactorSpill = formFactorScratchFiles();
-  const MovieRequest r = request(t, 16, 12, 0, 24);
+  const MovieExtent r = request(t, 16, 12, 0, 24);
   BakedMovie recomputed = TextureMovieBaker(t.scene, t.solution, kFps, {}).bake(r);
   TextureMovieBaker baker(t.scene, t.solution, kFps, {}, backends);
   BakedMovie spilled = baker.bake(r);
@@ -431,7 +431,7 @@ TEST(TextureMovieBaker, BackendsAreTheOnesUsedAndTheSpillChangesNoBit) {
 TEST(TextureMovieBaker, BadRequestsAreInputErrors) {
   TestScene t = makeScene(false, false);
   TextureMovieBaker baker(t.scene, t.solution, kFps, {});
-  MovieRequest r = request(t, 4, 4);
+  MovieExtent r = request(t, 4, 4);
   r.patch.top = 99;
   try {
     baker.bake(r);
