@@ -1,7 +1,10 @@
+// DESIGN.md §10 ("How error is measured"): RMSE / mean and bias over non-emitters, the
+// references' noise removed with two references of independent seeds.
 #include "libcommon/reference/image_difference.h"
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "libcommon/core/error.h"
 
@@ -101,29 +104,203 @@ DifferenceStats compareImages(const FloatImage& test, const FloatImage& referenc
   return s;
 }
 
-SequenceDifference compareSequence(
-    const std::vector<int>& frames,
-    const std::function<std::pair<FloatImage, FloatImage>(int frame)>& load,
-    double staticTolerance) {
+// ---- DESIGN.md §10 ---------------------------------------------------------------------------
+
+std::vector<double> luminanceWeights(const std::vector<std::string>& channels) {
+  std::vector<double> w(channels.size(), 0.0);
+  const char* names[3] = {"R", "G", "B"};
+  const double rec709[3] = {0.2126, 0.7152, 0.0722};
+  int found = 0;
+  for (int k = 0; k < 3; ++k)
+    for (std::size_t c = 0; c < channels.size(); ++c)
+      if (channels[c] == names[k]) {
+        w[c] = rec709[k];
+        ++found;
+        break;
+      }
+  if (found == 3) return w;
+  std::fill(w.begin(), w.end(), channels.empty() ? 0.0 : 1.0 / double(channels.size()));
+  return w;
+}
+
+std::string EmitterRule::toString() const {
+  std::ostringstream os;
+  if (threshold)
+    os << "Y > " << *threshold;
+  else
+    os << "Y > " << kMedianFactor << " x median luminance of the lit reference pixels";
+  return os.str();
+}
+
+namespace {
+
+double pixelLuminance(const float* p, const std::vector<double>& w) {
+  double y = 0.0;
+  for (std::size_t c = 0; c < w.size(); ++c) y += w[c] * double(p[c]);
+  return y;
+}
+
+double ratio(double numerator, double mean) {
+  if (numerator == 0.0) return 0.0;
+  if (!(mean > 0.0)) return std::copysign(std::numeric_limits<double>::infinity(), numerator);
+  return numerator / mean;
+}
+
+}  // namespace
+
+double emitterThreshold(const FloatImage& reference, const EmitterRule& rule) {
+  if (rule.threshold) return *rule.threshold;
+  const std::vector<double> w = luminanceWeights(reference.channels);
+  const std::size_t nc = std::size_t(reference.channelCount());
+  const std::size_t pixels = std::size_t(reference.width) * std::size_t(reference.height);
+  std::vector<double> lit;
+  lit.reserve(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const double y = pixelLuminance(&reference.pixels[p * nc], w);
+    if (std::isfinite(y) && y > 0.0) lit.push_back(y);
+  }
+  if (lit.empty()) return std::numeric_limits<double>::infinity();
+  auto middle = lit.begin() + std::ptrdiff_t(lit.size() / 2);
+  std::nth_element(lit.begin(), middle, lit.end());
+  return EmitterRule::kMedianFactor * *middle;
+}
+
+void PixelSetStats::merge(const PixelSetStats& o) {
+  pixels += o.pixels;
+  samples += o.samples;
+  twoReferences = twoReferences || o.twoReferences;
+  sumReference += o.sumReference;
+  sumError += o.sumError;
+  sumSquaredError1 += o.sumSquaredError1;
+  sumSquaredError2 += o.sumSquaredError2;
+  sumSquaredBetween += o.sumSquaredBetween;
+}
+
+double PixelSetStats::meanReference() const {
+  return samples > 0 ? sumReference / double(samples) : 0.0;
+}
+
+double PixelSetStats::rawRmse() const {
+  if (samples == 0) return 0.0;
+  const double sum = twoReferences ? (sumSquaredError1 + sumSquaredError2) / 2.0 : sumSquaredError1;
+  return std::sqrt(sum / double(samples));
+}
+
+double PixelSetStats::noise() const {
+  if (samples == 0 || !twoReferences) return 0.0;
+  return std::sqrt(sumSquaredBetween / (2.0 * double(samples)));
+}
+
+double PixelSetStats::rmse() const {
+  const double raw = rawRmse(), n = noise();
+  return std::sqrt(std::max(0.0, raw * raw - n * n));
+}
+
+double PixelSetStats::rmseOverMean() const {
+  return ratio(rmse(), meanReference());
+}
+double PixelSetStats::rawRmseOverMean() const {
+  return ratio(rawRmse(), meanReference());
+}
+double PixelSetStats::noiseOverMean() const {
+  return ratio(noise(), meanReference());
+}
+double PixelSetStats::bias() const {
+  return samples > 0 ? ratio(sumError / double(samples), meanReference()) : 0.0;
+}
+
+void ErrorFigures::merge(const ErrorFigures& o) {
+  surfaces.merge(o.surfaces);
+  emitters.merge(o.emitters);
+}
+
+ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
+                          const FloatImage* reference2, const EmitterRule& rule,
+                          const std::string& testWhere, const std::string& reference2Where) {
+  requireSameShape(test, reference, testWhere);
+  if (reference2) requireSameShape(*reference2, reference, reference2Where);
+  ErrorFigures f;
+  f.surfaces.twoReferences = f.emitters.twoReferences = reference2 != nullptr;
+  // With two references the emitters are decided from their mean, the same reference as the
+  // mean and the bias, so that both references' pixels fall on the same side.
+  FloatImage mean;
+  if (reference2) {
+    mean = reference;
+    for (std::size_t i = 0; i < mean.pixels.size(); ++i)
+      mean.pixels[i] = 0.5f * (reference.pixels[i] + reference2->pixels[i]);
+  }
+  const FloatImage& r = reference2 ? mean : reference;
+  f.emitterThreshold = emitterThreshold(r, rule);
+  const std::vector<double> w = luminanceWeights(reference.channels);
+  const std::size_t nc = std::size_t(reference.channelCount());
+  const std::size_t pixels = std::size_t(reference.width) * std::size_t(reference.height);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const std::size_t base = p * nc;
+    bool finite = true;
+    for (std::size_t c = 0; c < nc; ++c)
+      finite = finite && std::isfinite(test.pixels[base + c]) &&
+               std::isfinite(reference.pixels[base + c]) &&
+               (!reference2 || std::isfinite(reference2->pixels[base + c]));
+    if (!finite) continue;
+    PixelSetStats& s =
+        pixelLuminance(&r.pixels[base], w) > f.emitterThreshold ? f.emitters : f.surfaces;
+    ++s.pixels;
+    for (std::size_t c = 0; c < nc; ++c) {
+      const double t = test.pixels[base + c], r1 = reference.pixels[base + c];
+      const double r2 = reference2 ? double(reference2->pixels[base + c]) : r1;
+      const double rm = reference2 ? 0.5 * (r1 + r2) : r1;
+      ++s.samples;
+      s.sumReference += rm;
+      s.sumError += t - rm;
+      s.sumSquaredError1 += (t - r1) * (t - r1);
+      s.sumSquaredError2 += (t - r2) * (t - r2);
+      s.sumSquaredBetween += (r1 - r2) * (r1 - r2);
+    }
+  }
+  return f;
+}
+
+// ---- Sequences -------------------------------------------------------------------------------
+
+SequenceDifference compareSequence(const std::vector<int>& frames,
+                                   const std::function<FrameImages(int frame)>& load,
+                                   double staticTolerance, const EmitterRule& rule) {
   SequenceDifference result;
   FloatImage previousTest, previousReference;
   int previousFrame = 0;
   bool havePrevious = false;
   for (int frame : frames) {
-    auto [test, reference] = load(frame);
+    FrameImages im = load(frame);
+    const bool two = !im.reference2.pixels.empty();
+    const std::string where = "frame " + std::to_string(frame);
     FrameDifference fd;
     fd.frame = frame;
-    fd.stats = compareImages(test, reference, "frame " + std::to_string(frame));
+    fd.stats = compareImages(im.test, im.reference, where);
+    fd.error = measureError(im.test, im.reference, two ? &im.reference2 : nullptr, rule, where,
+                            where + ": second reference");
     result.total.merge(fd.stats);
+    result.totalError.merge(fd.error);
     result.frames.push_back(fd);
     if (havePrevious && frame == previousFrame + 1)
-      result.flicker.addPair(previousTest, test, previousReference, reference, staticTolerance);
-    previousTest = std::move(test);
-    previousReference = std::move(reference);
+      result.flicker.addPair(previousTest, im.test, previousReference, im.reference,
+                             staticTolerance);
+    previousTest = std::move(im.test);
+    previousReference = std::move(im.reference);
     previousFrame = frame;
     havePrevious = true;
   }
   return result;
+}
+
+SequenceDifference compareSequence(
+    const std::vector<int>& frames,
+    const std::function<std::pair<FloatImage, FloatImage>(int frame)>& load, double staticTolerance,
+    const EmitterRule& rule) {
+  return compareSequence(frames, std::function<FrameImages(int)>([&](int frame) {
+                           auto [test, reference] = load(frame);
+                           return FrameImages{std::move(test), std::move(reference), FloatImage()};
+                         }),
+                         staticTolerance, rule);
 }
 
 }  // namespace rad
