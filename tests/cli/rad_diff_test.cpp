@@ -120,5 +120,111 @@ TEST(RadDiff, DirectoriesMatchFramesByNameAndMeasureFlicker) {
   EXPECT_EQ(countLines(r.err), 1);
 }
 
+// A 10x10 room: walls of radiance `wall` (grey), a 2x2 light of 100 at x 4-5, y 0-1. With
+// `noise`, wall pixel (x, y) gets noise * a or noise * b, a and b = +-1 by the parity of x and
+// of y: over the walls (24 pixels of each of the four (a, b)), mean a = mean b = mean ab = 0,
+// so two references made with a and with b have independent noise of sigma = noise exactly.
+FloatImage room(float wall, float noise, bool useB) {
+  FloatImage im(10, 10, {"R", "G", "B"});
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 10; ++x) {
+      const bool light = x >= 4 && x < 6 && y < 2;
+      const float sign = (useB ? y % 2 : x % 2) ? 1.0f : -1.0f;
+      for (int c = 0; c < 3; ++c) im.at(x, y, c) = light ? 100.0f : wall + noise * sign;
+    }
+  return im;
+}
+
+// DESIGN.md §10 figures in --json, with values in closed form (binary fractions, exact in
+// float): the walls 12.5 % too dark, the light right.
+TEST(RadDiff, JsonLeadsWithTheNonEmitterFigure) {
+  fs::path d = freshDir("honest");
+  const std::string t = (d / "t.exr").string(), r1 = (d / "r1.exr").string(),
+                    r2 = (d / "r2.exr").string(), small = (d / "small.exr").string();
+  writeExrImage(t, room(0.875f, 0.0f, false));
+  writeExrImage(r1, room(1.0f, 0.125f, false));
+  writeExrImage(r2, room(1.0f, 0.125f, true));
+  writeExrImage(small, constant(4, 3, 1.0f));
+
+  // One reference: its noise (sigma 0.125) adds to the error: sqrt(0.125^2 + 0.125^2).
+  CommandResult r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out)["difference"];
+  EXPECT_DOUBLE_EQ(j["rmse_over_mean"].get<double>(), 0.125 * std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(j["bias"].get<double>(), -0.125);
+  EXPECT_EQ(j["emitter_pixels"].get<int>(), 4);
+  EXPECT_EQ(j["surface_pixels"].get<int>(), 96);
+  EXPECT_EQ(j["emitter_rmse_over_mean"].get<double>(), 0.0);
+  EXPECT_FALSE(j.contains("noise_over_mean"));
+  // The old figure, over every sample and divided by the reference RMS, reads under 1 %.
+  EXPECT_NEAR(j["relative_l2"].get<double>(), std::sqrt(9.0 / (292.5 + 120000.0)), 1e-12);
+  EXPECT_DOUBLE_EQ(j["rmse"].get<double>(), std::sqrt(9.0 / 300.0));
+
+  // Two references: their noise is removed and the error of the walls comes out exactly.
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --ref2 " + r2 + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  j = nlohmann::json::parse(r.out)["difference"];
+  EXPECT_DOUBLE_EQ(j["rmse_over_mean"].get<double>(), 0.125);
+  EXPECT_DOUBLE_EQ(j["noise_over_mean"].get<double>(), 0.125);
+  EXPECT_DOUBLE_EQ(j["raw_rmse_over_mean"].get<double>(), 0.125 * std::sqrt(2.0));
+  EXPECT_DOUBLE_EQ(j["bias"].get<double>(), -0.125);
+  EXPECT_EQ(j["emitter_pixels"].get<int>(), 4);
+
+  // An absolute threshold above the light makes every pixel a surface.
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --emitter-threshold 1000 --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["difference"]["emitter_pixels"].get<int>(), 0);
+
+  // The text leads with the figure and labels the relative L2.
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --ref2 " + r2);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("rmse/mean 0.125  bias -0.125  (noise/mean 0.125"), std::string::npos)
+      << r.out;
+  EXPECT_LT(r.out.find("rmse/mean"), r.out.find("relative L2"));
+  EXPECT_NE(r.out.find("relative L2 (normalised by the reference RMS; dominated by visible "
+                       "emitters)"),
+            std::string::npos);
+
+  // A second reference of another size: one line, exit 1.
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --ref2 " + small);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err, "rad-diff: " + small + ": size 4x3 differs from the reference's 10x10\n");
+  // A negative threshold is a usage error.
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --emitter-threshold -1");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+}
+
+// Directories with --ref2: per-frame and pooled figures; a frame missing from the second
+// reference is named.
+TEST(RadDiff, DirectoriesWithSecondReference) {
+  fs::path test = freshDir("seq2/test"), ref = freshDir("seq2/ref"), ref2 = freshDir("seq2/ref2");
+  for (int f = 1; f <= 2; ++f) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%04d.exr", f);
+    writeExrImage((test / name).string(), room(0.875f, 0.0f, false));
+    writeExrImage((ref / name).string(), room(1.0f, 0.125f, false));
+    writeExrImage((ref2 / name).string(), room(1.0f, 0.125f, true));
+  }
+  CommandResult r = runCommand(tool("rad-diff") + " " + test.string() + " " + ref.string() +
+                               " --ref2 " + ref2.string() + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_DOUBLE_EQ(j["difference"]["rmse_over_mean"].get<double>(), 0.125);
+  EXPECT_DOUBLE_EQ(j["difference"]["bias"].get<double>(), -0.125);
+  EXPECT_EQ(j["difference"]["emitter_pixels"].get<int>(), 8);
+  ASSERT_EQ(j["per_frame"].size(), 2u);
+  EXPECT_DOUBLE_EQ(j["per_frame"][1]["noise_over_mean"].get<double>(), 0.125);
+  EXPECT_EQ(j["per_frame"][1]["emitter_pixels"].get<int>(), 4);
+
+  fs::remove(ref2 / "0002.exr");
+  r = runCommand(tool("rad-diff") + " " + test.string() + " " + ref.string() + " --ref2 " +
+                 ref2.string());
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(ref2.string() + ": no frame 2"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace rad::test

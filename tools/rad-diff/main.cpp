@@ -1,6 +1,8 @@
 // rad-diff: how far a rendered image or frame sequence is from a reference (DESIGN.md §8,
-// "error vs converged reference" and "temporal flicker"): RMSE, relative L2, max abs
-// difference, PSNR and the flicker of the test sequence where the reference is static.
+// "error vs converged reference" and "temporal flicker"; §10, "How error is measured"):
+// RMSE / mean and bias over the non-emitter pixels (emitters apart, a second reference's noise
+// removed with --ref2), then RMSE, relative L2, max abs difference and PSNR over every sample,
+// and the flicker of the test sequence where the reference is static.
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -21,10 +23,11 @@ constexpr const char* kTool = "rad-diff";
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string test, reference;
+  std::string test, reference, reference2;
   bool json = false;
   std::string channels = "R,G,B";
   double staticTolerance = 0.0;
+  rad::EmitterRule emitters;
 };
 
 std::vector<std::string> splitChannels(const std::string& spec) {
@@ -64,95 +67,177 @@ std::string text(double x) {
   return os.str();
 }
 
-nlohmann::json statsJson(const rad::DifferenceStats& s) {
-  return {{"samples", s.samples},
-          {"non_finite", s.nonFinite},
-          {"rmse", number(s.rmse())},
-          {"relative_l2", number(s.relativeL2())},
-          {"max_abs", s.maxAbsDifference},
-          {"psnr_db", number(s.psnr())},
-          {"reference_peak", number(s.referencePeak)}};
+// One "difference" object: the DESIGN.md §10 figures first (over non-emitter pixels, emitters
+// apart), then the figures over every sample that bench.py and tradeoff.py read (rmse,
+// relative_l2 normalised by the reference RMS, max_abs, psnr_db), with their meaning unchanged.
+nlohmann::json statsJson(const rad::DifferenceStats& s, const rad::ErrorFigures& e, bool oneFrame) {
+  const rad::PixelSetStats &n = e.surfaces, &m = e.emitters;
+  nlohmann::json j = {{"rmse_over_mean", number(n.rmseOverMean())},
+                      {"bias", number(n.bias())},
+                      {"mean_reference", n.meanReference()},
+                      {"surface_pixels", n.pixels},
+                      {"emitter_pixels", m.pixels},
+                      {"emitter_rmse_over_mean", number(m.rmseOverMean())},
+                      {"emitter_bias", number(m.bias())},
+                      {"samples", s.samples},
+                      {"non_finite", s.nonFinite},
+                      {"rmse", number(s.rmse())},
+                      {"relative_l2", number(s.relativeL2())},
+                      {"max_abs", s.maxAbsDifference},
+                      {"psnr_db", number(s.psnr())},
+                      {"reference_peak", number(s.referencePeak)}};
+  if (n.twoReferences) {
+    j["noise_over_mean"] = number(n.noiseOverMean());
+    j["raw_rmse_over_mean"] = number(n.rawRmseOverMean());
+  }
+  if (oneFrame) j["emitter_threshold"] = number(e.emitterThreshold);
+  return j;
 }
 
-std::string statsText(const rad::DifferenceStats& s) {
+std::string errorText(const rad::ErrorFigures& e) {
+  const rad::PixelSetStats &n = e.surfaces, &m = e.emitters;
   std::ostringstream os;
-  os << "rmse " << text(s.rmse()) << "  relative_l2 " << text(s.relativeL2()) << "  max_abs "
-     << text(s.maxAbsDifference) << "  psnr " << text(s.psnr()) << " dB (peak "
+  os << "rmse/mean " << text(n.rmseOverMean()) << "  bias " << text(n.bias());
+  if (n.twoReferences)
+    os << "  (noise/mean " << text(n.noiseOverMean()) << ", raw rmse/mean "
+       << text(n.rawRmseOverMean()) << ")";
+  os << " over " << n.pixels << " non-emitter px;  emitters " << m.pixels << " px";
+  if (m.pixels > 0) os << " rmse/mean " << text(m.rmseOverMean());
+  return os.str();
+}
+
+std::string statsText(const rad::DifferenceStats& s, const char* relativeLabel) {
+  std::ostringstream os;
+  os << "rmse " << text(s.rmse()) << "  " << relativeLabel << " " << text(s.relativeL2())
+     << "  max_abs " << text(s.maxAbsDifference) << "  psnr " << text(s.psnr()) << " dB (peak "
      << text(s.referencePeak) << ")";
   if (s.nonFinite > 0) os << "  non_finite " << s.nonFinite;
   return os.str();
 }
 
+constexpr const char* kLongRelative =
+    "relative L2 (normalised by the reference RMS; dominated by visible emitters)";
+
+std::string legend(const Options& o) {
+  return std::string(
+             "  rmse/mean and bias over the pixels that are not emitters (DESIGN.md "
+             "§10)") +
+         (o.reference2.empty() ? "" : ", the references' noise removed") +
+         "; emitters: " + o.emitters.toString() + "\n";
+}
+
+// Two single files.
+void compareFiles(const Options& o, const std::vector<std::string>& channels, nlohmann::json& j,
+                  std::ostream& out) {
+  rad::FloatImage test = rad::readExrImage(o.test, channels);
+  rad::FloatImage reference = rad::readExrImage(o.reference, channels);
+  rad::FloatImage reference2;
+  if (!o.reference2.empty()) reference2 = rad::readExrImage(o.reference2, channels);
+  rad::DifferenceStats s = rad::compareImages(test, reference, o.test);
+  rad::ErrorFigures e =
+      rad::measureError(test, reference, o.reference2.empty() ? nullptr : &reference2, o.emitters,
+                        o.test, o.reference2);
+  j["size"] = {test.width, test.height};
+  j["difference"] = statsJson(s, e, true);
+  out << o.test << " vs " << o.reference;
+  if (!o.reference2.empty()) out << " and " << o.reference2;
+  out << " (" << test.width << "x" << test.height << ", " << o.channels << "):\n"
+      << legend(o) << "  " << errorText(e) << " (emitter threshold " << text(e.emitterThreshold)
+      << ")\n  every pixel: " << statsText(s, kLongRelative) << "\n";
+}
+
+// Two (or three, with --ref2) frame directories, matched by frame number.
+void compareDirectories(const Options& o, const std::vector<std::string>& channels,
+                        nlohmann::json& j, std::ostream& out) {
+  std::map<int, std::string> tests = frameFiles(o.test), refs = frameFiles(o.reference);
+  std::map<int, std::string> refs2;
+  if (!o.reference2.empty()) refs2 = frameFiles(o.reference2);
+  std::vector<int> frames;
+  int onlyTest = 0;
+  for (const auto& [f, p] : tests) {
+    if (refs.count(f))
+      frames.push_back(f);
+    else
+      ++onlyTest;
+  }
+  const int onlyReference = int(refs.size()) - int(frames.size());
+  if (frames.empty())
+    throw rad::inputError(o.test, "no frame NNNN.exr in common with " + o.reference);
+  for (int f : frames)
+    if (!o.reference2.empty() && !refs2.count(f))
+      throw rad::inputError(o.reference2, "no frame " + std::to_string(f) + " (" +
+                                              fs::path(refs[f]).filename().string() +
+                                              " is in the reference)");
+  rad::SequenceDifference seq = rad::compareSequence(
+      frames,
+      [&](int f) {
+        rad::FrameImages im{rad::readExrImage(tests[f], channels),
+                            rad::readExrImage(refs[f], channels), rad::FloatImage()};
+        rad::requireSameShape(im.test, im.reference, tests[f]);
+        if (!o.reference2.empty()) {
+          im.reference2 = rad::readExrImage(refs2[f], channels);
+          rad::requireSameShape(im.reference2, im.reference, refs2[f]);
+        }
+        return im;
+      },
+      o.staticTolerance, o.emitters);
+  j["frames_compared"] = frames.size();
+  j["frames_only_in_test"] = onlyTest;
+  j["frames_only_in_reference"] = onlyReference;
+  j["difference"] = statsJson(seq.total, seq.totalError, false);
+  j["flicker"] = {{"mean_abs", seq.flicker.mean()},
+                  {"max_abs", seq.flicker.maxAbsChange},
+                  {"static_pixels", seq.flicker.staticPixels},
+                  {"frame_pairs", seq.flicker.framePairs},
+                  {"static_tolerance", o.staticTolerance}};
+  nlohmann::json per = nlohmann::json::array();
+  out << o.test << " vs " << o.reference;
+  if (!o.reference2.empty()) out << " and " << o.reference2;
+  out << ": " << frames.size() << " frame(s) compared";
+  if (onlyTest + onlyReference > 0)
+    out << " (" << onlyTest << " only in test, " << onlyReference << " only in reference)";
+  out << "\n" << legend(o);
+  for (const rad::FrameDifference& fd : seq.frames) {
+    nlohmann::json fj = statsJson(fd.stats, fd.error, true);
+    fj["frame"] = fd.frame;
+    per.push_back(fj);
+    out << "  frame " << std::setw(4) << std::setfill('0') << fd.frame << std::setfill(' ') << ": "
+        << errorText(fd.error) << "  |  " << statsText(fd.stats, "relative_l2") << "\n";
+  }
+  j["per_frame"] = per;
+  out << "  all frames (pooled): " << errorText(seq.totalError)
+      << "\n  all frames, every pixel: " << statsText(seq.total, kLongRelative) << "\n";
+  out << "  flicker: mean |test(n+1)-test(n)| " << text(seq.flicker.mean()) << " (max "
+      << text(seq.flicker.maxAbsChange) << ") over " << seq.flicker.staticPixels
+      << " static pixel(s) in " << seq.flicker.framePairs << " frame pair(s)\n";
+}
+
 int run(const Options& o) {
   const std::vector<std::string> channels = splitChannels(o.channels);
-  for (const std::string& p : {o.test, o.reference})
+  if (o.emitters.threshold && !(*o.emitters.threshold >= 0.0))
+    throw rad::Error(rad::ExitCode::kUsage, "--emitter-threshold", "must be >= 0");
+  std::vector<std::string> inputs = {o.test, o.reference};
+  if (!o.reference2.empty()) inputs.push_back(o.reference2);
+  for (const std::string& p : inputs)
     if (!fs::exists(p)) throw rad::inputError(p, "cannot open (missing)");
   const bool testDir = fs::is_directory(o.test), refDir = fs::is_directory(o.reference);
   if (testDir != refDir)
     throw rad::Error(rad::ExitCode::kUsage, o.test,
                      "TEST and REFERENCE must both be .exr files or both directories");
+  if (!o.reference2.empty() && fs::is_directory(o.reference2) != refDir)
+    throw rad::Error(rad::ExitCode::kUsage, o.reference2,
+                     "--ref2 must be of the reference's kind (.exr file or directory)");
   nlohmann::json j;
   j["test"] = o.test;
   j["reference"] = o.reference;
+  if (!o.reference2.empty()) j["reference2"] = o.reference2;
   j["channels"] = channels;
+  j["emitter_rule"] = o.emitters.toString();
   std::ostringstream out;
-  if (!testDir) {
-    rad::FloatImage test = rad::readExrImage(o.test, channels);
-    rad::FloatImage reference = rad::readExrImage(o.reference, channels);
-    rad::DifferenceStats s = rad::compareImages(test, reference, o.test);
-    j["size"] = {test.width, test.height};
-    j["difference"] = statsJson(s);
-    out << o.test << " vs " << o.reference << " (" << test.width << "x" << test.height << ", "
-        << o.channels << "):\n  " << statsText(s) << "\n";
-  } else {
-    std::map<int, std::string> tests = frameFiles(o.test), refs = frameFiles(o.reference);
-    std::vector<int> frames;
-    int onlyTest = 0;
-    for (const auto& [f, p] : tests) {
-      if (refs.count(f))
-        frames.push_back(f);
-      else
-        ++onlyTest;
-    }
-    const int onlyReference = int(refs.size()) - int(frames.size());
-    if (frames.empty())
-      throw rad::inputError(o.test, "no frame NNNN.exr in common with " + o.reference);
-    rad::SequenceDifference seq = rad::compareSequence(
-        frames,
-        [&](int f) {
-          rad::FloatImage test = rad::readExrImage(tests[f], channels);
-          rad::FloatImage ref = rad::readExrImage(refs[f], channels);
-          rad::requireSameShape(test, ref, tests[f]);
-          return std::make_pair(std::move(test), std::move(ref));
-        },
-        o.staticTolerance);
-    j["frames_compared"] = frames.size();
-    j["frames_only_in_test"] = onlyTest;
-    j["frames_only_in_reference"] = onlyReference;
-    j["difference"] = statsJson(seq.total);
-    j["flicker"] = {{"mean_abs", seq.flicker.mean()},
-                    {"max_abs", seq.flicker.maxAbsChange},
-                    {"static_pixels", seq.flicker.staticPixels},
-                    {"frame_pairs", seq.flicker.framePairs},
-                    {"static_tolerance", o.staticTolerance}};
-    nlohmann::json per = nlohmann::json::array();
-    out << o.test << " vs " << o.reference << ": " << frames.size() << " frame(s) compared";
-    if (onlyTest + onlyReference > 0)
-      out << " (" << onlyTest << " only in test, " << onlyReference << " only in reference)";
-    out << "\n";
-    for (const rad::FrameDifference& fd : seq.frames) {
-      nlohmann::json fj = statsJson(fd.stats);
-      fj["frame"] = fd.frame;
-      per.push_back(fj);
-      out << "  frame " << std::setw(4) << std::setfill('0') << fd.frame << std::setfill(' ')
-          << ": " << statsText(fd.stats) << "\n";
-    }
-    j["per_frame"] = per;
-    out << "  all frames: " << statsText(seq.total) << "\n";
-    out << "  flicker: mean |test(n+1)-test(n)| " << text(seq.flicker.mean()) << " (max "
-        << text(seq.flicker.maxAbsChange) << ") over " << seq.flicker.staticPixels
-        << " static pixel(s) in " << seq.flicker.framePairs << " frame pair(s)\n";
-  }
+  if (!testDir)
+    compareFiles(o, channels, j, out);
+  else
+    compareDirectories(o, channels, j, out);
   if (o.json)
     std::cout << j.dump(1) << "\n";
   else
@@ -164,16 +249,36 @@ int run(const Options& o) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Compares a test image or frame directory (NNNN.exr) with a reference: RMSE, relative L2, "
-      "max abs difference, PSNR (peak = max of the reference) and, for sequences, the temporal "
-      "flicker of the test where the reference does not change."};
+      "Compares a test image or frame directory (NNNN.exr) with a reference. It reports first "
+      "the error figure of DESIGN.md §10, over the pixels that are not emitters (channels "
+      "pooled): rmse/mean = sqrt(mean((test-ref)^2)) / mean(ref) and bias = mean(test-ref) / "
+      "mean(ref). Emitter pixels (a visible light) are reported apart (their count and "
+      "rmse/mean): by default a pixel whose reference luminance Y = 0.2126 R + 0.7152 G + 0.0722 "
+      "B exceeds 10 x the median Y of the lit (Y > 0) reference pixels of the frame; the median, "
+      "unlike the mean, is not lifted by the light it is meant to find, and a lit diffuse wall "
+      "stays within a few times the typical wall while a visible light is far above it. With "
+      "--ref2 (a second reference of another seed) the references' own noise is removed: "
+      "noise^2 = mean((ref-ref2)^2)/2, rmse^2 = (rmse(test,ref)^2 + rmse(test,ref2)^2)/2 - "
+      "noise^2, mean and bias against (ref+ref2)/2. Then, over every sample: RMSE, relative L2 "
+      "(||test-ref|| / ||ref||, normalised by the reference RMS and so dominated by visible "
+      "emitters), max abs difference, PSNR (peak = max of the reference) and, for sequences, the "
+      "temporal flicker of the test where the reference does not change. Sequence totals pool "
+      "the sums of every frame."};
   Options o;
-  rad::setUpApp(app, kTool, "rad-diff out/frames ref/frames --json");
+  rad::setUpApp(app, kTool, "rad-diff out/frames ref-seed1/frames --ref2 ref-seed2/frames --json");
   app.add_option("TEST", o.test, "test .exr file or directory of NNNN.exr")->required();
   app.add_option("REFERENCE", o.reference, "reference .exr file or directory of NNNN.exr")
       ->required();
+  app.add_option("--ref2", o.reference2,
+                 "second reference of another seed (same kind and frames as REFERENCE): removes "
+                 "the references' noise from rmse/mean");
+  app.add_option("--emitter-threshold", o.emitters.threshold,
+                 "a pixel whose reference luminance Y exceeds this is an emitter (default: 10 x "
+                 "the median Y of the lit reference pixels, per frame)");
   app.add_flag("--json", o.json, "print JSON on stdout instead of text");
-  app.add_option("--channels", o.channels, "comma-separated channels to compare")
+  app.add_option("--channels", o.channels,
+                 "comma-separated channels to compare (luminance: Rec. 709 when R, G, B are all "
+                 "present, else the channels' mean)")
       ->capture_default_str();
   app.add_option("--static-tolerance", o.staticTolerance,
                  "flicker: a reference pixel is static when no channel changes by more")
