@@ -140,6 +140,16 @@ double pixelLuminance(const float* p, const std::vector<double>& w) {
   return y;
 }
 
+void requireMaskShape(const FloatImage& mask, const FloatImage& reference,
+                      const std::string& where) {
+  if (mask.width != reference.width || mask.height != reference.height)
+    throw inputError(where, "size " + std::to_string(mask.width) + "x" +
+                                std::to_string(mask.height) + " differs from the reference's " +
+                                std::to_string(reference.width) + "x" +
+                                std::to_string(reference.height));
+  if (mask.channelCount() < 1) throw inputError(where, "emitter mask has no channel");
+}
+
 double ratio(double numerator, double mean) {
   if (numerator == 0.0) return 0.0;
   if (!(mean > 0.0)) return std::copysign(std::numeric_limits<double>::infinity(), numerator);
@@ -216,9 +226,11 @@ void ErrorFigures::merge(const ErrorFigures& o) {
 
 ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
                           const FloatImage* reference2, const EmitterRule& rule,
-                          const std::string& testWhere, const std::string& reference2Where) {
+                          const std::string& testWhere, const std::string& reference2Where,
+                          const FloatImage* emitterMask, const std::string& maskWhere) {
   requireSameShape(test, reference, testWhere);
   if (reference2) requireSameShape(*reference2, reference, reference2Where);
+  if (emitterMask) requireMaskShape(*emitterMask, reference, maskWhere);
   ErrorFigures f;
   f.surfaces.twoReferences = f.emitters.twoReferences = reference2 != nullptr;
   // With two references the emitters are decided from their mean, the same reference as the
@@ -230,7 +242,9 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
       mean.pixels[i] = 0.5f * (reference.pixels[i] + reference2->pixels[i]);
   }
   const FloatImage& r = reference2 ? mean : reference;
-  f.emitterThreshold = emitterThreshold(r, rule);
+  f.emitterThreshold =
+      emitterMask ? std::numeric_limits<double>::quiet_NaN() : emitterThreshold(r, rule);
+  const std::size_t maskChannels = emitterMask ? std::size_t(emitterMask->channelCount()) : 0;
   const std::vector<double> w = luminanceWeights(reference.channels);
   const std::size_t nc = std::size_t(reference.channelCount());
   const std::size_t pixels = std::size_t(reference.width) * std::size_t(reference.height);
@@ -242,8 +256,9 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
                std::isfinite(reference.pixels[base + c]) &&
                (!reference2 || std::isfinite(reference2->pixels[base + c]));
     if (!finite) continue;
-    PixelSetStats& s =
-        pixelLuminance(&r.pixels[base], w) > f.emitterThreshold ? f.emitters : f.surfaces;
+    const bool emitter = emitterMask ? emitterMask->pixels[p * maskChannels] > 0.5f
+                                     : pixelLuminance(&r.pixels[base], w) > f.emitterThreshold;
+    PixelSetStats& s = emitter ? f.emitters : f.surfaces;
     ++s.pixels;
     for (std::size_t c = 0; c < nc; ++c) {
       const double t = test.pixels[base + c], r1 = reference.pixels[base + c];
@@ -276,8 +291,10 @@ SequenceDifference compareSequence(const std::vector<int>& frames,
     FrameDifference fd;
     fd.frame = frame;
     fd.stats = compareImages(im.test, im.reference, where);
+    const bool masked = !im.emitterMask.pixels.empty();
     fd.error = measureError(im.test, im.reference, two ? &im.reference2 : nullptr, rule, where,
-                            where + ": second reference");
+                            where + ": second reference", masked ? &im.emitterMask : nullptr,
+                            where + ": emitter mask");
     result.total.merge(fd.stats);
     result.totalError.merge(fd.error);
     result.frames.push_back(fd);
@@ -296,11 +313,12 @@ SequenceDifference compareSequence(
     const std::vector<int>& frames,
     const std::function<std::pair<FloatImage, FloatImage>(int frame)>& load, double staticTolerance,
     const EmitterRule& rule) {
-  return compareSequence(frames, std::function<FrameImages(int)>([&](int frame) {
-                           auto [test, reference] = load(frame);
-                           return FrameImages{std::move(test), std::move(reference), FloatImage()};
-                         }),
-                         staticTolerance, rule);
+  return compareSequence(
+      frames, std::function<FrameImages(int)>([&](int frame) {
+        auto [test, reference] = load(frame);
+        return FrameImages{std::move(test), std::move(reference), FloatImage(), FloatImage()};
+      }),
+      staticTolerance, rule);
 }
 
 }  // namespace rad

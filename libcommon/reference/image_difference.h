@@ -137,12 +137,18 @@ struct ErrorFigures {
   void merge(const ErrorFigures& other);
 };
 
-// `reference2` may be null (one reference). All images must have the same shape (throws as
-// requireSameShape, naming testWhere or reference2Where).
+// `reference2` may be null (one reference). `emitterMask` may be null (the rule decides);
+// otherwise its first channel > 0.5 marks a pixel as an emitter and the rule is not used
+// (emitterThreshold is then NaN): the scene's own word, where rad-compose or rad-reference
+// wrote one, beats a luminance guess. All images must have the same size, test and references
+// the same channels (throws as requireSameShape, naming testWhere, reference2Where or
+// maskWhere).
 ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
                           const FloatImage* reference2, const EmitterRule& rule,
                           const std::string& testWhere = "test image",
-                          const std::string& reference2Where = "second reference");
+                          const std::string& reference2Where = "second reference",
+                          const FloatImage* emitterMask = nullptr,
+                          const std::string& maskWhere = "emitter mask");
 
 // ---- Sequences -------------------------------------------------------------------------------
 
@@ -159,9 +165,10 @@ struct SequenceDifference {
   FlickerStats flicker;                 // over pairs of consecutive frame numbers
 };
 
-// One frame's images; reference2 empty (0x0) when there is no second reference.
+// One frame's images; reference2 empty (0x0) when there is no second reference, emitterMask
+// empty when the rule decides which pixels are emitters.
 struct FrameImages {
-  FloatImage test, reference, reference2;
+  FloatImage test, reference, reference2, emitterMask;
 };
 
 // Compares a sequence frame by frame. `load(frame)` returns the images of one frame number

@@ -190,6 +190,30 @@ TEST(RadDiff, JsonLeadsWithTheNonEmitterFigure) {
   EXPECT_EQ(r.exitCode, 1);
   EXPECT_EQ(countLines(r.err), 1) << r.err;
   EXPECT_EQ(r.err, "rad-diff: " + small + ": size 4x3 differs from the reference's 10x10\n");
+  // An emitter mask (one channel, > 0.5) replaces the luminance rule: here it marks the light
+  // and the first wall row as emitters, so 4 + 8 pixels are left out of the figure.
+  FloatImage mask(10, 10, {"Y"});
+  for (int x = 0; x < 10; ++x) mask.at(x, 9, 0) = 1.0f;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 4; x < 6; ++x) mask.at(x, y, 0) = 0.75f;
+  mask.at(0, 9, 0) = mask.at(9, 9, 0) = 0.5f;  // not above 0.5: a surface
+  const std::string m = (d / "mask.exr").string();
+  writeExrImage(m, mask);
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --emitter-mask " + m + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["difference"]["emitter_pixels"].get<int>(), 4 + 8);
+  EXPECT_EQ(j["difference"]["surface_pixels"].get<int>(), 88);
+  EXPECT_TRUE(j["difference"]["emitter_threshold"].is_null());
+  EXPECT_EQ(j["emitter_mask"].get<std::string>(), m);
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --emitter-mask " + small);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(r.err, "rad-diff: " + small + ": size 4x3 differs from the reference's 10x10\n");
+  r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --emitter-mask " + m +
+                 " --emitter-threshold 3");
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+
   // A negative threshold is a usage error.
   r = runCommand(tool("rad-diff") + " " + t + " " + r1 + " --emitter-threshold -1");
   EXPECT_EQ(r.exitCode, 2);
@@ -217,6 +241,21 @@ TEST(RadDiff, DirectoriesWithSecondReference) {
   ASSERT_EQ(j["per_frame"].size(), 2u);
   EXPECT_DOUBLE_EQ(j["per_frame"][1]["noise_over_mean"].get<double>(), 0.125);
   EXPECT_EQ(j["per_frame"][1]["emitter_pixels"].get<int>(), 4);
+
+  // A folder of masks, one per frame: here every pixel of frame 1 is marked, none of frame 2.
+  fs::path masks = freshDir("seq2/masks");
+  FloatImage all(10, 10, {"A"}), none(10, 10, {"A"});
+  for (float& v : all.pixels) v = 1.0f;
+  writeExrImage((masks / "0001.exr").string(), all);
+  writeExrImage((masks / "0002.exr").string(), none);
+  r = runCommand(tool("rad-diff") + " " + test.string() + " " + ref.string() + " --ref2 " +
+                 ref2.string() + " --emitter-mask " + masks.string() + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["per_frame"][0]["emitter_pixels"].get<int>(), 100);
+  EXPECT_EQ(j["per_frame"][1]["emitter_pixels"].get<int>(), 0);
+  EXPECT_EQ(j["difference"]["emitter_pixels"].get<int>(), 100);
+  EXPECT_EQ(j["difference"]["surface_pixels"].get<int>(), 100);
 
   fs::remove(ref2 / "0002.exr");
   r = runCommand(tool("rad-diff") + " " + test.string() + " " + ref.string() + " --ref2 " +

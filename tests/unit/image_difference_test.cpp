@@ -188,6 +188,26 @@ TEST(ImageDifference, EmitterThresholdRule) {
   EXPECT_EQ(measureError(uniform, uniform, nullptr, EmitterRule{}).emitters.pixels, 0);
 }
 
+// A mask replaces the rule: its first channel > 0.5 marks emitters, whatever their luminance.
+TEST(ImageDifference, EmitterMaskReplacesTheRule) {
+  FloatImage ref = wallsAndLight(1.0f, 200.0f), test = wallsAndLight(0.91f, 200.0f);
+  FloatImage mask(20, 20, {"Y", "Z"});
+  for (int x = 0; x < 20; ++x) mask.at(x, 19, 0) = 1.0f;  // the bottom row, not the light
+  for (int x = 0; x < 20; ++x) mask.at(x, 18, 1) = 1.0f;  // second channel: ignored
+  ErrorFigures e = measureError(test, ref, nullptr, EmitterRule{}, "t", "r2", &mask, "m.exr");
+  EXPECT_EQ(e.emitters.pixels, 20);
+  EXPECT_EQ(e.surfaces.pixels, 380);
+  EXPECT_TRUE(std::isnan(e.emitterThreshold));
+  EXPECT_NEAR(e.emitters.bias(), -(1.0 - double(0.91f)), 1e-12);
+  FloatImage small(4, 4, {"Y"});
+  try {
+    measureError(test, ref, nullptr, EmitterRule{}, "t", "r2", &small, "m.exr");
+    FAIL() << "no error";
+  } catch (const Error& err) {
+    EXPECT_EQ(std::string(err.what()), "m.exr: size 4x4 differs from the reference's 20x20");
+  }
+}
+
 // Deterministic noise, uniform in [-a, a] (a 64-bit LCG; the same on every platform).
 struct Lcg {
   unsigned long long state;

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/exr_image.h"
+#include "formats/exr_info.h"
 #include "libcommon/reference/image_difference.h"
 #include "tools/common/tool_main.h"
 
@@ -23,7 +24,7 @@ constexpr const char* kTool = "rad-diff";
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string test, reference, reference2;
+  std::string test, reference, reference2, emitterMask;
   bool json = false;
   std::string channels = "R,G,B";
   double staticTolerance = 0.0;
@@ -118,12 +119,26 @@ std::string statsText(const rad::DifferenceStats& s, const char* relativeLabel) 
 constexpr const char* kLongRelative =
     "relative L2 (normalised by the reference RMS; dominated by visible emitters)";
 
+std::string emitterRuleText(const Options& o) {
+  if (o.emitterMask.empty()) return o.emitters.toString();
+  return "first channel > 0.5 in " + o.emitterMask;
+}
+
+// An emitter mask: the first channel the file lists (EXR lists channels by name, so a mask
+// should have one channel), read alone.
+rad::FloatImage readEmitterMask(const std::string& path) {
+  const nlohmann::json info = rad::readExrInfo(path);
+  const nlohmann::json& channels = info["parts"][0]["channels"];
+  if (channels.empty()) throw rad::inputError(path, "emitter mask has no channel");
+  return rad::readExrImage(path, {channels[0]["name"].get<std::string>()});
+}
+
 std::string legend(const Options& o) {
   return std::string(
              "  rmse/mean and bias over the pixels that are not emitters (DESIGN.md "
              "§10)") +
          (o.reference2.empty() ? "" : ", the references' noise removed") +
-         "; emitters: " + o.emitters.toString() + "\n";
+         "; emitters: " + emitterRuleText(o) + "\n";
 }
 
 // Two single files.
@@ -133,25 +148,29 @@ void compareFiles(const Options& o, const std::vector<std::string>& channels, nl
   rad::FloatImage reference = rad::readExrImage(o.reference, channels);
   rad::FloatImage reference2;
   if (!o.reference2.empty()) reference2 = rad::readExrImage(o.reference2, channels);
+  rad::FloatImage mask;
+  if (!o.emitterMask.empty()) mask = readEmitterMask(o.emitterMask);
   rad::DifferenceStats s = rad::compareImages(test, reference, o.test);
-  rad::ErrorFigures e =
-      rad::measureError(test, reference, o.reference2.empty() ? nullptr : &reference2, o.emitters,
-                        o.test, o.reference2);
+  rad::ErrorFigures e = rad::measureError(
+      test, reference, o.reference2.empty() ? nullptr : &reference2, o.emitters, o.test,
+      o.reference2, o.emitterMask.empty() ? nullptr : &mask, o.emitterMask);
   j["size"] = {test.width, test.height};
   j["difference"] = statsJson(s, e, true);
   out << o.test << " vs " << o.reference;
   if (!o.reference2.empty()) out << " and " << o.reference2;
   out << " (" << test.width << "x" << test.height << ", " << o.channels << "):\n"
-      << legend(o) << "  " << errorText(e) << " (emitter threshold " << text(e.emitterThreshold)
-      << ")\n  every pixel: " << statsText(s, kLongRelative) << "\n";
+      << legend(o) << "  " << errorText(e);
+  if (o.emitterMask.empty()) out << " (emitter threshold " << text(e.emitterThreshold) << ")";
+  out << "\n  every pixel: " << statsText(s, kLongRelative) << "\n";
 }
 
 // Two (or three, with --ref2) frame directories, matched by frame number.
 void compareDirectories(const Options& o, const std::vector<std::string>& channels,
                         nlohmann::json& j, std::ostream& out) {
   std::map<int, std::string> tests = frameFiles(o.test), refs = frameFiles(o.reference);
-  std::map<int, std::string> refs2;
+  std::map<int, std::string> refs2, masks;
   if (!o.reference2.empty()) refs2 = frameFiles(o.reference2);
+  if (!o.emitterMask.empty()) masks = frameFiles(o.emitterMask);
   std::vector<int> frames;
   int onlyTest = 0;
   for (const auto& [f, p] : tests) {
@@ -164,20 +183,24 @@ void compareDirectories(const Options& o, const std::vector<std::string>& channe
   if (frames.empty())
     throw rad::inputError(o.test, "no frame NNNN.exr in common with " + o.reference);
   for (int f : frames)
-    if (!o.reference2.empty() && !refs2.count(f))
-      throw rad::inputError(o.reference2, "no frame " + std::to_string(f) + " (" +
-                                              fs::path(refs[f]).filename().string() +
-                                              " is in the reference)");
+    for (const auto& [dir, files] :
+         {std::pair(&o.reference2, &refs2), std::pair(&o.emitterMask, &masks)})
+      if (!dir->empty() && !files->count(f))
+        throw rad::inputError(*dir, "no frame " + std::to_string(f) + " (" +
+                                        fs::path(refs[f]).filename().string() +
+                                        " is in the reference)");
   rad::SequenceDifference seq = rad::compareSequence(
       frames,
       [&](int f) {
         rad::FrameImages im{rad::readExrImage(tests[f], channels),
-                            rad::readExrImage(refs[f], channels), rad::FloatImage()};
+                            rad::readExrImage(refs[f], channels), rad::FloatImage(),
+                            rad::FloatImage()};
         rad::requireSameShape(im.test, im.reference, tests[f]);
         if (!o.reference2.empty()) {
           im.reference2 = rad::readExrImage(refs2[f], channels);
           rad::requireSameShape(im.reference2, im.reference, refs2[f]);
         }
+        if (!o.emitterMask.empty()) im.emitterMask = readEmitterMask(masks[f]);
         return im;
       },
       o.staticTolerance, o.emitters);
@@ -217,22 +240,28 @@ int run(const Options& o) {
   if (o.emitters.threshold && !(*o.emitters.threshold >= 0.0))
     throw rad::Error(rad::ExitCode::kUsage, "--emitter-threshold", "must be >= 0");
   std::vector<std::string> inputs = {o.test, o.reference};
-  if (!o.reference2.empty()) inputs.push_back(o.reference2);
+  for (const std::string& p : {o.reference2, o.emitterMask})
+    if (!p.empty()) inputs.push_back(p);
   for (const std::string& p : inputs)
     if (!fs::exists(p)) throw rad::inputError(p, "cannot open (missing)");
   const bool testDir = fs::is_directory(o.test), refDir = fs::is_directory(o.reference);
   if (testDir != refDir)
     throw rad::Error(rad::ExitCode::kUsage, o.test,
                      "TEST and REFERENCE must both be .exr files or both directories");
-  if (!o.reference2.empty() && fs::is_directory(o.reference2) != refDir)
-    throw rad::Error(rad::ExitCode::kUsage, o.reference2,
-                     "--ref2 must be of the reference's kind (.exr file or directory)");
+  for (const auto& [path, flag] :
+       {std::pair(o.reference2, "--ref2"), std::pair(o.emitterMask, "--emitter-mask")})
+    if (!path.empty() && fs::is_directory(path) != refDir)
+      throw rad::Error(rad::ExitCode::kUsage, path,
+                       std::string(flag) +
+                           " must be of the reference's kind (.exr file or "
+                           "directory)");
   nlohmann::json j;
   j["test"] = o.test;
   j["reference"] = o.reference;
   if (!o.reference2.empty()) j["reference2"] = o.reference2;
   j["channels"] = channels;
-  j["emitter_rule"] = o.emitters.toString();
+  if (!o.emitterMask.empty()) j["emitter_mask"] = o.emitterMask;
+  j["emitter_rule"] = emitterRuleText(o);
   std::ostringstream out;
   if (!testDir)
     compareFiles(o, channels, j, out);
@@ -272,9 +301,14 @@ int main(int argc, char** argv) {
   app.add_option("--ref2", o.reference2,
                  "second reference of another seed (same kind and frames as REFERENCE): removes "
                  "the references' noise from rmse/mean");
-  app.add_option("--emitter-threshold", o.emitters.threshold,
-                 "a pixel whose reference luminance Y exceeds this is an emitter (default: 10 x "
-                 "the median Y of the lit reference pixels, per frame)");
+  auto* threshold = app.add_option(
+      "--emitter-threshold", o.emitters.threshold,
+      "a pixel whose reference luminance Y exceeds this is an emitter (default: 10 x "
+      "the median Y of the lit reference pixels, per frame)");
+  app.add_option("--emitter-mask", o.emitterMask,
+                 "EXR (or directory of NNNN.exr, like REFERENCE) whose first channel > 0.5 marks "
+                 "the emitter pixels; replaces the luminance rule")
+      ->excludes(threshold);
   app.add_flag("--json", o.json, "print JSON on stdout instead of text");
   app.add_option("--channels", o.channels,
                  "comma-separated channels to compare (luminance: Rec. 709 when R, G, B are all "
