@@ -278,21 +278,27 @@ int run(const Options& o) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Compares a test image or frame directory (NNNN.exr) with a reference. It reports first "
-      "the error figure of DESIGN.md §10, over the pixels that are not emitters (channels "
-      "pooled): rmse/mean = sqrt(mean((test-ref)^2)) / mean(ref) and bias = mean(test-ref) / "
-      "mean(ref). Emitter pixels (a visible light) are reported apart (their count and "
-      "rmse/mean): by default a pixel whose reference luminance Y = 0.2126 R + 0.7152 G + 0.0722 "
-      "B exceeds 10 x the median Y of the lit (Y > 0) reference pixels of the frame; the median, "
-      "unlike the mean, is not lifted by the light it is meant to find, and a lit diffuse wall "
-      "stays within a few times the typical wall while a visible light is far above it. With "
-      "--ref2 (a second reference of another seed) the references' own noise is removed: "
-      "noise^2 = mean((ref-ref2)^2)/2, rmse^2 = (rmse(test,ref)^2 + rmse(test,ref2)^2)/2 - "
-      "noise^2, mean and bias against (ref+ref2)/2. Then, over every sample: RMSE, relative L2 "
-      "(||test-ref|| / ||ref||, normalised by the reference RMS and so dominated by visible "
-      "emitters), max abs difference, PSNR (peak = max of the reference) and, for sequences, the "
-      "temporal flicker of the test where the reference does not change. Sequence totals pool "
-      "the sums of every frame."};
+      "Compares a test image or frame directory (NNNN.exr) with a reference.\n"
+      "\n"
+      "First, the error figure of DESIGN.md §10, over the pixels that are not emitters,\n"
+      "channels pooled (JSON: rmse_over_mean, bias):\n"
+      "  rmse/mean = sqrt(mean((test - ref)^2)) / mean(ref);  bias = mean(test - ref) / "
+      "mean(ref).\n"
+      "Emitter pixels (a visible light) are reported apart (emitter_pixels,\n"
+      "emitter_rmse_over_mean). By default a pixel is an emitter when its reference luminance\n"
+      "Y = 0.2126 R + 0.7152 G + 0.0722 B exceeds 10 x the median Y of the lit (Y > 0)\n"
+      "reference pixels of its frame: the median, unlike the mean, is not lifted by the light it\n"
+      "is to find, and lit diffuse walls stay within a few times the typical wall while a visible\n"
+      "light is far above it. --emitter-threshold or --emitter-mask replace the rule.\n"
+      "With --ref2 (a second reference of another seed) the references' own noise is removed:\n"
+      "  noise^2 = mean((ref - ref2)^2) / 2 (noise_over_mean),\n"
+      "  rmse^2 = (rmse(test, ref)^2 + rmse(test, ref2)^2) / 2 - noise^2,\n"
+      "and mean and bias are taken against (ref + ref2) / 2.\n"
+      "\n"
+      "Then, over every sample: rmse, relative_l2 = ||test - ref|| / ||ref|| (normalised by the\n"
+      "reference RMS, so dominated by visible emitters), max abs difference, PSNR (peak = max of\n"
+      "the reference) and, for sequences, the temporal flicker of the test where the reference\n"
+      "does not change. Totals over a sequence pool the sums of every frame."};
   Options o;
   rad::setUpApp(app, kTool, "rad-diff out/frames ref-seed1/frames --ref2 ref-seed2/frames --json");
   app.add_option("TEST", o.test, "test .exr file or directory of NNNN.exr")->required();
