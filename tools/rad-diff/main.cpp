@@ -295,10 +295,11 @@ int main(int argc, char** argv) {
       "  rmse^2 = (rmse(test, ref)^2 + rmse(test, ref2)^2) / 2 - noise^2,\n"
       "and mean and bias are taken against (ref + ref2) / 2.\n"
       "\n"
-      "Then, over every sample: rmse, relative_l2 = ||test - ref|| / ||ref|| (normalised by the\n"
-      "reference RMS, so dominated by visible emitters), max abs difference, PSNR (peak = max of\n"
-      "the reference) and, for sequences, the temporal flicker of the test where the reference\n"
-      "does not change. Totals over a sequence pool the sums of every frame."};
+      "Then, over every sample and against REFERENCE alone: rmse, relative_l2 =\n"
+      "||test - ref|| / ||ref|| (normalised by the reference RMS, so dominated by visible\n"
+      "emitters), max abs difference, PSNR (peak = max of the reference) and, for sequences, the\n"
+      "temporal flicker of the test where the reference does not change. Totals over a sequence\n"
+      "pool the sums of every frame."};
   Options o;
   rad::setUpApp(app, kTool, "rad-diff out/frames ref-seed1/frames --ref2 ref-seed2/frames --json");
   app.add_option("TEST", o.test, "test .exr file or directory of NNNN.exr")->required();
