@@ -16,9 +16,11 @@ as a ratio in one run. The coherent and scratch frames are compared with rad-dif
 
 Both are compared with rad-reference at one frame (midway between two key times near the
 middle; --reference-spp, 0 skips it): two independent path-traced references A and B (seeds 0
-and 1) give the error of a frame T with the references' own noise removed, d^2 = (rmse(T,A)^2 + rmse(T,B)^2)/2 - rmse(A,B)^2/2
-(E rmse(T,A)^2 = d^2 + s^2 and E rmse(A,B)^2 = 2 s^2 for reference noise s), reported as a
-relative L2 (d over the references' rms).
+and 1) give the error of a frame T as DESIGN.md §10 defines it, computed by `rad-diff T A --ref2
+B`: RMSE / mean and bias over the pixels that are not emitters, the references' own noise
+removed (d^2 = (rmse(T,A)^2 + rmse(T,B)^2)/2 - noise^2, noise^2 = mean((A-B)^2)/2). The older
+relative L2 (normalised by the reference's RMS, which a visible light dominates) is kept beside
+it, labelled as such.
 
 A finished run of one configuration and mode is kept in OUT/NAME/MODE/result.json with the
 frames, size, binaries' commit and pinned CPUs it was measured with; a later invocation with the
@@ -32,7 +34,6 @@ usage: bench.py [--frames N] [--size WxH] [--out DIR] [--bin DIR] [--only NAME,.
 import argparse
 import csv
 import json
-import math
 import os
 import shlex
 import shutil
@@ -166,9 +167,11 @@ def frame_difference(bin_dir, a, b):
         return None
 
 
-def rad_diff(bin_dir, test, reference):
-    """rad-diff's figures (the "difference" object of --json) of test against reference."""
-    p = subprocess.run([os.path.join(bin_dir, "rad-diff"), test, reference, "--json"],
+def rad_diff(bin_dir, test, reference, reference2=None):
+    """rad-diff's figures (the "difference" object of --json) of test against reference, and
+    against a second reference of another seed when given (its noise removed)."""
+    extra = ["--ref2", reference2] if reference2 else []
+    p = subprocess.run([os.path.join(bin_dir, "rad-diff"), test, reference, "--json"] + extra,
                        capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError("rad-diff %s %s: %s" % (test, reference, p.stderr.strip()))
@@ -176,31 +179,29 @@ def rad_diff(bin_dir, test, reference):
 
 
 class ReferenceNoise:
-    """Error against two path-traced references A, B (files or frame directories) with
-    independent noise, the references' noise removed: E rmse(T,A)^2 = d^2 + s^2 and
-    E rmse(A,B)^2 = 2 s^2, so d^2 = (rmse(T,A)^2 + rmse(T,B)^2)/2 - rmse(A,B)^2/2."""
+    """The error figure of DESIGN.md §10 against two path-traced references A, B (files or frame
+    directories) with independent noise, as rad-diff computes it (`rad-diff T A --ref2 B`):
+    RMSE / mean and bias over non-emitting pixels with the references' noise removed, the
+    emitters' own figure, and the older relative L2 against A (labelled as such)."""
 
     def __init__(self, bin_dir, refs):
         self.bin_dir, self.refs = bin_dir, refs
-        between = rad_diff(bin_dir, refs[1], refs[0])
-        self.noise2 = between["rmse"] ** 2 / 2.0  # one reference's variance per pixel channel
-        # 1 / rms of the reference: turns an rmse into a relative L2
-        self.scale = between["relative_l2"] / between["rmse"] if between["rmse"] > 0 else 0.0
+        self.noise = rad_diff(bin_dir, refs[0], refs[0], refs[1])["noise_over_mean"]
 
-    def relative_l2(self):
-        return math.sqrt(self.noise2) * self.scale
+    def noise_over_mean(self):
+        return self.noise
 
     def error_of(self, test):
-        da, db = (rad_diff(self.bin_dir, test, r) for r in self.refs)
-        raw2 = (da["rmse"] ** 2 + db["rmse"] ** 2) / 2.0
-        rmse = math.sqrt(max(0.0, raw2 - self.noise2))
-        return {"rmse": rmse, "relative_l2": rmse * self.scale,
-                "raw_relative_l2": math.sqrt(raw2) * self.scale}
+        d = rad_diff(self.bin_dir, test, self.refs[0], self.refs[1])
+        return {"rmse_over_mean": d["rmse_over_mean"], "bias": d["bias"],
+                "raw_rmse_over_mean": d["raw_rmse_over_mean"],
+                "emitter_rmse_over_mean": d["emitter_rmse_over_mean"],
+                "relative_l2": d["relative_l2"]}
 
 
 def reference_difference(bin_dir, scene, out, frame, size, spp, tests, log):
-    """Relative L2 of each tests[name] frame file against the path-traced reference at `frame`,
-    the references' noise removed (see the module docstring); rendered once and kept in
+    """The error of each tests[name] frame file against the path-traced references at `frame`
+    (ReferenceNoise: RMSE / mean and bias over non-emitters, the references' noise removed); rendered once and kept in
     OUT/reference-FRAME-SPP/. Returns {name: {...}} or None."""
     ref = os.path.join(bin_dir, "rad-reference")
     if not (os.path.exists(ref) and os.path.exists(os.path.join(bin_dir, "rad-diff"))):
@@ -215,7 +216,7 @@ def reference_difference(bin_dir, scene, out, frame, size, spp, tests, log):
         refs.append(os.path.join(d, name))
 
     noise = ReferenceNoise(bin_dir, refs)
-    result = {"frame": frame, "spp": spp, "reference_noise_relative_l2": noise.relative_l2()}
+    result = {"frame": frame, "spp": spp, "reference_noise_over_mean": noise.noise_over_mean()}
     for label, path in tests.items():
         if os.path.exists(path):
             result[label] = noise.error_of(path)
@@ -315,11 +316,13 @@ def print_tables(rows, frames, size, out):
                   file=out)
         refs = [(r["scene"], r["reference"]) for r in sel if r.get("reference")]
         for name, d in refs:
-            print("%-22s vs rad-reference at frame %d (%d spp x 2, noise %.2f %% removed): "
-                  "coherent %.2f %%, scratch %.2f %% relative L2" % (
-                      name, d["frame"], d["spp"], 100 * d["reference_noise_relative_l2"],
-                      100 * d.get("coherent", {}).get("relative_l2", float("nan")),
-                      100 * d.get("scratch", {}).get("relative_l2", float("nan"))), file=out)
+            fig = lambda m, k: 100 * d.get(m, {}).get(k, float("nan"))
+            print("%-22s vs rad-reference at frame %d (%d spp x 2, noise %.2f %% of the mean "
+                  "removed), over non-emitters: coherent RMSE/mean %.2f %% bias %+.2f %%, "
+                  "scratch %.2f %% bias %+.2f %%" % (
+                      name, d["frame"], d["spp"], 100 * d["reference_noise_over_mean"],
+                      fig("coherent", "rmse_over_mean"), fig("coherent", "bias"),
+                      fig("scratch", "rmse_over_mean"), fig("scratch", "bias")), file=out)
     out.flush()
 
 
@@ -329,6 +332,8 @@ def write_csv(rows, frames, path):
         w.writerow(["scene", "frames", "coherent_s", "coherent_s_per_frame", "scratch_s",
                     "scratch_s_per_frame", "speedup", "coherent_peak_mib", "scratch_peak_mib",
                     "links_min", "links_max", "links_mean", "links_percent",
+                    "coherent_vs_reference_rmse_over_mean", "coherent_vs_reference_bias",
+                    "scratch_vs_reference_rmse_over_mean", "scratch_vs_reference_bias",
                     "coherent_vs_reference_rel_l2", "scratch_vs_reference_rel_l2"]
                    + ["coherent_%s_s" % s for s in ("global", "intervals", "movies", "compose")]
                    + ["scratch_%s_s" % s for s in ("global", "intervals", "movies", "compose")])
@@ -337,6 +342,8 @@ def write_csv(rows, frames, path):
             ref = r.get("reference") or {}
             w.writerow(list(fmt_row(r, frames)[:1]) + [frames] + list(fmt_row(r, frames)[1:])
                        + [l.get("min"), l.get("max"), l.get("mean"), l.get("percent")]
+                       + [ref.get(m, {}).get(k) for m in ("coherent", "scratch")
+                          for k in ("rmse_over_mean", "bias")]
                        + [ref.get(m, {}).get("relative_l2") for m in ("coherent", "scratch")]
                        + [r["coherent"]["stages"][s][0] for s in
                           ("global", "intervals", "movies", "compose")]
