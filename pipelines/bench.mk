@@ -9,6 +9,9 @@
 #   make -f pipelines/bench.mk tradeoff [TRADEOFF_FRAMES=0-47] [TRADEOFF_SIZE=176x120] [TRADEOFF_SPP=128] [TRADEOFF_REPEAT=3]
 #       each accuracy knob swept against a converged rad-reference render: time per frame vs
 #       RMSE, Pareto front; out/tradeoff/tradeoff.csv and tradeoff.png (gnuplot)
+#   make -f pipelines/bench.mk furnace [FURNACE_RHO=0.5,0.9,0.99,0.999] [FURNACE_FLAGS="global=--eps 1e-4"]
+#       the closed furnace through the whole pipeline at each rho: frame mean against the exact
+#       L_e / (1 - rho), time and peak memory; out/furnace/
 
 BIN ?= build/bin
 BENCH_FRAMES ?= 400
@@ -21,7 +24,10 @@ TRADEOFF_SIZE ?= 176x120
 TRADEOFF_SPP ?= 128
 TRADEOFF_REPEAT ?= 3
 
-.PHONY: tables tradeoff
+FURNACE_RHO ?= 0.5,0.9,0.99,0.999
+FURNACE_FLAGS ?=
+
+.PHONY: tables tradeoff furnace
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -29,3 +35,7 @@ tables:
 tradeoff:
 	python3 pipelines/tradeoff.py --bin $(BIN) --scene $(TRADEOFF_SCENE) --frames $(TRADEOFF_FRAMES) \
 	  --size $(TRADEOFF_SIZE) --spp $(TRADEOFF_SPP) --repeat $(TRADEOFF_REPEAT) --out out/tradeoff
+
+furnace:
+	python3 pipelines/furnace.py --bin $(BIN) --rho $(FURNACE_RHO) --out out/furnace \
+	  $(if $(FURNACE_FLAGS),--flags "$(FURNACE_FLAGS)")

@@ -19,6 +19,7 @@ nlohmann::json GlobalOptions::toJson() const {
           {"tol", r.tol},
           {"bad-links", badLinkRuleName(spaceTime.badLinks)},
           {"partial-threshold", spaceTime.partialThreshold},
+          {"max-links", r.maxLinks},
           {"no-coherence", !spaceTime.coherence}};
 }
 
@@ -77,6 +78,7 @@ nlohmann::json GlobalReport::toJson() const {
                     {"nodes", r.nodes},
                     {"iterations", r.iterations},
                     {"refine_rounds", r.refineRounds},
+                    {"link_cap_reached", r.linkCapReached},
                     {"seconds_links", r.secondsLinks},
                     {"seconds_solve", r.secondsSolve},
                     {"seconds_coherence", r.secondsCoherence}});
@@ -91,7 +93,8 @@ nlohmann::json GlobalReport::toJson() const {
             {"iterations", t.iterations},
             {"union_nodes", solve.unionNodes},
             {"link_rows", solve.linkRows},
-            {"bad_pairs", solve.badPairs}}},
+            {"bad_pairs", solve.badPairs},
+            {"keys_at_link_cap", keysAtLinkCap()}}},
           {"seconds",
            {{"read", secondsRead},
             {"setup", solve.secondsSetup},
@@ -103,6 +106,20 @@ nlohmann::json GlobalReport::toJson() const {
             {"total", secondsTotal}}},
           {"peak_memory_mb", peakMemoryMb},
           {"coherence", coherence}};
+}
+
+size_t GlobalReport::keysAtLinkCap() const {
+  size_t n = 0;
+  for (const KeyTimeReport& r : solve.keys) n += r.linkCapReached;
+  return n;
+}
+
+std::string GlobalReport::linkCapWarning(const std::string& tool, size_t maxLinks) const {
+  const size_t n = keysAtLinkCap();
+  if (n == 0) return "";
+  return tool + ": warning: " + std::to_string(n) + " of " + std::to_string(solve.keys.size()) +
+         " key times stopped refining at the link bound (" + std::to_string(maxLinks) +
+         " links); the solution is coarser than the refinement threshold asks\n";
 }
 
 std::string GlobalReport::table(const std::string& tool) const {

@@ -32,7 +32,8 @@ struct GlobalOptions {
 
   // The provenance parameters: every parameter under its flag's name ("frames", "fps",
   // "key-step", "eps", "oracle", "min-area", "rays", "tol", "bad-links", "partial-threshold",
-  // "no-coherence"). Call it once frames and min-area are resolved, so the record says what ran.
+  // "max-links", "no-coherence"). Call it once frames and min-area are resolved, so the record says
+  // what ran.
   nlohmann::json toJson() const;
 };
 
@@ -57,6 +58,10 @@ struct GlobalReport {
   nlohmann::json toJson() const;
   // The stderr table: a header line naming `tool`, one row per key time, two total lines.
   std::string table(const std::string& tool) const;
+  // Key times whose refinement stopped at the link bound (RadiosityOptions::maxLinks).
+  size_t keysAtLinkCap() const;
+  // The one-line warning rad-global prints when keysAtLinkCap() > 0, else empty.
+  std::string linkCapWarning(const std::string& tool, size_t maxLinks) const;
 };
 
 }  // namespace rad

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <tbb/parallel_for.h>
@@ -218,11 +219,20 @@ class KeyTimeSolver {
   // channels) and the stop rule tol * (1 - rho_max) of the Gauss-Seidel sweeps.
   void setThresholds() {
     glm::dvec3 emitted(0.0);
-    double rhoMax = 0.0;
+    double rhoMax = 0.0, emissionMax = 0.0;
     for (int t = 0; t < h_.topCount(); ++t) {
       emitted += s_.area[size_t(t)] * surfaces_[size_t(t)].emission;
       rhoMax = std::max(rhoMax, maxComponent(surfaces_[size_t(t)].reflectance));
+      emissionMax = std::max(emissionMax, maxComponent(surfaces_[size_t(t)].emission));
     }
+    // No patch gathers more than the whole hemisphere (form factors sum to <= 1), so a solve
+    // is bounded by $B \le E_{max} / (1 - \rho_{max})$ (the furnace's B everywhere). Sweeps may
+    // overshoot that while refinement is under way (the furnace at rho = 0.99 passes 2x on the
+    // way to a finite answer), so only a solve a million times above it is called diverging:
+    // at rho x rowsum = 1.002 (the furnace at rho = 0.999) that takes ~7000 sweeps, long before
+    // B overflows to Inf and NaN, which the stop rule's std::max would not see.
+    radiosityBound_ =
+        rhoMax < 1.0 ? 1e6 * emissionMax / (1.0 - rhoMax) : std::numeric_limits<double>::infinity();
     epsAbs_ = opt_.eps * maxComponent(emitted);
     refineOn_ = opt_.refine && epsAbs_ > 0.0;
     stopChange_ = opt_.tol * std::max(1.0 - rhoMax, 1e-6);
@@ -327,6 +337,11 @@ class KeyTimeSolver {
         if (s_.links[li].refined || !oracleWantsRefinement(s_.links[li])) continue;
         int node = nodeToSplit(s_.links[li]);
         if (node < 0) continue;
+        if (s_.links.size() + 4 > opt_.maxLinks) {  // the memory bound: stop refining
+          s_.linkCapReached = true;
+          evaluateNewLinks();  // this generation's links, made before the bound, get F~ and V
+          return count;
+        }
         splitLink(li, node, next);
         ++count;
       }
@@ -389,6 +404,7 @@ class KeyTimeSolver {
     if (!s_.split[size_t(i)]) {
       const SurfaceProperties& sp = surfaces_[h_.node(i).id.top];
       glm::dvec3 b = sp.emission + sp.reflectance * H;
+      nonFinite_ |= !(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.z));
       maxDelta_ = std::max(maxDelta_, maxComponent(glm::abs(b - B_[size_t(i)])));
       maxB_ = std::max(maxB_, maxComponent(glm::abs(b)));
       B_[size_t(i)] = b;
@@ -414,6 +430,12 @@ class KeyTimeSolver {
       maxDelta_ = maxB_ = 0;
       for (int t = 0; t < h_.topCount(); ++t) gatherPushPull(t, glm::dvec3(0.0));
       ++s_.iterations;
+      if (nonFinite_ || maxB_ > radiosityBound_)
+        throw Error(ExitCode::kInternal, "",
+                    "the radiosity solve diverges (B reached " + std::to_string(maxB_) +
+                        " W/m^2, a million times E/(1 - rho) = " + std::to_string(radiosityBound_) +
+                        "): the refined links' form factors sum to more than 1/reflectance "
+                        "somewhere; use a lower reflectance or a coarser refinement threshold");
       s_.lastChange = maxB_ > 0 ? maxDelta_ / maxB_ : 0.0;
       if (s_.lastChange < stopChange_) break;
     }
@@ -443,6 +465,8 @@ class KeyTimeSolver {
   std::vector<size_t> adjStart_, adj_;
   std::vector<glm::dvec3> irr_;     // per dense node: H gathered at it and its ancestors
   double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
+  bool nonFinite_ = false;          // a sweep produced NaN or Inf
+  double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges
 };
 
 }  // namespace

@@ -65,6 +65,12 @@ struct RadiosityOptions {
   // Relative tolerance of the adaptive near-contact form factor. 1e-5 instead of 1e-7 halves
   // rad-global's time on the table scene and moves no radiosity by more than 3e-7 relative.
   double formFactorTolerance = 1e-5;
+  // Memory bound: refinement stops once a key time's solve holds this many links (refined ones
+  // included), and the solve goes on with the links it has; KeySolution::linkCapReached says
+  // so. About 160 bytes each through rad-global's peak (the closed furnace at rho = 0.99: 0.8 M
+  // links, 128 MB), so the default bounds a key's links to ~0.6 GB instead of running out of
+  // memory where the oracle never stops refining (the furnace at rho = 0.999).
+  size_t maxLinks = 4000000;
 };
 
 // Diffuse reflectance and emitted radiosity B_e = pi L_e (W/m^2) of one top-level patch.
@@ -126,6 +132,7 @@ struct KeySolution {
   std::vector<double> area;            // per dense node: world area
   int iterations = 0;                  // Gauss-Seidel sweeps, all rounds
   int refineRounds = 0;
+  bool linkCapReached = false;     // refinement stopped at RadiosityOptions::maxLinks
   size_t linksComputed = 0;        // links whose F or V was computed here
   size_t linksReused = 0;          // links whose F and V came from `reuse`
   size_t linksVisibilityOnly = 0;  // of linksComputed: F from `reuse`, V computed

@@ -259,6 +259,7 @@ KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, dou
   kr.visibilityOnly = s.linksVisibilityOnly;
   kr.iterations = s.iterations;
   kr.refineRounds = s.refineRounds;
+  kr.linkCapReached = s.linkCapReached;
   kr.secondsLinks = s.secondsLinks;
   kr.secondsSolve = s.secondsSolve;
   for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;

@@ -48,6 +48,7 @@ struct KeyTimeReport {
   size_t nodes = 0;           // nodes of this key's tree
   int iterations = 0;         // Gauss-Seidel sweeps
   int refineRounds = 0;
+  bool linkCapReached = false;  // refinement stopped at the link bound (RadiosityOptions)
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
 };
 

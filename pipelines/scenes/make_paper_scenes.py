@@ -121,9 +121,10 @@ class Gltf:
                              "perspective": {"yfov": yfov, "znear": 0.02, "zfar": 50.0}})
         return len(self.cameras) - 1
 
-    def write(self, path, light_strength):
+    def write(self, path, light_strength, materials=None):
+        """materials: (name, rgb, emission or None) per index; default the paper scenes'."""
         mats = []
-        for name, rgb, emission in MATERIALS:
+        for name, rgb, emission in materials or MATERIALS:
             m = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(rgb) + [1.0],
                                                         "metallicFactor": 0.0,
                                                         "roughnessFactor": 1.0}}
@@ -133,7 +134,8 @@ class Gltf:
                                    {"emissiveStrength": light_strength}}
             mats.append(m)
         g = {
-            "asset": {"version": "2.0", "generator": "rad pipelines/scenes/make_paper_scenes.py"},
+            "asset": {"version": "2.0", "generator": "rad pipelines/scenes/" +
+                      os.path.basename(sys.argv[0] or "make_paper_scenes.py")},
             "extensionsUsed": ["KHR_materials_emissive_strength"],
             "scene": 0,
             "scenes": [{"name": self.name, "nodes": list(range(len(self.nodes)))}],

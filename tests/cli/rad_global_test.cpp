@@ -104,10 +104,32 @@ TEST(RadGlobal, WithoutFramesCoversTheWholeAnimation) {
   fs::remove_all(d);
 }
 
+// The memory bound: at --max-links refinement stops with one warning line, the report counts
+// the key times it stopped, and the file is written from the links it has.
+TEST(RadGlobal, LinkBoundWarnsAndIsReported) {
+  fs::path d = scratchDir();
+  const std::string out = (d / "capped.rlh").string();
+  auto r = runCommand(tool("rad-global") + " " + kScene + " -o " + out + kFlags +
+                      " --max-links 1000 --report " + (d / "report.json").string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("rad-global: warning: 4 of 4 key times stopped refining at the link bound "
+                       "(1000 links)"),
+            std::string::npos)
+      << r.err;
+  nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "report.json").string()));
+  EXPECT_EQ(rep["totals"]["keys_at_link_cap"], 4);
+  for (const auto& k : rep["key_times"]) {
+    EXPECT_TRUE(k["link_cap_reached"].get<bool>());
+    EXPECT_LE(k["links"].get<size_t>(), 1000u);
+  }
+  EXPECT_EQ(ContainerReader::open(out).metadata().at("parameters").at("max-links"), 1000);
+  fs::remove_all(d);
+}
+
 TEST(RadGlobal, OutOfRangeParametersAreUsageErrors) {
   for (const char* bad :
        {"--eps -1", "--key-step 0", "--rays 0", "--tol 0", "--oracle fast", "--bad-links some",
-        "--partial-threshold 2", "--threads -1", "--frames 9-x"}) {
+        "--partial-threshold 2", "--threads -1", "--frames 9-x", "--max-links 0"}) {
     auto r = runCommand(tool("rad-global") + " " + kScene + " -o /tmp/never.rlh " + bad);
     EXPECT_EQ(r.exitCode, 2) << bad << ": " << r.err;
     EXPECT_EQ(test::countLines(r.err), 1) << bad << ": " << r.err;

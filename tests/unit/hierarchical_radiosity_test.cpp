@@ -2,6 +2,7 @@
 // there): uniform furnaces up to rho = 0.999, the exact one-emitter discrete systems, the
 // two-squares system, energy balance with refinement, and the shaft test.
 #include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/core/error.h"
 
 #include <array>
 #include <chrono>
@@ -403,6 +404,59 @@ TEST(HierarchicalRadiosity, ShaftMeetsBox) {
   for (auto& v : d.v) v = v * 0.1 + glm::dvec3(2, 2, 2);
   EXPECT_FALSE(shaftMeetsBox(c, d, {1.8, 0.0, 0.0}, {2.1, 0.3, 0.3}));
   EXPECT_TRUE(shaftMeetsBox(c, d, {0.95, 0.95, 0.95}, {1.15, 1.15, 1.15}));
+}
+
+}  // namespace
+}  // namespace rad
+
+namespace rad {
+namespace {
+
+std::vector<SurfaceProperties> furnaceSurfaces(const PatchHierarchy& h, double rho) {
+  std::vector<SurfaceProperties> surf(size_t(h.topCount()));
+  for (auto& s : surf) s.reflectance = glm::dvec3(rho), s.emission = glm::dvec3(0.5);
+  return surf;
+}
+
+// The closed furnace at rho = 0.999 with refinement at the default eps: the refined links'
+// form factors sum to a little more than 1 (the row-sum error), so rho x rowsum > 1 and the
+// Gauss-Seidel sweeps grow without bound. The solve must stop with one error, not hand back
+// NaN radiosity as converged (it did: NaN hid from the stop rule's std::max).
+TEST(HierarchicalRadiosity, DivergingSolveIsAnErrorNotNaN) {
+  PatchHierarchy h = hierarchyOf(geometry("unit_cube_6"));
+  std::vector<SurfaceProperties> surf = furnaceSurfaces(h, 0.999);
+  RadiosityOptions o;
+  try {
+    KeySolution s = solveKeyTime(h, surf, identityInput(h), o);
+    for (const glm::dvec3& b : s.radiosity)
+      ASSERT_TRUE(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.z));
+    SUCCEED() << "converged to finite values";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::kInternal);
+    EXPECT_NE(std::string(e.what()).find("diverges"), std::string::npos) << e.what();
+  }
+}
+
+// The link bound: refinement stops at maxLinks, says so, and the solve still converges on the
+// links it has (the furnace at rho = 0.5 refines far past 200 links at eps 1e-5).
+TEST(HierarchicalRadiosity, LinkBoundStopsRefiningAndSaysSo) {
+  PatchHierarchy h = hierarchyOf(geometry("unit_cube_6"));
+  std::vector<SurfaceProperties> surf = furnaceSurfaces(h, 0.5);
+  RadiosityOptions o;
+  o.eps = 1e-5;
+  o.maxLinks = 200;
+  KeySolution s = solveKeyTime(h, surf, identityInput(h), o);
+  EXPECT_TRUE(s.linkCapReached);
+  EXPECT_LE(s.links.size(), o.maxLinks);
+  for (const glm::dvec3& b : s.radiosity) {
+    ASSERT_TRUE(std::isfinite(b.x));
+    EXPECT_NEAR(b.x, 1.0, 0.05);  // E / (1 - rho) = 1, coarse links
+  }
+  PatchHierarchy h2 = hierarchyOf(geometry("unit_cube_6"));
+  o.maxLinks = RadiosityOptions().maxLinks;
+  KeySolution unbounded = solveKeyTime(h2, surf, identityInput(h2), o);
+  EXPECT_FALSE(unbounded.linkCapReached);
+  EXPECT_GT(unbounded.links.size(), size_t(200));
 }
 
 }  // namespace

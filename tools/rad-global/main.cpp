@@ -71,6 +71,11 @@ void addOptions(CLI::App& app, Options& o) {
                  "partial: a link is partly visible when threshold < V < 1")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--max-links", r.maxLinks,
+                 "memory bound: a key time stops refining at this many links (~160 bytes each) "
+                 "and warns")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_flag_callback(
       "--no-coherence", [&g] { g.spaceTime.coherence = false; },
       "recompute every link at every key time (the baseline of the speed-up)");
@@ -110,7 +115,7 @@ int run(Options o, int argc, char** argv) {
   report.secondsTotal = secondsSince(tStart);
   report.peakMemoryMb = rad::peakMemoryMb();
   report.coherence = g.spaceTime.coherence;
-  std::cerr << report.table(kTool);
+  std::cerr << report.table(kTool) << report.linkCapWarning(kTool, g.spaceTime.radiosity.maxLinks);
   if (!o.report.empty()) rad::writeTextFile(o.report, report.toJson().dump(1) + "\n");
   return 0;
 }

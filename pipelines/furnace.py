@@ -1,0 +1,109 @@
+#!/usr/bin/env python3
+"""The furnace through the whole pipeline, at the default settings (DESIGN.md §8, issue 15).
+
+A closed cube whose walls all emit L_e = 0.5 and reflect rho (pipelines/scenes/make_furnace.py)
+has the exact radiance L_e / (1 - rho) everywhere. Each rho runs the four stages of animation.mk
+(bench.stage_commands: the same command lines) and compares the frame's mean with that value;
+the time and the peak memory of the four stages are measured from the child processes. A stage
+that fails is reported with its one-line error (the log has the rest), not hidden.
+
+usage: furnace.py [--rho 0.5,0.9,0.99,0.999] [--size 88x60] [--bin DIR] [--out DIR]
+                  [--flags STAGE=ARGS ...] [--check]
+  --check   exit 1 unless every run ends with finite, non-negative frames or a one-line
+            error; the ctest `pipeline_furnace_never_silent` runs it
+"""
+import argparse
+import os
+import shlex
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import bench  # noqa: E402
+
+EMISSION = 0.5
+
+
+
+
+def run_one(bin_dir, out_root, rho, size, flags):
+    out = os.path.join(out_root, "rho%g" % rho)
+    os.makedirs(out, exist_ok=True)
+    scene = os.path.join(out, "furnace.gltf")
+    subprocess.run([sys.executable, os.path.join(HERE, "scenes", "make_furnace.py"), scene,
+                    repr(rho), "--emission", repr(EMISSION)], check=True,
+                   stderr=subprocess.DEVNULL)
+    log = os.path.join(out, "pipeline.log")
+    open(log, "w").close()
+    seconds = peak = 0.0
+    for stage, argv in bench.stage_commands(bin_dir, scene, out, "0-0", size, flags):
+        try:
+            t, mib, _ = bench.run(argv, log)
+        except RuntimeError:
+            with open(log) as f:
+                last = [l for l in f.read().splitlines() if l.startswith("rad-")][-1:]
+            return {"rho": rho, "failed": stage, "error": last[0] if last else "(see %s)" % log,
+                    "seconds": seconds, "peak_mib": peak}
+        seconds += t
+        peak = max(peak, mib)
+    mean, lo, bad = exr_mean(os.path.join(out, "frames", "0000.exr"))
+    exact = EMISSION / (1.0 - rho)
+    return {"rho": rho, "mean": mean, "exact": exact, "error": mean / exact - 1.0, "min": lo,
+            "non_finite": bad, "seconds": seconds, "peak_mib": peak}
+
+
+def exr_mean(path):
+    """Mean, minimum and non-finite count over every channel of an EXR, via oiiotool."""
+    p = subprocess.run(["oiiotool", path, "--printstats"], capture_output=True, text=True,
+                       check=True)
+    vals = {}
+    for line in p.stdout.splitlines():
+        line = line.strip()
+        for key in ("Stats Avg:", "Stats Min:", "NanCount:", "InfCount:"):
+            if line.startswith(key):
+                vals[key] = [float(x) for x in line[len(key):].split()
+                             if x.replace(".", "", 1).replace("-", "", 1).replace("e", "", 1)
+                             .replace("+", "", 1).isdigit()]
+    mean = sum(vals["Stats Avg:"]) / len(vals["Stats Avg:"])
+    bad = int(sum(vals.get("NanCount:", [0])) + sum(vals.get("InfCount:", [0])))
+    return mean, min(vals["Stats Min:"]), bad
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--rho", default="0.5,0.9,0.99,0.999")
+    ap.add_argument("--size", default="88x60")
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "furnace"))
+    ap.add_argument("--flags", action="append", default=[],
+                    help="STAGE=ARGS, e.g. global='--eps 1e-4' (repeatable)")
+    ap.add_argument("--check", action="store_true")
+    a = ap.parse_args()
+    flags = {}
+    for f in a.flags:
+        stage, _, args = f.partition("=")
+        flags[stage] = shlex.split(args)
+    rows = [run_one(a.bin, a.out, float(r), a.size, flags) for r in a.rho.split(",")]
+    print("%-7s %12s %12s %9s %8s %8s  %s" % ("rho", "frame mean", "exact", "error", "s",
+                                            "peak MiB", "note"))
+    silent = []
+    for r in rows:
+        if "failed" in r:
+            print("%-7g %12s %12.6g %9s %8.2f %8.1f  %s failed: %s" % (
+                r["rho"], "-", EMISSION / (1 - r["rho"]), "-", r["seconds"], r["peak_mib"],
+                r["failed"], r["error"]))
+            continue
+        note = "" if r["non_finite"] == 0 and r["min"] >= 0 else "NON-FINITE OR NEGATIVE"
+        if note:
+            silent.append(r["rho"])
+        print("%-7g %12.6g %12.6g %+8.2f%% %8.2f %8.1f  %s" % (
+            r["rho"], r["mean"], r["exact"], 100 * r["error"], r["seconds"], r["peak_mib"], note))
+    if a.check and silent:
+        sys.exit("furnace.py: rho %s: frames with NaN, Inf or negative values and exit 0"
+                 % ", ".join("%g" % r for r in silent))
+
+
+if __name__ == "__main__":
+    main()
