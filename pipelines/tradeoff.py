@@ -273,8 +273,8 @@ def write_plot(out, rows, front, defaults):
         f.write("set terminal pngcairo size 900,600\n" if has_cairo() else
                 "set terminal png size 900,600\n")
         f.write("set output '%s'\n" % os.path.join(out, "tradeoff.png"))
-        f.write("set logscale xy\nset xlabel 'CPU seconds per frame'\nset ylabel 'RMSE / mean over non-emitters vs"
-                " path-traced reference, its noise removed'\nset key outside right\nset grid\n")
+        f.write("set logscale xy\nset xlabel 'CPU seconds per frame'\nset ylabel 'RMSE / mean over non-emitters, vs"
+                " path-traced reference'\nset key outside right\nset grid\n")
         f.write("plot " + ", \\\n     ".join(plots) + "\n")
     if shutil.which("gnuplot"):
         subprocess.run(["gnuplot", gp], check=False)
