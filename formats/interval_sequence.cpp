@@ -8,14 +8,11 @@
 #include "formats/container.h"
 #include "formats/item_buffer_exr.h"
 #include "libcommon/core/error.h"
+#include "libcommon/core/stopwatch.h"
 
 namespace rad {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 TextureIntervals intervalsRecord(const std::vector<MovieExtent>& extents,
                                  const std::vector<int>& frames,

@@ -9,14 +9,10 @@
 #include "formats/atomic_file.h"
 #include "formats/texture_movie.h"
 #include "libcommon/core/error.h"
+#include "libcommon/core/stopwatch.h"
 
 namespace rad {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 // Streams each baked key into the movie's file (constant movies collapse to one key when
 // coherence is on, as the baker's in-memory bake does).
@@ -34,23 +30,23 @@ class MovieFileSink : public BakedKeySink {
   void discard() { writer_.reset(); }
 
   void begin(const BakedMovie& plan) override {
-    auto t = Clock::now();
+    auto t = SteadyClock::now();
     meta_.keyFrames = plan.keyFrames;
     meta_.keyTimes = plan.keyTimes;
     writer_ = std::make_unique<TextureMovieWriter>(path_, meta_, collapse_,
                                                    AtomicFile::Durability::kDeferred);
-    secondsWrite_ += since(t);
+    secondsWrite_ += secondsSince(t);
   }
   void key(size_t k, const std::vector<float>& texture) override {
-    auto t = Clock::now();
+    auto t = SteadyClock::now();
     writer_->writeKey(k, texture);
-    secondsWrite_ += since(t);
+    secondsWrite_ += secondsSince(t);
   }
   size_t finish() override {
-    auto t = Clock::now();
+    auto t = SteadyClock::now();
     size_t stored = writer_->commit();
     writer_.reset();
-    secondsWrite_ += since(t);
+    secondsWrite_ += secondsSince(t);
     return stored;
   }
 
@@ -107,9 +103,9 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
   }
   // One sync for all movies (AtomicFile::Durability::kDeferred) before the tool reports
   // success: Make's movies/.done stamp follows our exit status.
-  auto t = Clock::now();
+  auto t = SteadyClock::now();
   syncFileSystemOf(options.moviesDir);
-  report.secondsWrite += since(t);
+  report.secondsWrite += secondsSince(t);
   return report;
 }
 

@@ -155,15 +155,10 @@ def link_stats(report_path):
 
 
 def frame_difference(bin_dir, a, b):
-    diff = os.path.join(bin_dir, "rad-diff")
-    if not os.path.exists(diff):
-        return None
-    p = subprocess.run([diff, a, b, "--json"], capture_output=True, text=True)
-    if p.returncode != 0:
-        return None
+    """rad_diff of two frame folders, or None when rad-diff is missing or refuses them."""
     try:
-        return json.loads(p.stdout)
-    except ValueError:
+        return rad_diff(bin_dir, a, b)
+    except (OSError, RuntimeError, ValueError):
         return None
 
 
@@ -312,7 +307,7 @@ def print_tables(rows, frames, size, out):
             print("%-22s %s" % (r["scene"], ", ".join(st)), file=out)
         diffs = [(r["scene"], r["difference"]) for r in sel if r.get("difference")]
         for name, d in diffs:
-            print("%-22s coherent vs scratch: %s" % (name, json.dumps(d.get("difference", d))[:200]),
+            print("%-22s coherent vs scratch: %s" % (name, json.dumps(d)[:200]),
                   file=out)
         refs = [(r["scene"], r["reference"]) for r in sel if r.get("reference")]
         for name, d in refs:

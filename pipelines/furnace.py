@@ -26,8 +26,6 @@ import bench  # noqa: E402
 EMISSION = 0.5
 
 
-
-
 def run_one(bin_dir, out_root, rho, size, flags):
     out = os.path.join(out_root, "rho%g" % rho)
     os.makedirs(out, exist_ok=True)
@@ -55,20 +53,23 @@ def run_one(bin_dir, out_root, rho, size, flags):
 
 
 def exr_mean(path):
-    """Mean, minimum and non-finite count over every channel of an EXR, via oiiotool."""
+    """Mean, minimum and non-finite count over every channel of an EXR (oiiotool --printstats:
+    lines such as `Stats Avg: 1.0 1.0 1.0 (float)` and `NanCount: 0 0 0`)."""
     p = subprocess.run(["oiiotool", path, "--printstats"], capture_output=True, text=True,
                        check=True)
-    vals = {}
+    stats = {}
     for line in p.stdout.splitlines():
-        line = line.strip()
-        for key in ("Stats Avg:", "Stats Min:", "NanCount:", "InfCount:"):
-            if line.startswith(key):
-                vals[key] = [float(x) for x in line[len(key):].split()
-                             if x.replace(".", "", 1).replace("-", "", 1).replace("e", "", 1)
-                             .replace("+", "", 1).isdigit()]
-    mean = sum(vals["Stats Avg:"]) / len(vals["Stats Avg:"])
-    bad = int(sum(vals.get("NanCount:", [0])) + sum(vals.get("InfCount:", [0])))
-    return mean, min(vals["Stats Min:"]), bad
+        key, _, rest = line.strip().partition(":")
+        values = []
+        for word in rest.split():
+            try:
+                values.append(float(word))
+            except ValueError:
+                pass  # "(float)", units
+        stats[key] = values
+    avg = stats["Stats Avg"]
+    bad = sum(stats.get("NanCount", [])) + sum(stats.get("InfCount", []))
+    return sum(avg) / len(avg), min(stats["Stats Min"]), int(bad)
 
 
 def main():

@@ -25,16 +25,12 @@
 #include <tbb/parallel_for.h>
 
 #include "libcommon/core/error.h"
+#include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/scene/frame_range.h"
 
 namespace rad {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 struct Box {
   glm::dvec3 lo{std::numeric_limits<double>::infinity()};
@@ -296,7 +292,7 @@ class MovieBake {
           p.coherent ? coherentTransmittance(gl, p, k) : movingTransmittance(gl, p, k);
       combine(p, t, f);
     }
-    auto clock = Clock::now();
+    auto clock = SteadyClock::now();
     for (size_t x = 0; x < texels_; ++x)
       for (int c = 0; c < 3; ++c) {
         double v = acc_[x][c];
@@ -315,7 +311,7 @@ class MovieBake {
 
   // Good layer (paper §3.1: Gouraud over the patch from the global solution).
   void goodLayer(double t) {
-    auto clock = Clock::now();
+    auto clock = SteadyClock::now();
     const int R = int(req_.patch.top), w = geo_.width();
     parallelRows(geo_.height(), [&](int j) {
       for (int i = 0; i < w; ++i) {
@@ -330,7 +326,7 @@ class MovieBake {
   // with the static mask. Returns the pair's form factors (once per movie).
   const std::vector<double>& coherentTransmittance(OcclusionMaskRenderer& gl, const Pair& p,
                                                    int k) {
-    auto clock = Clock::now();
+    auto clock = SteadyClock::now();
     std::vector<BlockerTriangle> dynamicTris = p.dynamicList.empty()
                                                    ? std::vector<BlockerTriangle>()
                                                    : geo_.blockersAt(p, p.dynamicList, k);
@@ -344,7 +340,7 @@ class MovieBake {
   // A moving pair (or the baseline) at key k: every blocker in the key's shaft rendered from
   // the key's samples; the key's form factors read back from the spill or recomputed.
   const std::vector<double>& movingTransmittance(OcclusionMaskRenderer& gl, const Pair& p, int k) {
-    auto clock = Clock::now();
+    auto clock = SteadyClock::now();
     const std::vector<glm::dvec3> samples = geo_.samplesAt(p, k);
     const SampleMask valid = frontSampleMask(geo_.receiverWorld(k), samples);
     gl.render(geo_.receiverWorld(k), geo_.width(), geo_.height(), samples,
@@ -352,7 +348,7 @@ class MovieBake {
     for (size_t x = 0; x < texels_; ++x)
       transmittance_[x] = float(transmittanceFromMask(keyMask_[x], valid));
     stats_.secondsTransmittance += secondsSince(clock);
-    clock = Clock::now();
+    clock = SteadyClock::now();
     keyFormFactor_.resize(texels_);
     if (!spill_.get(p.spilled[size_t(k)], keyFormFactor_)) geo_.formFactorsAt(p, k, keyFormFactor_);
     stats_.secondsFormFactor += secondsSince(clock);
@@ -361,7 +357,7 @@ class MovieBake {
 
   // Combine: the bad layer B_S(t) F T added to the irradiance.
   void combine(const Pair& p, double t, const std::vector<double>& f) {
-    auto clock = Clock::now();
+    auto clock = SteadyClock::now();
     const glm::dvec3 B = solution_.radiosity(int(p.shooter), t);
     for (size_t x = 0; x < texels_; ++x) acc_[x] += B * (f[x] * double(transmittance_[x]));
     stats_.secondsCombine += secondsSince(clock);
@@ -405,7 +401,7 @@ bool MovieBake::planPair(uint32_t S, Pair& p) {
   if (!(maxF > 0.0)) return false;  // the shooter cannot reach this patch during the movie
 
   // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie.
-  auto clock = Clock::now();
+  auto clock = SteadyClock::now();
   p.samples = transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
                                        options_.maxSamples);
   stats_.samples += p.samples;
@@ -432,7 +428,7 @@ bool MovieBake::planPair(uint32_t S, Pair& p) {
 // scan stops once N has reached its maximum (more keys cannot change it; their sets are
 // computed when their key is baked).
 double MovieBake::scanFormFactors(Pair& p) {
-  auto clock = Clock::now();
+  auto clock = SteadyClock::now();
   double maxF = 0.0;
   if (p.coherent) {
     geo_.formFactorsAt(p, 0, p.formFactor);

@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "libcommon/core/error.h"
+#include "libcommon/core/stopwatch.h"
 
 namespace rad {
 
@@ -17,10 +18,6 @@ namespace {
 
 double maxComponent(const glm::dvec3& v) {
   return std::max(v.x, std::max(v.y, v.z));
-}
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // Size of a polygon (largest vertex distance from the first vertex), for relative tolerances.

@@ -9,14 +9,11 @@
 #include <unordered_map>
 
 #include "libcommon/core/error.h"
+#include "libcommon/core/stopwatch.h"
 
 namespace rad {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // What the merge needs of one key-time solve besides its links (which go straight into the
 // LinkIntervals store as each key finishes).

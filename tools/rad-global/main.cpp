@@ -9,6 +9,7 @@
 #include "formats/gltf_scene.h"
 #include "formats/link_hierarchy.h"
 #include "formats/provenance.h"
+#include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/global_stage.h"
 #include "tools/common/tool_main.h"
 
@@ -20,10 +21,6 @@ struct Options {
   std::string scene, output, report;
   rad::GlobalOptions global;
 };
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Binds every flag straight into the options; the defaults shown are the structs'.
 void addOptions(CLI::App& app, Options& o) {
@@ -89,7 +86,7 @@ int run(Options o, int argc, char** argv) {
   rad::GlobalReport report;
   auto tRead = std::chrono::steady_clock::now();
   rad::Scene scene = rad::readGltfScene(o.scene);
-  report.secondsRead = secondsSince(tRead);
+  report.secondsRead = rad::secondsSince(tRead);
   rad::FrameRange frames = given.empty() ? rad::animationFrames(scene, g.fps)
                                          : rad::FrameRange{given.front(), given.back()};
   if (given.empty()) g.frames = frames.toString();  // the provenance says what ran
@@ -111,8 +108,8 @@ int run(Options o, int argc, char** argv) {
                            {"first_frame", frames.first},
                            {"last_frame", frames.last},
                            {"coherence", g.spaceTime.coherence}});
-  report.secondsWrite = secondsSince(tWrite);
-  report.secondsTotal = secondsSince(tStart);
+  report.secondsWrite = rad::secondsSince(tWrite);
+  report.secondsTotal = rad::secondsSince(tStart);
   report.peakMemoryMb = rad::peakMemoryMb();
   report.coherence = g.spaceTime.coherence;
   std::cerr << report.table(kTool) << report.linkCapWarning(kTool, g.spaceTime.radiosity.maxLinks);

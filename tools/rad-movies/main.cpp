@@ -13,6 +13,7 @@
 #include "formats/movie_sequence.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
+#include "libcommon/core/stopwatch.h"
 #include "libcommon/movies/texture_movie_baker.h"
 #include "tools/common/tool_main.h"
 
@@ -28,20 +29,15 @@ struct Options {
   std::string report;
 };
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
 int run(Options o, int argc, char** argv) {
-  auto start = Clock::now();
+  auto start = rad::SteadyClock::now();
   const rad::MovieShard shard = rad::MovieShard::parse(o.shard);
   o.baker.merge = rad::parseMergeMode(o.merge);
   rad::Scene scene = rad::readGltfScene(o.scene);
   rad::GlobalSolution solution = rad::readLinkHierarchy(o.global, scene);
   rad::TextureIntervals intervals = rad::readTextureIntervals(o.intervals);
   rad::requireGlobalCoversIntervals(o.global, solution, o.intervals, intervals);
-  const double secondsRead = since(start);
+  const double secondsRead = rad::secondsSince(start);
 
   nlohmann::json parameters = o.baker.toJson();
   parameters["shard"] = o.shard;
@@ -70,7 +66,7 @@ int run(Options o, int argc, char** argv) {
     report["renderer"] = baker.rendererName();
     report["seconds"]["read"] = secondsRead;
     report["seconds"]["write"] = written.secondsWrite;
-    report["seconds"]["total"] = since(start);
+    report["seconds"]["total"] = rad::secondsSince(start);
     report["peak_memory_mb"] = rad::peakMemoryMb();
     rad::writeTextFile(o.report, report.dump(1) + "\n");
   }
