@@ -20,6 +20,7 @@ nlohmann::json GlobalOptions::toJson() const {
           {"bad-links", badLinkRuleName(spaceTime.badLinks)},
           {"partial-threshold", spaceTime.partialThreshold},
           {"max-links", r.maxLinks},
+          {"no-closure", !r.closure},
           {"no-coherence", !spaceTime.coherence}};
 }
 

@@ -10,12 +10,17 @@
 //    directions) and its visibility V from k stratified shadow-ray pairs (VisibilityScene),
 //    seeded from (receiver id, shooter id);
 //  * refine, brightness-weighted (HSA'91 §4, "BF refinement"): a link p <- q is refined while
-//    max_c B_q,c * F~_pq * V_pq * A_p > eps * Phi  (Phi = largest emitted power over the
-//    colour channels, so eps is relative and the scene's units do not matter) and the larger
+//    max_c B_q,c * F~_pq * V_pq * A_p > eps * Phi  (Phi = the largest power over the colour
+//    channels, emitted or, once the last solve carries more, carried: sum of A B; so eps is
+//    relative, the scene's units do not matter, and B >> E (rho -> 1) does not refine every
+//    link down to the link bound) and the larger
 //    of the two patches has area > minArea; the larger patch is subdivided and its four
 //    children's links are evaluated and refined in turn. Refined links are kept (flag
 //    refined) but not gathered;
 //  * accurate pass: leaf links get the accurate unoccluded F (polygonToPolygonFormFactor);
+//  * closure: each leaf's factor c that makes its row sum its own (exact in closed rooms);
+//  * exposure: each node's fraction not covered by a solid standing on it; its links'
+//    irradiance is divided by it, so B is the radiosity of the part that can be seen;
 //  * gather + push-pull (HSA'91 §5), Gauss-Seidel over the top-level patches, until the
 //    relative change of B is below tol * (1 - rho_max) (the stop rule of the furnace
 //    reference: a change below tol alone leaves an error of tol / (1 - rho));
@@ -71,12 +76,17 @@ struct RadiosityOptions {
   // links, 128 MB), so the default bounds a key's links to ~0.6 GB instead of running out of
   // memory where the oracle never stops refining (the furnace at rho = 0.999).
   size_t maxLinks = 4000000;
+  // Scale each leaf's gathered irradiance so that its row sum is its own (see computeClosure in
+  // the .cpp): exact energy balance in closed rooms whatever the refinement. false: the plain
+  // hierarchical gather (HSA'91), for comparison.
+  bool closure = true;
 };
 
 // Diffuse reflectance and emitted radiosity B_e = pi L_e (W/m^2) of one top-level patch.
 struct SurfaceProperties {
   glm::dvec3 reflectance{0.0};
   glm::dvec3 emission{0.0};
+  bool doubleSided = false;  // the material is doubleSided: its back is a surface too
   bool isEmitter() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
 };
 // From the scene's materials (reflectance clamped to [0, 1]; the glTF default material is
@@ -93,7 +103,8 @@ struct SolverLink {
   double estimate = 0;          // F~ of the oracle
   double spreadArea = 0;        // max(A_p dF(p -> q), A_q dF(q -> p)) of the error oracle (m^2)
   bool refined = false;         // kept for the hierarchy, not gathered
-  bool accurate = false;        // formFactor is the quadrature value
+  bool accurate = false;        // the accurate pass has seen it (an invisible link may keep F~)
+  bool integrated = false;      // formFactor is the quadrature value
   bool reused = false;          // F and V taken from the previous key time (coherence)
   bool visibilityOnly = false;  // F taken over, V recomputed (the shaft met a moving object)
   double knownFormFactor = -1;  // the accurate F when the previous key computed it, else < 0
@@ -128,9 +139,17 @@ struct KeySolution {
   std::vector<char> split;             // per dense node: subdivided in this key's tree
   std::vector<glm::dvec3> radiosity;   // per dense node of this key's tree (area average)
   std::vector<glm::dvec3> irradiance;  // per dense node: H gathered at it and its ancestors
-  std::vector<Polygon> world;          // per dense node: world polygon at this key
-  std::vector<double> area;            // per dense node: world area
-  int iterations = 0;                  // Gauss-Seidel sweeps, all rounds
+  // Per dense node: the closure factor of a leaf of this key's tree (1 elsewhere, and when
+  // RadiosityOptions::closure is off), for all of its links and for its good ones (shooters
+  // that do not emit). Empty without closure.
+  std::vector<double> closure, goodClosure;
+  // Per dense node of this key's tree: the fraction of its area that is exposed, not covered by
+  // a solid standing on it (see computeExposures in the .cpp); 1 without a visibility scene.
+  // Its radiosity and irradiance are those of the exposed part.
+  std::vector<double> exposure;
+  std::vector<Polygon> world;  // per dense node: world polygon at this key
+  std::vector<double> area;    // per dense node: world area
+  int iterations = 0;          // Gauss-Seidel sweeps, all rounds
   int refineRounds = 0;
   bool linkCapReached = false;     // refinement stopped at RadiosityOptions::maxLinks
   size_t linksComputed = 0;        // links whose F or V was computed here
@@ -143,7 +162,8 @@ struct KeySolution {
     int parent = h.node(node).parent;
     return parent < 0 || (size_t(parent) < split.size() && split[size_t(parent)]);
   }
-  // Power absorbed (sum over leaves of A (1 - rho) H) and emitted (sum A B_e), per channel.
+  // Power absorbed (sum over leaves of e A (1 - rho) H, e the exposure) and emitted (sum A B_e),
+  // per channel.
   glm::dvec3 absorbedPower(const PatchHierarchy& h,
                            const std::vector<SurfaceProperties>& surfaces) const;
   glm::dvec3 emittedPower(const PatchHierarchy& h,
@@ -177,6 +197,9 @@ bool mutuallyFacing(const Polygon& p, const Polygon& q);
 // a link whose ends and blockers did not move gets bit-identical visibility whether it is
 // reused (coherent) or recomputed (--no-coherence), and its shadow does not shimmer in time.
 uint64_t linkSeed(PatchId receiver, PatchId shooter);
+// Seed of a receiver's shadow-ray start points (VisibilityScene::samplePoints): the same for
+// all its links and its exposure, and at every key time.
+uint64_t receiverSeed(PatchId receiver);
 
 // The scene's triangles for visibility: mesh nodes static over [t0, t1] in the static BVH in
 // world space, each dynamic mesh node an instance whose transform setTime() updates. Every

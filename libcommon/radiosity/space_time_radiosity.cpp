@@ -19,6 +19,12 @@ namespace {
 // LinkIntervals store as each key finishes).
 struct KeyRecord {
   std::vector<glm::vec3> radiosity;  // per node of the union hierarchy at that time (push-down)
+  // Per node of the key's tree (1 elsewhere): the exposure its links' irradiance is divided
+  // by (KeySolution::exposure).
+  std::vector<float> exposure;
+  // Per node of the union hierarchy: the good-link closure factor of the key-tree leaf it is
+  // in or under (KeySolution::goodClosure; 1 for nodes above the leaves, or closure off).
+  std::vector<float> goodClosure;
 };
 
 // The links' activity intervals (paper §4.2), built incrementally as each key time finishes so
@@ -156,6 +162,21 @@ std::vector<glm::dvec3> pushedDown(const KeySolution& s, const PatchHierarchy& h
   return b;
 }
 
+// The key-tree leaves' good closure factors on every node of the union hierarchy: a node below
+// a leaf takes the leaf's, a node above the leaves 1 (it holds no leaf's own row sum).
+std::vector<float> pushedDownClosure(const KeySolution& s, const PatchHierarchy& h) {
+  std::vector<float> c(size_t(h.size()), 1.0f);
+  if (s.goodClosure.empty()) return c;
+  for (int i = 0; i < h.size(); ++i) {
+    bool inTree = size_t(i) < s.split.size() && s.inTree(i, h);
+    if (inTree && !s.split[size_t(i)] && size_t(i) < s.goodClosure.size())
+      c[size_t(i)] = float(s.goodClosure[size_t(i)]);
+    else if (!inTree)
+      c[size_t(i)] = c[size_t(h.node(i).parent)];
+  }
+  return c;
+}
+
 }  // namespace
 
 BadLinkRule parseBadLinkRule(const std::string& s) {
@@ -213,8 +234,8 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     CachedLink c;
     c.estimate = l.estimate;
     c.spreadArea = l.spreadArea;
-    // computeAccurate leaves F at the estimate for a link it finds invisible
-    c.formFactor = l.accurate && l.visibility > 0.0 ? l.formFactor : -1.0;
+    // computeAccurate leaves F at the estimate for a link it finds invisible (closure off)
+    c.formFactor = l.integrated ? l.formFactor : -1.0;
     c.visibility = l.visibility;
     c.visibilityValid = !hit;  // a moving object in the shaft: the shadow rays again
     cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
@@ -291,6 +312,9 @@ class KeyTimePass {
       foldLinks(s, uint32_t(k));
       std::vector<glm::dvec3> b = pushedDown(s, h_);
       records_[k].radiosity.assign(b.begin(), b.end());
+      records_[k].exposure.assign(s.exposure.begin(), s.exposure.end());
+      records_[k].exposure.resize(size_t(h_.size()), 1.0f);
+      records_[k].goodClosure = pushedDownClosure(s, h_);
       prev = std::move(s);
     }
   }
@@ -419,7 +443,8 @@ std::vector<glm::dvec3> mergeLinks(LinkIntervals& intervals, const std::vector<c
       const LinkIntervals::Row& r = intervals.row(ri);
       if (!bad && !r.refined)
         intervals.forEachKey(r, [&](uint32_t k, float fv) {
-          goodH[k * N + rcv] += double(fv) * glm::dvec3(records[k].radiosity[sh]);
+          const double e = records[k].exposure[rcv];  // the gather's division (exposure)
+          if (e > 0.0) goodH[k * N + rcv] += double(fv) * glm::dvec3(records[k].radiosity[sh]) / e;
         });
       g.links.push_back(globalLinkOf(intervals, r, rcv, sh, bad, g));
     }
@@ -461,10 +486,12 @@ LeafVertices leafVerticesOf(const PatchHierarchy& h, const std::vector<int>& lea
 }
 
 // Merge: good-link irradiance at the union leaves' vertices (Gouraud: a leaf's H is the sum of
-// goodH over it and its ancestors, averaged at each vertex over the leaves of the same
-// top-level patch that share it), per leaf, key and corner. Also sets g.leafRow.
-void mergeLeafVertexIrradiance(const std::vector<glm::dvec3>& goodH, const PatchHierarchy& h,
-                               size_t K, GlobalSolution& g) {
+// goodH over it and its ancestors times its good closure factor, averaged at each vertex over the
+// leaves of the same top-level patch that share it), per leaf, key and corner. Also sets g.leafRow.
+void mergeLeafVertexIrradiance(const std::vector<glm::dvec3>& goodH,
+                               const std::vector<KeyRecord>& records, const PatchHierarchy& h,
+                               GlobalSolution& g) {
+  const size_t K = records.size();
   const size_t N = size_t(h.size());
   g.leafRow.assign(N, -1);
   std::vector<int> leaves;
@@ -483,6 +510,9 @@ void mergeLeafVertexIrradiance(const std::vector<glm::dvec3>& goodH, const Patch
     for (size_t li = 0; li < L; ++li) {
       glm::dvec3 H(0.0);
       for (int a = leaves[li]; a >= 0; a = h.node(a).parent) H += nodeH[size_t(a)];
+      int inKey = leaves[li];  // nodes made after key k take their ancestor's factor there
+      while (size_t(inKey) >= records[k].goodClosure.size()) inKey = h.node(inKey).parent;
+      H *= double(records[k].goodClosure[size_t(inKey)]);
       const PatchNode& n = h.node(leaves[li]);
       for (int c = 0; c < (n.local.count == 3 ? 3 : 4); ++c)
         vertexSum[size_t(lv.leafVertex[li][size_t(c)])] += H;
@@ -514,7 +544,7 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
   std::vector<glm::dvec3> goodH =
       mergeLinks(pass.intervals(), pass.badPairs(), pass.records(), pass.hierarchy(), g);
   pass.intervals() = LinkIntervals();  // its memory back before the leaf arrays
-  mergeLeafVertexIrradiance(goodH, pass.hierarchy(), keyTimes.size(), g);
+  mergeLeafVertexIrradiance(goodH, pass.records(), pass.hierarchy(), g);
   rep.unionNodes = size_t(pass.hierarchy().size());
   g.hierarchy = std::move(pass.hierarchy());
   g.validate("rad-global");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <mutex>
 #include <numeric>
 #include <string>
@@ -130,6 +131,9 @@ struct VisibilityScene::Impl {
   std::vector<RTCScene> children;                   // [0] static, then one per dynamic object
   std::vector<RTCGeometry> instances;               // dynamic instances, by instance id
   std::deque<std::vector<std::uint32_t>> surfaces;  // stable addresses for the filter
+  // Per child scene (= per instance geometry id of the top scene, the static one first): its
+  // triangles' surface ids, null for an empty child.
+  std::vector<const std::vector<std::uint32_t>*> childSurfaces;
   std::mutex errorMutex;
   std::string lastError;
 
@@ -163,6 +167,7 @@ struct VisibilityScene::Impl {
     RTCScene scene = rtcNewScene(device);
     check("rtcNewScene");
     children.push_back(scene);
+    childSurfaces.push_back(nullptr);
     rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
     if (!tris.empty()) {
@@ -189,6 +194,8 @@ struct VisibilityScene::Impl {
       }
       rtcSetGeometryUserData(g, ids.data());
       rtcSetGeometryOccludedFilterFunction(g, ignoreEndSurfaces);
+      rtcSetGeometryIntersectFilterFunction(g, ignoreEndSurfaces);
+      childSurfaces.back() = &ids;
       rtcCommitGeometry(g);
       rtcAttachGeometry(scene, g);
       rtcReleaseGeometry(g);
@@ -311,6 +318,60 @@ double VisibilityScene::visibility(const Polygon& a, const Polygon& b, int k, st
     if (!occluded(pa, pb, ignoreA, ignoreB)) ++unoccluded;
   }
   return static_cast<double>(unoccluded) / k;
+}
+
+std::vector<glm::dvec3> VisibilityScene::samplePoints(const Polygon& p, int k, std::uint64_t seed) {
+  k = std::max(k, 1);
+  std::vector<glm::dvec2> s =
+      stratified(k, streamSeed(seed, kJitterA), streamSeed(seed, kPermuteA));
+  std::vector<glm::dvec3> out(static_cast<std::size_t>(k));
+  for (int i = 0; i < k; ++i) out[size_t(i)] = onPolygon(p, s[size_t(i)]);
+  return out;
+}
+
+double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints, const Polygon& b,
+                                       std::uint64_t seed, std::uint32_t ignoreA,
+                                       std::uint32_t ignoreB) const {
+  const int k = int(aPoints.size());
+  if (k == 0) return 1.0;
+  std::vector<glm::dvec2> sb =
+      stratified(k, streamSeed(seed, kJitterB), streamSeed(seed, kPermuteB));
+  std::vector<int> pair = permutation(k, streamSeed(seed, kPair));
+  int unoccluded = 0;
+  for (int i = 0; i < k; ++i)
+    if (!occluded(aPoints[size_t(i)], onPolygon(b, sb[size_t(pair[size_t(i)])]), ignoreA, ignoreB))
+      ++unoccluded;
+  return static_cast<double>(unoccluded) / k;
+}
+
+std::uint32_t VisibilityScene::firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
+                                        std::uint32_t ignore) const {
+  RTCRayHit rh;
+  rh.ray.org_x = static_cast<float>(origin.x);
+  rh.ray.org_y = static_cast<float>(origin.y);
+  rh.ray.org_z = static_cast<float>(origin.z);
+  rh.ray.dir_x = static_cast<float>(direction.x);
+  rh.ray.dir_y = static_cast<float>(direction.y);
+  rh.ray.dir_z = static_cast<float>(direction.z);
+  rh.ray.tnear = static_cast<float>(kSegmentEpsilon);
+  rh.ray.tfar = std::numeric_limits<float>::infinity();
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  if (!(rh.ray.dir_x != 0.0f || rh.ray.dir_y != 0.0f || rh.ray.dir_z != 0.0f)) return kNoSurface;
+  FilterContext fc;
+  rtcInitIntersectContext(&fc.context);
+  fc.ignoreA = ignore;
+  fc.ignoreB = ignore;
+  rtcIntersect1(impl_->top, &fc.context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return kNoSurface;
+  const unsigned child = rh.hit.instID[0];
+  if (child >= impl_->childSurfaces.size() || !impl_->childSurfaces[child]) return kNoSurface;
+  const std::vector<std::uint32_t>& ids = *impl_->childSurfaces[child];
+  return rh.hit.primID < ids.size() ? ids[rh.hit.primID] : kNoSurface;
 }
 
 std::vector<double> VisibilityScene::visibilityBatch(const std::vector<VisibilityQuery>& queries,

@@ -78,6 +78,20 @@ class VisibilityScene {
   // Estimator: E = V (unbiased); the standard deviation is at most 1/(2 sqrt(k)).
   double visibility(const Polygon& a, const Polygon& b, int k, std::uint64_t seed,
                     std::uint32_t ignoreA = kNoSurface, std::uint32_t ignoreB = kNoSurface) const;
+  // The same estimator with a's k sample points given (samplePoints(a, k, seedA)): every link
+  // of a receiver then shoots from the same points, the ones its exposure is measured at, so
+  // that dividing by the exposure removes exactly the pairs that start on a covered point.
+  double visibilityFrom(const std::vector<glm::dvec3>& aPoints, const Polygon& b,
+                        std::uint64_t seed, std::uint32_t ignoreA = kNoSurface,
+                        std::uint32_t ignoreB = kNoSurface) const;
+  // k stratified, area-uniform points on p (the strata of visibility()), from `seed`.
+  static std::vector<glm::dvec3> samplePoints(const Polygon& p, int k, std::uint64_t seed);
+  // The surface id of the first triangle that the ray origin + t direction, t in
+  // [kSegmentEpsilon, inf), hits, ignoring the triangles of surface `ignore`; kNoSurface when
+  // it hits nothing. Thread-safe after commit().
+  std::uint32_t firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
+                         std::uint32_t ignore = kNoSurface) const;
+
   // Many queries in parallel (TBB); results in input order, identical to calling visibility()
   // on each query in turn.
   std::vector<double> visibilityBatch(const std::vector<VisibilityQuery>& queries, int k) const;

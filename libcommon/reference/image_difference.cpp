@@ -222,12 +222,15 @@ double PixelSetStats::bias() const {
 void ErrorFigures::merge(const ErrorFigures& o) {
   surfaces.merge(o.surfaces);
   emitters.merge(o.emitters);
+  if (groups.size() < o.groups.size()) groups.resize(o.groups.size());
+  for (size_t g = 0; g < o.groups.size(); ++g) groups[g].merge(o.groups[g]);
 }
 
 ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
                           const FloatImage* reference2, const EmitterRule& rule,
                           const std::string& testWhere, const std::string& reference2Where,
-                          const FloatImage* emitterMask, const std::string& maskWhere) {
+                          const FloatImage* emitterMask, const std::string& maskWhere,
+                          const PixelGroups* groups) {
   requireSameShape(test, reference, testWhere);
   if (reference2) requireSameShape(*reference2, reference, reference2Where);
   if (emitterMask) requireMaskShape(*emitterMask, reference, maskWhere);
@@ -248,6 +251,18 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
   const std::vector<double> w = luminanceWeights(reference.channels);
   const std::size_t nc = std::size_t(reference.channelCount());
   const std::size_t pixels = std::size_t(reference.width) * std::size_t(reference.height);
+  if (groups) {
+    if (groups->ofPixel.size() != pixels)
+      throw inputError(testWhere, "pixel groups (item buffer) are not of the image's size");
+    f.groups.resize(size_t(std::max(groups->count, 0)));
+    for (PixelSetStats& g : f.groups) g.twoReferences = reference2 != nullptr;
+  }
+  if (groups) {
+    if (groups->ofPixel.size() != pixels)
+      throw inputError(testWhere, "pixel groups (item buffer) are not of the image's size");
+    f.groups.resize(size_t(std::max(groups->count, 0)));
+    for (PixelSetStats& g : f.groups) g.twoReferences = reference2 != nullptr;
+  }
   for (std::size_t p = 0; p < pixels; ++p) {
     const std::size_t base = p * nc;
     bool finite = true;
@@ -259,17 +274,23 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
     const bool emitter = emitterMask ? emitterMask->pixels[p * maskChannels] > 0.5f
                                      : pixelLuminance(&r.pixels[base], w) > f.emitterThreshold;
     PixelSetStats& s = emitter ? f.emitters : f.surfaces;
+    const int g = groups && !emitter ? groups->ofPixel[p] : -1;
+    PixelSetStats* group = g >= 0 && g < int(f.groups.size()) ? &f.groups[size_t(g)] : nullptr;
     ++s.pixels;
+    if (group) ++group->pixels;
     for (std::size_t c = 0; c < nc; ++c) {
       const double t = test.pixels[base + c], r1 = reference.pixels[base + c];
       const double r2 = reference2 ? double(reference2->pixels[base + c]) : r1;
       const double rm = reference2 ? 0.5 * (r1 + r2) : r1;
-      ++s.samples;
-      s.sumReference += rm;
-      s.sumError += t - rm;
-      s.sumSquaredError1 += (t - r1) * (t - r1);
-      s.sumSquaredError2 += (t - r2) * (t - r2);
-      s.sumSquaredBetween += (r1 - r2) * (r1 - r2);
+      for (PixelSetStats* x : {&s, group}) {
+        if (!x) continue;
+        ++x->samples;
+        x->sumReference += rm;
+        x->sumError += t - rm;
+        x->sumSquaredError1 += (t - r1) * (t - r1);
+        x->sumSquaredError2 += (t - r2) * (t - r2);
+        x->sumSquaredBetween += (r1 - r2) * (r1 - r2);
+      }
     }
   }
   return f;
@@ -294,7 +315,7 @@ SequenceDifference compareSequence(const std::vector<int>& frames,
     const bool masked = !im.emitterMask.pixels.empty();
     fd.error = measureError(im.test, im.reference, two ? &im.reference2 : nullptr, rule, where,
                             where + ": second reference", masked ? &im.emitterMask : nullptr,
-                            where + ": emitter mask");
+                            where + ": emitter mask", im.groups.count > 0 ? &im.groups : nullptr);
     result.total.merge(fd.stats);
     result.totalError.merge(fd.error);
     result.frames.push_back(fd);
@@ -316,7 +337,7 @@ SequenceDifference compareSequence(
   return compareSequence(
       frames, std::function<FrameImages(int)>([&](int frame) {
         auto [test, reference] = load(frame);
-        return FrameImages{std::move(test), std::move(reference), FloatImage(), FloatImage()};
+        return FrameImages{std::move(test), std::move(reference), FloatImage(), FloatImage(), {}};
       }),
       staticTolerance, rule);
 }

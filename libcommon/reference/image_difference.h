@@ -136,8 +136,17 @@ struct PixelSetStats {
 // any channel of any image is in neither (DifferenceStats counts it in nonFinite).
 struct ErrorFigures {
   PixelSetStats surfaces, emitters;
+  // Per pixel group (PixelGroups, e.g. the material seen in an item buffer): its non-emitter
+  // pixels, so that a bias can be traced to the surfaces that have it. Empty without groups.
+  std::vector<PixelSetStats> groups;
   double emitterThreshold = std::numeric_limits<double>::infinity();  // one frame's; see rule
   void merge(const ErrorFigures& other);
+};
+
+// Which group each pixel is in (row-major, -1: none) and how many groups there are.
+struct PixelGroups {
+  std::vector<int> ofPixel;
+  int count = 0;
 };
 
 // `reference2` may be null (one reference). `emitterMask` may be null (the rule decides);
@@ -151,7 +160,8 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
                           const std::string& testWhere = "test image",
                           const std::string& reference2Where = "second reference",
                           const FloatImage* emitterMask = nullptr,
-                          const std::string& maskWhere = "emitter mask");
+                          const std::string& maskWhere = "emitter mask",
+                          const PixelGroups* groups = nullptr);
 
 // ---- Sequences -------------------------------------------------------------------------------
 
@@ -172,6 +182,7 @@ struct SequenceDifference {
 // empty when the rule decides which pixels are emitters.
 struct FrameImages {
   FloatImage test, reference, reference2, emitterMask;
+  PixelGroups groups;  // empty (count 0): no per-surface figures
 };
 
 // Compares a sequence frame by frame. `load(frame)` returns the images of one frame number

@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/exr_image.h"
+#include "formats/gltf_scene.h"
+#include "formats/item_buffer_exr.h"
 #include "tests/cli/cli_util.h"
 
 namespace rad::test {
@@ -263,6 +265,60 @@ TEST(RadDiff, DirectoriesWithSecondReference) {
   EXPECT_EQ(r.exitCode, 1);
   EXPECT_EQ(countLines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(ref2.string() + ": no frame 2"), std::string::npos) << r.err;
+}
+
+// --surfaces: the figures per glTF node and material seen in rad-intervals' item buffer. A
+// test frame 50 % too bright on the red wall alone and exact elsewhere reads bias +0.5 there
+// and 0 on every other surface, and the groups' pixels add up to the covered pixels.
+TEST(RadDiff, PerSurfaceBiasNamesTheWrongSurface) {
+  const std::string scene = RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
+  fs::path d = freshDir("surfaces");
+  CommandResult r =
+      runCommand(tool("rad-intervals") + " " + scene + " -o " + (d / "i.rti").string() +
+                 " --frames 0-0 --size 88x60 --item-buffers " + (d / "items").string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const ItemBuffer items = readItemBufferExr((d / "items" / "0000.exr").string());
+  const Scene sc = readGltfScene(scene);
+  const uint64_t T = sc.inputPolygons().size();
+  FloatImage ref = constant(88, 60, 0.1f), test = ref;
+  long long red = 0, covered = 0;
+  for (size_t p = 0; p < items.id.size(); ++p) {
+    if (items.id[p] == 0) continue;
+    ++covered;
+    uint64_t node = items.id[p] - 1;  // formats/texture_intervals.md: parent of j >= T is (j-T)/4
+    while (node >= T) node = (node - T) / 4;
+    const InputPolygon& top = sc.inputPolygons()[size_t(node)];
+    if (sc.nodes[size_t(top.node)].name != "red_wall") continue;
+    ++red;
+    for (int c = 0; c < 3; ++c) test.pixels[3 * p + size_t(c)] = 0.15f;
+  }
+  ASSERT_GT(red, 0);
+  writeExrImage((d / "test.exr").string(), test);
+  writeExrImage((d / "ref.exr").string(), ref);
+  r = runCommand(tool("rad-diff") + " " + (d / "test.exr").string() + " " +
+                 (d / "ref.exr").string() + " --surfaces " + (d / "items" / "0000.exr").string() +
+                 " --scene " + scene + " --emitter-threshold 1 --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  long long pixels = 0;
+  bool sawRed = false;
+  for (const nlohmann::json& g : j["per_surface"]) {
+    pixels += g["pixels"].get<long long>();
+    if (g["surface"] == "red_wall (red)") {
+      sawRed = true;
+      EXPECT_EQ(g["pixels"].get<long long>(), red);
+      EXPECT_NEAR(g["bias"].get<double>(), 0.5, 1e-6);
+    } else {
+      EXPECT_EQ(g["bias"].get<double>(), 0.0) << g["surface"];
+    }
+  }
+  EXPECT_TRUE(sawRed);
+  EXPECT_EQ(pixels, covered);
+  // --surfaces without --scene is a usage error, one line.
+  r = runCommand(tool("rad-diff") + " " + (d / "test.exr").string() + " " +
+                 (d / "ref.exr").string() + " --surfaces " + (d / "items" / "0000.exr").string());
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("--surfaces and --scene go together"), std::string::npos) << r.err;
 }
 
 }  // namespace

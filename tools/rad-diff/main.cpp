@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <regex>
 #include <sstream>
 
@@ -15,6 +16,8 @@
 
 #include "formats/exr_image.h"
 #include "formats/exr_info.h"
+#include "formats/gltf_scene.h"
+#include "formats/item_buffer_exr.h"
 #include "libcommon/reference/image_difference.h"
 #include "tools/common/tool_main.h"
 
@@ -24,7 +27,7 @@ constexpr const char* kTool = "rad-diff";
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string test, reference, reference2, emitterMask;
+  std::string test, reference, reference2, emitterMask, surfaces, scene;
   bool json = false;
   std::string channels = "R,G,B";
   double staticTolerance = 0.0;
@@ -133,6 +136,88 @@ rad::FloatImage readEmitterMask(const std::string& path) {
   return rad::readExrImage(path, {channels[0]["name"].get<std::string>()});
 }
 
+// Per-surface figures (--surfaces ITEMS --scene SCENE): each pixel's group is the glTF node and
+// material of the patch rad-intervals' item buffer saw there. Item ids are dense node indices + 1
+// of the regular subdivision (formats/texture_intervals.md): the top-level patches 0..T-1, then
+// four children per node in order, so node j >= T has parent (j - T) / 4.
+struct SurfaceGroups {
+  std::vector<std::string> names;  // per group: "node (material)"
+  const rad::Scene* scene = nullptr;
+  std::vector<int> groupOfTop;  // per top-level patch
+
+  explicit SurfaceGroups(const rad::Scene& s) : scene(&s) {
+    const std::vector<rad::InputPolygon>& tops = s.inputPolygons();
+    std::map<std::pair<int, int>, int> groupOf;  // (mesh node, material)
+    for (const rad::InputPolygon& p : tops) {
+      auto [it, fresh] = groupOf.emplace(std::pair(p.node, p.material), int(names.size()));
+      if (fresh) names.push_back(nameOf(s, p));
+      groupOfTop.push_back(it->second);
+    }
+  }
+
+  // "node (material)", by glTF name where there is one.
+  static std::string nameOf(const rad::Scene& s, const rad::InputPolygon& p) {
+    std::string node =
+        p.node >= 0 && p.node < int(s.nodes.size()) && !s.nodes[size_t(p.node)].name.empty()
+            ? s.nodes[size_t(p.node)].name
+            : "node " + std::to_string(p.node);
+    std::string material =
+        p.material < 0 ? "default"
+        : p.material < int(s.materials.size()) && !s.materials[size_t(p.material)].name.empty()
+            ? s.materials[size_t(p.material)].name
+            : "material " + std::to_string(p.material);
+    return node + " (" + material + ")";
+  }
+
+  rad::PixelGroups of(const std::string& itemsPath, const rad::FloatImage& like) const {
+    const rad::ItemBuffer items = rad::readItemBufferExr(itemsPath);
+    if (items.width != like.width || items.height != like.height)
+      throw rad::inputError(itemsPath, "item buffer is " + std::to_string(items.width) + "x" +
+                                           std::to_string(items.height) + ", the images " +
+                                           std::to_string(like.width) + "x" +
+                                           std::to_string(like.height));
+    const uint64_t T = groupOfTop.size();
+    rad::PixelGroups g;
+    g.count = int(names.size());
+    g.ofPixel.assign(items.id.size(), -1);
+    for (size_t p = 0; p < items.id.size(); ++p) {
+      if (items.id[p] == rad::kNoItem || items.id[p] == 0) continue;
+      uint64_t node = items.id[p] - 1;
+      while (node >= T) node = (node - T) / 4;
+      g.ofPixel[p] = groupOfTop[size_t(node)];
+    }
+    return g;
+  }
+};
+
+nlohmann::json surfacesJson(const rad::ErrorFigures& e, const SurfaceGroups& sg) {
+  nlohmann::json a = nlohmann::json::array();
+  for (size_t g = 0; g < e.groups.size(); ++g) {
+    const rad::PixelSetStats& s = e.groups[g];
+    if (s.pixels == 0) continue;
+    a.push_back({{"surface", sg.names[g]},
+                 {"pixels", s.pixels},
+                 {"mean_reference", s.meanReference()},
+                 {"bias", number(s.bias())},
+                 {"rmse_over_mean", number(s.rmseOverMean())}});
+  }
+  return a;
+}
+
+std::string surfacesText(const rad::ErrorFigures& e, const SurfaceGroups& sg) {
+  std::ostringstream os;
+  os << "  per surface (node and material; non-emitter pixels): pixels, mean(ref), bias, "
+        "rmse/mean\n";
+  for (size_t g = 0; g < e.groups.size(); ++g) {
+    const rad::PixelSetStats& s = e.groups[g];
+    if (s.pixels == 0) continue;
+    os << "    " << std::left << std::setw(28) << sg.names[g] << std::right << std::setw(8)
+       << s.pixels << "  " << std::setw(10) << text(s.meanReference()) << "  " << std::setw(10)
+       << text(s.bias()) << "  " << text(s.rmseOverMean()) << "\n";
+  }
+  return os.str();
+}
+
 std::string legend(const Options& o) {
   return std::string(
              "  rmse/mean and bias over the pixels that are not emitters (DESIGN.md "
@@ -151,26 +236,43 @@ void compareFiles(const Options& o, const std::vector<std::string>& channels, nl
   rad::FloatImage mask;
   if (!o.emitterMask.empty()) mask = readEmitterMask(o.emitterMask);
   rad::DifferenceStats s = rad::compareImages(test, reference, o.test);
+  std::optional<rad::Scene> scene;
+  std::optional<SurfaceGroups> sg;
+  rad::PixelGroups groups;
+  if (!o.surfaces.empty()) {
+    scene = rad::readGltfScene(o.scene);
+    sg.emplace(*scene);
+    groups = sg->of(o.surfaces, reference);
+  }
   rad::ErrorFigures e = rad::measureError(
       test, reference, o.reference2.empty() ? nullptr : &reference2, o.emitters, o.test,
-      o.reference2, o.emitterMask.empty() ? nullptr : &mask, o.emitterMask);
+      o.reference2, o.emitterMask.empty() ? nullptr : &mask, o.emitterMask, sg ? &groups : nullptr);
   j["size"] = {test.width, test.height};
   j["difference"] = statsJson(s, e, true);
+  if (sg) j["per_surface"] = surfacesJson(e, *sg);
   out << o.test << " vs " << o.reference;
   if (!o.reference2.empty()) out << " and " << o.reference2;
   out << " (" << test.width << "x" << test.height << ", " << o.channels << "):\n"
       << legend(o) << "  " << errorText(e);
   if (o.emitterMask.empty()) out << " (emitter threshold " << text(e.emitterThreshold) << ")";
   out << "\n  every pixel: " << statsText(s, kLongRelative) << "\n";
+  if (sg) out << surfacesText(e, *sg);
 }
 
 // Two (or three, with --ref2) frame directories, matched by frame number.
 void compareDirectories(const Options& o, const std::vector<std::string>& channels,
                         nlohmann::json& j, std::ostream& out) {
   std::map<int, std::string> tests = frameFiles(o.test), refs = frameFiles(o.reference);
-  std::map<int, std::string> refs2, masks;
+  std::map<int, std::string> refs2, masks, items;
   if (!o.reference2.empty()) refs2 = frameFiles(o.reference2);
   if (!o.emitterMask.empty()) masks = frameFiles(o.emitterMask);
+  std::optional<rad::Scene> scene;
+  std::optional<SurfaceGroups> sg;
+  if (!o.surfaces.empty()) {
+    items = frameFiles(o.surfaces);
+    scene = rad::readGltfScene(o.scene);
+    sg.emplace(*scene);
+  }
   std::vector<int> frames;
   int onlyTest = 0;
   for (const auto& [f, p] : tests) {
@@ -184,7 +286,8 @@ void compareDirectories(const Options& o, const std::vector<std::string>& channe
     throw rad::inputError(o.test, "no frame NNNN.exr in common with " + o.reference);
   for (int f : frames)
     for (const auto& [dir, files] :
-         {std::pair(&o.reference2, &refs2), std::pair(&o.emitterMask, &masks)})
+         {std::pair(&o.reference2, &refs2), std::pair(&o.emitterMask, &masks),
+          std::pair(&o.surfaces, &items)})
       if (!dir->empty() && !files->count(f))
         throw rad::inputError(*dir, "no frame " + std::to_string(f) + " (" +
                                         fs::path(refs[f]).filename().string() +
@@ -193,14 +296,17 @@ void compareDirectories(const Options& o, const std::vector<std::string>& channe
       frames,
       [&](int f) {
         rad::FrameImages im{rad::readExrImage(tests[f], channels),
-                            rad::readExrImage(refs[f], channels), rad::FloatImage(),
-                            rad::FloatImage()};
+                            rad::readExrImage(refs[f], channels),
+                            rad::FloatImage(),
+                            rad::FloatImage(),
+                            {}};
         rad::requireSameShape(im.test, im.reference, tests[f]);
         if (!o.reference2.empty()) {
           im.reference2 = rad::readExrImage(refs2[f], channels);
           rad::requireSameShape(im.reference2, im.reference, refs2[f]);
         }
         if (!o.emitterMask.empty()) im.emitterMask = readEmitterMask(masks[f]);
+        if (sg) im.groups = sg->of(items[f], im.reference);
         return im;
       },
       o.staticTolerance, o.emitters);
@@ -208,6 +314,7 @@ void compareDirectories(const Options& o, const std::vector<std::string>& channe
   j["frames_only_in_test"] = onlyTest;
   j["frames_only_in_reference"] = onlyReference;
   j["difference"] = statsJson(seq.total, seq.totalError, false);
+  if (sg) j["per_surface"] = surfacesJson(seq.totalError, *sg);
   j["flicker"] = {{"mean_abs", seq.flicker.mean()},
                   {"max_abs", seq.flicker.maxAbsChange},
                   {"static_pixels", seq.flicker.staticPixels},
@@ -233,6 +340,7 @@ void compareDirectories(const Options& o, const std::vector<std::string>& channe
   out << "  flicker: mean |test(n+1)-test(n)| " << text(seq.flicker.mean()) << " (max "
       << text(seq.flicker.maxAbsChange) << ") over " << seq.flicker.staticPixels
       << " static pixel(s) in " << seq.flicker.framePairs << " frame pair(s)\n";
+  if (sg) out << surfacesText(seq.totalError, *sg);
 }
 
 int run(const Options& o) {
@@ -240,7 +348,10 @@ int run(const Options& o) {
   if (o.emitters.threshold && !(*o.emitters.threshold >= 0.0))
     throw rad::Error(rad::ExitCode::kUsage, "--emitter-threshold", "must be >= 0");
   std::vector<std::string> inputs = {o.test, o.reference};
-  for (const std::string& p : {o.reference2, o.emitterMask})
+  if (o.surfaces.empty() != o.scene.empty())
+    throw rad::Error(rad::ExitCode::kUsage, o.surfaces.empty() ? "--scene" : "--surfaces",
+                     "--surfaces and --scene go together");
+  for (const std::string& p : {o.reference2, o.emitterMask, o.surfaces, o.scene})
     if (!p.empty()) inputs.push_back(p);
   for (const std::string& p : inputs)
     if (!fs::exists(p)) throw rad::inputError(p, "cannot open (missing)");
@@ -249,7 +360,8 @@ int run(const Options& o) {
     throw rad::Error(rad::ExitCode::kUsage, o.test,
                      "TEST and REFERENCE must both be .exr files or both directories");
   for (const auto& [path, flag] :
-       {std::pair(o.reference2, "--ref2"), std::pair(o.emitterMask, "--emitter-mask")})
+       {std::pair(o.reference2, "--ref2"), std::pair(o.emitterMask, "--emitter-mask"),
+        std::pair(o.surfaces, "--surfaces")})
     if (!path.empty() && fs::is_directory(path) != refDir)
       throw rad::Error(rad::ExitCode::kUsage, path,
                        std::string(flag) +
@@ -316,6 +428,12 @@ int main(int argc, char** argv) {
                  "EXR (or directory of NNNN.exr, like REFERENCE) whose first channel > 0.5 marks "
                  "the emitter pixels; replaces the luminance rule")
       ->excludes(threshold);
+  app.add_option(
+      "--surfaces", o.surfaces,
+      "item buffer (rad-intervals --item-buffers; a file, or a directory like "
+      "REFERENCE) of the frames: adds the figures per surface (glTF node and material) seen, "
+      "which say where a bias is; needs --scene");
+  app.add_option("--scene", o.scene, "the scene of --surfaces (its patches and materials)");
   app.add_flag("--json", o.json, "print JSON on stdout instead of text");
   app.add_option("--channels", o.channels,
                  "comma-separated channels to compare (luminance: Rec. 709 when R, G, B are all "

@@ -36,8 +36,10 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_option("--key-step", g.keyStep, "frames between key times (the last frame is always one)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  app.add_option("--eps", r.eps,
-                 "refinement threshold: refine while B_q F_pq V A_p > eps x largest emitted power")
+  app.add_option(
+         "--eps", r.eps,
+         "refinement threshold: refine while B_q F_pq V A_p > eps x the largest power emitted or, "
+         "once it is larger, carried (sum of A B over the patches)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option_function<std::string>(
@@ -73,6 +75,10 @@ void addOptions(CLI::App& app, Options& o) {
                  "and warns")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_flag_callback(
+      "--no-closure", [&r] { r.closure = false; },
+      "gather without the closure factor (each leaf's row sum its own; exact energy balance in "
+      "closed rooms): the plain hierarchical gather, for comparison");
   app.add_flag_callback(
       "--no-coherence", [&g] { g.spaceTime.coherence = false; },
       "recompute every link at every key time (the baseline of the speed-up)");
