@@ -200,6 +200,7 @@ class KeyTimeSolver {
       computeExposures();
       solve();
       raiseThresholdToCarriedPower();
+      measureShooterRanges();
       s_.secondsSolve += secondsSince(ts);
       s_.refineRounds = round + 1;
       if (!refineOn_ || round + 1 >= opt_.maxRefineRounds) break;
@@ -255,6 +256,28 @@ class KeyTimeSolver {
     epsAbs_ = std::max(epsAbs_, opt_.eps * maxComponent(carried));
   }
 
+  // Per node of this key's tree: the range (max - min over the colour channel of largest
+  // range) of B over the leaves below it, from the last solve; 0 for a leaf.
+  void measureShooterRanges() {
+    const size_t N = size_t(h_.size());
+    std::vector<glm::dvec3> lo(N), hi(N);
+    shooterRange_.assign(N, 0.0);
+    for (size_t i = N; i-- > 0;) {  // children (higher indices) before their parent
+      if (!s_.inTree(int(i), h_)) continue;
+      if (!s_.split[i]) {
+        lo[i] = hi[i] = B_[i];
+        continue;
+      }
+      const int first = h_.node(int(i)).firstChild;
+      lo[i] = lo[size_t(first)], hi[i] = hi[size_t(first)];
+      for (int c = 1; c < 4; ++c) {
+        lo[i] = glm::min(lo[i], lo[size_t(first + c)]);
+        hi[i] = glm::max(hi[i], hi[size_t(first + c)]);
+      }
+      shooterRange_[i] = maxComponent(hi[i] - lo[i]);
+    }
+  }
+
   // Evaluate: the oracle's estimate F~ (and spread) and the visibility V of every link made
   // since the last call, in parallel (each link writes only itself).
   void evaluateNewLinks() {
@@ -271,8 +294,8 @@ class KeyTimeSolver {
     auto shadowRays = [&] {
       return input_.visibility
                  ? input_.visibility->visibilityFrom(
-                       VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)), Q,
-                       linkSeed(r.id, q.id), r.id.top, q.id.top)
+                       VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)), P.normal(),
+                       Q, linkSeed(r.id, q.id), r.id.top, q.id.top)
                  : 1.0;
     };
     if (input_.reuse) {
@@ -309,7 +332,12 @@ class KeyTimeSolver {
   // either one, against eps * Phi.
   bool oracleWantsRefinement(const SolverLink& l) const {
     double bv = maxComponent(B_[size_t(l.shooter)]) * l.visibility;
-    bool power = bv * l.estimate * s_.area[size_t(l.receiver)] > epsAbs_;
+    // The shooter's B varies inside it (a shadow across the floor patch a box face gathers
+    // from): the link's error is up to that range times F V A_p. Counted in the power oracle,
+    // which otherwise sees only the shooter's mean.
+    double range = size_t(l.shooter) < shooterRange_.size() ? shooterRange_[size_t(l.shooter)] : 0;
+    bool power =
+        std::max(bv, range * l.visibility) * l.estimate * s_.area[size_t(l.receiver)] > epsAbs_;
     bool error = bv * l.spreadArea > epsAbs_;
     return opt_.oracle == RefinementOracle::kPower   ? power
            : opt_.oracle == RefinementOracle::kError ? error
@@ -623,8 +651,9 @@ class KeyTimeSolver {
   bool refineOn_ = false;
   double stopChange_ = 0;  // tol * (1 - rho_max)
   std::vector<size_t> adjStart_, adj_;
-  std::vector<glm::dvec3> irr_;   // per dense node: H gathered at it and its ancestors
-  std::vector<double> exposure_;  // per dense node: exposureOf once computed, else < 0
+  std::vector<glm::dvec3> irr_;       // per dense node: H gathered at it and its ancestors
+  std::vector<double> exposure_;      // per dense node: exposureOf once computed, else < 0
+  std::vector<double> shooterRange_;  // per dense node: measureShooterRanges
   // Per dense node: F(node -> top-level patch) computed for the closure in this key's solve.
   std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor_;
   double maxDelta_ = 0, maxB_ = 0;  // of the current sweep

@@ -329,7 +329,8 @@ std::vector<glm::dvec3> VisibilityScene::samplePoints(const Polygon& p, int k, s
   return out;
 }
 
-double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints, const Polygon& b,
+double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints,
+                                       const glm::dvec3& aNormal, const Polygon& b,
                                        std::uint64_t seed, std::uint32_t ignoreA,
                                        std::uint32_t ignoreB) const {
   const int k = int(aPoints.size());
@@ -337,11 +338,27 @@ double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints, c
   std::vector<glm::dvec2> sb =
       stratified(k, streamSeed(seed, kJitterB), streamSeed(seed, kPermuteB));
   std::vector<int> pair = permutation(k, streamSeed(seed, kPair));
+  const glm::dvec3 bNormal = b.normal();
+  double weighted = 0.0, weight = 0.0;
   int unoccluded = 0;
-  for (int i = 0; i < k; ++i)
-    if (!occluded(aPoints[size_t(i)], onPolygon(b, sb[size_t(pair[size_t(i)])]), ignoreA, ignoreB))
-      ++unoccluded;
-  return static_cast<double>(unoccluded) / k;
+  for (int i = 0; i < k; ++i) {
+    const glm::dvec3 pa = aPoints[size_t(i)];
+    const glm::dvec3 pb = onPolygon(b, sb[size_t(pair[size_t(i)])]);
+    const bool open = !occluded(pa, pb, ignoreA, ignoreB);
+    unoccluded += open ? 1 : 0;
+    // The pair's weight in F: cos(theta_a) cos(theta_b) / r^2, 0 where either point is behind
+    // the other's plane (those pairs carry no energy, but an area-uniform count would let them
+    // darken the link: a box face gathering from a floor patch half behind it read V = 0.5).
+    const glm::dvec3 d = pb - pa;
+    const double r2 = glm::dot(d, d);
+    const double w = r2 > 0.0 ? std::max(0.0, glm::dot(aNormal, d)) *
+                                    std::max(0.0, -glm::dot(bNormal, d)) / (r2 * r2)
+                              : 0.0;
+    weight += w;
+    weighted += open ? w : 0.0;
+  }
+  // No pair that exchanges energy among the samples: the area-uniform fraction.
+  return weight > 0.0 ? weighted / weight : static_cast<double>(unoccluded) / k;
 }
 
 std::uint32_t VisibilityScene::firstHit(const glm::dvec3& origin, const glm::dvec3& direction,

@@ -78,11 +78,15 @@ class VisibilityScene {
   // Estimator: E = V (unbiased); the standard deviation is at most 1/(2 sqrt(k)).
   double visibility(const Polygon& a, const Polygon& b, int k, std::uint64_t seed,
                     std::uint32_t ignoreA = kNoSurface, std::uint32_t ignoreB = kNoSurface) const;
-  // The same estimator with a's k sample points given (samplePoints(a, k, seedA)): every link
-  // of a receiver then shoots from the same points, the ones its exposure is measured at, so
-  // that dividing by the exposure removes exactly the pairs that start on a covered point.
-  double visibilityFrom(const std::vector<glm::dvec3>& aPoints, const Polygon& b,
-                        std::uint64_t seed, std::uint32_t ignoreA = kNoSurface,
+  // Visibility of a link from a's k sample points (samplePoints(a, k, seedA), so that every
+  // link of a receiver shoots from the same points, the ones its exposure is measured at) to
+  // k stratified points on b: the kernel-weighted fraction of unoccluded pairs,
+  //   $V = \sum_i K_i v_i / \sum_i K_i$, $K_i = \cos\theta_a \cos\theta_b / r^2$ (0 behind),
+  // the ratio estimator of F_occluded / F_unoccluded (Cohen & Wallace ch. 4). An area-uniform
+  // count lets pairs that exchange no energy (behind either plane) decide the link's
+  // visibility. When no sample pair has K > 0, the area-uniform fraction.
+  double visibilityFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
+                        const Polygon& b, std::uint64_t seed, std::uint32_t ignoreA = kNoSurface,
                         std::uint32_t ignoreB = kNoSurface) const;
   // k stratified, area-uniform points on p (the strata of visibility()), from `seed`.
   static std::vector<glm::dvec3> samplePoints(const Polygon& p, int k, std::uint64_t seed);
