@@ -206,5 +206,28 @@ TEST(Visibility, RandomNumbersAreCounterBased) {
   EXPECT_NEAR(sum / 100000, 0.5, 4 * std::sqrt(1.0 / 12.0 / 100000));
 }
 
+// The link estimator weighs each ray pair by the kernel (cos cos / r^2, 0 behind either
+// plane): a box face R gathering from a floor S that extends in front of it, under the box and
+// behind it. Only the third in front carries energy, and it is unoccluded, so V = 1; an
+// area-uniform count also counts the pairs through the box's back face (the third behind) as
+// blocked and reads 2/3, which darkened every face of the bundled scene's boxes.
+TEST(Visibility, PairsThatCarryNoEnergyDoNotDecide) {
+  const Polygon R = squareA();                                           // z = 0, facing +z
+  const Polygon S = quad({0, 0, -2}, {0, 0, 1}, {1, 0, 1}, {1, 0, -2});  // y = 0, facing +y
+  const Polygon back = quad({0, 0, -1}, {0, 1, -1}, {1, 1, -1}, {1, 0, -1});
+  std::vector<VisibilityTriangle> t;
+  addQuad(t, R, kSurfA);
+  addQuad(t, S, kSurfB);
+  addQuad(t, back, kSurfBlocker);
+  VisibilityScene scene(t);
+  const std::vector<glm::dvec3> points = VisibilityScene::samplePoints(R, 64, 7);
+  EXPECT_EQ(scene.visibilityFrom(points, R.normal(), S, 11, kSurfA, kSurfB), 1.0);
+  const double uniform = scene.visibility(R, S, 64, 11, kSurfA, kSurfB);
+  EXPECT_NEAR(uniform, 2.0 / 3.0, 0.1) << "the area-uniform count";
+  // Without energy-carrying pairs among the samples it falls back to the uniform count.
+  const Polygon behind = quad({0, 0, -2}, {0, 0, -1.5}, {1, 0, -1.5}, {1, 0, -2});
+  EXPECT_EQ(scene.visibilityFrom(points, R.normal(), behind, 11, kSurfA, kSurfB), 0.0);
+}
+
 }  // namespace
 }  // namespace rad
