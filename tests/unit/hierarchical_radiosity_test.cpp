@@ -427,6 +427,7 @@ TEST(HierarchicalRadiosity, DivergingSolveIsAnErrorNotNaN) {
   std::vector<SurfaceProperties> surf = furnaceSurfaces(h, 0.999);
   RadiosityOptions o;
   o.closure = false;  // refined row sums above 1 / rho: diverges
+  o.oracle = RefinementOracle::kPower;
   try {
     KeySolution s = solveKeyTime(h, surf, identityInput(h), o);
     for (const glm::dvec3& b : s.radiosity)
@@ -488,8 +489,9 @@ TEST(HierarchicalRadiosity, RefinedFurnaceConservesEnergy) {
     }
   }
   PatchHierarchy h = hierarchyOf(geometry("unit_cube_6"));
-  RadiosityOptions plain;
+  RadiosityOptions plain;  // HSA'91's power oracle without the closure
   plain.closure = false;
+  plain.oracle = RefinementOracle::kPower;
   KeySolution s = solveKeyTime(h, furnaceSurfaces(h, 0.9), identityInput(h), plain);
   double mean = 0, area = 0;
   for (int i = 0; i < h.size(); ++i)
