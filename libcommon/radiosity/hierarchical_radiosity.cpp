@@ -102,6 +102,34 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relT
   return swap ? std::min(1.0, f * aq / ap) : f;
 }
 
+// Distance from point x to the convex planar polygon q (its nearest point).
+double distanceToPolygon(const glm::dvec3& x, const Polygon& q) {
+  const glm::dvec3 n = q.normal();
+  const glm::dvec3 onPlane = x - glm::dot(x - q.v[0], n) * n;
+  bool inside = true;
+  double edge = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < q.count; ++i) {
+    const glm::dvec3 a = q.v[size_t(i)], b = q.v[size_t((i + 1) % q.count)];
+    if (glm::dot(glm::cross(b - a, onPlane - a), n) < 0.0) inside = false;
+    const glm::dvec3 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    const double t = len2 > 0.0 ? glm::clamp(glm::dot(x - a, ab) / len2, 0.0, 1.0) : 0.0;
+    edge = std::min(edge, glm::length(x - (a + t * ab)));
+  }
+  return inside ? std::abs(glm::dot(x - q.v[0], n)) : edge;
+}
+
+double leafFormFactor(const Polygon& r, const Polygon& q, double relTol) {
+  // F(x -> q) is smooth over r on the scale of x's distance to q (its plane and its contour), so
+  // a fixed Gauss rule on r is accurate once that distance is large against r's size; a large
+  // q far from r's centroid by its own size (linkFormFactor's test) does not make it hard.
+  const double size = polygonSize(r);
+  const double ratio = size > 0.0 ? distanceToPolygon(r.centroid(), q) / size : 0.0;
+  if (ratio < 0.25) return polygonToPolygonFormFactorAdaptive(r, q, relTol, 1e-12, 4096).value;
+  const int order = ratio >= 20 ? 2 : ratio >= 5 ? 4 : ratio >= 2 ? 6 : ratio >= 1 ? 8 : 12;
+  return polygonToPolygonFormFactor(r, q, order);
+}
+
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
                                                    const PatchHierarchy& hierarchy) {
   std::vector<SurfaceProperties> out(size_t(hierarchy.topCount()));
@@ -453,6 +481,18 @@ class KeyTimeSolver {
     tbb::parallel_for(size_t(0), leaves.size(), [&](size_t li) { closeLeaf(leaves[li]); });
   }
 
+  // F(leaf r -> top q): taken over from the previous key when both are static (coherence;
+  // the same value recomputing gives), else integrated.
+  double leafToTop(int r, uint32_t q) const {
+    if (input_.reuseLeafFormFactors) {
+      auto it = input_.reuseLeafFormFactors->find({h_.node(r).id.packed(), uint64_t(q)});
+      if (it != input_.reuseLeafFormFactors->end()) return it->second;
+    }
+    if (opt_.quadratureOrder != kAutoOrder)
+      return polygonToPolygonFormFactor(s_.world[size_t(r)], s_.world[q], opt_.quadratureOrder);
+    return leafFormFactor(s_.world[size_t(r)], s_.world[q], opt_.formFactorTolerance);
+  }
+
   struct TopShare {  // one top-level shooter's links in a leaf's chain
     uint32_t top = 0;
     double fv = 0;
@@ -479,10 +519,7 @@ class KeyTimeSolver {
         auto it =
             std::find_if(known.begin(), known.end(),
                          [&](const std::pair<uint32_t, double>& p) { return p.first == t.top; });
-        if (it == known.end())
-          it = known.insert(
-              known.end(), {t.top, linkFormFactor(s_.world[size_t(r)], s_.world[t.top],
-                                                  opt_.quadratureOrder, opt_.formFactorTolerance)});
+        if (it == known.end()) it = known.insert(known.end(), {t.top, leafToTop(r, t.top)});
         g = it->second;
       }
       const double good = surfaces_[t.top].isEmitter() ? 0.0 : 1.0;
@@ -631,6 +668,7 @@ class KeyTimeSolver {
       s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
     }
     s_.radiosity = std::move(B_);
+    s_.leafTopFormFactor = std::move(leafTopFormFactor_);
     s_.exposure = std::move(exposure_);
     s_.exposure.resize(size_t(h_.size()), 1.0);
     for (double& e : s_.exposure)

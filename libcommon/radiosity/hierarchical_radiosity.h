@@ -130,11 +130,15 @@ struct LinkKeyHash {
   }
 };
 using LinkCache = std::unordered_map<std::pair<uint64_t, uint64_t>, CachedLink, LinkKeyHash>;
+// The closure's leaf-to-top form factors F(leaf -> top-level patch) a key-time solve may take
+// over (both static): keyed by (leaf id, top index).
+using LeafFormFactorCache = std::unordered_map<std::pair<uint64_t, uint64_t>, double, LinkKeyHash>;
 
 struct KeySolveInput {
   std::vector<glm::dmat4> topToWorld;           // per top-level patch: its node's world transform
   const VisibilityScene* visibility = nullptr;  // null: every link fully visible
   const LinkCache* reuse = nullptr;             // coherence: values to take over
+  const LeafFormFactorCache* reuseLeafFormFactors = nullptr;  // coherence: the closure's
 };
 
 struct KeySolution {
@@ -150,6 +154,8 @@ struct KeySolution {
   // a solid standing on it (see computeExposures in the .cpp); 1 without a visibility scene.
   // Its radiosity and irradiance are those of the exposed part.
   std::vector<double> exposure;
+  // Per dense node: the (top, F(node -> top)) the closure computed or took over at this key.
+  std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor;
   std::vector<Polygon> world;  // per dense node: world polygon at this key
   std::vector<double> area;    // per dense node: world area
   int iterations = 0;          // Gauss-Seidel sweeps, all rounds

@@ -204,6 +204,25 @@ const char* badLinkRuleName(BadLinkRule r) {
   return "?";
 }
 
+LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy& h,
+                                            const Scene& scene, double t0, double t1) {
+  std::unordered_map<int, bool> dynamic;
+  for (int node : scene.meshNodes()) dynamic[node] = scene.isDynamic(node, t0, t1);
+  std::vector<char> staticTop(size_t(h.topCount()));
+  for (int t = 0; t < h.topCount(); ++t) {
+    auto it = dynamic.find(h.top(t).node);
+    staticTop[size_t(t)] = h.top(t).node < 0 || it == dynamic.end() || !it->second;
+  }
+  LeafFormFactorCache cache;
+  for (size_t i = 0; i < prev.leafTopFormFactor.size(); ++i) {
+    const PatchNode& n = h.node(int(i));
+    if (prev.leafTopFormFactor[i].empty() || !staticTop[n.id.top]) continue;
+    for (const auto& [q, f] : prev.leafTopFormFactor[i])
+      if (staticTop[q]) cache.emplace(std::make_pair(n.id.packed(), uint64_t(q)), f);
+  }
+  return cache;
+}
+
 LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const Scene& scene,
                         double t0, double t1) {
   // Per mesh node: static over [t0, t1]? Dynamic ones contribute their swept bounds.
@@ -334,11 +353,14 @@ class KeyTimePass {
     in.topToWorld = topTransforms(scene_, h_, t);
     in.visibility = &vis_->visibility();
     LinkCache cache;
+    LeafFormFactorCache leafCache;
     double secondsCoherence = 0;
     if (opt_.coherence && k > 0) {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
       in.reuse = &cache;
+      leafCache = reusableLeafFormFactors(prev, h_, scene_, keyTimes_[k - 1], t);
+      in.reuseLeafFormFactors = &leafCache;
       secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);

@@ -63,6 +63,12 @@ struct SpaceTimeReport {
 LinkCache reusableLinks(const KeySolution& previous, const PatchHierarchy& hierarchy,
                         const Scene& scene, double t0, double t1);
 
+// The closure's leaf-to-top form factors of `previous` that stay valid until t1: the leaf's and
+// the top's mesh nodes both static over [t0, t1].
+LeafFormFactorCache reusableLeafFormFactors(const KeySolution& previous,
+                                            const PatchHierarchy& hierarchy, const Scene& scene,
+                                            double t0, double t1);
+
 // The whole first pass: key times must be strictly increasing. Two passes: the key-time pass
 // (per key: the visibility scene at t, the links coherence keeps from the previous key,
 // solveKeyTime, its links folded into activity intervals and bad pairs), then the merge into
