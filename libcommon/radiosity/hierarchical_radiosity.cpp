@@ -497,6 +497,7 @@ class KeyTimeSolver {
     uint32_t top = 0;
     double fv = 0;
     bool unoccluded = true;
+    bool fromAncestor = false;  // some of them are at an ancestor (else F is the leaf's own)
   };
 
   void closeLeaf(int r) {
@@ -507,15 +508,16 @@ class KeyTimeSolver {
         const uint32_t q = h_.node(l.shooter).id.top;
         auto it = std::find_if(shares.begin(), shares.end(),
                                [&](const TopShare& t) { return t.top == q; });
-        if (it == shares.end()) it = shares.insert(shares.end(), TopShare{q, 0.0, true});
+        if (it == shares.end()) it = shares.insert(shares.end(), TopShare{q, 0.0, true, false});
         it->fv += l.fv();
         it->unoccluded = it->unoccluded && l.visibility >= 1.0;
+        it->fromAncestor = it->fromAncestor || a != r;
       }
     std::vector<std::pair<uint32_t, double>>& known = leafTopFormFactor_[size_t(r)];
     glm::dvec2 own(0.0), averaged(0.0);  // (all, good)
     for (const TopShare& t : shares) {
       double g = t.fv;
-      if (t.unoccluded) {
+      if (t.unoccluded && t.fromAncestor) {
         auto it =
             std::find_if(known.begin(), known.end(),
                          [&](const std::pair<uint32_t, double>& p) { return p.first == t.top; });
