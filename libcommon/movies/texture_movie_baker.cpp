@@ -553,8 +553,9 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
   if (options_.keyStep < 1) throw Error(ExitCode::kUsage, "--movie-key-step", "must be >= 1");
   if (options_.maxSamples < 1 || options_.maxSamples > kMaxTransmittanceSamples)
     throw Error(ExitCode::kUsage, "--max-samples", "must be in 1..64");
-  if (options_.minSamples < 1 || options_.minSamples > options_.maxSamples)
-    throw Error(ExitCode::kUsage, "--min-samples", "must be in 1..--max-samples");
+  // A --max-samples below --min-samples lowers the minimum too (transmittanceSampleCount
+  // clamps it): `--max-samples 4` means at most 4, whatever the default minimum.
+  if (options_.minSamples < 1) throw Error(ExitCode::kUsage, "--min-samples", "must be >= 1");
   if (!(options_.samplesPerFormFactor >= 0.0))
     throw Error(ExitCode::kUsage, "--samples-per-form-factor", "must be >= 0");
   if (!(options_.maxTextureMemoryMiB > 0.0))

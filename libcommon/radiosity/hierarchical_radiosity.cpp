@@ -490,7 +490,7 @@ class KeyTimeSolver {
     }
     if (opt_.quadratureOrder != kAutoOrder)
       return polygonToPolygonFormFactor(s_.world[size_t(r)], s_.world[q], opt_.quadratureOrder);
-    return leafFormFactor(s_.world[size_t(r)], s_.world[q], opt_.formFactorTolerance);
+    return leafFormFactor(s_.world[size_t(r)], s_.world[q], std::max(opt_.formFactorTolerance, 1e-4));
   }
 
   struct TopShare {  // one top-level shooter's links in a leaf's chain

@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->excludes(keyStep)
       ->group("Deprecated");
-  app.add_option("--min-samples", b.minSamples, "shooter samples per bad link, at least")
+  app.add_option("--min-samples", b.minSamples, "shooter samples per bad link, at least (at most --max-samples)")
       ->capture_default_str();
   app.add_option("--max-samples", b.maxSamples, "shooter samples per bad link, at most (<= 64)")
       ->capture_default_str();
