@@ -19,6 +19,7 @@ usage: tradeoff.py [--scene GLTF] [--frames 0-47] [--size 176x120] [--spp 128] [
 """
 import argparse
 import csv
+import hashlib
 import json
 import os
 import shutil
@@ -134,9 +135,14 @@ def main():
 
     # Pixel-centre samples: rad-compose point-samples pixels, so an antialiased reference would
     # add an edge-coverage error floor that no accuracy knob moves.
+    # Named by the scene's content hash, so that a sweep of another scene into the same --out
+    # renders its own references instead of taking another scene's.
+    with open(a.scene, "rb") as f:
+        scene_hash = hashlib.sha256(f.read()).hexdigest()[:12]
     refs = []
     for seed in (0, 1):
-        ref = os.path.join(a.out, "reference-centres-%dspp-seed%d" % (a.spp, seed))
+        ref = os.path.join(a.out, "reference-%s-%s-%s-centres-%dspp-seed%d" % (
+            scene_hash, a.frames, a.size, a.spp, seed))
         if not os.path.exists(os.path.join(ref, "%04d.exr" % last)):
             print("tradeoff: reference, %d spp, seed %d" % (a.spp, seed), file=sys.stderr,
                   flush=True)
