@@ -490,7 +490,8 @@ class KeyTimeSolver {
     }
     if (opt_.quadratureOrder != kAutoOrder)
       return polygonToPolygonFormFactor(s_.world[size_t(r)], s_.world[q], opt_.quadratureOrder);
-    return leafFormFactor(s_.world[size_t(r)], s_.world[q], std::max(opt_.formFactorTolerance, 1e-4));
+    return leafFormFactor(s_.world[size_t(r)], s_.world[q],
+                          std::max(opt_.formFactorTolerance, 1e-4));
   }
 
   struct TopShare {  // one top-level shooter's links in a leaf's chain
@@ -502,17 +503,24 @@ class KeyTimeSolver {
 
   void closeLeaf(int r) {
     std::vector<TopShare> shares;
+    // Per top, its index in `shares` (first-seen order, so the sums below do not depend on
+    // it), -1 elsewhere; one per thread, reset after each leaf.
+    thread_local std::vector<int> slot;
+    slot.resize(size_t(h_.topCount()), -1);
     for (int a = r; a >= 0; a = h_.node(a).parent)
       for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k) {
         const SolverLink& l = s_.links[adj_[k]];
         const uint32_t q = h_.node(l.shooter).id.top;
-        auto it = std::find_if(shares.begin(), shares.end(),
-                               [&](const TopShare& t) { return t.top == q; });
-        if (it == shares.end()) it = shares.insert(shares.end(), TopShare{q, 0.0, true, false});
-        it->fv += l.fv();
-        it->unoccluded = it->unoccluded && l.visibility >= 1.0;
-        it->fromAncestor = it->fromAncestor || a != r;
+        if (slot[q] < 0) {
+          slot[q] = int(shares.size());
+          shares.push_back(TopShare{q, 0.0, true, false});
+        }
+        TopShare& t = shares[size_t(slot[q])];
+        t.fv += l.fv();
+        t.unoccluded = t.unoccluded && l.visibility >= 1.0;
+        t.fromAncestor = t.fromAncestor || a != r;
       }
+    for (const TopShare& t : shares) slot[t.top] = -1;
     std::vector<std::pair<uint32_t, double>>& known = leafTopFormFactor_[size_t(r)];
     glm::dvec2 own(0.0), averaged(0.0);  // (all, good)
     for (const TopShare& t : shares) {
