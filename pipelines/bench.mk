@@ -27,7 +27,7 @@ TRADEOFF_REPEAT ?= 3
 FURNACE_RHO ?= 0.5,0.9,0.99,0.999
 FURNACE_FLAGS ?=
 
-.PHONY: tables tradeoff furnace
+.PHONY: tables tradeoff furnace contact
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -35,6 +35,9 @@ tables:
 tradeoff:
 	python3 pipelines/tradeoff.py --bin $(BIN) --scene $(TRADEOFF_SCENE) --frames $(TRADEOFF_FRAMES) \
 	  --size $(TRADEOFF_SIZE) --spp $(TRADEOFF_SPP) --repeat $(TRADEOFF_REPEAT) --out out/tradeoff
+
+contact:
+	python3 pipelines/contact.py --bin $(BIN) --out out/contact
 
 furnace:
 	python3 pipelines/furnace.py --bin $(BIN) --rho $(FURNACE_RHO) --out out/furnace \

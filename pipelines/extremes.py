@@ -90,29 +90,38 @@ def black_materials(g):
     return g
 
 
-def with_sliver(g):
-    """A triangle 0.5 m long and 50 um wide, 1 mm above the floor, from wall to wall."""
-    pts = [(0.0, 0.001, 0.3), (0.556, 0.001, 0.3), (0.556, 0.001, 0.30005)]
-    data = b"".join(struct.pack("<3f", *p) for p in pts) + struct.pack("<3H", 0, 2, 1) + b"\0\0"
-    g["buffers"].append({"byteLength": len(data),
+def add_mesh(g, name, triangles, material):
+    """Appends a mesh node of `triangles` (lists of three (x, y, z), counter-clockwise seen from
+    the front) with one material, its data in a buffer of its own."""
+    pts = [p for t in triangles for p in t]
+    data = b"".join(struct.pack("<3f", *p) for p in pts)
+    idx = b"".join(struct.pack("<H", i) for i in range(len(pts)))
+    pad = b"\0" * (-len(idx) % 4)
+    g["buffers"].append({"byteLength": len(data) + len(idx) + len(pad),
                          "uri": "data:application/octet-stream;base64," +
-                                base64.b64encode(data).decode()})
+                                base64.b64encode(data + idx + pad).decode()})
     b = len(g["buffers"]) - 1
-    g["bufferViews"] += [{"buffer": b, "byteOffset": 0, "byteLength": 36},
-                         {"buffer": b, "byteOffset": 36, "byteLength": 6}]
+    g["bufferViews"] += [{"buffer": b, "byteOffset": 0, "byteLength": len(data)},
+                         {"buffer": b, "byteOffset": len(data), "byteLength": len(idx)}]
     v = len(g["bufferViews"]) - 2
-    lo = [min(p[k] for p in pts) for k in range(3)]
-    hi = [max(p[k] for p in pts) for k in range(3)]
-    g["accessors"] += [{"bufferView": v, "componentType": 5126, "count": 3, "type": "VEC3",
-                        "min": [struct.unpack("<f", struct.pack("<f", x))[0] for x in lo],
-                        "max": [struct.unpack("<f", struct.pack("<f", x))[0] for x in hi]},
-                       {"bufferView": v + 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]
+    f32 = lambda x: struct.unpack("<f", struct.pack("<f", x))[0]  # noqa: E731
+    g["accessors"] += [{"bufferView": v, "componentType": 5126, "count": len(pts), "type": "VEC3",
+                        "min": [f32(min(p[k] for p in pts)) for k in range(3)],
+                        "max": [f32(max(p[k] for p in pts)) for k in range(3)]},
+                       {"bufferView": v + 1, "componentType": 5123, "count": len(pts),
+                        "type": "SCALAR"}]
     a = len(g["accessors"]) - 2
-    g["meshes"].append({"name": "sliver", "primitives": [
-        {"attributes": {"POSITION": a}, "indices": a + 1, "material": 0}]})
-    g["nodes"].append({"name": "sliver", "mesh": len(g["meshes"]) - 1})
+    g["meshes"].append({"name": name, "primitives": [
+        {"attributes": {"POSITION": a}, "indices": a + 1, "material": material}]})
+    g["nodes"].append({"name": name, "mesh": len(g["meshes"]) - 1})
     g["scenes"][g.get("scene", 0)]["nodes"].append(len(g["nodes"]) - 1)
     return g
+
+
+def with_sliver(g):
+    """A triangle 0.5 m long and 50 um wide, 1 mm above the floor, from wall to wall."""
+    return add_mesh(g, "sliver", [[(0.0, 0.001, 0.3), (0.556, 0.001, 0.30005),
+                                   (0.556, 0.001, 0.3)]], 0)
 
 
 VARIANTS = [
