@@ -494,6 +494,13 @@ class KeyTimeSolver {
                           std::max(opt_.formFactorTolerance, 1e-4));
   }
 
+  // A pair with a moving end would need its F(leaf -> top) at every key time (32 moving cubes
+  // made that most of rad-global's time); moving objects are small against the rooms they
+  // move in, and the closed rooms the closure is exact for are static.
+  bool moves(uint32_t top) const {
+    return top < input_.movingTops.size() && input_.movingTops[top];
+  }
+
   struct TopShare {  // one top-level shooter's links in a leaf's chain
     uint32_t top = 0;
     double fv = 0;
@@ -525,7 +532,7 @@ class KeyTimeSolver {
     glm::dvec2 own(0.0), averaged(0.0);  // (all, good)
     for (const TopShare& t : shares) {
       double g = t.fv;
-      if (t.unoccluded && t.fromAncestor) {
+      if (t.unoccluded && t.fromAncestor && !moves(t.top) && !moves(h_.node(r).id.top)) {
         auto it =
             std::find_if(known.begin(), known.end(),
                          [&](const std::pair<uint32_t, double>& p) { return p.first == t.top; });

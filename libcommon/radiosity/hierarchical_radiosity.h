@@ -139,6 +139,9 @@ struct KeySolveInput {
   const VisibilityScene* visibility = nullptr;  // null: every link fully visible
   const LinkCache* reuse = nullptr;             // coherence: values to take over
   const LeafFormFactorCache* reuseLeafFormFactors = nullptr;  // coherence: the closure's
+  // Per top-level patch: it moves at some time of the animation. The closure corrects only
+  // pairs of patches that never move (empty: none moves).
+  std::vector<char> movingTops;
 };
 
 struct KeySolution {

@@ -323,6 +323,14 @@ class KeyTimePass {
     rep_.secondsSetup = secondsSince(tSetup);
     rep_.topPatches = T_;
     records_.resize(keyTimes.size());
+    std::unordered_map<int, bool> dynamic;
+    for (int node : scene.meshNodes())
+      dynamic[node] = scene.isDynamic(node, keyTimes.front(), keyTimes.back());
+    movingTops_.assign(T_, 0);
+    for (size_t t = 0; t < T_; ++t) {
+      auto it = dynamic.find(h_.top(int(t)).node);
+      movingTops_[t] = it != dynamic.end() && it->second;
+    }
     badPair_.assign(T_ * T_, 0);
   }
 
@@ -351,6 +359,7 @@ class KeyTimePass {
     vis_->setTime(t);
     KeySolveInput in;
     in.topToWorld = topTransforms(scene_, h_, t);
+    in.movingTops = movingTops_;
     in.visibility = &vis_->visibility();
     LinkCache cache;
     LeafFormFactorCache leafCache;
@@ -394,6 +403,7 @@ class KeyTimePass {
   // result, not every key's links).
   LinkIntervals intervals_;
   std::vector<char> badPair_;
+  std::vector<char> movingTops_;  // per top: moves during the key times (KeySolveInput)
 };
 
 // Merge: radiosity per node and key; nodes created after key k take their ancestor's value
