@@ -726,6 +726,18 @@ KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>
   return KeyTimeSolver(h, surfaces, input, opt).run();
 }
 
+std::vector<char> movingTopsOf(const Scene& scene, const PatchHierarchy& hierarchy, double t0,
+                               double t1) {
+  std::unordered_map<int, bool> dynamic;
+  for (int node : scene.meshNodes()) dynamic[node] = scene.isDynamic(node, t0, t1);
+  std::vector<char> out(size_t(hierarchy.topCount()), 0);
+  for (int t = 0; t < hierarchy.topCount(); ++t) {
+    auto it = dynamic.find(hierarchy.top(t).node);
+    out[size_t(t)] = it != dynamic.end() && it->second;
+  }
+  return out;
+}
+
 std::vector<glm::dmat4> topTransforms(const Scene& scene, const PatchHierarchy& hierarchy,
                                       double t) {
   std::vector<glm::dmat4> out(size_t(hierarchy.topCount()), glm::dmat4(1.0));

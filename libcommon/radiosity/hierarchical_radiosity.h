@@ -229,6 +229,10 @@ class SceneVisibility {
   std::vector<std::pair<int, int>> instances_;  // (mesh node, instance id)
 };
 
+// Per top-level patch: its node moves somewhere in [t0, t1] (KeySolveInput::movingTops).
+std::vector<char> movingTopsOf(const Scene& scene, const PatchHierarchy& hierarchy, double t0,
+                               double t1);
+
 // World transform of every top-level patch's node at time t.
 std::vector<glm::dmat4> topTransforms(const Scene& scene, const PatchHierarchy& hierarchy,
                                       double t);

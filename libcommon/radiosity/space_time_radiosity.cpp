@@ -323,14 +323,7 @@ class KeyTimePass {
     rep_.secondsSetup = secondsSince(tSetup);
     rep_.topPatches = T_;
     records_.resize(keyTimes.size());
-    std::unordered_map<int, bool> dynamic;
-    for (int node : scene.meshNodes())
-      dynamic[node] = scene.isDynamic(node, keyTimes.front(), keyTimes.back());
-    movingTops_.assign(T_, 0);
-    for (size_t t = 0; t < T_; ++t) {
-      auto it = dynamic.find(h_.top(int(t)).node);
-      movingTops_[t] = it != dynamic.end() && it->second;
-    }
+    movingTops_ = movingTopsOf(scene, h_, keyTimes.front(), keyTimes.back());
     badPair_.assign(T_ * T_, 0);
   }
 

@@ -194,6 +194,7 @@ TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
     KeySolveInput in;
     in.topToWorld = topTransforms(scene, h, keys[k]);
     in.visibility = &vis.visibility();
+    in.movingTops = movingTopsOf(scene, h, keys.front(), keys.back());
     KeySolution s = solveKeyTime(h, surfaces, in, o.radiosity);
     for (const SolverLink& l : s.links)
       perLink[{uint32_t(l.receiver), uint32_t(l.shooter)}].push_back(
