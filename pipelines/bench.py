@@ -97,6 +97,43 @@ def pipeline(bin_dir, scene, out, frames, size, flags, log):
     return {"stages": stages, "total": total, "cpu_total": cpu, "peak_mib": peak}
 
 
+def run_stages(bin_dir, scene, out, frames, size, flags, log):
+    """The four stages of animation.mk into out/, until one fails (its output appended to log).
+    Returns {"seconds", "peak_mib", "failed": the stage that failed or None, "error": its last
+    `rad-` line or None}: for the scripts that report a failed stage and go on."""
+    os.makedirs(out, exist_ok=True)
+    result = {"seconds": 0.0, "peak_mib": 0.0, "failed": None, "error": None}
+    for stage, argv in stage_commands(bin_dir, scene, out, frames, size, flags):
+        try:
+            t, mib, _ = run(argv, log)
+        except RuntimeError:
+            with open(log) as f:
+                last = [l for l in f.read().splitlines() if l.startswith("rad-")][-1:]
+            result.update(failed=stage, error=last[0] if last else "(see %s)" % log)
+            return result
+        result["seconds"] += t
+        result["peak_mib"] = max(result["peak_mib"], mib)
+    return result
+
+
+def oiiotool_stats(args):
+    """`oiiotool ARGS --printstats` as {key: [numbers]}, from lines such as
+    `Stats Avg: 1.0 1.0 1.0 (float)` and `NanCount: 0 0 0`."""
+    p = subprocess.run(["oiiotool"] + list(args) + ["--printstats"], capture_output=True,
+                       text=True, check=True)
+    stats = {}
+    for line in p.stdout.splitlines():
+        key, _, rest = line.strip().partition(":")
+        values = []
+        for word in rest.split():
+            try:
+                values.append(float(word))
+            except ValueError:
+                pass  # "(float)", units
+        stats[key] = values
+    return stats
+
+
 def settings_of(bin_dir, frames, size):
     """What a stored result must match to be reused: the run's shape, the binaries (commit of
     the source tree and the rad-* modification times) and the CPUs this process may use."""

@@ -32,7 +32,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import bench  # noqa: E402
-from extremes import SCENE, add_mesh  # noqa: E402
+from extremes import SCENE, add_mesh, run_variant  # noqa: E402
 
 W, H, D = 0.556, 0.5488, 0.5592  # the room (pipelines/scenes/make_cornell_moving.py)
 BIAS_BOUND = 0.02
@@ -121,25 +121,14 @@ def main():
     for name, make in VARIANTS:
         if only and name not in only:
             continue
-        out = os.path.join(a.out, name)
-        os.makedirs(out, exist_ok=True)
-        scene = os.path.join(out, "scene.gltf")
-        with open(scene, "w") as f:
-            json.dump(make(copy.deepcopy(source)), f)
-        log = os.path.join(out, "pipeline.log")
-        open(log, "w").close()
-        seconds, failed = 0.0, None
-        for stage, argv in bench.stage_commands(a.bin, scene, out, "0-0", a.size, {}):
-            try:
-                seconds += bench.run(argv, log)[0]
-            except RuntimeError:
-                failed = stage
-                break
-        if failed:
-            print("%-16s %12s %9s %12s %8.2f  %s failed (see %s)" % (name, "-", "-", "-", seconds,
-                                                                    failed, log))
-            failures.append("%s: %s failed" % (name, failed))
+        out, r = run_variant(a.bin, a.out, name, make(copy.deepcopy(source)), a.size)
+        seconds, log = r["seconds"], os.path.join(out, "pipeline.log")
+        if r["failed"]:
+            print("%-16s %12s %9s %12s %8.2f  %s failed: %s" % (name, "-", "-", "-", seconds,
+                                                               r["failed"], r["error"]))
+            failures.append("%s: %s failed" % (name, r["failed"]))
             continue
+        scene = os.path.join(out, "scene.gltf")
         refs = [reference(a.bin, scene, out, s, a.size, a.spp, log) for s in (0, 1)]
         p = subprocess.run([os.path.join(a.bin, "rad-diff"), os.path.join(out, "frames", "0000.exr"),
                             os.path.join(refs[0], "0000.exr"), "--ref2",

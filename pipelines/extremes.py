@@ -135,6 +135,19 @@ VARIANTS = [
 ]
 
 
+def run_variant(bin_dir, out_root, name, gltf, size):
+    """Writes the variant's scene to OUT_ROOT/NAME/scene.gltf and runs the four stages there on
+    frame 0. Returns (its folder, bench.run_stages' result)."""
+    out = os.path.join(out_root, name)
+    os.makedirs(out, exist_ok=True)
+    scene = os.path.join(out, "scene.gltf")
+    with open(scene, "w") as f:
+        json.dump(gltf, f)
+    log = os.path.join(out, "pipeline.log")
+    open(log, "w").close()
+    return out, bench.run_stages(bin_dir, scene, out, "0-0", size, {}, log)
+
+
 def frame_stats(path):
     mean, lo, bad = furnace.exr_mean(path)
     return {"mean": mean, "min": lo, "non_finite": bad}
@@ -145,19 +158,9 @@ def relative_difference(a, b, scale_a, out):
     scaled = os.path.join(out, "scaled.exr")
     subprocess.run(["oiiotool", a, "--mulc", repr(scale_a), "-d", "float", "-o", scaled],
                    check=True, capture_output=True)
-    p = subprocess.run(["oiiotool", scaled, b, "--absdiff", "--printstats"], capture_output=True,
-                       text=True, check=True)
-    q = subprocess.run(["oiiotool", b, "--abs", "--printstats"], capture_output=True, text=True,
-                       check=True)
-
-    def stat(text, key):
-        for line in text.splitlines():
-            k, _, rest = line.strip().partition(":")
-            if k == key:
-                return max(float(w) for w in rest.split() if w[0].isdigit() or w[0] == "-")
-        raise RuntimeError("no %s in oiiotool output" % key)
-    return stat(p.stdout, "Stats Max") / max(stat(q.stdout, "Stats Max"), 1e-300)
-
+    diff = bench.oiiotool_stats([scaled, b, "--absdiff"])["Stats Max"]
+    ref = bench.oiiotool_stats([b, "--abs"])["Stats Max"]
+    return max(diff) / max(max(ref), 1e-300)
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -171,23 +174,10 @@ def main():
     frames, failures = {}, []
     print("%-14s %12s %12s %6s  %s" % ("variant", "frame mean", "min", "bad", "note"))
     for name, make in VARIANTS:
-        out = os.path.join(a.out, name)
-        os.makedirs(out, exist_ok=True)
-        scene = os.path.join(out, "scene.gltf")
-        with open(scene, "w") as f:
-            json.dump(make(copy.deepcopy(source)), f)
-        log = os.path.join(out, "pipeline.log")
-        open(log, "w").close()
-        failed = None
-        for stage, argv in bench.stage_commands(a.bin, scene, out, "0-0", a.size, {}):
-            try:
-                bench.run(argv, log)
-            except RuntimeError:
-                failed = stage
-                break
-        if failed:
-            failures.append("%s: %s failed (see %s)" % (name, failed, log))
-            print("%-14s %12s %12s %6s  %s failed" % (name, "-", "-", "-", failed))
+        out, r = run_variant(a.bin, a.out, name, make(copy.deepcopy(source)), a.size)
+        if r["failed"]:
+            failures.append("%s: %s failed: %s" % (name, r["failed"], r["error"]))
+            print("%-14s %12s %12s %6s  %s failed" % (name, "-", "-", "-", r["failed"]))
             continue
         frames[name] = os.path.join(out, "frames", "0000.exr")
         s = frame_stats(frames[name])

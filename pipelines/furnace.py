@@ -37,17 +37,11 @@ def run_one(bin_dir, out_root, rho, size, flags):
                    stderr=subprocess.DEVNULL)
     log = os.path.join(out, "pipeline.log")
     open(log, "w").close()
-    seconds = peak = 0.0
-    for stage, argv in bench.stage_commands(bin_dir, scene, out, "0-0", size, flags):
-        try:
-            t, mib, _ = bench.run(argv, log)
-        except RuntimeError:
-            with open(log) as f:
-                last = [l for l in f.read().splitlines() if l.startswith("rad-")][-1:]
-            return {"rho": rho, "failed": stage, "error": last[0] if last else "(see %s)" % log,
-                    "seconds": seconds, "peak_mib": peak}
-        seconds += t
-        peak = max(peak, mib)
+    r = bench.run_stages(bin_dir, scene, out, "0-0", size, flags, log)
+    seconds, peak = r["seconds"], r["peak_mib"]
+    if r["failed"]:
+        return {"rho": rho, "failed": r["failed"], "error": r["error"], "seconds": seconds,
+                "peak_mib": peak}
     mean, lo, bad = exr_mean(os.path.join(out, "frames", "0000.exr"))
     exact = EMISSION / (1.0 - rho)
     return {"rho": rho, "mean": mean, "exact": exact, "error": mean / exact - 1.0, "min": lo,
@@ -60,20 +54,8 @@ def goal_of(rho):
 
 
 def exr_mean(path):
-    """Mean, minimum and non-finite count over every channel of an EXR (oiiotool --printstats:
-    lines such as `Stats Avg: 1.0 1.0 1.0 (float)` and `NanCount: 0 0 0`)."""
-    p = subprocess.run(["oiiotool", path, "--printstats"], capture_output=True, text=True,
-                       check=True)
-    stats = {}
-    for line in p.stdout.splitlines():
-        key, _, rest = line.strip().partition(":")
-        values = []
-        for word in rest.split():
-            try:
-                values.append(float(word))
-            except ValueError:
-                pass  # "(float)", units
-        stats[key] = values
+    """Mean, minimum and non-finite count over every channel of an EXR."""
+    stats = bench.oiiotool_stats([path])
     avg = stats["Stats Avg"]
     bad = sum(stats.get("NanCount", [])) + sum(stats.get("InfCount", []))
     return sum(avg) / len(avg), min(stats["Stats Min"]), int(bad)

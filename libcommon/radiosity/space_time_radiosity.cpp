@@ -204,40 +204,24 @@ const char* badLinkRuleName(BadLinkRule r) {
   return "?";
 }
 
-LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy& h,
-                                            const Scene& scene, double t0, double t1) {
-  std::unordered_map<int, bool> dynamic;
-  for (int node : scene.meshNodes()) dynamic[node] = scene.isDynamic(node, t0, t1);
-  std::vector<char> staticTop(size_t(h.topCount()));
-  for (int t = 0; t < h.topCount(); ++t) {
-    auto it = dynamic.find(h.top(t).node);
-    staticTop[size_t(t)] = h.top(t).node < 0 || it == dynamic.end() || !it->second;
-  }
+LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy& h) {
+  // The closure integrates only pairs of patches that never move (KeySolveInput::movingTops),
+  // so every value it kept stays valid at the next key time.
   LeafFormFactorCache cache;
-  for (size_t i = 0; i < prev.leafTopFormFactor.size(); ++i) {
-    const PatchNode& n = h.node(int(i));
-    if (prev.leafTopFormFactor[i].empty() || !staticTop[n.id.top]) continue;
+  for (size_t i = 0; i < prev.leafTopFormFactor.size(); ++i)
     for (const auto& [q, f] : prev.leafTopFormFactor[i])
-      if (staticTop[q]) cache.emplace(std::make_pair(n.id.packed(), uint64_t(q)), f);
-  }
+      cache.emplace(std::make_pair(h.node(int(i)).id.packed(), uint64_t(q)), f);
   return cache;
 }
 
 LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const Scene& scene,
                         double t0, double t1) {
-  // Per mesh node: static over [t0, t1]? Dynamic ones contribute their swept bounds.
-  std::unordered_map<int, bool> dynamic;
+  // Static over [t0, t1]? Moving mesh nodes contribute their swept bounds.
+  const std::vector<char> moving = movingTopsOf(scene, h, t0, t1);
+  auto isStatic = [&](int top) { return !moving[size_t(top)]; };
   std::vector<std::array<glm::dvec3, 2>> swept;
-  for (int node : scene.meshNodes()) {
-    bool d = scene.isDynamic(node, t0, t1);
-    dynamic[node] = d;
-    if (d) swept.push_back(scene.sweptBounds(node, t0, t1));
-  }
-  auto isStatic = [&](int top) {
-    int node = h.top(top).node;
-    auto it = dynamic.find(node);
-    return node < 0 || it == dynamic.end() || !it->second;
-  };
+  for (int node : scene.meshNodes())
+    if (scene.isDynamic(node, t0, t1)) swept.push_back(scene.sweptBounds(node, t0, t1));
   LinkCache cache;
   cache.reserve(prev.links.size());
   for (const SolverLink& l : prev.links) {
@@ -334,8 +318,7 @@ class KeyTimePass {
       foldLinks(s, uint32_t(k));
       std::vector<glm::dvec3> b = pushedDown(s, h_);
       records_[k].radiosity.assign(b.begin(), b.end());
-      records_[k].exposure.assign(s.exposure.begin(), s.exposure.end());
-      records_[k].exposure.resize(size_t(h_.size()), 1.0f);
+      records_[k].exposure.assign(s.exposure.begin(), s.exposure.end());  // one per node
       records_[k].goodClosure = pushedDownClosure(s, h_);
       prev = std::move(s);
     }
@@ -361,7 +344,7 @@ class KeyTimePass {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
       in.reuse = &cache;
-      leafCache = reusableLeafFormFactors(prev, h_, scene_, keyTimes_[k - 1], t);
+      leafCache = reusableLeafFormFactors(prev, h_);
       in.reuseLeafFormFactors = &leafCache;
       secondsCoherence = secondsSince(tc);
     }

@@ -63,11 +63,10 @@ struct SpaceTimeReport {
 LinkCache reusableLinks(const KeySolution& previous, const PatchHierarchy& hierarchy,
                         const Scene& scene, double t0, double t1);
 
-// The closure's leaf-to-top form factors of `previous` that stay valid until t1: the leaf's and
-// the top's mesh nodes both static over [t0, t1].
+// The closure's leaf-to-top form factors of `previous`, all valid at the next key time: the
+// closure integrates only pairs of patches that never move.
 LeafFormFactorCache reusableLeafFormFactors(const KeySolution& previous,
-                                            const PatchHierarchy& hierarchy, const Scene& scene,
-                                            double t0, double t1);
+                                            const PatchHierarchy& hierarchy);
 
 // The whole first pass: key times must be strictly increasing. Two passes: the key-time pass
 // (per key: the visibility scene at t, the links coherence keeps from the previous key,

@@ -123,6 +123,37 @@ glm::dvec3 onPolygon(const Polygon& p, glm::dvec2 s) {
   return onTriangle(p.v[0], p.v[2], p.v[3], std::min((s.x - w) / (1.0 - w), 1.0), s.y);
 }
 
+// The ray origin + t direction for t in [kSegmentEpsilon, tfar] (in units of |direction|), in
+// Embree's single precision; no time, every mask bit.
+RTCRay rayOf(const glm::dvec3& origin, const glm::dvec3& direction, double tfar) {
+  RTCRay ray;
+  ray.org_x = static_cast<float>(origin.x);
+  ray.org_y = static_cast<float>(origin.y);
+  ray.org_z = static_cast<float>(origin.z);
+  ray.dir_x = static_cast<float>(direction.x);
+  ray.dir_y = static_cast<float>(direction.y);
+  ray.dir_z = static_cast<float>(direction.z);
+  ray.tnear = static_cast<float>(VisibilityScene::kSegmentEpsilon);
+  ray.tfar = static_cast<float>(tfar);
+  ray.time = 0.0f;
+  ray.mask = 0xffffffffu;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
+}
+
+// The k stratified points on b of a query seeded `seed`, in the order they pair with a's
+// (samplePoints(a, k, seed)): b's strata randomly permuted against a's.
+std::vector<glm::dvec3> pairedPoints(const Polygon& b, int k, std::uint64_t seed) {
+  k = std::max(k, 1);
+  std::vector<glm::dvec2> sb =
+      stratified(k, streamSeed(seed, kJitterB), streamSeed(seed, kPermuteB));
+  std::vector<int> pair = permutation(k, streamSeed(seed, kPair));
+  std::vector<glm::dvec3> out(static_cast<std::size_t>(k));
+  for (int i = 0; i < k; ++i) out[size_t(i)] = onPolygon(b, sb[size_t(pair[size_t(i)])]);
+  return out;
+}
+
 }  // namespace
 
 struct VisibilityScene::Impl {
@@ -280,20 +311,7 @@ int VisibilityScene::instanceCount() const {
 
 bool VisibilityScene::occluded(const glm::dvec3& from, const glm::dvec3& to, std::uint32_t ignoreA,
                                std::uint32_t ignoreB) const {
-  glm::dvec3 d = to - from;
-  RTCRay ray;
-  ray.org_x = static_cast<float>(from.x);
-  ray.org_y = static_cast<float>(from.y);
-  ray.org_z = static_cast<float>(from.z);
-  ray.dir_x = static_cast<float>(d.x);
-  ray.dir_y = static_cast<float>(d.y);
-  ray.dir_z = static_cast<float>(d.z);
-  ray.tnear = static_cast<float>(kSegmentEpsilon);
-  ray.tfar = static_cast<float>(1.0 - kSegmentEpsilon);
-  ray.time = 0.0f;
-  ray.mask = 0xffffffffu;
-  ray.id = 0;
-  ray.flags = 0;
+  RTCRay ray = rayOf(from, to - from, 1.0 - kSegmentEpsilon);
   if (!(ray.dir_x != 0.0f || ray.dir_y != 0.0f || ray.dir_z != 0.0f)) return false;
   FilterContext fc;
   rtcInitIntersectContext(&fc.context);
@@ -305,19 +323,11 @@ bool VisibilityScene::occluded(const glm::dvec3& from, const glm::dvec3& to, std
 
 double VisibilityScene::visibility(const Polygon& a, const Polygon& b, int k, std::uint64_t seed,
                                    std::uint32_t ignoreA, std::uint32_t ignoreB) const {
-  k = std::max(k, 1);
-  std::vector<glm::dvec2> sa =
-      stratified(k, streamSeed(seed, kJitterA), streamSeed(seed, kPermuteA));
-  std::vector<glm::dvec2> sb =
-      stratified(k, streamSeed(seed, kJitterB), streamSeed(seed, kPermuteB));
-  std::vector<int> pair = permutation(k, streamSeed(seed, kPair));
+  const std::vector<glm::dvec3> pa = samplePoints(a, k, seed), pb = pairedPoints(b, k, seed);
   int unoccluded = 0;
-  for (int i = 0; i < k; ++i) {
-    glm::dvec3 pa = onPolygon(a, sa[i]);
-    glm::dvec3 pb = onPolygon(b, sb[pair[i]]);
-    if (!occluded(pa, pb, ignoreA, ignoreB)) ++unoccluded;
-  }
-  return static_cast<double>(unoccluded) / k;
+  for (size_t i = 0; i < pa.size(); ++i)
+    if (!occluded(pa[i], pb[i], ignoreA, ignoreB)) ++unoccluded;
+  return static_cast<double>(unoccluded) / static_cast<double>(pa.size());
 }
 
 std::vector<glm::dvec3> VisibilityScene::samplePoints(const Polygon& p, int k, std::uint64_t seed) {
@@ -335,15 +345,12 @@ double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints,
                                        std::uint32_t ignoreB) const {
   const int k = int(aPoints.size());
   if (k == 0) return 1.0;
-  std::vector<glm::dvec2> sb =
-      stratified(k, streamSeed(seed, kJitterB), streamSeed(seed, kPermuteB));
-  std::vector<int> pair = permutation(k, streamSeed(seed, kPair));
+  const std::vector<glm::dvec3> bPoints = pairedPoints(b, k, seed);
   const glm::dvec3 bNormal = b.normal();
   double weighted = 0.0, weight = 0.0;
   int unoccluded = 0;
   for (int i = 0; i < k; ++i) {
-    const glm::dvec3 pa = aPoints[size_t(i)];
-    const glm::dvec3 pb = onPolygon(b, sb[size_t(pair[size_t(i)])]);
+    const glm::dvec3 pa = aPoints[size_t(i)], pb = bPoints[size_t(i)];
     const bool open = !occluded(pa, pb, ignoreA, ignoreB);
     unoccluded += open ? 1 : 0;
     // The pair's weight in F: cos(theta_a) cos(theta_b) / r^2, 0 where either point is behind
@@ -364,18 +371,7 @@ double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints,
 std::uint32_t VisibilityScene::firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
                                         std::uint32_t ignore) const {
   RTCRayHit rh;
-  rh.ray.org_x = static_cast<float>(origin.x);
-  rh.ray.org_y = static_cast<float>(origin.y);
-  rh.ray.org_z = static_cast<float>(origin.z);
-  rh.ray.dir_x = static_cast<float>(direction.x);
-  rh.ray.dir_y = static_cast<float>(direction.y);
-  rh.ray.dir_z = static_cast<float>(direction.z);
-  rh.ray.tnear = static_cast<float>(kSegmentEpsilon);
-  rh.ray.tfar = std::numeric_limits<float>::infinity();
-  rh.ray.time = 0.0f;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
+  rh.ray = rayOf(origin, direction, std::numeric_limits<double>::infinity());
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   if (!(rh.ray.dir_x != 0.0f || rh.ray.dir_y != 0.0f || rh.ray.dir_z != 0.0f)) return kNoSurface;
