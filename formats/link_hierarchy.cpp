@@ -42,6 +42,7 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
   static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 is not 3 packed floats");
   w.addRawView("node_radiosity", DType::kF32, {N, K, 3}, s.nodeRadiosity.data(),
                s.nodeRadiosity.size() * sizeof(glm::vec3));
+  if (!s.nodeExposure.empty()) w.addArrayView("node_exposure", s.nodeExposure, {N, K});
   w.addArray("leaf_row", s.leafRow);
   size_t L = s.leafVertexGoodIrradiance.size() / std::max<size_t>(1, K * 4);
   w.addRawView("leaf_vertex_good_irradiance", DType::kF32, {L, K, 4, 3},
@@ -60,6 +61,8 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
   w.addArrayView("link_flags", flags);
   w.addArrayView("link_sample_keys", s.linkSampleKeys);
   w.addArrayView("link_sample_values", s.linkSampleValues);
+  if (!s.linkSampleVisibility.empty())
+    w.addArrayView("link_sample_visibility", s.linkSampleVisibility);
   std::vector<uint32_t> pairs;
   for (auto& p : s.badPairs) {
     pairs.push_back(p.first);
@@ -113,6 +116,7 @@ GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool r
     s.validateRadiosity(where);
     return s;
   }
+  if (r.has("node_exposure")) s.nodeExposure = r.array<float>("node_exposure");  // since 1.2
   s.leafVertexGoodIrradiance = unflatten(r.array<float>("leaf_vertex_good_irradiance"));
   std::vector<uint32_t> cols = r.array<uint32_t>("links");
   std::vector<uint8_t> flags = r.array<uint8_t>("link_flags");
@@ -125,6 +129,8 @@ GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool r
   }
   s.linkSampleKeys = r.array<uint32_t>("link_sample_keys");
   s.linkSampleValues = r.array<float>("link_sample_values");
+  if (r.has("link_sample_visibility"))  // since 1.2
+    s.linkSampleVisibility = r.array<float>("link_sample_visibility");
   std::vector<uint32_t> pairs = r.array<uint32_t>("bad_pairs");
   if (pairs.size() % 2) throw inputError(where, "bad_pairs has an odd size");
   for (size_t i = 0; i < pairs.size(); i += 2) s.badPairs.emplace_back(pairs[i], pairs[i + 1]);

@@ -14,7 +14,7 @@ namespace rad {
 
 constexpr const char* kLinkHierarchyKind = "linkhier";
 constexpr int kLinkHierarchyMajor = 1;
-constexpr int kLinkHierarchyMinor = 1;
+constexpr int kLinkHierarchyMinor = 2;
 
 // Writes `solution` atomically. `metadata` (an object) is stored as the kind's metadata; the
 // writer adds key_count, node_count, link_count, top_count.

@@ -130,6 +130,7 @@ class MovieGeometry {
   double keyTime(int k) const { return keyTimes_[size_t(k)]; }
   const Scene& scene() const { return scene_; }
   const glm::dvec2& topUv(size_t x) const { return topUv_[x]; }
+  MovieTexels texelPoints() const { return {topUv_, localPoint_, w_, h_}; }
   const Polygon& receiverWorld(int k) const { return receiverWorld_[size_t(k)]; }
   bool receiverDynamic() const { return receiverDynamic_; }
 
@@ -257,7 +258,7 @@ class MovieBake {
   MovieBake(const GlobalSolution& solution, const std::vector<InputPolygon>& tops,
             const TextureMovieBakerOptions& options, TextureMovieBakerStats& stats,
             const std::function<OcclusionMaskRenderer&()>& renderer, FormFactorSpill& spill,
-            const MovieExtent& req, MovieGeometry& geometry)
+            const MovieExtent& req, MovieGeometry& geometry, const GoodLinkGather* gather)
       : solution_(solution),
         tops_(tops),
         options_(options),
@@ -266,6 +267,7 @@ class MovieBake {
         spill_(spill),
         req_(req),
         geo_(geometry),
+        gather_(gather),
         texels_(geometry.texels()),
         acc_(texels_),
         transmittance_(texels_),
@@ -309,9 +311,15 @@ class MovieBake {
   std::vector<int> blockerCandidates(uint32_t S) const;
   void planCoherentBlockers(Pair& p, const std::vector<int>& candidates);
 
-  // Good layer (paper §3.1: Gouraud over the patch from the global solution).
+  // Good layer: gathered per texel over the good links, or (paper §3.1) Gouraud over the patch
+  // from the global solution.
   void goodLayer(double t) {
     auto clock = SteadyClock::now();
+    if (gather_) {
+      gather_->gather(t, acc_);
+      stats_.secondsGood += secondsSince(clock);
+      return;
+    }
     const int R = int(req_.patch.top), w = geo_.width();
     parallelRows(geo_.height(), [&](int j) {
       for (int i = 0; i < w; ++i) {
@@ -371,6 +379,7 @@ class MovieBake {
   FormFactorSpill& spill_;
   const MovieExtent& req_;
   MovieGeometry& geo_;
+  const GoodLinkGather* gather_;  // null: Gouraud
   const size_t texels_;
   int saturatedSamples_ = 0;
   std::vector<Pair> pairs_;
@@ -496,12 +505,25 @@ void MovieBake::planCoherentBlockers(Pair& p, const std::vector<int>& candidates
 
 }  // namespace
 
+const char* goodLayerName(GoodLayer g) {
+  return g == GoodLayer::kGather ? "gather" : "gouraud";
+}
+
+GoodLayer parseGoodLayer(const std::string& name) {
+  if (name == "gather") return GoodLayer::kGather;
+  if (name == "gouraud") return GoodLayer::kGouraud;
+  throw Error(ExitCode::kUsage, "--good-layer", "'" + name + "': expected gather or gouraud");
+}
+
 nlohmann::json TextureMovieBakerOptions::toJson() const {
   return {{"movie-key-step", keyStep},
           {"min-samples", minSamples},
           {"max-samples", maxSamples},
           {"samples-per-form-factor", samplesPerFormFactor},
           {"merge", mergeModeName(merge)},
+          {"good-layer", goodLayerName(goodLayer)},
+          {"gather-shooter-ratio", gatherShooterRatio},
+          {"gather-weak-share", gatherWeakShare},
           {"no-coherence", !coherence},
           {"max-texture-memory", maxTextureMemoryMiB}};
 }
@@ -520,6 +542,11 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"render_passes", passes},
           {"sample_passes", samplePasses},
           {"render_passes_saved_by_coherence", passesSavedByCoherence},
+          {"good_layer_gather",
+           {{"links", gather.links},
+            {"entries", gather.entries},
+            {"cached_entries", gather.cachedEntries},
+            {"interpolated_entries", gather.interpolatedEntries}}},
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
@@ -555,6 +582,10 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
     throw Error(ExitCode::kUsage, "--max-samples", "must be in 1..64");
   // A --max-samples below --min-samples lowers the minimum too (transmittanceSampleCount
   // clamps it): `--max-samples 4` means at most 4, whatever the default minimum.
+  if (!(options_.gatherShooterRatio >= 0.0) || !std::isfinite(options_.gatherShooterRatio))
+    throw Error(ExitCode::kUsage, "--gather-shooter-ratio", "must be a finite number >= 0");
+  if (!(options_.gatherWeakShare >= 0.0 && options_.gatherWeakShare <= 1.0))
+    throw Error(ExitCode::kUsage, "--gather-weak-share", "must be in [0, 1]");
   if (options_.minSamples < 1) throw Error(ExitCode::kUsage, "--min-samples", "must be >= 1");
   if (!(options_.samplesPerFormFactor >= 0.0))
     throw Error(ExitCode::kUsage, "--samples-per-form-factor", "must be >= 0");
@@ -654,7 +685,17 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
   const std::function<OcclusionMaskRenderer&()> gl = [this]() -> OcclusionMaskRenderer& {
     return renderer();
   };
-  MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry);
+  std::unique_ptr<GoodLinkGather> gather;
+  if (options_.goodLayer == GoodLayer::kGather) {
+    if (!goodLinks_) goodLinks_ = std::make_unique<GoodLinksByReceiver>(solution_);
+    auto clock = SteadyClock::now();
+    gather = std::make_unique<GoodLinkGather>(
+        scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
+        options_.gatherShooterRatio, options_.gatherWeakShare,
+        0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather);
+    stats_.secondsGood += secondsSince(clock);
+  }
+  MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry, gather.get());
   bake.plan(badShooters);
   sink.begin(movie);
   for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);

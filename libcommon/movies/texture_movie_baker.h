@@ -7,7 +7,8 @@
 //
 //   H(x, t) = G(x, t) + \sum_{S \in bad(R)} B_S(t) \, F(x \to S(t)) \, T(x, S, t)
 //
-// with G the global solution's good-link irradiance (Gouraud), B_S the shooter's radiosity,
+// with G the global solution's good-link irradiance (gathered per texel over the good links,
+// good_link_gather.h, or the paper's Gouraud), B_S the shooter's radiosity,
 // F the exact point-to-polygon form factor and T the transmittance (transmittance.h).
 //
 // Coherence (§5): for a bad pair whose receiver and shooter are static over the movie, F is
@@ -43,6 +44,7 @@
 
 #include "libcommon/intervals/movie_extent.h"
 #include "libcommon/movies/form_factor_spill.h"
+#include "libcommon/movies/good_link_gather.h"
 #include "libcommon/movies/occlusion_mask_renderer.h"
 #include "libcommon/movies/transmittance.h"
 #include "libcommon/radiosity/global_solution.h"
@@ -51,18 +53,31 @@
 
 namespace rad {
 
+// The good layer G(x, t): the paper's Gouraud interpolation of the global solution's vertex
+// irradiance, or the per-texel gather over its good links (good_link_gather.h).
+enum class GoodLayer { kGouraud, kGather };
+const char* goodLayerName(GoodLayer g);
+GoodLayer parseGoodLayer(const std::string& name);  // throws a usage Error
+
 // rad-movies binds its flags to these fields; toJson() is the provenance parameters, keyed by
 // the flag names.
 struct TextureMovieBakerOptions {
-  int keyStep = 6;                      // --movie-key-step: frames between key textures (>= 1)
+  int keyStep = 6;  // --movie-key-step: frames between key textures (>= 1)
   // Shooter samples per bad link, lower bound. 16, not 4: the small light of the Cornell box
   // got 4-8 samples (256 x its form factor), and its penumbrae showed as straight-edged bands,
   // one hard shadow per sample; at 16 the bands are gone and rad-movies' time hardly moves.
   int minSamples = 16;
-  int maxSamples = 64;                  // upper bound (<= 64)
-  double samplesPerFormFactor = 256.0;  // N = ceil(this * max texel form factor), then clamped
-  MergeMode merge = MergeMode::kExact;  // static/dynamic occlusion merge
-  bool coherence = true;                // false: the per-key baseline
+  int maxSamples = 64;                       // upper bound (<= 64)
+  double samplesPerFormFactor = 256.0;       // N = ceil(this * max texel form factor), then clamped
+  MergeMode merge = MergeMode::kExact;       // static/dynamic occlusion merge
+  GoodLayer goodLayer = GoodLayer::kGather;  // --good-layer
+  // --gather-shooter-ratio: a gathered link's shooter is split into the parts of its sub-tree
+  // larger than this times their distance to the receiver (good_link_gather.h); 0: no split.
+  double gatherShooterRatio = 1.0;
+  // --gather-weak-share: links carrying less than this share of what their receiver's chain
+  // gathers are interpolated from the receiver node's corners, not evaluated per texel.
+  double gatherWeakShare = 0.0;
+  bool coherence = true;  // false: the per-key baseline
   // Working memory of one movie (one key's buffers plus the per-pair buffers, see
   // movieWorkingBytes); a movie that needs more is refused with an environment error.
   double maxTextureMemoryMiB = 1024.0;
@@ -113,6 +128,7 @@ struct TextureMovieBakerStats {
   long staticBlockers = 0, dynamicBlockers = 0;  // per pair, in the pair's (swept) shaft
   long passes = 0, samplePasses = 0;             // transmittance renders
   long passesSavedByCoherence = 0;               // static-blocker renders not repeated
+  GoodLinkGatherStats gather;                    // --good-layer gather
   double secondsGood = 0, secondsFormFactor = 0, secondsTransmittance = 0, secondsCombine = 0;
   // Moving pairs' form factors computed ahead of the keys only to find their largest value
   // (which fixes N): the price of baking key by key without every key's form factors held.
@@ -156,6 +172,7 @@ class TextureMovieBaker {
   TextureMovieBakerBackends backends_;
   std::vector<InputPolygon> tops_;
   std::unique_ptr<OcclusionMaskRenderer> renderer_;
+  std::unique_ptr<GoodLinksByReceiver> goodLinks_;  // --good-layer gather
   TextureMovieBakerStats stats_;
 
   OcclusionMaskRenderer& renderer();

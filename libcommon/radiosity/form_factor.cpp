@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <queue>
 
 namespace rad {
@@ -439,6 +440,36 @@ double formFactorSpread(const Polygon& from, const Polygon& to, double atCentroi
     hi = std::max(hi, f);
   }
   return hi - lo;
+}
+
+double polygonSize(const Polygon& p) {
+  double s = 0;
+  for (int i = 1; i < p.count; ++i) s = std::max(s, glm::length(p.v[i] - p.v[0]));
+  return s;
+}
+
+double distanceToPolygon(const glm::dvec3& x, const Polygon& q) {
+  const glm::dvec3 n = q.normal();
+  const glm::dvec3 onPlane = x - glm::dot(x - q.v[0], n) * n;
+  bool inside = true;
+  double edge = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < q.count; ++i) {
+    const glm::dvec3 a = q.v[size_t(i)], b = q.v[size_t((i + 1) % q.count)];
+    if (glm::dot(glm::cross(b - a, onPlane - a), n) < 0.0) inside = false;
+    const glm::dvec3 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    const double t = len2 > 0.0 ? glm::clamp(glm::dot(x - a, ab) / len2, 0.0, 1.0) : 0.0;
+    edge = std::min(edge, glm::length(x - (a + t * ab)));
+  }
+  return inside ? std::abs(glm::dot(x - q.v[0], n)) : edge;
+}
+
+double areaAverageFormFactor(const Polygon& r, const Polygon& q, double relTol) {
+  const double size = polygonSize(r);
+  const double ratio = size > 0.0 ? distanceToPolygon(r.centroid(), q) / size : 0.0;
+  if (ratio < 0.25) return polygonToPolygonFormFactorAdaptive(r, q, relTol, 1e-12, 4096).value;
+  const int order = ratio >= 20 ? 2 : ratio >= 5 ? 4 : ratio >= 2 ? 6 : ratio >= 1 ? 8 : 12;
+  return polygonToPolygonFormFactor(r, q, order);
 }
 
 }  // namespace rad

@@ -88,6 +88,18 @@ AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const Polygon& from, const
                                                       double relTol = 1e-12, double absTol = 0.0,
                                                       int maxCells = 200000);
 
+// F(r -> q) as an area average over r to about relTol, at the cost the pair needs: F(x -> q) is
+// smooth over r on the scale of x's distance to q (its plane and its contour), so a fixed
+// Gauss rule on r is accurate once that distance is large against r's size, and the adaptive
+// rule takes over below a quarter of it (contact, shared edges). rad-global's closure and
+// rad-movies' good-link gather use it, so both see the same F.
+double areaAverageFormFactor(const Polygon& r, const Polygon& q, double relTol);
+
+// Size of a polygon (largest vertex distance from the first vertex), for relative tolerances.
+double polygonSize(const Polygon& p);
+// Distance from point x to the convex planar polygon q (its nearest point).
+double distanceToPolygon(const glm::dvec3& x, const Polygon& q);
+
 // Cheap unoccluded estimate for refinement oracles: the exact point-to-polygon factor from the
 // centroid of `from` (one Lambert evaluation, the n = 1 column of the reference table). Exact
 // in the far field to O((s/d)^2); near contact it may be off by O(1), so an oracle should also

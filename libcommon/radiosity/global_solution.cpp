@@ -138,6 +138,30 @@ glm::dvec3 GlobalSolution::goodIrradiance(int top, glm::dvec2 uv, double t) cons
   return (1.0 - w) * a + w * goodIrradianceAtKey(top, uv, k1);
 }
 
+namespace {
+// A row's samples (keys[0..n), values) at key k: piecewise linear, held outside.
+double sampleAtKey(const uint32_t* keys, const float* values, uint32_t n, int key) {
+  if (key <= int(keys[0])) return values[0];
+  if (key >= int(keys[n - 1])) return values[n - 1];
+  const uint32_t j = uint32_t(std::upper_bound(keys, keys + n, uint32_t(key)) - keys);
+  const double w = double(key - int(keys[j - 1])) / double(keys[j] - keys[j - 1]);
+  return (1.0 - w) * values[j - 1] + w * values[j];
+}
+}  // namespace
+
+double GlobalSolution::linkFvAtKey(const GlobalLink& l, int key) const {
+  if (key < int(l.firstKey) || key > int(l.lastKey)) return 0.0;
+  return sampleAtKey(&linkSampleKeys[l.sampleOffset], &linkSampleValues[l.sampleOffset],
+                     l.sampleCount, key);
+}
+
+double GlobalSolution::linkVisibilityAtKey(const GlobalLink& l, int key) const {
+  if (linkSampleVisibility.empty()) return 1.0;
+  if (key < int(l.firstKey) || key > int(l.lastKey)) return 0.0;
+  return sampleAtKey(&linkSampleKeys[l.sampleOffset], &linkSampleVisibility[l.sampleOffset],
+                     l.sampleCount, key);
+}
+
 std::vector<uint32_t> GlobalSolution::badShooters(uint32_t receiverTop) const {
   std::vector<uint32_t> out;
   auto it = std::lower_bound(badPairs.begin(), badPairs.end(), std::make_pair(receiverTop, 0u));
@@ -179,7 +203,19 @@ void GlobalSolution::validate(const std::string& where) const {
   size_t leaves = 0;
   for (int32_t row : leafRow) leaves += row >= 0;
   if (leafVertexGoodIrradiance.size() != leaves * K * 4) bad("leaf irradiance has the wrong size");
+  if (!nodeExposure.empty()) {
+    if (nodeExposure.size() != size_t(hierarchy.size()) * keyTimes.size())
+      bad("node_exposure has the wrong size");
+    for (float e : nodeExposure)
+      if (!(e >= 0.0f && e <= 1.0f)) bad("node exposure outside [0, 1]");
+  }
   if (linkSampleKeys.size() != linkSampleValues.size()) bad("link sample arrays differ in size");
+  if (!linkSampleVisibility.empty()) {
+    if (linkSampleVisibility.size() != linkSampleKeys.size())
+      bad("link_sample_visibility has the wrong size");
+    for (float v : linkSampleVisibility)
+      if (!(v >= 0.0f && v <= 1.0f)) bad("link visibility outside [0, 1]");
+  }
   for (const GlobalLink& l : links) {
     if (l.receiver >= N || l.shooter >= N) bad("link names a node out of range");
     if (l.firstKey > l.lastKey || l.lastKey >= K) bad("link interval out of range");

@@ -47,6 +47,10 @@ class GlobalSolution {
   // Radiosity B (W/m^2, RGB) of node i at key k: nodeRadiosity[i * K + k]. Interior nodes hold
   // the area average of their children (push-pull), so a top's value is its mean radiosity.
   std::vector<glm::vec3> nodeRadiosity;
+  // Exposure e of node i at key k (the share of it not covered by a touching surface; rad-global
+  // divides the node's gathered irradiance by it): nodeExposure[i * K + k]; empty = every node
+  // 1 (files before linkhier 1.2).
+  std::vector<float> nodeExposure;
   // Good-link irradiance H_good (W/m^2) at the vertices of every union leaf, per key:
   // leafVertexGoodIrradiance[(leafRow[i] * K + k) * 4 + c] for corner c of node i
   // (triangles use c = 0..2). leafRow[i] = -1 for interior nodes.
@@ -57,6 +61,9 @@ class GlobalSolution {
   std::vector<GlobalLink> links;
   std::vector<uint32_t> linkSampleKeys;
   std::vector<float> linkSampleValues;
+  // The visibility V of each sample (kernel-weighted over the pairs of sample points); empty in
+  // files before linkhier 1.2.
+  std::vector<float> linkSampleVisibility;
   // Bad (receiver top, shooter top) pairs, sorted, unique.
   std::vector<std::pair<uint32_t, uint32_t>> badPairs;
 
@@ -73,6 +80,14 @@ class GlobalSolution {
   // Gouraud-interpolated over the union leaf that contains the point.
   glm::dvec3 goodIrradianceAtKey(int top, glm::dvec2 uv, int key) const;
   glm::dvec3 goodIrradiance(int top, glm::dvec2 uv, double t) const;
+  double exposureAtKey(int node, int key) const {
+    return nodeExposure.empty() ? 1.0 : double(nodeExposure[size_t(node) * keyCount() + key]);
+  }
+  // F·V of link row l at key k: piecewise linear through its samples, held outside them; 0 when
+  // k is outside the row's activity interval.
+  double linkFvAtKey(const GlobalLink& l, int key) const;
+  // V of link row l at key k, the same way (1 when the file has no visibility samples).
+  double linkVisibilityAtKey(const GlobalLink& l, int key) const;
   // Shooter tops of the bad pairs whose receiver is `receiverTop`, ascending.
   std::vector<uint32_t> badShooters(uint32_t receiverTop) const;
   bool isBadPair(uint32_t receiverTop, uint32_t shooterTop) const;

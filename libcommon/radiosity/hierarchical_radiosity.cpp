@@ -20,13 +20,6 @@ double maxComponent(const glm::dvec3& v) {
   return std::max(v.x, std::max(v.y, v.z));
 }
 
-// Size of a polygon (largest vertex distance from the first vertex), for relative tolerances.
-double polygonSize(const Polygon& p) {
-  double s = 0;
-  for (int i = 1; i < p.count; ++i) s = std::max(s, glm::length(p.v[i] - p.v[0]));
-  return s;
-}
-
 // Some vertex of `p` lies strictly in front of the plane of `q`.
 bool someVertexInFront(const Polygon& p, const Polygon& q) {
   glm::dvec3 n = q.normal();
@@ -100,34 +93,6 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relT
   else
     f = polygonToPolygonFormFactor(from, to, kAutoOrder);
   return swap ? std::min(1.0, f * aq / ap) : f;
-}
-
-// Distance from point x to the convex planar polygon q (its nearest point).
-double distanceToPolygon(const glm::dvec3& x, const Polygon& q) {
-  const glm::dvec3 n = q.normal();
-  const glm::dvec3 onPlane = x - glm::dot(x - q.v[0], n) * n;
-  bool inside = true;
-  double edge = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < q.count; ++i) {
-    const glm::dvec3 a = q.v[size_t(i)], b = q.v[size_t((i + 1) % q.count)];
-    if (glm::dot(glm::cross(b - a, onPlane - a), n) < 0.0) inside = false;
-    const glm::dvec3 ab = b - a;
-    const double len2 = glm::dot(ab, ab);
-    const double t = len2 > 0.0 ? glm::clamp(glm::dot(x - a, ab) / len2, 0.0, 1.0) : 0.0;
-    edge = std::min(edge, glm::length(x - (a + t * ab)));
-  }
-  return inside ? std::abs(glm::dot(x - q.v[0], n)) : edge;
-}
-
-double leafFormFactor(const Polygon& r, const Polygon& q, double relTol) {
-  // F(x -> q) is smooth over r on the scale of x's distance to q (its plane and its contour), so
-  // a fixed Gauss rule on r is accurate once that distance is large against r's size; a large
-  // q far from r's centroid by its own size (linkFormFactor's test) does not make it hard.
-  const double size = polygonSize(r);
-  const double ratio = size > 0.0 ? distanceToPolygon(r.centroid(), q) / size : 0.0;
-  if (ratio < 0.25) return polygonToPolygonFormFactorAdaptive(r, q, relTol, 1e-12, 4096).value;
-  const int order = ratio >= 20 ? 2 : ratio >= 5 ? 4 : ratio >= 2 ? 6 : ratio >= 1 ? 8 : 12;
-  return polygonToPolygonFormFactor(r, q, order);
 }
 
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
@@ -490,7 +455,7 @@ class KeyTimeSolver {
     }
     if (opt_.quadratureOrder != kAutoOrder)
       return polygonToPolygonFormFactor(s_.world[size_t(r)], s_.world[q], opt_.quadratureOrder);
-    return leafFormFactor(s_.world[size_t(r)], s_.world[q],
+    return areaAverageFormFactor(s_.world[size_t(r)], s_.world[q],
                           std::max(opt_.formFactorTolerance, 1e-4));
   }
 

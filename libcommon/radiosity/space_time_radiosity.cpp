@@ -43,7 +43,8 @@ class LinkIntervals {
   struct Row {
     uint32_t firstKey = 0, lastKey = 0;
     float firstFv = 0, firstVisibility = 0;
-    // F·V at every key of the run once one differed from firstFv (in its bits), else none.
+    // (F·V, V) at every key of the run once one differed from (firstFv, firstVisibility) in
+    // its bits, else none.
     uint32_t firstBlock = kNone, lastBlock = kNone;
     uint32_t valueCount = 0;
     uint32_t nextRow = kNone;  // the same link's next row (later keys)
@@ -59,12 +60,13 @@ class LinkIntervals {
       if (r.lastKey + 1 == key && r.refined == refined) {  // the run goes on
         r.lastKey = key;
         r.visibilityChanged |= visibility != r.firstVisibility;
-        r.constant &= fv == r.firstFv;
-        // Values are kept from the first one that differs in its bits (F·V changed, or only
-        // the sign of a zero: such a row stays constant, but its values are kept exact).
-        if (r.valueCount == 0 && (!r.constant || !sameBits(fv, r.firstFv)))
-          for (uint32_t k = r.firstKey; k < key; ++k) append(r, r.firstFv);
-        if (r.valueCount > 0) append(r, fv);
+        r.constant &= fv == r.firstFv && visibility == r.firstVisibility;
+        // Values are kept from the first one that differs in its bits (F·V or V changed, or
+        // only the sign of a zero: such a row stays constant, but its values are kept exact).
+        if (r.valueCount == 0 &&
+            (!r.constant || !sameBits(fv, r.firstFv) || !sameBits(visibility, r.firstVisibility)))
+          for (uint32_t k = r.firstKey; k < key; ++k) append(r, {r.firstFv, r.firstVisibility});
+        if (r.valueCount > 0) append(r, {fv, visibility});
         return;
       }
     }
@@ -96,26 +98,30 @@ class LinkIntervals {
   size_t rowCount() const { return rows_.size(); }
   // The samples a row contributes to GlobalSolution::linkSample*.
   static uint32_t sampleCount(const Row& r) { return r.constant ? 1 : r.valueCount; }
-  // Calls f(key, fv) for every key of the row's run.
+  // Calls f(key, fv, visibility) for every key of the row's run.
   template <class F>
   void forEachKey(const Row& r, F&& f) const {
     if (r.valueCount == 0) {  // every value had the bits of the first
-      for (uint32_t k = r.firstKey; k <= r.lastKey; ++k) f(k, r.firstFv);
+      for (uint32_t k = r.firstKey; k <= r.lastKey; ++k) f(k, r.firstFv, r.firstVisibility);
       return;
     }
     uint32_t k = r.firstKey, left = r.valueCount;
     for (uint32_t b = r.firstBlock; b != kNone && left > 0; b = block(b).next) {
       const Block& blk = block(b);
-      for (uint32_t j = 0; j < kBlockValues && left > 0; ++j, --left) f(k++, blk.values[j]);
+      for (uint32_t j = 0; j < kBlockValues && left > 0; ++j, --left)
+        f(k++, blk.values[j].fv, blk.values[j].visibility);
     }
   }
 
  private:
   // Values live in fixed-size blocks chained per row, allocated from slabs that never move: no
   // per-link vector slack and no reallocation copies (a row wastes less than one block).
-  static constexpr uint32_t kBlockValues = 15;
+  struct Value {
+    float fv, visibility;
+  };
+  static constexpr uint32_t kBlockValues = 7;
   struct Block {
-    float values[kBlockValues];
+    Value values[kBlockValues];
     uint32_t next;
   };
   static bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
@@ -135,7 +141,7 @@ class LinkIntervals {
     block(i).next = kNone;
     return i;
   }
-  void append(Row& r, float fv) {
+  void append(Row& r, Value v) {
     uint32_t slot = r.valueCount % kBlockValues;
     if (slot == 0) {
       uint32_t b = newBlock();
@@ -145,7 +151,7 @@ class LinkIntervals {
         block(r.lastBlock).next = b;
       r.lastBlock = b;
     }
-    block(r.lastBlock).values[slot] = fv;
+    block(r.lastBlock).values[slot] = v;
     ++r.valueCount;
   }
 
@@ -417,10 +423,12 @@ GlobalLink globalLinkOf(const LinkIntervals& intervals, const LinkIntervals::Row
   if (r.constant) {
     g.linkSampleKeys.push_back(r.firstKey);
     g.linkSampleValues.push_back(r.firstFv);
+    g.linkSampleVisibility.push_back(r.firstVisibility);
   } else {
-    intervals.forEachKey(r, [&](uint32_t k, float fv) {
+    intervals.forEachKey(r, [&](uint32_t k, float fv, float v) {
       g.linkSampleKeys.push_back(k);
       g.linkSampleValues.push_back(fv);
+      g.linkSampleVisibility.push_back(v);
     });
   }
   gl.sampleCount = uint32_t(g.linkSampleKeys.size()) - gl.sampleOffset;
@@ -446,13 +454,14 @@ std::vector<glm::dvec3> mergeLinks(LinkIntervals& intervals, const std::vector<c
   g.links.reserve(intervals.rowCount());
   g.linkSampleKeys.reserve(sampleTotal);
   g.linkSampleValues.reserve(sampleTotal);
+  g.linkSampleVisibility.reserve(sampleTotal);
   for (const auto& [key, firstRow] : linkKeys) {
     uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
     bool bad = badPair[size_t(h.node(int(rcv)).id.top) * T + h.node(int(sh)).id.top];
     for (uint32_t ri = firstRow; ri != LinkIntervals::kNone; ri = intervals.row(ri).nextRow) {
       const LinkIntervals::Row& r = intervals.row(ri);
       if (!bad && !r.refined)
-        intervals.forEachKey(r, [&](uint32_t k, float fv) {
+        intervals.forEachKey(r, [&](uint32_t k, float fv, float) {
           const double e = records[k].exposure[rcv];  // the gather's division (exposure)
           if (e > 0.0) goodH[k * N + rcv] += double(fv) * glm::dvec3(records[k].radiosity[sh]) / e;
         });
@@ -664,6 +673,17 @@ void mergeLeafVertexIrradiance(const std::vector<glm::dvec3>& goodH,
   }
 }
 
+// Merge: each node's exposure at each key (1 for nodes not in that key's tree), for the
+// per-texel gather of rad-movies (good_link_gather.h), which divides as the solve did.
+void mergeNodeExposure(const std::vector<KeyRecord>& records, const PatchHierarchy& h,
+                       GlobalSolution& g) {
+  const size_t K = records.size(), N = size_t(h.size());
+  g.nodeExposure.assign(N * K, 1.0f);
+  for (size_t k = 0; k < K; ++k)
+    for (size_t i = 0; i < std::min(N, records[k].exposure.size()); ++i)
+      g.nodeExposure[i * K + k] = records[k].exposure[i];
+}
+
 }  // namespace
 
 GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
@@ -678,6 +698,7 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
   GlobalSolution g;
   g.keyTimes = keyTimes;
   mergeNodeRadiosity(pass.records(), pass.hierarchy(), g);
+  mergeNodeExposure(pass.records(), pass.hierarchy(), g);
   mergeBadPairs(pass.badPairs(), size_t(pass.hierarchy().topCount()), g);
   std::vector<glm::dvec3> goodH =
       mergeLinks(pass.intervals(), pass.badPairs(), pass.records(), pass.hierarchy(), g);

@@ -2,7 +2,7 @@
 // the global solution's links nor copies of the movie textures, and stays flat in the number of
 // frames composed. The real stages (rad-global, rad-intervals, rad-movies) run on the bundled
 // moving Cornell box, frames 0-47 at 352x240. Then:
-//  - global.rlh padded with 6 M unused F·V samples (+48 MB on disk) must raise rad-compose's
+//  - global.rlh padded with 4 M unused link samples (+48 MB on disk) must raise rad-compose's
 //    peak by less than 32 MiB: it reads only the radiosity and releases the file's bytes once
 //    read (they are in memory only while the file is validated, before the GL context, Embree
 //    and the movies). Before, the whole file and a copy of its link arrays were held for the
@@ -74,9 +74,10 @@ TEST(RadComposeMemory, HoldsNeitherTheLinksNorTextureCopiesAndIsFlatInLength) {
     Scene scene = readGltfScene(kScene);
     ContainerReader reader = ContainerReader::open(g);
     GlobalSolution s = readLinkHierarchy(reader, scene);
-    const size_t extra = 6u << 20;
+    const size_t extra = 4u << 20;  // keys, F·V and V: 48 MB
     s.linkSampleKeys.resize(s.linkSampleKeys.size() + extra, 0u);
     s.linkSampleValues.resize(s.linkSampleValues.size() + extra, 0.5f);
+    s.linkSampleVisibility.resize(s.linkSampleValues.size(), 1.0f);
     writeLinkHierarchy(padded, s, reader.provenance(), reader.metadata());
   }
   ASSERT_GT(fs::file_size(padded), fs::file_size(g) + (45u << 20));

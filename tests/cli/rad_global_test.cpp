@@ -64,6 +64,8 @@ TEST(RadGlobal, CoherentFileEqualsNoCoherenceFile) {
   EXPECT_TRUE(c.nodeRadiosity == n.nodeRadiosity);
   EXPECT_TRUE(c.leafVertexGoodIrradiance == n.leafVertexGoodIrradiance);
   EXPECT_TRUE(c.linkSampleValues == n.linkSampleValues);
+  EXPECT_TRUE(c.linkSampleVisibility == n.linkSampleVisibility);
+  EXPECT_TRUE(c.nodeExposure == n.nodeExposure);
   EXPECT_TRUE(c.linkSampleKeys == n.linkSampleKeys);
   EXPECT_EQ(c.links.size(), n.links.size());
   fs::remove_all(d);

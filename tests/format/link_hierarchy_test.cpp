@@ -68,6 +68,8 @@ TEST(LinkHierarchy, RoundTrip) {
   }
   EXPECT_EQ(r.linkSampleKeys, g.linkSampleKeys);
   EXPECT_EQ(r.linkSampleValues, g.linkSampleValues);
+  EXPECT_EQ(r.linkSampleVisibility, g.linkSampleVisibility);
+  EXPECT_EQ(r.nodeExposure, g.nodeExposure);
   EXPECT_EQ(r.badPairs, g.badPairs);
   EXPECT_GT(g.hierarchy.size(), g.hierarchy.topCount());
   // Queries answer the same.

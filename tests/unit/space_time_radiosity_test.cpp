@@ -47,6 +47,8 @@ void expectIdentical(const GlobalSolution& a, const GlobalSolution& b) {
   }
   EXPECT_TRUE(a.linkSampleKeys == b.linkSampleKeys);
   EXPECT_TRUE(a.linkSampleValues == b.linkSampleValues);
+  EXPECT_TRUE(a.linkSampleVisibility == b.linkSampleVisibility);
+  EXPECT_TRUE(a.nodeExposure == b.nodeExposure);
   EXPECT_TRUE(a.badPairs == b.badPairs);
 }
 
@@ -169,8 +171,8 @@ TEST(SpaceTimeRadiosity, MergedSolutionIsConsistent) {
 // The link rows are compacted as each key time finishes (memory: the compact result, not every
 // key's links); they must be exactly the rows of the plain merge of the per-key link lists: per
 // link (ascending receiver, shooter), the maximal runs of consecutive keys with the same refined
-// flag, one sample when F·V is the same at every key of the run, else one per key. Twenty key
-// times, so that runs outgrow the store's 15-value blocks.
+// flag, one sample when F·V and V are the same at every key of the run, else one per key. Twenty
+// key times, so that runs outgrow the store's 15-value blocks.
 TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
   Scene scene = cornell();
   std::vector<double> keys;
@@ -203,14 +205,14 @@ TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
   ASSERT_EQ(h.size(), g.hierarchy.size());
   std::vector<GlobalLink> rows;
   std::vector<uint32_t> sampleKeys;
-  std::vector<float> sampleValues;
+  std::vector<float> sampleValues, sampleVisibility;
   for (const auto& [link, v] : perLink)
     for (size_t a = 0; a < v.size();) {
       size_t b = a + 1;
       while (b < v.size() && v[b].key == v[b - 1].key + 1 && v[b].refined == v[a].refined) ++b;
       bool constant = true, visibilityChanged = false;
       for (size_t j = a + 1; j < b; ++j) {
-        constant &= v[j].fv == v[a].fv;
+        constant &= v[j].fv == v[a].fv && v[j].visibility == v[a].visibility;
         visibilityChanged |= v[j].visibility != v[a].visibility;
       }
       GlobalLink r;
@@ -222,6 +224,7 @@ TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
       for (size_t j = a; j < (constant ? a + 1 : b); ++j) {
         sampleKeys.push_back(v[j].key);
         sampleValues.push_back(v[j].fv);
+        sampleVisibility.push_back(v[j].visibility);
       }
       r.sampleCount = uint32_t(sampleKeys.size()) - r.sampleOffset;
       // --bad-links lights (the default): a link is bad when its shooter emits.
@@ -256,6 +259,7 @@ TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
   }
   EXPECT_TRUE(g.linkSampleKeys == sampleKeys);
   EXPECT_TRUE(g.linkSampleValues == sampleValues);
+  EXPECT_TRUE(g.linkSampleVisibility == sampleVisibility);
 }
 
 // A floor of two coplanar tiles side by side, under a ceiling, with a small light over the

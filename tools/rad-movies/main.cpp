@@ -25,6 +25,7 @@ struct Options {
   std::string scene, global, intervals, outDir;
   rad::TextureMovieBakerOptions baker;  // bound to the flags; its toJson() is the provenance
   std::string merge = "exact";
+  std::string goodLayer = "gather";
   std::string shard = "0/1";
   std::string report;
 };
@@ -33,6 +34,7 @@ int run(Options o, int argc, char** argv) {
   auto start = rad::SteadyClock::now();
   const rad::MovieShard shard = rad::MovieShard::parse(o.shard);
   o.baker.merge = rad::parseMergeMode(o.merge);
+  o.baker.goodLayer = rad::parseGoodLayer(o.goodLayer);
   rad::Scene scene = rad::readGltfScene(o.scene);
   rad::GlobalSolution solution = rad::readLinkHierarchy(o.global, scene);
   rad::TextureIntervals intervals = rad::readTextureIntervals(o.intervals);
@@ -103,7 +105,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->excludes(keyStep)
       ->group("Deprecated");
-  app.add_option("--min-samples", b.minSamples, "shooter samples per bad link, at least (at most --max-samples)")
+  app.add_option("--min-samples", b.minSamples,
+                 "shooter samples per bad link, at least (at most --max-samples)")
       ->capture_default_str();
   app.add_option("--max-samples", b.maxSamples, "shooter samples per bad link, at most (<= 64)")
       ->capture_default_str();
@@ -115,6 +118,20 @@ int main(int argc, char** argv) {
                  "max, sum, independent")
       ->capture_default_str()
       ->check(CLI::IsMember({"exact", "max", "sum", "independent"}));
+  app.add_option("--good-layer", o.goodLayer,
+                 "indirect light of the good links: gather (per texel, exact point form factors "
+                 "to each link's shooter) or gouraud (the global solution's vertex values, paper "
+                 "§3.1)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"gather", "gouraud"}));
+  app.add_option("--gather-shooter-ratio", b.gatherShooterRatio,
+                 "gather: split a link's shooter into the parts of its sub-tree larger than "
+                 "this times their distance to the receiver (0: no split)")
+      ->capture_default_str();
+  app.add_option("--gather-weak-share", b.gatherWeakShare,
+                 "gather: interpolate links under this share of their receiver's irradiance "
+                 "from the receiver's corners (faster, less accurate)")
+      ->capture_default_str();
   app.add_flag_callback(
       "--no-coherence", [&b] { b.coherence = false; },
       "re-render every blocker and recompute every form factor at every key, store every "
