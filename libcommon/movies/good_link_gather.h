@@ -95,7 +95,7 @@ class GoodLinkGather {
   std::vector<Link> links_;
   // A link is far when its shooter part is farther from the receiver node than kFarRatio times
   // the node's size.
-  static constexpr double kFarRatio = 2.0;
+  static constexpr double kFarRatio = 4.0;
   struct ReceiverNode {  // a node of the texels' chains
     int node = 0, corners = 4;
     std::array<glm::dvec3, 4> cornerLocal{};    // in the top's local frame
