@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <map>
 
 #include <tbb/blocked_range.h>
@@ -29,12 +30,10 @@ GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
 GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
                                const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                                const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
-                               double shooterRatio, double weakShare, double cacheBytes,
-                               GoodLinkGatherStats& stats)
+                               double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats)
     : scene_(scene),
       solution_(solution),
       shooterRatio_(shooterRatio),
-      weakShare_(weakShare),
       texels_(texels),
       keyTimes_(movieKeyTimes),
       receiverTop_(int(request.patch.top)) {
@@ -52,7 +51,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   stats.links += long(links_.size());
   stats.entries += long(texelLinks_.size());
   if (cached_) stats.cachedEntries += long(texelLinks_.size());
-  stats.interpolatedEntries += long(texelNodes_.size());
+  stats.tileEntries += long(tileLinks_.size());
 }
 
 Polygon GoodLinkGather::nodeWorld(uint32_t node, double t) const {
@@ -168,128 +167,114 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
   });
 }
 
-// Which links a texel evaluates itself (near and strong) and which are interpolated from the
-// receiver node's corners: far ones, over which F varies so slowly that the error of bilinear
-// interpolation (as (size / distance)^2) is negligible, and weak ones, under weakShare_ of the
-// irradiance the node's chain gathers (cubic, 189 patches, had 600 links per texel, most of
-// them carrying a fraction of a per cent).
-void GoodLinkGather::classifyLinks(const std::map<int, uint32_t>& nodeOf, double t0) {
-  const PatchHierarchy& h = solution_.hierarchy;
-  std::vector<double> strength(links_.size(), 0.0);
-  std::vector<double> nodeStrength(nodes_.size(), 0.0);
-  std::vector<char> far(links_.size(), 0);
-  tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
-    const int r = int(solution_.links[links_[j].row].receiver);
-    const Polygon receiver = nodeWorld(uint32_t(r), t0), shooter = nodeWorld(links_[j].shooter, t0);
-    double d = distanceToPolygon(receiver.centroid(), shooter);
-    for (int i = 0; i < receiver.count; ++i)
-      d = std::min(d, distanceToPolygon(receiver.v[i], shooter));
-    far[j] = d > kFarRatio * polygonSize(receiver);
-    double b = 0.0;
-    for (const glm::dvec3& w : links_[j].weight) b = std::max(b, std::max(w.x, std::max(w.y, w.z)));
-    strength[j] = b * areaAverageFormFactor(receiver, shooter, 1e-2);
-  });
-  for (size_t j = 0; j < links_.size(); ++j)
-    nodeStrength[nodeOf.at(int(solution_.links[links_[j].row].receiver))] += strength[j];
-  for (size_t j = 0; j < links_.size(); ++j) {
-    const int r = int(solution_.links[links_[j].row].receiver);
-    double chain = 0.0;  // what the receiver node and its ancestors gather
-    for (int a = r; a >= 0; a = h.node(a).parent) {
-      auto it = nodeOf.find(a);
-      if (it != nodeOf.end()) chain += nodeStrength[it->second];
-    }
-    links_[j].far = far[j] || strength[j] < weakShare_ * chain;
-    ReceiverNode& n = nodes_[nodeOf.at(r)];
-    (links_[j].far ? n.farLinks : n.nearLinks).push_back(uint32_t(j));
-  }
+// A texel's leaf chain, deepest first, as far up as (not including) `stop` (-1: to the top).
+template <class F>
+void forChain(const PatchHierarchy& h, int leaf, int stop, F&& f) {
+  for (int a = leaf; a >= 0 && a != stop; a = h.node(a).parent) f(a);
 }
 
-// The receiver nodes the texels' chains run through, each with its far links and corners, and per
-// texel its near links (form factors kept when no end moves and the terms fit in `cacheBytes`).
+// The deepest node whose domain holds both a and b.
+int commonAncestor(const PatchHierarchy& h, int a, int b) {
+  while (a != b) {
+    if (h.node(a).id.level() >= h.node(b).id.level())
+      a = h.node(a).parent;
+    else
+      b = h.node(b).parent;
+    if (a < 0 || b < 0) return -1;
+  }
+  return a;
+}
+
+// Per tile of kTile x kTile texels: the links of the nodes that hold the whole tile go to the
+// tile when their shooter part is farther than kTileFarRatio times the tile's size (F evaluated
+// at the tile's corners, which are texel centres shared with the neighbouring tiles, and
+// interpolated bilinearly: the error falls as (size / distance)^2), the others to each texel.
+// The per-texel form factors of links that do not move are kept when they fit in cacheBytes.
 void GoodLinkGather::planTexels(double cacheBytes) {
   const PatchHierarchy& h = solution_.hierarchy;
-  const InputPolygon& top = h.top(receiverTop_);
-  const bool triangle = top.local.count == 3;
   const double t0 = keyTimes_.front();
-  std::map<int, uint32_t> nodeOf;  // receiver node -> nodes_ index
+  std::map<int, std::pair<uint32_t, uint32_t>> linksOf;  // receiver node -> links_ range
   for (uint32_t j = 0; j < uint32_t(links_.size()); ++j) {
-    const int r = int(solution_.links[links_[j].row].receiver);
-    auto [it, fresh] = nodeOf.emplace(r, uint32_t(nodes_.size()));
-    if (fresh) {
-      ReceiverNode n;
-      n.node = r;
-      n.corners = triangle ? 3 : 4;
-      static const glm::dvec2 quad[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-      static const glm::dvec2 tri[3] = {{0, 0}, {1, 0}, {0, 1}};
-      for (int c = 0; c < n.corners; ++c)
-        n.cornerLocal[size_t(c)] = polygonPointAt(
-            top.local, topUvFromNodeUv(h.node(r).id, triangle ? tri[c] : quad[c], triangle));
-      nodes_.push_back(n);
-    }
-    (void)it;
+    auto [it, fresh] =
+        linksOf.emplace(int(solution_.links[links_[j].row].receiver), std::make_pair(j, j + 1));
+    if (!fresh) it->second.second = j + 1;
   }
-  classifyLinks(nodeOf, t0);
+  auto linksAt = [&](int node, auto&& f) {
+    auto it = linksOf.find(node);
+    if (it != linksOf.end())
+      for (uint32_t j = it->second.first; j < it->second.second; ++j) f(j);
+  };
+  const int w = texels_.width, hgt = texels_.height;
   const size_t T = texels_.topUv.size();
-  texelStart_.assign(T + 1, 0);
-  texelNodeStart_.assign(T + 1, 0);
-  for (size_t x = 0; x < T; ++x) {
-    for (int a = leafAtTopUv(h, receiverTop_, texels_.topUv[x]); a >= 0; a = h.node(a).parent) {
-      auto it = nodeOf.find(a);
-      if (it == nodeOf.end()) continue;
-      const ReceiverNode& n = nodes_[it->second];
-      if (!n.farLinks.empty()) {
-        texelNodes_.push_back(it->second);
-        texelNodeUv_.push_back(clampToParameterDomain(
-            nodeUvFromTopUv(h.node(a).id, texels_.topUv[x], triangle), triangle));
-      }
-      texelLinks_.insert(texelLinks_.end(), n.nearLinks.begin(), n.nearLinks.end());
-    }
-    texelStart_[x + 1] = uint32_t(texelLinks_.size());
-    texelNodeStart_[x + 1] = uint32_t(texelNodes_.size());
-  }
-  // The form factors of links that do not move, once per movie (within the budget); a moving
-  // link's are recomputed at every key.
-  cached_ = double(texelLinks_.size()) * sizeof(float) <= cacheBytes;
+  std::vector<int> leaf(T);
+  for (size_t x = 0; x < T; ++x) leaf[x] = leafAtTopUv(h, receiverTop_, texels_.topUv[x]);
   const TexelFrame frame = texelFrame(t0);
+  auto world = [&](size_t x) {
+    return glm::dvec3(frame.m * glm::dvec4(texels_.localPoint[x], 1.0));
+  };
   std::vector<Polygon> shooter(links_.size());
   for (size_t j = 0; j < links_.size(); ++j) shooter[j] = nodeWorld(links_[j].shooter, t0);
-  tbb::parallel_for(size_t(0), nodes_.size(), [&](size_t i) {
-    ReceiverNode& n = nodes_[i];
-    n.cornerFormFactor.assign(n.farLinks.size() * 4, 0.0);
-    for (size_t f = 0; f < n.farLinks.size(); ++f)
-      cornerFormFactors(n, frame, nodeWorld(uint32_t(n.node), t0), shooter[n.farLinks[f]],
-                        &n.cornerFormFactor[f * 4]);
+
+  tilesX_ = (w + kTile - 1) / kTile;
+  tilesY_ = (hgt + kTile - 1) / kTile;
+  tiles_.assign(size_t(tilesX_) * tilesY_, Tile());
+  std::vector<std::vector<uint32_t>> nearOfTile(tiles_.size());
+  tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
+    Tile& tile = tiles_[ti];
+    tile.i0 = int(ti % size_t(tilesX_)) * kTile;
+    tile.j0 = int(ti / size_t(tilesX_)) * kTile;
+    tile.i1 = std::min(tile.i0 + kTile, w - 1);  // corner columns and rows: texel centres
+    tile.j1 = std::min(tile.j0 + kTile, hgt - 1);
+    int common = leaf[size_t(tile.j0) * w + tile.i0];
+    for (int j = tile.j0; j < std::min(tile.j0 + kTile, hgt); ++j)
+      for (int i = tile.i0; i < std::min(tile.i0 + kTile, w); ++i)
+        if (common >= 0) common = commonAncestor(h, common, leaf[size_t(j) * w + i]);
+    tile.common = common;
+    const size_t corner[4] = {size_t(tile.j0) * w + tile.i0, size_t(tile.j0) * w + tile.i1,
+                              size_t(tile.j1) * w + tile.i1, size_t(tile.j1) * w + tile.i0};
+    glm::dvec3 p[4];
+    double size = 0.0;
+    for (int c = 0; c < 4; ++c) p[c] = world(corner[c]);
+    for (int c = 0; c < 4; ++c) size = std::max(size, glm::length(p[c] - p[(c + 2) % 4]));
+    forChain(h, common, -1, [&](int node) {
+      linksAt(node, [&](uint32_t j) {
+        double d = std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 4; ++c) d = std::min(d, distanceToPolygon(p[c], shooter[j]));
+        if (d > kTileFarRatio * size) {
+          tile.links.push_back(j);
+          for (int c = 0; c < 4; ++c)
+            tile.formFactor.push_back(
+                links_[j].moves ? 0.0 : pointToPolygonFormFactor(p[c], frame.n, shooter[j]));
+        } else {
+          nearOfTile[ti].push_back(j);
+        }
+      });
+    });
   });
+  for (const Tile& tile : tiles_)
+    tileLinks_.insert(tileLinks_.end(), tile.links.begin(), tile.links.end());
+  // Per texel, in texel order: its chain below its tile's common node, then the tile's near links.
+  texelStart_.assign(T + 1, 0);
+  for (int j = 0; j < hgt; ++j)
+    for (int i = 0; i < w; ++i) {
+      const size_t x = size_t(j) * w + i;
+      const size_t ti = size_t(j / kTile) * size_t(tilesX_) + size_t(i / kTile);
+      forChain(h, leaf[x], tiles_[ti].common,
+               [&](int node) { linksAt(node, [&](uint32_t l) { texelLinks_.push_back(l); }); });
+      texelLinks_.insert(texelLinks_.end(), nearOfTile[ti].begin(), nearOfTile[ti].end());
+      texelStart_[x + 1] = uint32_t(texelLinks_.size());
+    }
+  cached_ = double(texelLinks_.size()) * sizeof(float) <= cacheBytes;
   if (!cached_) return;
   texelFormFactor_.resize(texelLinks_.size());
   tbb::parallel_for(size_t(0), T, [&](size_t x) {
-    const glm::dvec3 p(frame.m * glm::dvec4(texels_.localPoint[x], 1.0));
+    const glm::dvec3 p = world(x);
     for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
       const uint32_t j = texelLinks_[e];
       texelFormFactor_[e] =
           links_[j].moves ? 0.0f : float(pointToPolygonFormFactor(p, frame.n, shooter[j]));
     }
   });
-}
-
-// A far link's form factors at the receiver node's corners, scaled so that their interpolation
-// keeps the node's area average F(node -> shooter): F is peaked over a receiver facing its
-// shooter, and its corner values alone, interpolated, made every scene 1-8 % too dark.
-void GoodLinkGather::cornerFormFactors(const ReceiverNode& n, const TexelFrame& frame,
-                                       const Polygon& receiverWorld, const Polygon& shooter,
-                                       double* out) const {
-  double mean = 0.0;
-  for (int c = 0; c < n.corners; ++c) {
-    out[c] = pointToPolygonFormFactor(
-        glm::dvec3(frame.m * glm::dvec4(n.cornerLocal[size_t(c)], 1.0)), frame.n, shooter);
-    mean += out[c] / n.corners;
-  }
-  const double average = areaAverageFormFactor(receiverWorld, shooter, 1e-3);
-  if (mean > 0.0) {
-    for (int c = 0; c < n.corners; ++c) out[c] *= average / mean;
-  } else {
-    for (int c = 0; c < n.corners; ++c) out[c] = average;
-  }
 }
 
 GoodLinkGather::TexelFrame GoodLinkGather::texelFrame(double t) const {
@@ -313,42 +298,45 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
     if (l.moves || !cached_) shooter[j] = nodeWorld(l.shooter, t);
   }
   const TexelFrame frame = texelFrame(t);
-  // Far links: their irradiance at each receiver node's corners.
-  std::vector<std::array<glm::dvec3, 4>> cornerH(nodes_.size());
-  for (size_t i = 0; i < nodes_.size(); ++i) {
-    const ReceiverNode& n = nodes_[i];
-    cornerH[i].fill(glm::dvec3(0.0));
-    for (size_t f = 0; f < n.farLinks.size(); ++f) {
-      const uint32_t j = n.farLinks[f];
-      double moving[4];
-      const double* F = &n.cornerFormFactor[f * 4];
-      if (links_[j].moves) {
-        cornerFormFactors(n, frame, nodeWorld(uint32_t(n.node), t), shooter[j], moving);
-        F = moving;
-      }
-      for (int c = 0; c < n.corners; ++c) cornerH[i][size_t(c)] += F[c] * weight[j];
-    }
-  }
-  tbb::parallel_for(size_t(0), texels_.topUv.size(), [&](size_t x) {
-    const glm::dvec3 p(frame.m * glm::dvec4(texels_.localPoint[x], 1.0));
-    glm::dvec3 H(0.0);
-    for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
-      const uint32_t j = texelLinks_[e];
+  const int width = texels_.width, height = texels_.height;
+  auto world = [&](size_t x) {
+    return glm::dvec3(frame.m * glm::dvec4(texels_.localPoint[x], 1.0));
+  };
+  tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
+    const Tile& tile = tiles_[ti];
+    // The tile's far links at its corners (corner c: (i0,j0), (i1,j0), (i1,j1), (i0,j1)).
+    glm::dvec3 corner[4] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
+    const size_t cornerTexel[4] = {
+        size_t(tile.j0) * width + tile.i0, size_t(tile.j0) * width + tile.i1,
+        size_t(tile.j1) * width + tile.i1, size_t(tile.j1) * width + tile.i0};
+    for (size_t k = 0; k < tile.links.size(); ++k) {
+      const uint32_t j = tile.links[k];
       if (weight[j] == glm::dvec3(0.0)) continue;
-      const double f = cached_ && !links_[j].moves
-                           ? double(texelFormFactor_[e])
-                           : pointToPolygonFormFactor(p, frame.n, shooter[j]);
-      H += f * weight[j];
+      for (int c = 0; c < 4; ++c) {
+        const double f = links_[j].moves
+                             ? pointToPolygonFormFactor(world(cornerTexel[c]), frame.n, shooter[j])
+                             : tile.formFactor[k * 4 + size_t(c)];
+        corner[c] += f * weight[j];
+      }
     }
-    for (uint32_t e = texelNodeStart_[x]; e < texelNodeStart_[x + 1]; ++e) {
-      const ReceiverNode& n = nodes_[texelNodes_[e]];
-      const std::array<glm::dvec3, 4>& c = cornerH[texelNodes_[e]];
-      const glm::dvec2 uv = texelNodeUv_[e];
-      H += n.corners == 3 ? (1.0 - uv.x - uv.y) * c[0] + uv.x * c[1] + uv.y * c[2]
-                          : (1.0 - uv.x) * (1.0 - uv.y) * c[0] + uv.x * (1.0 - uv.y) * c[1] +
-                                uv.x * uv.y * c[2] + (1.0 - uv.x) * uv.y * c[3];
-    }
-    acc[x] = H;
+    for (int j = tile.j0; j < std::min(tile.j0 + kTile, height); ++j)
+      for (int i = tile.i0; i < std::min(tile.i0 + kTile, width); ++i) {
+        const size_t x = size_t(j) * width + i;
+        const double u = tile.i1 > tile.i0 ? double(i - tile.i0) / (tile.i1 - tile.i0) : 0.0;
+        const double v = tile.j1 > tile.j0 ? double(j - tile.j0) / (tile.j1 - tile.j0) : 0.0;
+        glm::dvec3 H = (1 - u) * (1 - v) * corner[0] + u * (1 - v) * corner[1] + u * v * corner[2] +
+                       (1 - u) * v * corner[3];
+        const glm::dvec3 p = world(x);
+        for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
+          const uint32_t l = texelLinks_[e];
+          if (weight[l] == glm::dvec3(0.0)) continue;
+          const double f = cached_ && !links_[l].moves
+                               ? double(texelFormFactor_[e])
+                               : pointToPolygonFormFactor(p, frame.n, shooter[l]);
+          H += f * weight[l];
+        }
+        acc[x] = H;
+      }
   });
 }
 

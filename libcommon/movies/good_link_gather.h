@@ -16,8 +16,9 @@
 // the bright band next to a lit wall. For an unoccluded link the texel's sum is the exact
 // form factor, so a closed room sums to 1 at every texel, not only per element.
 //
-// Cost: a link whose shooter part is far from the receiver node (kFarRatio) is evaluated at the
-// node's corners and interpolated bilinearly, so only near links cost a form factor per texel.
+// Cost: texels are planned in tiles of 8 x 8; a link whose shooter part is far from a tile
+// (kTileFarRatio times its size) is evaluated at the tile's corners and interpolated
+// bilinearly, so only near links cost a form factor per texel.
 //
 // Between key times the gather is linear in t, as the Gouraud layer is. Coherence (§5): for a
 // link whose two ends do not move during the movie, F(x -> q) is computed once per movie and
@@ -55,24 +56,22 @@ struct MovieTexels {
 };
 
 struct GoodLinkGatherStats {
-  long links = 0;                // link rows gathered, summed over movies
-  long entries = 0;              // (texel, near link) terms per key, summed over movies
-  long cachedEntries = 0;        // of which F was computed once per movie
-  long interpolatedEntries = 0;  // (texel, receiver node) interpolations of far links' corners
+  long links = 0;          // link rows gathered, summed over movies
+  long entries = 0;        // (texel, near link) terms per key, summed over movies
+  long cachedEntries = 0;  // of which F was computed once per movie
+  long tileEntries = 0;    // (tile, far link) terms, each 4 corner form factors
 };
 
 class GoodLinkGather {
  public:
   // Plans the gather of one movie: its links (each shooter split into the parts of its union
-  // sub-tree larger than shooterRatio times their distance to the receiver; 0: no split; links
-  // under weakShare of their chain's irradiance interpolated from the node corners), their
+  // sub-tree larger than shooterRatio times their distance to the receiver; 0: no split), their
   // visibility at the global keys it needs and, within `cacheBytes`, the per-texel form factors
   // of the links whose ends do not move.
   GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
                  const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                  const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
-                 double shooterRatio, double weakShare, double cacheBytes,
-                 GoodLinkGatherStats& stats);
+                 double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats);
 
   // acc[x] = G(x, t).
   void gather(double t, std::vector<glm::dvec3>& acc) const;
@@ -80,35 +79,33 @@ class GoodLinkGather {
  private:
   struct Link {  // one link row's share from one part of its shooter
     uint32_t row = 0;
-    uint32_t shooter = 0;  // dense node: the link's shooter or a node of its sub-tree
-    bool moves = false;    // an end moves during the movie: F per key
-    bool far = false;      // far or weak: gathered at the receiver node's corners, interpolated
+    uint32_t shooter = 0;            // dense node: the link's shooter or a node of its sub-tree
+    bool moves = false;              // an end moves during the movie: F per key
     std::vector<glm::dvec3> weight;  // per global key: B_q(k) \bar V(k); 0 when inactive
   };
   const Scene& scene_;
   const GlobalSolution& solution_;
   const double shooterRatio_;
-  const double weakShare_;
   const MovieTexels texels_;
   const std::vector<double>& keyTimes_;
   int receiverTop_ = 0;
   std::vector<Link> links_;
-  // A link is far when its shooter part is farther from the receiver node than kFarRatio times
-  // the node's size.
-  static constexpr double kFarRatio = 4.0;
-  struct ReceiverNode {  // a node of the texels' chains
-    int node = 0, corners = 4;
-    std::array<glm::dvec3, 4> cornerLocal{};    // in the top's local frame
-    std::vector<uint32_t> nearLinks, farLinks;  // links_ indices
-    std::vector<double> cornerFormFactor;       // per far link, 4 corners (at the movie's start)
+  // Texels are planned in tiles of kTile x kTile; a link whose shooter part is farther than
+  // kTileFarRatio times a tile's size is evaluated at the tile's corners and interpolated.
+  static constexpr int kTile = 8;
+  static constexpr double kTileFarRatio = 4.0;
+  struct Tile {
+    int i0 = 0, j0 = 0, i1 = 0, j1 = 0;  // first texel and the corner texels (last column, row)
+    int common = -1;                     // deepest node holding every texel of the tile
+    std::vector<uint32_t> links;         // links_ indices interpolated over the tile
+    std::vector<double> formFactor;      // per tile link, its 4 corners (links that do not move)
   };
-  std::vector<ReceiverNode> nodes_;
-  // Per texel its near terms: links_ indices texelLinks_[texelStart_[x] .. texelStart_[x + 1])
-  // and, when cached_, the form factors of the links that do not move in the same places; and
-  // the chain nodes with far links, texelNodes_[texelNodeStart_[x] ..), with the texel's (u,v)
-  // in each.
-  std::vector<uint32_t> texelStart_, texelLinks_, texelNodeStart_, texelNodes_;
-  std::vector<glm::dvec2> texelNodeUv_;
+  int tilesX_ = 0, tilesY_ = 0;
+  std::vector<Tile> tiles_;
+  std::vector<uint32_t> tileLinks_;  // all tiles' links (for the stats)
+  // Per texel its own terms: links_ indices texelLinks_[texelStart_[x] .. texelStart_[x + 1])
+  // and, when cached_, the form factors of the links that do not move in the same places.
+  std::vector<uint32_t> texelStart_, texelLinks_;
   std::vector<float> texelFormFactor_;
   bool cached_ = false;
 
@@ -117,15 +114,12 @@ class GoodLinkGather {
                     std::vector<uint32_t>& out) const;
   void planWeights(const std::vector<char>& neededKeys);
   void planTexels(double cacheBytes);
-  void classifyLinks(const std::map<int, uint32_t>& nodeOf, double t0);
   Polygon nodeWorld(uint32_t node, double t) const;
   struct TexelFrame {  // the receiver's local-to-world map and world normal at one time
     glm::dmat4 m;
     glm::dvec3 n;
   };
   TexelFrame texelFrame(double t) const;
-  void cornerFormFactors(const ReceiverNode& n, const TexelFrame& frame,
-                         const Polygon& receiverWorld, const Polygon& shooter, double* out) const;
 };
 
 }  // namespace rad

@@ -523,7 +523,6 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"merge", mergeModeName(merge)},
           {"good-layer", goodLayerName(goodLayer)},
           {"gather-shooter-ratio", gatherShooterRatio},
-          {"gather-weak-share", gatherWeakShare},
           {"no-coherence", !coherence},
           {"max-texture-memory", maxTextureMemoryMiB}};
 }
@@ -546,7 +545,7 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
            {{"links", gather.links},
             {"entries", gather.entries},
             {"cached_entries", gather.cachedEntries},
-            {"interpolated_entries", gather.interpolatedEntries}}},
+            {"tile_entries", gather.tileEntries}}},
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
@@ -584,8 +583,6 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
   // clamps it): `--max-samples 4` means at most 4, whatever the default minimum.
   if (!(options_.gatherShooterRatio >= 0.0) || !std::isfinite(options_.gatherShooterRatio))
     throw Error(ExitCode::kUsage, "--gather-shooter-ratio", "must be a finite number >= 0");
-  if (!(options_.gatherWeakShare >= 0.0 && options_.gatherWeakShare <= 1.0))
-    throw Error(ExitCode::kUsage, "--gather-weak-share", "must be in [0, 1]");
   if (options_.minSamples < 1) throw Error(ExitCode::kUsage, "--min-samples", "must be >= 1");
   if (!(options_.samplesPerFormFactor >= 0.0))
     throw Error(ExitCode::kUsage, "--samples-per-form-factor", "must be >= 0");
@@ -691,8 +688,7 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     auto clock = SteadyClock::now();
     gather = std::make_unique<GoodLinkGather>(
         scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
-        options_.gatherShooterRatio, options_.gatherWeakShare,
-        0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather);
+        options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather);
     stats_.secondsGood += secondsSince(clock);
   }
   MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry, gather.get());

@@ -74,9 +74,6 @@ struct TextureMovieBakerOptions {
   // --gather-shooter-ratio: a gathered link's shooter is split into the parts of its sub-tree
   // larger than this times their distance to the receiver (good_link_gather.h); 0: no split.
   double gatherShooterRatio = 1.0;
-  // --gather-weak-share: links carrying less than this share of what their receiver's chain
-  // gathers are interpolated from the receiver node's corners, not evaluated per texel.
-  double gatherWeakShare = 0.0;
   bool coherence = true;  // false: the per-key baseline
   // Working memory of one movie (one key's buffers plus the per-pair buffers, see
   // movieWorkingBytes); a movie that needs more is refused with an environment error.

@@ -128,10 +128,6 @@ int main(int argc, char** argv) {
                  "gather: split a link's shooter into the parts of its sub-tree larger than "
                  "this times their distance to the receiver (0: no split)")
       ->capture_default_str();
-  app.add_option("--gather-weak-share", b.gatherWeakShare,
-                 "gather: interpolate links under this share of their receiver's irradiance "
-                 "from the receiver's corners (faster, less accurate)")
-      ->capture_default_str();
   app.add_flag_callback(
       "--no-coherence", [&b] { b.coherence = false; },
       "re-render every blocker and recompute every form factor at every key, store every "
