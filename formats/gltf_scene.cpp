@@ -392,6 +392,16 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
                                  std::to_string(mat->baseColorTexCoord));
       }
     }
+    // glTF §3.7.2.1: NORMAL is float VEC3, unit length; the shading normal (flat without it).
+    std::vector<double> normals;
+    auto na = prim.attributes.find("NORMAL");
+    if (na != prim.attributes.end()) {
+      normals = readAccessor(na->second, where + " NORMAL", nc);
+      if (nc != 3) fail(where + ": NORMAL is not VEC3");
+      if (normals.size() / 3 != vertexCount)
+        fail(where + ": NORMAL count differs from POSITION count");
+      if (!allFinite(normals)) fail(where + ": non-finite normal");
+    }
     std::vector<uint32_t> idx;
     if (prim.indices >= 0) {
       if (prim.indices >= int(m_.accessors.size())) fail(where + ": indices accessor out of range");
@@ -435,7 +445,22 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
         const size_t v = t[k];
         mt.p[k] = {p[3 * v], p[3 * v + 1], p[3 * v + 2]};
         if (!uv.empty()) mt.uv[k] = {uv[2 * v], uv[2 * v + 1]};
+        if (!normals.empty()) {
+          const glm::dvec3 n(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
+          const double len = glm::length(n);
+          mt.normal[k] = len > 1e-12 ? n / len : glm::dvec3(0.0);
+        }
       }
+      // A triangle with a zero normal at a vertex, or whose normals all equal its flat
+      // normal (a flat-shaded export), stays flat.
+      bool smooth = !normals.empty(), flat = true;
+      const glm::dvec3 faceNormal =
+          glm::normalize(glm::cross(mt.p[1] - mt.p[0], mt.p[2] - mt.p[0]));
+      for (size_t k = 0; k < 3 && smooth; ++k) {
+        smooth = mt.normal[k] != glm::dvec3(0.0);
+        flat = flat && glm::dot(mt.normal[k], faceNormal) > 1.0 - 1e-9;
+      }
+      if (!smooth || flat) mt.normal = {};
       // Zero area (relative to the longest edge, so needles of collinear points count too).
       const double twiceArea = glm::length(glm::cross(mt.p[1] - mt.p[0], mt.p[2] - mt.p[0]));
       double edge = 0.0;

@@ -209,9 +209,8 @@ void GoodLinkGather::planTexels(double cacheBytes) {
   std::vector<int> leaf(T);
   for (size_t x = 0; x < T; ++x) leaf[x] = leafAtTopUv(h, receiverTop_, texels_.topUv[x]);
   const TexelFrame frame = texelFrame(t0);
-  auto world = [&](size_t x) {
-    return glm::dvec3(frame.m * glm::dvec4(texels_.localPoint[x], 1.0));
-  };
+  auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
+  auto normal = [&](size_t x) { return frame.normal(texels_.localNormal[x]); };
   std::vector<Polygon> shooter(links_.size());
   for (size_t j = 0; j < links_.size(); ++j) shooter[j] = nodeWorld(links_[j].shooter, t0);
 
@@ -232,9 +231,12 @@ void GoodLinkGather::planTexels(double cacheBytes) {
     tile.common = common;
     const size_t corner[4] = {size_t(tile.j0) * w + tile.i0, size_t(tile.j0) * w + tile.i1,
                               size_t(tile.j1) * w + tile.i1, size_t(tile.j1) * w + tile.i0};
-    glm::dvec3 p[4];
+    glm::dvec3 p[4], n[4];
     double size = 0.0;
-    for (int c = 0; c < 4; ++c) p[c] = world(corner[c]);
+    for (int c = 0; c < 4; ++c) {
+      p[c] = world(corner[c]);
+      n[c] = normal(corner[c]);
+    }
     for (int c = 0; c < 4; ++c) size = std::max(size, glm::length(p[c] - p[(c + 2) % 4]));
     forChain(h, common, -1, [&](int node) {
       linksAt(node, [&](uint32_t j) {
@@ -244,7 +246,7 @@ void GoodLinkGather::planTexels(double cacheBytes) {
           tile.links.push_back(j);
           for (int c = 0; c < 4; ++c)
             tile.formFactor.push_back(
-                links_[j].moves ? 0.0 : pointToPolygonFormFactor(p[c], frame.n, shooter[j]));
+                links_[j].moves ? 0.0 : pointToPolygonFormFactor(p[c], n[c], shooter[j]));
         } else {
           nearOfTile[ti].push_back(j);
         }
@@ -268,11 +270,11 @@ void GoodLinkGather::planTexels(double cacheBytes) {
   if (!cached_) return;
   texelFormFactor_.resize(texelLinks_.size());
   tbb::parallel_for(size_t(0), T, [&](size_t x) {
-    const glm::dvec3 p = world(x);
+    const glm::dvec3 p = world(x), nx = normal(x);
     for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
       const uint32_t j = texelLinks_[e];
       texelFormFactor_[e] =
-          links_[j].moves ? 0.0f : float(pointToPolygonFormFactor(p, frame.n, shooter[j]));
+          links_[j].moves ? 0.0f : float(pointToPolygonFormFactor(p, nx, shooter[j]));
     }
   });
 }
@@ -281,8 +283,7 @@ GoodLinkGather::TexelFrame GoodLinkGather::texelFrame(double t) const {
   const InputPolygon& top = solution_.hierarchy.top(receiverTop_);
   TexelFrame f;
   f.m = scene_.worldTransform(top.node, t);
-  f.n = glm::normalize(
-      glm::dvec3(glm::transpose(glm::inverse(f.m)) * glm::dvec4(top.local.normal(), 0.0)));
+  f.normalMap = glm::transpose(glm::inverse(glm::dmat3(f.m)));
   return f;
 }
 
@@ -299,9 +300,8 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   }
   const TexelFrame frame = texelFrame(t);
   const int width = texels_.width, height = texels_.height;
-  auto world = [&](size_t x) {
-    return glm::dvec3(frame.m * glm::dvec4(texels_.localPoint[x], 1.0));
-  };
+  auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
+  auto normal = [&](size_t x) { return frame.normal(texels_.localNormal[x]); };
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     const Tile& tile = tiles_[ti];
     // The tile's far links at its corners (corner c: (i0,j0), (i1,j0), (i1,j1), (i0,j1)).
@@ -314,7 +314,8 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
       if (weight[j] == glm::dvec3(0.0)) continue;
       for (int c = 0; c < 4; ++c) {
         const double f = links_[j].moves
-                             ? pointToPolygonFormFactor(world(cornerTexel[c]), frame.n, shooter[j])
+                             ? pointToPolygonFormFactor(world(cornerTexel[c]),
+                                                        normal(cornerTexel[c]), shooter[j])
                              : tile.formFactor[k * 4 + size_t(c)];
         corner[c] += f * weight[j];
       }
@@ -326,13 +327,13 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
         const double v = tile.j1 > tile.j0 ? double(j - tile.j0) / (tile.j1 - tile.j0) : 0.0;
         glm::dvec3 H = (1 - u) * (1 - v) * corner[0] + u * (1 - v) * corner[1] + u * v * corner[2] +
                        (1 - u) * v * corner[3];
-        const glm::dvec3 p = world(x);
+        const glm::dvec3 p = world(x), nx = normal(x);
         for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
           const uint32_t l = texelLinks_[e];
           if (weight[l] == glm::dvec3(0.0)) continue;
           const double f = cached_ && !links_[l].moves
                                ? double(texelFormFactor_[e])
-                               : pointToPolygonFormFactor(p, frame.n, shooter[l]);
+                               : pointToPolygonFormFactor(p, nx, shooter[l]);
           H += f * weight[l];
         }
         acc[x] = H;

@@ -52,6 +52,7 @@ struct GoodLinksByReceiver {
 struct MovieTexels {
   const std::vector<glm::dvec2>& topUv;
   const std::vector<glm::dvec3>& localPoint;
+  const std::vector<glm::dvec3>& localNormal;  // shading normals (shadingNormalAt)
   int width = 0, height = 0;
 };
 
@@ -115,9 +116,13 @@ class GoodLinkGather {
   void planWeights(const std::vector<char>& neededKeys);
   void planTexels(double cacheBytes);
   Polygon nodeWorld(uint32_t node, double t) const;
-  struct TexelFrame {  // the receiver's local-to-world map and world normal at one time
+  struct TexelFrame {  // the receiver's local-to-world map and its normal map at one time
     glm::dmat4 m;
-    glm::dvec3 n;
+    glm::dmat3 normalMap;
+    glm::dvec3 point(const glm::dvec3& local) const {
+      return glm::dvec3(m * glm::dvec4(local, 1.0));
+    }
+    glm::dvec3 normal(const glm::dvec3& local) const { return glm::normalize(normalMap * local); }
   };
   TexelFrame texelFrame(double t) const;
 };

@@ -120,7 +120,6 @@ class MovieGeometry {
       receiverTransform_[k] = scene_.worldTransform(receiverTop_.node, keyTimes_[k]);
       receiverWorld_[k] = nodeWorldPolygon(scene_, receiverTop_, req.patch, keyTimes_[k]);
     }
-    receiverNormalLocal_ = receiverTop_.local.normal();
   }
 
   int width() const { return w_; }
@@ -130,7 +129,7 @@ class MovieGeometry {
   double keyTime(int k) const { return keyTimes_[size_t(k)]; }
   const Scene& scene() const { return scene_; }
   const glm::dvec2& topUv(size_t x) const { return topUv_[x]; }
-  MovieTexels texelPoints() const { return {topUv_, localPoint_, w_, h_}; }
+  MovieTexels texelPoints() const { return {topUv_, localPoint_, localNormal_, w_, h_}; }
   const Polygon& receiverWorld(int k) const { return receiverWorld_[size_t(k)]; }
   bool receiverDynamic() const { return receiverDynamic_; }
 
@@ -150,18 +149,17 @@ class MovieGeometry {
     return it->second;
   }
 
-  // Unoccluded form factors F(x -> S) per texel at key k.
+  // Unoccluded form factors F(x -> S) per texel at key k, about the texel's shading normal.
   void formFactorsAt(const Pair& p, int k, std::vector<double>& f) const {
     f.resize(texels());
     const glm::dmat4& m = receiverTransform_[size_t(k)];
-    glm::dvec3 n = glm::normalize(
-        glm::dvec3(glm::transpose(glm::inverse(m)) * glm::dvec4(receiverNormalLocal_, 0.0)));
+    const glm::dmat3 normalMap = glm::transpose(glm::inverse(glm::dmat3(m)));
     const Polygon& sw = p.shooterWorld[size_t(k)];
     parallelRows(h_, [&](int j) {
       for (int i = 0; i < w_; ++i) {
         size_t x = size_t(j) * w_ + i;
         glm::dvec3 pt(m * glm::dvec4(localPoint_[x], 1.0));
-        f[x] = pointToPolygonFormFactor(pt, n, sw);
+        f[x] = pointToPolygonFormFactor(pt, glm::normalize(normalMap * localNormal_[x]), sw);
       }
     });
   }
@@ -207,11 +205,13 @@ class MovieGeometry {
     const bool triangle = receiverTop_.local.count == 3;
     topUv_.resize(texels());
     localPoint_.resize(texels());
+    localNormal_.resize(texels());
     for (int j = 0; j < h_; ++j)
       for (int i = 0; i < w_; ++i) {
         size_t x = size_t(j) * w_ + i;
         topUv_[x] = topUvFromNodeUv(patch, {(i + 0.5) / w_, (j + 0.5) / h_}, triangle);
         localPoint_[x] = polygonPointAt(receiverTop_.local, topUv_[x]);
+        localNormal_[x] = shadingNormalAt(receiverTop_, topUv_[x]);
       }
   }
 
@@ -222,13 +222,12 @@ class MovieGeometry {
   const int w_, h_;
   const double t0_, t1_;
   std::vector<glm::dvec2> topUv_;
-  std::vector<glm::dvec3> localPoint_;
+  std::vector<glm::dvec3> localPoint_, localNormal_;  // texel centres and shading normals
   std::vector<signed char> nodeMoves_;
   std::unordered_map<int, std::array<glm::dvec3, 2>> nodeSwept_;
   bool receiverDynamic_ = false;
   std::vector<Polygon> receiverWorld_;
   std::vector<glm::dmat4> receiverTransform_;
-  glm::dvec3 receiverNormalLocal_{0.0};
   std::unordered_map<long long, glm::dmat4> nodeWorldAtKey_;
 };
 

@@ -102,6 +102,8 @@ struct PathTracer::Impl {
     const Texture* texture = nullptr;
     glm::dvec3 factor{0.0};
     std::array<glm::dvec2, 4> uv{};
+    // Shading normals at the vertices (glTF NORMAL, world, unit); zero: flat.
+    std::array<glm::dvec3, 4> shadingNormal{};
     int frontEmitter = -1;  // index into emitters of the side facing the front normal
     int backEmitter = -1;   // of the back side (doubleSided emitters only)
   };
@@ -180,6 +182,12 @@ struct PathTracer::Impl {
       }
       Surface surface{world, n, m.reflectance, m.emission, m.doubleSided};
       surface.frontEmitter = emitter;
+      if (in.normal[0] != glm::dvec3(0.0)) {
+        const glm::dmat3 normalMap =
+            glm::transpose(glm::inverse(glm::dmat3(worldFromLocal[size_t(in.node)])));
+        for (int k = 0; k < world.count; ++k)
+          surface.shadingNormal[size_t(k)] = glm::normalize(normalMap * in.normal[size_t(k)]);
+      }
       if (m.baseColorTexture >= 0 && m.baseColorTexture < int(scene.textures.size())) {
         const Texture& tex = scene.textures[size_t(m.baseColorTexture)];
         if (tex.width > 0 && tex.height > 0 &&
@@ -285,6 +293,18 @@ struct PathTracer::Impl {
     return hit;
   }
 
+  // The shading normal at a hit on the side of the flat normal n (which is s.normal or its
+  // negation): the vertex normals interpolated over the hit's fan triangle, normalised; n
+  // itself for a flat polygon or where the interpolation faces away from n.
+  glm::dvec3 shadingNormal(const Surface& s, const Hit& h, const glm::dvec3& n) const {
+    if (s.shadingNormal[0] == glm::dvec3(0.0)) return n;
+    glm::dvec3 ns = (1.0 - h.u - h.v) * s.shadingNormal[0] + h.u * s.shadingNormal[size_t(h.fan)] +
+                    h.v * s.shadingNormal[size_t(h.fan + 1)];
+    if (glm::dot(n, s.normal) < 0.0) ns = -ns;
+    const double len = glm::length(ns);
+    return len > 1e-12 && glm::dot(ns, n) > 0.0 ? ns / len : n;
+  }
+
   // Reflectance at a hit: constant, or factor x bilinear texel lookup (glTF: uv (0, 0) is the
   // top-left corner of the image, texel centres at half-integers, REPEAT wrap).
   glm::dvec3 reflectanceAt(const Surface& s, const Hit& h) const {
@@ -341,15 +361,15 @@ struct PathTracer::Impl {
 
   // Next-event estimate of the reflected-radiance integrand's emitter part at x (normal n on
   // the side the path arrived from): one emitter point, returns sum L_e cos cos' / d^2 / pdf.
-  glm::dvec3 directLight(const glm::dvec3& x, const glm::dvec3& n, std::uint32_t surface,
-                         RandomStream& rng) const {
+  glm::dvec3 directLight(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& geometric,
+                         std::uint32_t surface, RandomStream& rng) const {
     const double u0 = rng.next(), u1 = rng.next(), u2 = rng.next();
     if (emitters.empty()) return glm::dvec3(0.0);
     const size_t e =
         size_t(std::lower_bound(emitterCdf.begin(), emitterCdf.end(), u0) - emitterCdf.begin());
     const Emitter& em = emitters[std::min(e, emitters.size() - 1)];
     if (!(em.probability > 0.0)) return glm::dvec3(0.0);
-    const glm::dvec3 origin = liftOff(x, n);
+    const glm::dvec3 origin = liftOff(x, geometric);
     const glm::dvec3 y = pointOnPolygon(em.world, u1, u2);
     const glm::dvec3 d = y - origin;
     const double dist2 = glm::dot(d, d);
@@ -357,7 +377,8 @@ struct PathTracer::Impl {
     const double dist = std::sqrt(dist2);
     const glm::dvec3 w = d / dist;
     const double cosX = glm::dot(n, w), cosY = -glm::dot(em.normal, w);
-    if (cosX <= 0.0 || cosY <= 0.0) return glm::dvec3(0.0);  // one-sided emitter / receiver
+    if (cosX <= 0.0 || cosY <= 0.0) return glm::dvec3(0.0);     // one-sided emitter / receiver
+    if (glm::dot(geometric, w) <= 0.0) return glm::dvec3(0.0);  // below the surface itself
     if (occluded(origin, w, dist * (1.0 - kShadowShortening), surface)) return glm::dvec3(0.0);
     // Multiple importance sampling against the cosine-distributed continuation (Veach &
     // Guibas 1995, power heuristic), both densities per unit solid angle.
@@ -423,8 +444,11 @@ struct PathTracer::Impl {
       const glm::dvec3 rho = reflectanceAt(s, h);
       if (maxComponent(rho) <= 0.0) break;
       const glm::dvec3 x = origin + t * dir;
+      // The shading normal (glTF NORMAL, interpolated; Cycles and glTF viewers shade with it)
+      // on the side the path arrived from; the flat n keeps the ray offsets and side tests.
+      const glm::dvec3 ns = shadingNormal(s, h, n);
       // Reflected direct light: BRDF rho / pi times the NEE estimate.
-      L += throughput * rho * (1.0 / kPi) * directLight(x, n, hit, rng);
+      L += throughput * rho * (1.0 / kPi) * directLight(x, ns, n, hit, rng);
       // Continue with a cosine-distributed direction: BRDF x cos / pdf = rho.
       const double u1 = rng.next(), u2 = rng.next(), uRoulette = rng.next();
       throughput *= rho;
@@ -434,8 +458,9 @@ struct PathTracer::Impl {
         throughput /= q;
       }
       origin = liftOff(x, n);
-      dir = cosineDirection(n, u1, u2);
-      pdfBsdf = std::max(glm::dot(n, dir), 0.0) / kPi;
+      dir = cosineDirection(ns, u1, u2);
+      if (glm::dot(dir, n) <= 0.0) break;  // into the surface: absorbed
+      pdfBsdf = std::max(glm::dot(ns, dir), 0.0) / kPi;
       tNear = 0.0;
       tFar = std::numeric_limits<double>::infinity();
       from = hit;

@@ -4,6 +4,8 @@
 // Appendix C "Animation Sampler Interpolation Modes" (Khronos, glTF 2.0.1).
 #include "libcommon/scene/scene.h"
 
+#include "libcommon/scene/patch_hierarchy.h"
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -341,6 +343,7 @@ namespace {
 struct Tri {
   std::array<glm::dvec3, 3> p;
   std::array<glm::dvec2, 3> uv;
+  std::array<glm::dvec3, 3> normal;
   int material;
 };
 
@@ -405,6 +408,7 @@ bool tryMerge(const Tri& ti, const Tri& tj, InputPolygon* out) {
       out->local.count = 4;
       out->local.v = v;
       out->uv = {ti.uv[ia], tj.uv[jd], ti.uv[ib], ti.uv[ic]};
+      out->normal = {ti.normal[ia], tj.normal[jd], ti.normal[ib], ti.normal[ic]};
       out->material = ti.material;
       return true;
     }
@@ -423,19 +427,33 @@ InputPolygon reversed(const InputPolygon& p) {
   for (int i = 1; i < p.local.count; ++i) {
     r.local.v[size_t(i)] = p.local.v[size_t(p.local.count - i)];
     r.uv[size_t(i)] = p.uv[size_t(p.local.count - i)];
+    r.normal[size_t(i)] = -p.normal[size_t(p.local.count - i)];
   }
+  r.normal[0] = -p.normal[0];
   r.backFace = true;
   return r;
 }
 
 }  // namespace
 
+glm::dvec3 shadingNormalAt(const InputPolygon& p, glm::dvec2 uv) {
+  const glm::dvec3 flat = p.local.normal();
+  if (p.normal[0] == glm::dvec3(0.0)) return flat;
+  Polygon normals;  // the vertex normals, interpolated as points are
+  normals.count = p.local.count;
+  for (int k = 0; k < p.local.count; ++k) normals.v[size_t(k)] = p.normal[size_t(k)];
+  const glm::dvec3 n = polygonPointAt(normals, uv);
+  const double len = glm::length(n);
+  if (!(len > 1e-12) || !(glm::dot(n, flat) > 0.0)) return flat;
+  return n / len;
+}
+
 std::vector<InputPolygon> Scene::inputPolygons() const {
   std::vector<InputPolygon> out;
   for (int node : meshNodes()) {
     const Mesh& mesh = meshes[size_t(nodes[size_t(node)].mesh)];
     std::vector<Tri> tris;
-    for (const MeshTriangle& t : mesh.triangles) tris.push_back({t.p, t.uv, t.material});
+    for (const MeshTriangle& t : mesh.triangles) tris.push_back({t.p, t.uv, t.normal, t.material});
     // Directed edge -> triangles that have it, to find the neighbour across an edge.
     std::map<EdgeKey, std::vector<size_t>> byEdge;
     for (size_t i = 0; i < tris.size(); ++i)
@@ -468,6 +486,7 @@ std::vector<InputPolygon> Scene::inputPolygons() const {
         for (size_t k = 0; k < 3; ++k) {
           poly.local.v[k] = tris[i].p[k];
           poly.uv[k] = tris[i].uv[k];
+          poly.normal[k] = tris[i].normal[k];
         }
         poly.material = tris[i].material;
       }

@@ -46,7 +46,9 @@ struct Material {
 struct MeshTriangle {
   std::array<glm::dvec3, 3> p{};
   std::array<glm::dvec2, 3> uv{};  // TEXCOORD_n of the material's base colour, or zero
-  int material = -1;               // index into Scene::materials (-1 = glTF default material)
+  // glTF NORMAL at the vertices (unit, local frame), the shading normal; zero: flat (none).
+  std::array<glm::dvec3, 3> normal{};
+  int material = -1;  // index into Scene::materials (-1 = glTF default material)
 };
 
 struct Mesh {
@@ -101,10 +103,19 @@ struct CameraView {
 struct InputPolygon {
   Polygon local;
   std::array<glm::dvec2, 4> uv{};  // texture coordinates at the vertices
-  int node = -1;                   // mesh node that places it in the world
+  // Shading normals at the vertices (glTF NORMAL, local frame); zero: flat. Only the per-texel
+  // and per-pixel terms use them (rad-movies, rad-reference); the polygon stays the flat
+  // radiosity element.
+  std::array<glm::dvec3, 4> normal{};
+  int node = -1;  // mesh node that places it in the world
   int material = -1;
   bool backFace = false;  // the reversed copy made for a doubleSided material
 };
+
+// The shading normal of `p` at its (u,v) (the vertex normals interpolated with the weights of
+// polygonPointAt, normalised), in its local frame; the flat normal when it has none, or when
+// the interpolation degenerates or faces away from the flat normal's side.
+glm::dvec3 shadingNormalAt(const InputPolygon& p, glm::dvec2 uv);
 
 class Scene {
  public:

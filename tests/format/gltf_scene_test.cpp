@@ -528,4 +528,36 @@ TEST_F(BadInput, StripSparseAndNormalisedTexcoords) {
 }
 
 }  // namespace
+// glTF NORMAL (§3.7.2.1): read as the vertex shading normals, normalised; a triangle whose
+// normals are its flat normal is flat; a NORMAL that is not VEC3 is one line.
+TEST_F(BadInput, NormalsAreReadNormalisedAndCheckedForType) {
+  std::string bin = triangleBin();                         // 44 bytes
+  float n[9] = {0, 0, 2, 0.6f, 0, 0.8f, 0, 0, 1};          // not unit at vertex 0
+  bin.append(reinterpret_cast<const char*>(n), sizeof n);  // 44..79
+  write("tri.bin", bin);
+  auto gltf = [](const std::string& type) {
+    return R"({"asset": {"version": "2.0"}, "nodes": [{"mesh": 0}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 2}, "indices": 1}]}],
+      "buffers": [{"uri": "tri.bin", "byteLength": 80}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                      {"buffer": 0, "byteOffset": 36, "byteLength": 8},
+                      {"buffer": 0, "byteOffset": 44, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3,
+                     "min": [0,0,0], "max": [1,1,0]},
+                    {"bufferView": 1, "componentType": 5123, "type": "SCALAR", "count": 3},
+                    {"bufferView": 2, "componentType": 5126, "type": ")" +
+           type + R"(", "count": 3}]})";
+  };
+  Scene s = readGltfScene(write("n.gltf", gltf("VEC3")));
+  ASSERT_EQ(s.meshes[0].triangles.size(), 1u);
+  const MeshTriangle& t = s.meshes[0].triangles[0];
+  EXPECT_EQ(t.normal[0], glm::dvec3(0, 0, 1));
+  EXPECT_NEAR(t.normal[1].x, 0.6, 1e-7);
+  EXPECT_NEAR(glm::length(t.normal[1]), 1.0, 1e-12);
+  const InputPolygon p = s.inputPolygons()[0];
+  EXPECT_NEAR(shadingNormalAt(p, {0, 0}).z, 1.0, 1e-12);
+  EXPECT_GT(shadingNormalAt(p, {1, 0}).x, 0.5);
+  expectBadInput(write("n2.gltf", gltf("VEC2")), "NORMAL is not VEC3");
+}
+
 }  // namespace rad

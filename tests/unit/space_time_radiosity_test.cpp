@@ -280,8 +280,8 @@ TEST(SpaceTimeRadiosity, GoodIrradianceIsContinuousAcrossLeavesAndTiles) {
     Mesh m;
     m.name = name;
     for (const auto& q : quads) {
-      m.triangles.push_back({{q[0], q[1], q[2]}, {}, material});
-      m.triangles.push_back({{q[0], q[2], q[3]}, {}, material});
+      m.triangles.push_back({{q[0], q[1], q[2]}, {}, {}, material});
+      m.triangles.push_back({{q[0], q[2], q[3]}, {}, {}, material});
     }
     scene.meshes.push_back(m);
     Node n;
