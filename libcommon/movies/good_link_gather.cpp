@@ -212,7 +212,15 @@ void GoodLinkGather::planTexels(double cacheBytes) {
   auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
   auto normal = [&](size_t x) { return frame.normal(texels_.localNormal[x]); };
   std::vector<Polygon> shooter(links_.size());
-  for (size_t j = 0; j < links_.size(); ++j) shooter[j] = nodeWorld(links_[j].shooter, t0);
+  std::vector<glm::dvec3> shooterCentre(links_.size());
+  std::vector<double> shooterRadius(links_.size(), 0.0);
+  for (size_t j = 0; j < links_.size(); ++j) {
+    shooter[j] = nodeWorld(links_[j].shooter, t0);
+    shooterCentre[j] = shooter[j].centroid();
+    for (int k = 0; k < shooter[j].count; ++k)
+      shooterRadius[j] =
+          std::max(shooterRadius[j], glm::length(shooter[j].v[size_t(k)] - shooterCentre[j]));
+  }
 
   tilesX_ = (w + kTile - 1) / kTile;
   tilesY_ = (hgt + kTile - 1) / kTile;
@@ -238,11 +246,29 @@ void GoodLinkGather::planTexels(double cacheBytes) {
       n[c] = normal(corner[c]);
     }
     for (int c = 0; c < 4; ++c) size = std::max(size, glm::length(p[c] - p[(c + 2) % 4]));
+    // Far: the nearest corner farther from the shooter part than kTileFarRatio x size. Bounding
+    // spheres decide most pairs without the four point-to-polygon distances.
+    glm::dvec3 centre(0.0);
+    for (int c = 0; c < 4; ++c) centre += 0.25 * p[c];
+    double radius = 0.0;
+    for (int c = 0; c < 4; ++c) radius = std::max(radius, glm::length(p[c] - centre));
+    const double limit = kTileFarRatio * size;
+    auto isFar = [&](uint32_t j) {
+      const double dc = glm::length(centre - shooterCentre[j]);
+      if (dc - radius - shooterRadius[j] > limit) return true;
+      if (dc - radius <= limit) {  // some corner within limit of the shooter's centroid
+        double nearest = std::numeric_limits<double>::infinity();
+        for (int c = 0; c < 4; ++c)
+          nearest = std::min(nearest, glm::length(p[c] - shooterCentre[j]));
+        if (nearest <= limit) return false;
+      }
+      double d = std::numeric_limits<double>::infinity();
+      for (int c = 0; c < 4; ++c) d = std::min(d, distanceToPolygon(p[c], shooter[j]));
+      return d > limit;
+    };
     forChain(h, common, -1, [&](int node) {
       linksAt(node, [&](uint32_t j) {
-        double d = std::numeric_limits<double>::infinity();
-        for (int c = 0; c < 4; ++c) d = std::min(d, distanceToPolygon(p[c], shooter[j]));
-        if (d > kTileFarRatio * size) {
+        if (isFar(j)) {
           tile.links.push_back(j);
           for (int c = 0; c < 4; ++c)
             tile.formFactor.push_back(

@@ -94,7 +94,7 @@ class GoodLinkGather {
   // Texels are planned in tiles of kTile x kTile; a link whose shooter part is farther than
   // kTileFarRatio times a tile's size is evaluated at the tile's corners and interpolated.
   static constexpr int kTile = 8;
-  static constexpr double kTileFarRatio = 4.0;
+  static constexpr double kTileFarRatio = 2.0;
   struct Tile {
     int i0 = 0, j0 = 0, i1 = 0, j1 = 0;  // first texel and the corner texels (last column, row)
     int common = -1;                     // deepest node holding every texel of the tile
