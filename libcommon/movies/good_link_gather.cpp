@@ -51,7 +51,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   stats.links += long(links_.size());
   stats.entries += long(texelLinks_.size());
   if (cached_) stats.cachedEntries += long(texelLinks_.size());
-  stats.tileEntries += long(tileLinks_.size());
+  stats.tileEntries += long(tileLinkCount_);
 }
 
 Polygon GoodLinkGather::nodeWorld(uint32_t node, double t) const {
@@ -223,8 +223,8 @@ void GoodLinkGather::planTexels(double cacheBytes) {
   }
 
   tilesX_ = (w + kTile - 1) / kTile;
-  tilesY_ = (hgt + kTile - 1) / kTile;
-  tiles_.assign(size_t(tilesX_) * tilesY_, Tile());
+  const int tilesY = (hgt + kTile - 1) / kTile;
+  tiles_.assign(size_t(tilesX_) * size_t(tilesY), Tile());
   std::vector<std::vector<uint32_t>> nearOfTile(tiles_.size());
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     Tile& tile = tiles_[ti];
@@ -279,8 +279,7 @@ void GoodLinkGather::planTexels(double cacheBytes) {
       });
     });
   });
-  for (const Tile& tile : tiles_)
-    tileLinks_.insert(tileLinks_.end(), tile.links.begin(), tile.links.end());
+  for (const Tile& tile : tiles_) tileLinkCount_ += tile.links.size();
   // Per texel, in texel order: its chain below its tile's common node, then the tile's near links.
   texelStart_.assign(T + 1, 0);
   for (int j = 0; j < hgt; ++j)

@@ -7,14 +7,14 @@
 //   G(x, k) = \sum_{l = (p <- q) good, p \in c(x), active at k}  B_q(k) \, \bar V_l(k) \, F(x \to
 //   q)
 //
-// with F(x -> q) the exact point-to-polygon form factor at the texel and \bar V_l the link's
-// visibility, recovered from the stored F·V as  \bar V = F V_l / (\bar F(p -> q) e_p),  clamped
-// to [0, 1], where \bar F is the area-average form factor (areaAverageFormFactor) and e_p the
-// receiver's exposure (the share of it that is not covered; rad-global divides its gather by
-// it). The Gouraud layer spreads a receiver element's mean irradiance linearly over it; the
-// point form factor follows what the element really sees: the darkening into a concave corner,
-// the bright band next to a lit wall. For an unoccluded link the texel's sum is the exact
-// form factor, so a closed room sums to 1 at every texel, not only per element.
+// with F(x -> q) the exact point-to-polygon form factor at the texel, about its shading normal,
+// and \bar V_l = V_l / e_p clamped to [0, 1]: the link's stored visibility (linkhier 1.2; older
+// files: F·V / \bar F, the area-average form factor) over the receiver's exposure e_p (the share
+// of it not covered by a touching solid, whose sample points count as occluded; rad-global
+// divides its gather by it). The Gouraud layer spreads a receiver element's mean irradiance
+// linearly over it; the point form factor follows what the element really sees: the darkening into
+// a concave corner, the bright band next to a lit wall. For an unoccluded link the texel's sum is
+// the exact form factor, so a closed room sums to 1 at every texel, not only per element.
 //
 // Cost: texels are planned in tiles of 8 x 8; a link whose shooter part is far from a tile
 // (kTileFarRatio times its size) is evaluated at the tile's corners and interpolated
@@ -101,9 +101,9 @@ class GoodLinkGather {
     std::vector<uint32_t> links;         // links_ indices interpolated over the tile
     std::vector<double> formFactor;      // per tile link, its 4 corners (links that do not move)
   };
-  int tilesX_ = 0, tilesY_ = 0;
+  int tilesX_ = 0;
   std::vector<Tile> tiles_;
-  std::vector<uint32_t> tileLinks_;  // all tiles' links (for the stats)
+  size_t tileLinkCount_ = 0;  // over all tiles (the stats)
   // Per texel its own terms: links_ indices texelLinks_[texelStart_[x] .. texelStart_[x + 1])
   // and, when cached_, the form factors of the links that do not move in the same places.
   std::vector<uint32_t> texelStart_, texelLinks_;
