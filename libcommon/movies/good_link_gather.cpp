@@ -5,6 +5,7 @@
 #include <array>
 #include <limits>
 #include <map>
+#include <unordered_map>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -239,11 +240,10 @@ void GoodLinkGather::planTexels(double cacheBytes) {
     tile.common = common;
     const size_t corner[4] = {size_t(tile.j0) * w + tile.i0, size_t(tile.j0) * w + tile.i1,
                               size_t(tile.j1) * w + tile.i1, size_t(tile.j1) * w + tile.i0};
-    glm::dvec3 p[4], n[4];
+    glm::dvec3 p[4];
     double size = 0.0;
     for (int c = 0; c < 4; ++c) {
       p[c] = world(corner[c]);
-      n[c] = normal(corner[c]);
     }
     for (int c = 0; c < 4; ++c) size = std::max(size, glm::length(p[c] - p[(c + 2) % 4]));
     // Far: the nearest corner farther from the shooter part than kTileFarRatio x size. Bounding
@@ -270,9 +270,6 @@ void GoodLinkGather::planTexels(double cacheBytes) {
       linksAt(node, [&](uint32_t j) {
         if (isFar(j)) {
           tile.links.push_back(j);
-          for (int c = 0; c < 4; ++c)
-            tile.formFactor.push_back(
-                links_[j].moves ? 0.0 : pointToPolygonFormFactor(p[c], n[c], shooter[j]));
         } else {
           nearOfTile[ti].push_back(j);
         }
@@ -280,6 +277,49 @@ void GoodLinkGather::planTexels(double cacheBytes) {
     });
   });
   for (const Tile& tile : tiles_) tileLinkCount_ += tile.links.size();
+  // The far links' form factors at the tiles' corners, once per corner texel and link: a corner
+  // is shared by up to four tiles, which mostly interpolate the same links.
+  std::unordered_map<size_t, std::vector<uint32_t>> cornerLinks;
+  auto cornersOf = [&](const Tile& tile) {
+    return std::array<size_t, 4>{size_t(tile.j0) * w + tile.i0, size_t(tile.j0) * w + tile.i1,
+                                 size_t(tile.j1) * w + tile.i1, size_t(tile.j1) * w + tile.i0};
+  };
+  for (const Tile& tile : tiles_)
+    for (size_t corner : cornersOf(tile)) {
+      std::vector<uint32_t>& ids = cornerLinks[corner];
+      for (uint32_t j : tile.links)
+        if (!links_[j].moves) ids.push_back(j);
+    }
+  std::vector<std::pair<size_t, std::vector<uint32_t>*>> corners;
+  for (auto& [corner, ids] : cornerLinks) {
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    corners.emplace_back(corner, &ids);
+  }
+  std::unordered_map<size_t, std::vector<double>> cornerF;
+  for (const auto& c : corners) cornerF[c.first].resize(c.second->size());
+  tbb::parallel_for(size_t(0), corners.size(), [&](size_t i) {
+    const size_t x = corners[i].first;
+    const std::vector<uint32_t>& ids = *corners[i].second;
+    std::vector<double>& f = cornerF.at(x);
+    const glm::dvec3 p = world(x), nx = normal(x);
+    for (size_t k = 0; k < ids.size(); ++k) f[k] = pointToPolygonFormFactor(p, nx, shooter[ids[k]]);
+  });
+  tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
+    Tile& tile = tiles_[ti];
+    const std::array<size_t, 4> c4 = cornersOf(tile);
+    tile.formFactor.assign(tile.links.size() * 4, 0.0);
+    for (int c = 0; c < 4; ++c) {
+      const std::vector<uint32_t>& ids = cornerLinks.at(c4[size_t(c)]);
+      const std::vector<double>& f = cornerF.at(c4[size_t(c)]);
+      for (size_t k = 0; k < tile.links.size(); ++k) {
+        const uint32_t j = tile.links[k];
+        if (links_[j].moves) continue;
+        const size_t at = size_t(std::lower_bound(ids.begin(), ids.end(), j) - ids.begin());
+        tile.formFactor[k * 4 + size_t(c)] = f[at];
+      }
+    }
+  });
   // Per texel, in texel order: its chain below its tile's common node, then the tile's near links.
   texelStart_.assign(T + 1, 0);
   for (int j = 0; j < hgt; ++j)
