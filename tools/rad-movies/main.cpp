@@ -136,7 +136,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-texture-memory", b.maxTextureMemoryMiB,
                  "MiB of working memory per movie: one key's texel buffers plus, per bad shooter "
                  "of a static pair, its form factors and static-blocker masks (independent of "
-                 "the number of keys); a movie that needs more is refused (exit 4)")
+                 "the number of keys); a movie that needs more is refused (exit 4). The gather "
+                 "keeps its per-texel form factors in half of it, else recomputes them per key")
       ->capture_default_str();
   app.add_option("--report", o.report, "write timings and counts as JSON to this file");
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
