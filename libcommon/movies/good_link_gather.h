@@ -97,9 +97,14 @@ class GoodLinkGather {
   static constexpr double kTileFarRatio = 2.0;
   struct Tile {
     int i0 = 0, j0 = 0, i1 = 0, j1 = 0;  // first texel and the corner texels (last column, row)
-    int common = -1;                     // deepest node holding every texel of the tile
-    std::vector<uint32_t> links;         // links_ indices interpolated over the tile
-    std::vector<double> formFactor;      // per tile link, its 4 corners (links that do not move)
+    // The corner texels (i0,j0), (i1,j0), (i1,j1), (i0,j1) of a texture `width` wide.
+    std::array<size_t, 4> cornerTexels(int width) const {
+      return {size_t(j0) * width + i0, size_t(j0) * width + i1, size_t(j1) * width + i1,
+              size_t(j1) * width + i0};
+    }
+    int common = -1;                 // deepest node holding every texel of the tile
+    std::vector<uint32_t> links;     // links_ indices interpolated over the tile
+    std::vector<double> formFactor;  // per tile link, its 4 corners (links that do not move)
   };
   int tilesX_ = 0;
   std::vector<Tile> tiles_;
@@ -110,12 +115,12 @@ class GoodLinkGather {
   std::vector<float> texelFormFactor_;
   bool cached_ = false;
 
+  Polygon nodeWorld(uint32_t node, double t) const;
   void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request);
   void shooterParts(const Polygon& receiver, uint32_t shooter, double t,
                     std::vector<uint32_t>& out) const;
   void planWeights(const std::vector<char>& neededKeys);
   void planTexels(double cacheBytes);
-  Polygon nodeWorld(uint32_t node, double t) const;
   struct TexelFrame {  // the receiver's local-to-world map and its normal map at one time
     glm::dmat4 m;
     glm::dmat3 normalMap;

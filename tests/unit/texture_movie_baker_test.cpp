@@ -458,6 +458,51 @@ TEST(TextureMovieBaker, BadRequestsAreInputErrors) {
   EXPECT_THROW(TextureMovieBaker(t.scene, t.solution, kFps, o), Error);
 }
 
+// One key texture (frame 0) of top-level patch `top`, w x h texels, with each texel's centre
+// (the scenes below are static, so local is world) and its red irradiance.
+struct BakedTexel {
+  glm::dvec3 x;
+  double h;
+};
+std::vector<BakedTexel> bakeTop(const Scene& s, const GlobalSolution& g, int top, int w, int h,
+                                const TextureMovieBakerOptions& o = {}) {
+  TextureMovieBaker baker(s, g, kFps, o);
+  MovieExtent r;
+  r.patch = PatchId{uint32_t(top), 1u};
+  r.firstFrame = r.lastFrame = 0;
+  r.width = w;
+  r.height = h;
+  const std::vector<float> key = baker.bake(r).keys[0];
+  std::vector<BakedTexel> out;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i)
+      out.push_back({polygonPointAt(g.hierarchy.top(top).local, {(i + 0.5) / w, (j + 0.5) / h}),
+                     key[(size_t(j) * w + i) * 3]});
+  return out;
+}
+
+// Per texel row y of an n x n bake, the irradiance of side a (x < edge) and side b (x > edge) at
+// the edge x = `edge`, each extrapolated linearly from its two texels nearest it; rows where a
+// texel is missing or not lit are left out.
+std::vector<std::pair<double, double>> extrapolatedToEdge(const std::vector<BakedTexel>& a,
+                                                          const std::vector<BakedTexel>& b,
+                                                          double edge, int n) {
+  auto at = [&](const std::vector<BakedTexel>& t, double x, double y) {
+    for (const BakedTexel& e : t)
+      if (std::abs(e.x.x - x) < 0.25 / n && std::abs(e.x.y - y) < 0.25 / n) return e.h;
+    return -1.0;
+  };
+  std::vector<std::pair<double, double>> out;
+  for (int j = 0; j < n; ++j) {
+    const double y = (j + 0.5) / n;
+    const double a1 = at(a, edge - 0.5 / n, y), a2 = at(a, edge - 1.5 / n, y);
+    const double b1 = at(b, edge + 0.5 / n, y), b2 = at(b, edge + 1.5 / n, y);
+    if (a1 <= 0 || a2 <= 0 || b1 <= 0 || b2 <= 0) continue;
+    out.emplace_back(a1 + 0.5 * (a1 - a2), b1 - 0.5 * (b2 - b1));
+  }
+  return out;
+}
+
 // The gathered good layer at a concave corner (good_link_gather.h): a floor meets an emitting,
 // non-reflecting wall, every link good and unoccluded, so the exact irradiance at a floor texel
 // is B_wall F(x -> wall), which climbs steeply towards the corner. The gather sums the exact
@@ -488,27 +533,17 @@ TEST(TextureMovieBaker, GatheredGoodLayerIsTheExactPointFormFactorIntoACorner) {
   auto bakeTile = [&](int node, GoodLayer layer, int w, int h) {
     TextureMovieBakerOptions o;
     o.goodLayer = layer;
-    TextureMovieBaker baker(s, g, kFps, o);
-    MovieExtent r;
-    r.patch = PatchId{uint32_t(topOfNode(g, node)), 1u};
-    r.firstFrame = r.lastFrame = 0;
-    r.width = w;
-    r.height = h;
-    return baker.bake(r).keys[0];
+    return bakeTop(s, g, topOfNode(g, node), w, h, o);
   };
   const int w = 32, h = 8;
-  const Polygon& floorA = g.hierarchy.top(topOfNode(g, tileA)).local;
   double gatherWorst = 0.0, gouraudWorst = 0.0;
-  const std::vector<float> gathered = bakeTile(tileA, GoodLayer::kGather, w, h);
-  const std::vector<float> gouraud = bakeTile(tileA, GoodLayer::kGouraud, w, h);
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      const glm::dvec3 x = polygonPointAt(floorA, {(i + 0.5) / w, (j + 0.5) / h});
-      const double exact = B * pointToPolygonFormFactor(x, {0, 0, 1}, wallPoly);
-      const size_t at = (size_t(j) * w + i) * 3;
-      gatherWorst = std::max(gatherWorst, std::abs(gathered[at] - exact) / exact);
-      gouraudWorst = std::max(gouraudWorst, std::abs(gouraud[at] - exact) / exact);
-    }
+  const std::vector<BakedTexel> gathered = bakeTile(tileA, GoodLayer::kGather, w, h);
+  const std::vector<BakedTexel> gouraud = bakeTile(tileA, GoodLayer::kGouraud, w, h);
+  for (size_t x = 0; x < gathered.size(); ++x) {
+    const double exact = B * pointToPolygonFormFactor(gathered[x].x, {0, 0, 1}, wallPoly);
+    gatherWorst = std::max(gatherWorst, std::abs(gathered[x].h - exact) / exact);
+    gouraudWorst = std::max(gouraudWorst, std::abs(gouraud[x].h - exact) / exact);
+  }
   EXPECT_LT(gatherWorst, 1e-5);
   EXPECT_GT(gouraudWorst, 2.0 * gatherWorst) << "Gouraud misses the corner by " << gouraudWorst;
 }
@@ -542,44 +577,12 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
   ASSERT_NE(leavesA, leavesB) << "the tiles must be refined differently";
 
   const int n = 64;
-  struct Texel {
-    glm::dvec3 x;
-    float h;
-  };
-  auto bake = [&](int top) {
-    TextureMovieBaker baker(s, g, kFps, {});
-    MovieExtent r;
-    r.patch = PatchId{uint32_t(top), 1u};
-    r.firstFrame = r.lastFrame = 0;
-    r.width = r.height = n;
-    const std::vector<float> key = baker.bake(r).keys[0];
-    std::vector<Texel> out;
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        out.push_back({polygonPointAt(g.hierarchy.top(top).local, {(i + 0.5) / n, (j + 0.5) / n}),
-                       key[(size_t(j) * n + i) * 3]});
-    return out;
-  };
-  const std::vector<Texel> a = bake(topA), b = bake(topB);
-  // Per row, each side's two texels nearest the edge, extrapolated linearly to x = 1 (the lamp's
-  // direct light alone falls 3 % from one texel to the next there).
-  auto at = [&](const std::vector<Texel>& t, double x, double y) {
-    for (const Texel& e : t)
-      if (std::abs(e.x.x - x) < 0.25 / n && std::abs(e.x.y - y) < 0.25 / n) return double(e.h);
-    return -1.0;
-  };
-  int compared = 0;
+  // The lamp's direct light alone falls 3 % from one texel to the next at the edge x = 1.
+  const auto sides =
+      extrapolatedToEdge(bakeTop(s, g, topA, n, n), bakeTop(s, g, topB, n, n), 1.0, n);
   double worst = 0.0;
-  for (int j = 0; j < n; ++j) {
-    const double y = (j + 0.5) / n;
-    const double a1 = at(a, 1 - 0.5 / n, y), a2 = at(a, 1 - 1.5 / n, y);
-    const double b1 = at(b, 1 + 0.5 / n, y), b2 = at(b, 1 + 1.5 / n, y);
-    if (a1 < 0 || a2 < 0 || b1 < 0 || b2 < 0) continue;
-    const double fromA = a1 + 0.5 * (a1 - a2), fromB = b1 - 0.5 * (b2 - b1);
-    worst = std::max(worst, std::abs(fromA - fromB) / fromA);
-    ++compared;
-  }
-  EXPECT_EQ(compared, n);
+  for (const auto& [fromA, fromB] : sides) worst = std::max(worst, std::abs(fromA - fromB) / fromA);
+  EXPECT_EQ(int(sides.size()), n);
   EXPECT_LT(worst, 0.01) << "step across the edge";
 }
 
@@ -626,40 +629,12 @@ TEST(TextureMovieBaker, ShadingNormalsMakeACreaseSmooth) {
     so.radiosity.minArea = 1e-3;
     GlobalSolution g = solveSpaceTime(s, {0.0}, so);
     const int n = 32;
-    auto texels = [&](int node) {
-      const int top = topOfNode(g, node);
-      TextureMovieBaker baker(s, g, kFps, {});
-      MovieExtent r;
-      r.patch = PatchId{uint32_t(top), 1u};
-      r.firstFrame = r.lastFrame = 0;
-      r.width = r.height = n;
-      const std::vector<float> key = baker.bake(r).keys[0];
-      std::vector<std::pair<glm::dvec3, double>> out;
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-          out.emplace_back(
-              polygonPointAt(g.hierarchy.top(top).local, {(i + 0.5) / n, (j + 0.5) / n}),
-              key[(size_t(j) * n + i) * 3]);
-      return out;
-    };
-    const auto ta = texels(a), tb = texels(b);
-    auto at = [&](const std::vector<std::pair<glm::dvec3, double>>& t, double x, double y) {
-      for (const auto& [p, h] : t)
-        if (std::abs(p.x - x) < 0.25 / n && std::abs(p.y - y) < 0.25 / n) return h;
-      return -1.0;
-    };
+    const auto sides = extrapolatedToEdge(bakeTop(s, g, topOfNode(g, a), n, n),
+                                          bakeTop(s, g, topOfNode(g, b), n, n), 0.0, n);
     double worst = 0.0;
-    int compared = 0;
-    for (int j = 0; j < n; ++j) {
-      const double y = (j + 0.5) / n;
-      const double a1 = at(ta, -0.5 / n, y), a2 = at(ta, -1.5 / n, y);
-      const double b1 = at(tb, 0.5 / n, y), b2 = at(tb, 1.5 / n, y);
-      if (a1 <= 0 || a2 <= 0 || b1 <= 0 || b2 <= 0) continue;
-      const double fromA = a1 + 0.5 * (a1 - a2), fromB = b1 - 0.5 * (b2 - b1);
+    for (const auto& [fromA, fromB] : sides)
       worst = std::max(worst, std::abs(fromA - fromB) / fromB);
-      ++compared;
-    }
-    EXPECT_EQ(compared, n);
+    EXPECT_EQ(int(sides.size()), n);
     return worst;
   };
   const double smoothStep = bakeCrease(true), flatStep = bakeCrease(false);
