@@ -16,8 +16,7 @@ noise removed):
   shelf-on-wall     a 1 cm shelf against the back wall, 25 cm above the floor
 
 usage: contact.py [--bin DIR] [--out DIR] [--size 176x120] [--spp 256] [--only a,b] [--check]
-  --check   exit 1 when a variant's stage fails or its |bias| exceeds 2 %, except the two
-            double-sided lamp variants (README: +12 %, not fixed yet); ctest `pipeline_contact`
+  --check   exit 1 when a variant's stage fails or its |bias| exceeds 2 %; ctest `pipeline_contact`
 References are kept in OUT/NAME/reference-seedS and reused when the scene has not changed.
 """
 import argparse
@@ -36,9 +35,6 @@ from extremes import SCENE, add_mesh, run_variant  # noqa: E402
 
 W, H, D = 0.556, 0.5488, 0.5592  # the room (pipelines/scenes/make_cornell_moving.py)
 BIAS_BOUND = 0.02
-# The light a double-sided lamp sends into the gap above it comes out too bright (+12 % at the
-# defaults, +5 % at --eps 1e-4): reported, not checked, until it is fixed.
-KNOWN_LEAKS = ("lamp-two-sided", "blender-style")
 
 
 def static_room(g, keep=()):
@@ -116,8 +112,7 @@ def main():
     with open(SCENE) as f:
         source = json.load(f)
     only = set(a.only.split(",")) if a.only else None
-    print("%-16s %12s %9s %12s %8s  %s" % ("variant", "RMSE/mean", "bias", "ref noise", "s",
-                                           "note"))
+    print("%-16s %12s %9s %12s %8s" % ("variant", "RMSE/mean", "bias", "ref noise", "s"))
     for name, make in VARIANTS:
         if only and name not in only:
             continue
@@ -135,11 +130,9 @@ def main():
                             os.path.join(refs[1], "0000.exr"), "--json"],
                            capture_output=True, text=True, check=True)
         d = json.loads(p.stdout)["difference"]
-        known = name in KNOWN_LEAKS
-        print("%-16s %11.2f%% %+8.2f%% %11.2f%% %8.2f  %s" % (
-            name, 100 * d["rmse_over_mean"], 100 * d["bias"], 100 * d["noise_over_mean"], seconds,
-            "known leak, not checked" if known else ""))
-        if not known and abs(d["bias"]) > BIAS_BOUND:
+        print("%-16s %11.2f%% %+8.2f%% %11.2f%% %8.2f" % (
+            name, 100 * d["rmse_over_mean"], 100 * d["bias"], 100 * d["noise_over_mean"], seconds))
+        if abs(d["bias"]) > BIAS_BOUND:
             failures.append("%s: bias %+.2f %% (bound %g %%)" % (name, 100 * d["bias"],
                                                                 100 * BIAS_BOUND))
     if a.check and failures:

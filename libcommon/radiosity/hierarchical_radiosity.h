@@ -102,7 +102,10 @@ struct SolverLink {
   int receiver = 0;             // dense node index (gathers)
   int shooter = 0;              // dense node index (shoots)
   double formFactor = 0;        // unoccluded F(receiver -> shooter); the estimate until `accurate`
-  double visibility = 0;        // V in [0, 1]
+  double visibility = 0;        // V in [0, 1] as gathered: rayVisibility weighted by the
+                                // shooter's radiosity at the rays' ends (weightVisibility...)
+  double rayVisibility = 0;     // V of the shadow rays, kernel-weighted (visibilityFrom)
+  uint64_t openPairs = 0;       // which of those ray pairs were unoccluded (bit i: pair i < 64)
   double estimate = 0;          // F~ of the oracle
   double spreadArea = 0;        // max(A_p dF(p -> q), A_q dF(q -> p)) of the error oracle (m^2)
   bool refined = false;         // kept for the hierarchy, not gathered
@@ -121,8 +124,9 @@ struct SolverLink {
 struct CachedLink {
   double estimate = 0, spreadArea = 0;  // geometry only: valid while both ends are static
   double formFactor = -1;               // accurate unoccluded F, or < 0 when never computed
-  double visibility = 0;
-  bool visibilityValid = false;  // false: a moving object's swept bound met the link's shaft
+  double visibility = 0;                // the shadow rays' V (SolverLink::rayVisibility)
+  uint64_t openPairs = 0;               // and their unoccluded pairs
+  bool visibilityValid = false;         // false: a moving object's swept bound met the link's shaft
 };
 struct LinkKeyHash {
   size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {

@@ -247,7 +247,8 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     c.spreadArea = l.spreadArea;
     // computeAccurate leaves F at the estimate for a link it finds invisible (closure off)
     c.formFactor = l.integrated ? l.formFactor : -1.0;
-    c.visibility = l.visibility;
+    c.visibility = l.rayVisibility;
+    c.openPairs = l.openPairs;
     c.visibilityValid = !hit;  // a moving object in the shaft: the shadow rays again
     cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
   }
@@ -271,8 +272,8 @@ void markBadPair(char& bad, BadLinkRule rule, const SolverLink& l, bool shooterE
       bad |= shooterEmits;
       break;
     case BadLinkRule::kPartial:
-      bad |= shooterEmits ||
-             (!l.refined && float(l.visibility) > partialThreshold && float(l.visibility) < 1.0f);
+      bad |= shooterEmits || (!l.refined && float(l.rayVisibility) > partialThreshold &&
+                              float(l.rayVisibility) < 1.0f);
       break;
   }
 }

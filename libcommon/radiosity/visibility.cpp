@@ -342,28 +342,43 @@ std::vector<glm::dvec3> VisibilityScene::samplePoints(const Polygon& p, int k, s
 double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints,
                                        const glm::dvec3& aNormal, const Polygon& b,
                                        std::uint64_t seed, std::uint32_t ignoreA,
-                                       std::uint32_t ignoreB) const {
+                                       std::uint32_t ignoreB, std::uint64_t* openPairs) const {
+  return weightedVisibilityFrom(aPoints, aNormal, b, seed, ignoreA, ignoreB, nullptr, nullptr,
+                                openPairs);
+}
+
+double VisibilityScene::weightedVisibilityFrom(
+    const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal, const Polygon& b,
+    std::uint64_t seed, std::uint32_t ignoreA, std::uint32_t ignoreB,
+    const std::uint64_t* knownOpenPairs, const std::function<double(const glm::dvec3&)>& weightAtB,
+    std::uint64_t* openPairs) const {
   const int k = int(aPoints.size());
   if (k == 0) return 1.0;
   const std::vector<glm::dvec3> bPoints = pairedPoints(b, k, seed);
   const glm::dvec3 bNormal = b.normal();
+  const bool known = knownOpenPairs && k <= kMaxRecordedPairs;
   double weighted = 0.0, weight = 0.0;
   int unoccluded = 0;
+  std::uint64_t open = 0;
   for (int i = 0; i < k; ++i) {
     const glm::dvec3 pa = aPoints[size_t(i)], pb = bPoints[size_t(i)];
-    const bool open = !occluded(pa, pb, ignoreA, ignoreB);
-    unoccluded += open ? 1 : 0;
+    const bool isOpen =
+        known ? ((*knownOpenPairs >> i) & 1u) != 0 : !occluded(pa, pb, ignoreA, ignoreB);
+    unoccluded += isOpen ? 1 : 0;
+    if (isOpen && i < kMaxRecordedPairs) open |= std::uint64_t(1) << i;
     // The pair's weight in F: cos(theta_a) cos(theta_b) / r^2, 0 where either point is behind
     // the other's plane (those pairs carry no energy, but an area-uniform count would let them
     // darken the link: a box face gathering from a floor patch half behind it read V = 0.5).
     const glm::dvec3 d = pb - pa;
     const double r2 = glm::dot(d, d);
-    const double w = r2 > 0.0 ? std::max(0.0, glm::dot(aNormal, d)) *
-                                    std::max(0.0, -glm::dot(bNormal, d)) / (r2 * r2)
-                              : 0.0;
+    double w = r2 > 0.0 ? std::max(0.0, glm::dot(aNormal, d)) *
+                              std::max(0.0, -glm::dot(bNormal, d)) / (r2 * r2)
+                        : 0.0;
+    if (weightAtB) w *= std::max(0.0, weightAtB(pb));
     weight += w;
-    weighted += open ? w : 0.0;
+    weighted += isOpen ? w : 0.0;
   }
+  if (openPairs) *openPairs = open;
   // No pair that exchanges energy among the samples: the area-uniform fraction.
   return weight > 0.0 ? weighted / weight : static_cast<double>(unoccluded) / k;
 }

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -85,9 +86,23 @@ class VisibilityScene {
   // the ratio estimator of F_occluded / F_unoccluded (Cohen & Wallace ch. 4). An area-uniform
   // count lets pairs that exchange no energy (behind either plane) decide the link's
   // visibility. When no sample pair has K > 0, the area-uniform fraction.
+  // `openPairs`, when given, receives bit i set for each unoccluded pair i < kMaxRecordedPairs.
   double visibilityFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
                         const Polygon& b, std::uint64_t seed, std::uint32_t ignoreA = kNoSurface,
-                        std::uint32_t ignoreB = kNoSurface) const;
+                        std::uint32_t ignoreB = kNoSurface,
+                        std::uint64_t* openPairs = nullptr) const;
+  // visibilityFrom with each pair's kernel also weighted by weightAtB(its point on b):
+  //   $V_w = \sum_i K_i w(y_i) v_i / \sum_i K_i w(y_i)$.
+  // With w = the shooter's radiosity this is the share of the power leaving b towards a that
+  // arrives (a shooter bright where it is hidden, the ceiling above a lamp, is not averaged
+  // with its visible part). The pairs are visibilityFrom's; `knownOpenPairs` (its openPairs of
+  // the same arguments) spares the rays when k <= kMaxRecordedPairs. A null weightAtB: w = 1.
+  double weightedVisibilityFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
+                                const Polygon& b, std::uint64_t seed, std::uint32_t ignoreA,
+                                std::uint32_t ignoreB, const std::uint64_t* knownOpenPairs,
+                                const std::function<double(const glm::dvec3&)>& weightAtB,
+                                std::uint64_t* openPairs = nullptr) const;
+  static constexpr int kMaxRecordedPairs = 64;
   // k stratified, area-uniform points on p (the strata of visibility()), from `seed`.
   static std::vector<glm::dvec3> samplePoints(const Polygon& p, int k, std::uint64_t seed);
   // The surface id of the first triangle that the ray origin + t direction, t in

@@ -229,5 +229,42 @@ TEST(Visibility, PairsThatCarryNoEnergyDoNotDecide) {
   EXPECT_EQ(scene.visibilityFrom(points, R.normal(), behind, 11, kSurfA, kSurfB), 0.0);
 }
 
+// The radiosity-weighted visibility: a blocker hides exactly the half x < 0.5 of B from A's
+// points under it (a slab just below B). B bright on the hidden half and dark on the visible
+// one sends nothing to A: V_w = 0, where the plain estimator reads about 1/2 and would let the
+// hidden half's light through (the ceiling above a double-sided lamp). Bright where visible:
+// V_w = 1. Uniform weight: the plain estimator, bit for bit; the recorded pairs give the same
+// values without rays.
+TEST(Visibility, RadiosityWeightedVisibilityFollowsWhereTheShooterIsBright) {
+  std::vector<VisibilityTriangle> t = endSquares();
+  addQuad(t, slab(-1.0, 0.5, -1.0, 2.0, 0.999), kSurfBlocker);
+  VisibilityScene scene(t);
+  const Polygon A = squareA(), B = squareB();
+  const std::vector<glm::dvec3> points = VisibilityScene::samplePoints(A, 64, 3);
+  std::uint64_t open = 0;
+  const double plain = scene.visibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, &open);
+  EXPECT_GT(plain, 0.3);
+  EXPECT_LT(plain, 0.7);
+  auto hiddenHalf = [](const glm::dvec3& y) { return y.x < 0.5 ? 1.0 : 0.0; };
+  auto visibleHalf = [](const glm::dvec3& y) { return y.x < 0.5 ? 0.0 : 1.0; };
+  auto uniform = [](const glm::dvec3&) { return 2.0; };
+  EXPECT_EQ(
+      scene.weightedVisibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, nullptr, hiddenHalf),
+      0.0);
+  EXPECT_EQ(
+      scene.weightedVisibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, nullptr, visibleHalf),
+      1.0);
+  EXPECT_EQ(
+      scene.weightedVisibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, nullptr, uniform),
+      plain);
+  // The recorded pairs: no rays, the same value (a scene without the blocker would say 1).
+  VisibilityScene empty(endSquares());
+  EXPECT_EQ(empty.weightedVisibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, &open, uniform),
+            plain);
+  EXPECT_EQ(
+      empty.weightedVisibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, &open, hiddenHalf),
+      0.0);
+}
+
 }  // namespace
 }  // namespace rad
