@@ -34,13 +34,25 @@ GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
 GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
                                const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                                const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
-                               double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats)
+                               double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
+                               SceneVisibility* visibility, int visibilityRays)
     : scene_(scene),
       solution_(solution),
       shooterRatio_(shooterRatio),
       texels_(texels),
       keyTimes_(movieKeyTimes),
-      receiverTop_(int(request.patch.top)) {
+      receiverTop_(int(request.patch.top)),
+      visibility_(visibility),
+      visibilityRays_(visibilityRays) {
+  if (visibility_) {  // the nodes that move during the movie (their swept bounds)
+    std::vector<int> seen;
+    for (const InputPolygon& top : solution.hierarchy.tops()) {
+      if (top.node < 0 || std::find(seen.begin(), seen.end(), top.node) != seen.end()) continue;
+      seen.push_back(top.node);
+      if (scene.isDynamic(top.node, keyTimes_.front(), keyTimes_.back()))
+        swept_.push_back(scene.sweptBounds(top.node, keyTimes_.front(), keyTimes_.back()));
+    }
+  }
   planLinks(byReceiver, request);
   // The global keys the movie's key times fall between.
   std::vector<char> needed(size_t(solution.keyCount()), 0);
@@ -56,6 +68,10 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   stats.entries += long(texelLinks_.size());
   if (cached_) stats.cachedEntries += long(texelLinks_.size());
   stats.tileEntries += long(tileLinkCount_);
+  for (const Link& l : links_) {
+    stats.partialLinks += l.partial ? 1 : 0;
+    stats.partialLinksMovingBlockers += l.partial && l.movingBlockers ? 1 : 0;
+  }
 }
 
 Polygon GoodLinkGather::nodeWorld(uint32_t node, double t) const {
@@ -74,6 +90,7 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
     movieNode = h.find(id);
   }
   if (movieNode < 0) movieNode = receiverTop_;
+  movieNode_ = movieNode;
   for (int a = h.node(movieNode).parent; a >= 0; a = h.node(a).parent) receivers.push_back(a);
   std::vector<int> stack{movieNode};
   while (!stack.empty()) {
@@ -163,10 +180,12 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
       }
       // A receiver partly covered by a touching solid: V counts the covered sample points as
       // occluded towards shooters outside the solid; the texel is exposed.
+      if (visibility_ && storedVisibility && v > 0.0 && v < 1.0) l.partial = true;
       const double e = solution_.exposureAtKey(int(g.receiver), k);
       v = e > 0.0 ? std::clamp(v / e, 0.0, 1.0) : 0.0;
       l.weight[size_t(k)] = solution_.radiosityAtKey(int(l.shooter), k) * v;
     }
+    if (l.partial) planVisibility(l, needed);
   });
 }
 
@@ -292,26 +311,38 @@ void GoodLinkGather::planTexels(double cacheBytes) {
     corners.emplace_back(corner, &ids);
   }
   std::unordered_map<size_t, std::vector<double>> cornerF;
-  for (const auto& c : corners) cornerF[c.first].resize(c.second->size());
+  std::unordered_map<size_t, std::vector<uint64_t>> cornerOpen;
+  for (const auto& c : corners) {
+    cornerF[c.first].resize(c.second->size());
+    cornerOpen[c.first].resize(c.second->size());
+  }
   tbb::parallel_for(size_t(0), corners.size(), [&](size_t i) {
     const size_t x = corners[i].first;
     const std::vector<uint32_t>& ids = *corners[i].second;
     std::vector<double>& f = cornerF.at(x);
+    std::vector<uint64_t>& open = cornerOpen.at(x);
     const glm::dvec3 p = world(x), nx = normal(x);
-    for (size_t k = 0; k < ids.size(); ++k) f[k] = pointToPolygonFormFactor(p, nx, shooter[ids[k]]);
+    for (size_t k = 0; k < ids.size(); ++k) {
+      f[k] = pointToPolygonFormFactor(p, nx, shooter[ids[k]]);
+      const Link& l = links_[ids[k]];
+      if (l.partial) open[k] = openRays(visibility_->staticPart(), p, l, l.points);
+    }
   });
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     Tile& tile = tiles_[ti];
     const std::array<size_t, 4> c4 = tile.cornerTexels(w);
     tile.formFactor.assign(tile.links.size() * 4, 0.0);
+    tile.open.assign(tile.links.size() * 4, 0);
     for (int c = 0; c < 4; ++c) {
       const std::vector<uint32_t>& ids = cornerLinks.at(c4[size_t(c)]);
       const std::vector<double>& f = cornerF.at(c4[size_t(c)]);
+      const std::vector<uint64_t>& open = cornerOpen.at(c4[size_t(c)]);
       for (size_t k = 0; k < tile.links.size(); ++k) {
         const uint32_t j = tile.links[k];
         if (links_[j].moves) continue;
         const size_t at = size_t(std::lower_bound(ids.begin(), ids.end(), j) - ids.begin());
         tile.formFactor[k * 4 + size_t(c)] = f[at];
+        tile.open[k * 4 + size_t(c)] = open[at];
       }
     }
   });
@@ -326,15 +357,22 @@ void GoodLinkGather::planTexels(double cacheBytes) {
       texelLinks_.insert(texelLinks_.end(), nearOfTile[ti].begin(), nearOfTile[ti].end());
       texelStart_[x + 1] = uint32_t(texelLinks_.size());
     }
-  cached_ = double(texelLinks_.size()) * sizeof(float) <= cacheBytes;
+  bool anyFixed = false;  // partial links whose ends do not move: static rays cached
+  for (const Link& l : links_) anyFixed = anyFixed || (l.partial && !l.moves);
+  const double entryBytes = sizeof(float) + (anyFixed ? sizeof(uint64_t) : 0);
+  cached_ = double(texelLinks_.size()) * entryBytes <= cacheBytes;
   if (!cached_) return;
   texelFormFactor_.resize(texelLinks_.size());
+  if (anyFixed) texelOpen_.assign(texelLinks_.size(), 0);
   tbb::parallel_for(size_t(0), T, [&](size_t x) {
     const glm::dvec3 p = world(x), nx = normal(x);
     for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
       const uint32_t j = texelLinks_[e];
       texelFormFactor_[e] =
           links_[j].moves ? 0.0f : float(pointToPolygonFormFactor(p, nx, shooter[j]));
+      const Link& l = links_[j];
+      if (l.partial && !l.moves)
+        texelOpen_[e] = openRays(visibility_->staticPart(), p, l, l.points);
     }
   });
 }
@@ -347,17 +385,92 @@ GoodLinkGather::TexelFrame GoodLinkGather::texelFrame(double t) const {
   return f;
 }
 
+// A partly occluded link part: V per texel (pointVisibility) from visibilityRays_ points on the
+// shooter part, the same for every texel (one shadow per point, as the bad layer's samples: no
+// noise from texel to texel), each weighted by the radiosity of the union leaf under it. The
+// weights keep the light of a shooter bright where the receiver cannot see it (the ceiling
+// above a double-sided lamp) from coming out through its visible part, as rad-global's
+// radiosity-weighted link visibility does. Its weight is then B_q alone (no V, no exposure:
+// a texel's own rays say what it sees).
+void GoodLinkGather::planVisibility(Link& l, const std::vector<char>& needed) const {
+  const PatchHierarchy& h = solution_.hierarchy;
+  const GlobalLink& g = solution_.links[l.row];
+  const int K = solution_.keyCount(), k = visibilityRays_;
+  for (int key = 0; key < K; ++key)
+    if (needed[size_t(key)] && solution_.linkFvAtKey(g, key) > 0.0)
+      l.weight[size_t(key)] = solution_.radiosityAtKey(int(l.shooter), key);
+  l.seed = linkSeed(h.node(int(g.receiver)).id, h.node(int(l.shooter)).id);
+  const double t0 = keyTimes_.front();
+  const Polygon shooter = nodeWorld(l.shooter, t0);
+  const std::vector<glm::dvec3> points = VisibilityScene::samplePoints(shooter, k, l.seed);
+  const bool triangle = h.topOf(int(l.shooter)).local.count == 3;
+  const int top = int(h.node(int(l.shooter)).id.top);
+  l.pointLeaf.resize(size_t(k));
+  for (int i = 0; i < k; ++i) {
+    const glm::dvec2 uv = clampToParameterDomain(polygonUvAt(shooter, points[size_t(i)]), triangle);
+    l.pointLeaf[size_t(i)] =
+        leafAtTopUv(h, top, topUvFromNodeUv(h.node(int(l.shooter)).id, uv, triangle));
+  }
+  l.pointWeight.assign(size_t(K) * size_t(k), 0.0);
+  for (int key = 0; key < K; ++key)
+    if (needed[size_t(key)])
+      for (int i = 0; i < k; ++i) {
+        const glm::dvec3 b = solution_.radiosityAtKey(l.pointLeaf[size_t(i)], key);
+        l.pointWeight[size_t(key) * k + i] = b.x + b.y + b.z;
+      }
+  l.movingBlockers = l.moves;
+  if (!l.moves) {
+    const Polygon receiver = nodeWorld(uint32_t(movieNode_), t0);
+    for (const auto& box : swept_)
+      if (shaftMeetsBox(receiver, shooter, box[0], box[1])) l.movingBlockers = true;
+    l.points = points;
+  }
+}
+
+uint64_t GoodLinkGather::openRays(const VisibilityScene& blockers, const glm::dvec3& x,
+                                  const Link& l, const std::vector<glm::dvec3>& points,
+                                  uint64_t candidates) const {
+  return blockers.openFrom(x, points, uint32_t(receiverTop_),
+                           uint32_t(solution_.hierarchy.node(int(l.shooter)).id.top), candidates);
+}
+
+double GoodLinkGather::visibilityAt(const glm::dvec3& x, const glm::dvec3& n, const Link& l,
+                                    const std::vector<glm::dvec3>& points,
+                                    const glm::dvec3& shooterNormal, const uint64_t* open,
+                                    const double* weight) const {
+  uint64_t bits = open ? *open : openRays(visibility_->staticPart(), x, l, points);
+  if (l.movingBlockers && bits != 0 && visibility_->dynamicNodeCount() > 0)
+    bits = openRays(visibility_->movingPart(), x, l, points, bits);
+  return pointVisibility(x, n, points, shooterNormal, bits, weight);
+}
+
 void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   int k0, k1;
   double w;
   solution_.keyWeights(t, k0, k1, w);
   std::vector<glm::dvec3> weight(links_.size());
   std::vector<Polygon> shooter(links_.size());
+  // Partial links: the shooter points (moving ones where they are at t) and their weights at t.
+  const int rays = visibilityRays_;
+  std::vector<std::vector<glm::dvec3>> points(links_.size());
+  std::vector<double> pointWeight(links_.size() * size_t(rays));
+  bool castNow = false;
   for (size_t j = 0; j < links_.size(); ++j) {
     const Link& l = links_[j];
     weight[j] = (1.0 - w) * l.weight[size_t(k0)] + w * l.weight[size_t(k1)];
-    if (l.moves || !cached_) shooter[j] = nodeWorld(l.shooter, t);
+    if (l.moves || !cached_ || l.partial) shooter[j] = nodeWorld(l.shooter, t);
+    if (!l.partial) continue;
+    for (int i = 0; i < rays; ++i)
+      pointWeight[j * rays + i] = (1.0 - w) * l.pointWeight[size_t(k0) * rays + i] +
+                                  w * l.pointWeight[size_t(k1) * rays + i];
+    if (l.moves) points[j] = VisibilityScene::samplePoints(shooter[j], rays, l.seed);
+    castNow = castNow || l.movingBlockers;
   }
+  // Rays cast now see the moving nodes where they are at t (not thread-safe: before the loop).
+  if (castNow && visibility_->dynamicNodeCount() > 0) visibility_->setTime(t);
+  auto pointsOf = [&](uint32_t j) -> const std::vector<glm::dvec3>& {
+    return links_[j].moves ? points[j] : links_[j].points;
+  };
   const TexelFrame frame = texelFrame(t);
   const int width = texels_.width, height = texels_.height;
   auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
@@ -369,12 +482,16 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
     const std::array<size_t, 4> cornerTexel = tile.cornerTexels(width);
     for (size_t k = 0; k < tile.links.size(); ++k) {
       const uint32_t j = tile.links[k];
+      const Link& l = links_[j];
       if (weight[j] == glm::dvec3(0.0)) continue;
       for (int c = 0; c < 4; ++c) {
-        const double f = links_[j].moves
-                             ? pointToPolygonFormFactor(world(cornerTexel[c]),
-                                                        normal(cornerTexel[c]), shooter[j])
-                             : tile.formFactor[k * 4 + size_t(c)];
+        const size_t x = cornerTexel[size_t(c)];
+        double f = l.moves ? pointToPolygonFormFactor(world(x), normal(x), shooter[j])
+                           : tile.formFactor[k * 4 + size_t(c)];
+        if (l.partial && f > 0.0)
+          f *= visibilityAt(world(x), normal(x), l, pointsOf(j), shooter[j].normal(),
+                            l.moves ? nullptr : &tile.open[k * 4 + size_t(c)],
+                            &pointWeight[j * rays]);
         corner[c] += f * weight[j];
       }
     }
@@ -388,10 +505,14 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
         const glm::dvec3 p = world(x), nx = normal(x);
         for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
           const uint32_t l = texelLinks_[e];
+          const Link& link = links_[l];
           if (weight[l] == glm::dvec3(0.0)) continue;
-          const double f = cached_ && !links_[l].moves
-                               ? double(texelFormFactor_[e])
-                               : pointToPolygonFormFactor(p, nx, shooter[l]);
+          double f = cached_ && !link.moves ? double(texelFormFactor_[e])
+                                            : pointToPolygonFormFactor(p, nx, shooter[l]);
+          if (link.partial && f > 0.0)
+            f *= visibilityAt(p, nx, link, pointsOf(l), shooter[l].normal(),
+                              cached_ && !link.moves ? &texelOpen_[e] : nullptr,
+                              &pointWeight[l * rays]);
           H += f * weight[l];
         }
         acc[x] = H;

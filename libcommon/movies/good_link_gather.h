@@ -16,6 +16,18 @@
 // a concave corner, the bright band next to a lit wall. For an unoccluded link the texel's sum is
 // the exact form factor, so a closed room sums to 1 at every texel, not only per element.
 //
+// A link whose stored V is partial (0 < V < 1 at a key the movie needs) takes its visibility
+// per texel instead, V(x, q): --gather-rays shadow rays from x to points on the shooter part q
+// (the same points for every texel), each weighted by the kernel and by the global solution's B
+// at its end (pointVisibility), so that
+//
+//   term = B_q(k) F(x -> q) V(x, q)
+//
+// One V per receiver node stepped where two nodes whose links are occluded differently meet
+// (4.3 % on the bundled scene's back wall); per texel the bundled scene went from 7.5 to 6.0 %
+// RMSE / mean, and the B weights keep a double-sided lamp's gap from leaking (+0.1 %, against
+// +8.7 % unweighted). Static blockers are cast once per movie, moving ones per key (§5).
+//
 // Cost: texels are planned in tiles of 8 x 8; a link whose shooter part is far from a tile
 // (kTileFarRatio times its size) is evaluated at the tile's corners and interpolated
 // bilinearly, so only near links cost a form factor per texel.
@@ -35,6 +47,7 @@
 
 #include "libcommon/intervals/movie_extent.h"
 #include "libcommon/radiosity/global_solution.h"
+#include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {
@@ -57,10 +70,12 @@ struct MovieTexels {
 };
 
 struct GoodLinkGatherStats {
-  long links = 0;          // link rows gathered, summed over movies
-  long entries = 0;        // (texel, near link) terms per key, summed over movies
-  long cachedEntries = 0;  // of which F was computed once per movie
-  long tileEntries = 0;    // (tile, far link) terms, each 4 corner form factors
+  long links = 0;                       // link rows gathered, summed over movies
+  long entries = 0;                     // (texel, near link) terms per key, summed over movies
+  long cachedEntries = 0;               // of which F was computed once per movie
+  long tileEntries = 0;                 // (tile, far link) terms, each 4 corner form factors
+  long partialLinks = 0;                // links with V per texel (partly occluded)
+  long partialLinksMovingBlockers = 0;  // of which rays also meet moving blockers per key
 };
 
 class GoodLinkGather {
@@ -72,7 +87,8 @@ class GoodLinkGather {
   GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
                  const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                  const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
-                 double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats);
+                 double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
+                 SceneVisibility* visibility = nullptr, int visibilityRays = 16);
 
   // acc[x] = G(x, t).
   void gather(double t, std::vector<glm::dvec3>& acc) const;
@@ -80,9 +96,20 @@ class GoodLinkGather {
  private:
   struct Link {  // one link row's share from one part of its shooter
     uint32_t row = 0;
-    uint32_t shooter = 0;            // dense node: the link's shooter or a node of its sub-tree
-    bool moves = false;              // an end moves during the movie: F per key
-    std::vector<glm::dvec3> weight;  // per global key: B_q(k) \bar V(k); 0 when inactive
+    uint32_t shooter = 0;  // dense node: the link's shooter or a node of its sub-tree
+    bool moves = false;    // an end moves during the movie: F per key
+    // Partly occluded at a needed key (0 < V < 1): V per texel from rays to its shooter part
+    // instead of the link's one V (pointVisibility); its weight is then B_q alone.
+    bool partial = false;
+    // Coherence (§5), as the bad layer's static and dynamic blockers: the rays of a partial link
+    // whose ends do not move are cast against the static blockers once per movie; against the
+    // moving ones at every key, only when a moving node's swept bounds meet its shaft.
+    bool movingBlockers = false;
+    uint64_t seed = 0;                // of its shooter points (the same for every texel)
+    std::vector<glm::dvec3> points;   // ends static: the shooter points (world)
+    std::vector<int> pointLeaf;       // the union leaf under each shooter point
+    std::vector<double> pointWeight;  // per global key k: [k * rays + i] B there (channel sum)
+    std::vector<glm::dvec3> weight;   // per global key: B_q(k) \bar V(k); 0 when inactive
   };
   const Scene& scene_;
   const GlobalSolution& solution_;
@@ -90,6 +117,8 @@ class GoodLinkGather {
   const MovieTexels texels_;
   const std::vector<double>& keyTimes_;
   int receiverTop_ = 0;
+  SceneVisibility* visibility_ = nullptr;
+  int visibilityRays_ = 16;
   std::vector<Link> links_;
   // Texels are planned in tiles of kTile x kTile; a link whose shooter part is farther than
   // kTileFarRatio times a tile's size is evaluated at the tile's corners and interpolated.
@@ -105,6 +134,7 @@ class GoodLinkGather {
     int common = -1;                 // deepest node holding every texel of the tile
     std::vector<uint32_t> links;     // links_ indices interpolated over the tile
     std::vector<double> formFactor;  // per tile link, its 4 corners (links that do not move)
+    std::vector<uint64_t> open;      // per tile link, its 4 corners' rays open past static blockers
   };
   int tilesX_ = 0;
   std::vector<Tile> tiles_;
@@ -113,7 +143,10 @@ class GoodLinkGather {
   // and, when cached_, the form factors of the links that do not move in the same places.
   std::vector<uint32_t> texelStart_, texelLinks_;
   std::vector<float> texelFormFactor_;
+  std::vector<uint64_t> texelOpen_;  // with texelFormFactor_: rays open past static blockers
   bool cached_ = false;
+  int movieNode_ = 0;
+  std::vector<std::array<glm::dvec3, 2>> swept_;  // of the nodes that move during the movie
 
   Polygon nodeWorld(uint32_t node, double t) const;
   void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request);
@@ -130,6 +163,16 @@ class GoodLinkGather {
     glm::dvec3 normal(const glm::dvec3& local) const { return glm::normalize(normalMap * local); }
   };
   TexelFrame texelFrame(double t) const;
+  void planVisibility(Link& l, const std::vector<char>& neededKeys) const;
+  uint64_t openRays(const VisibilityScene& blockers, const glm::dvec3& x, const Link& l,
+                    const std::vector<glm::dvec3>& points,
+                    uint64_t candidates = ~uint64_t(0)) const;
+  // V of link part l at texel point x (normal n): its rays open past the static blockers
+  // (`open`, or cast now when null) and, for a link with moving blockers, past those at the
+  // current time, weighted by the kernel and the shooter's B at their ends (`weight`).
+  double visibilityAt(const glm::dvec3& x, const glm::dvec3& n, const Link& l,
+                      const std::vector<glm::dvec3>& points, const glm::dvec3& shooterNormal,
+                      const uint64_t* open, const double* weight) const;
 };
 
 }  // namespace rad

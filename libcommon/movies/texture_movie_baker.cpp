@@ -522,6 +522,7 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"merge", mergeModeName(merge)},
           {"good-layer", goodLayerName(goodLayer)},
           {"gather-shooter-ratio", gatherShooterRatio},
+          {"gather-rays", gatherRays},
           {"no-coherence", !coherence},
           {"max-texture-memory", maxTextureMemoryMiB}};
 }
@@ -544,7 +545,9 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
            {{"links", gather.links},
             {"entries", gather.entries},
             {"cached_entries", gather.cachedEntries},
-            {"tile_entries", gather.tileEntries}}},
+            {"tile_entries", gather.tileEntries},
+            {"partial_links", gather.partialLinks},
+            {"partial_links_moving_blockers", gather.partialLinksMovingBlockers}}},
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
@@ -582,6 +585,8 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
   // clamps it): `--max-samples 4` means at most 4, whatever the default minimum.
   if (!(options_.gatherShooterRatio >= 0.0) || !std::isfinite(options_.gatherShooterRatio))
     throw Error(ExitCode::kUsage, "--gather-shooter-ratio", "must be a finite number >= 0");
+  if (options_.gatherRays < 0 || options_.gatherRays > VisibilityScene::kMaxRecordedPairs)
+    throw Error(ExitCode::kUsage, "--gather-rays", "must be in 0..64");
   if (options_.minSamples < 1) throw Error(ExitCode::kUsage, "--min-samples", "must be >= 1");
   if (!(options_.samplesPerFormFactor >= 0.0))
     throw Error(ExitCode::kUsage, "--samples-per-form-factor", "must be >= 0");
@@ -655,6 +660,17 @@ void TextureMovieBaker::checkRequest(const MovieExtent& req, size_t badShooters)
   }
 }
 
+SceneVisibility* TextureMovieBaker::sceneVisibility() {
+  if (options_.gatherRays <= 0) return nullptr;
+  if (!visibility_) {  // once per baker: Embree's BVH of the whole scene
+    const std::vector<double>& k = solution_.keyTimes;
+    visibility_ = std::make_unique<SceneVisibility>(scene_, solution_.hierarchy, k.front(),
+                                                    k.back(), /*split=*/true);
+    visibility_->setTime(k.front());
+  }
+  return visibility_.get();
+}
+
 BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
   const std::string where = "movie " + std::to_string(req.movie);
   if (req.patch.top >= tops_.size())
@@ -687,7 +703,8 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     auto clock = SteadyClock::now();
     gather = std::make_unique<GoodLinkGather>(
         scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
-        options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather);
+        options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather,
+        sceneVisibility(), options_.gatherRays);
     stats_.secondsGood += secondsSince(clock);
   }
   MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry, gather.get());

@@ -756,7 +756,8 @@ std::vector<glm::dmat4> topTransforms(const Scene& scene, const PatchHierarchy& 
   return out;
 }
 
-SceneVisibility::SceneVisibility(const Scene& scene, const PatchHierarchy& h, double t0, double t1)
+SceneVisibility::SceneVisibility(const Scene& scene, const PatchHierarchy& h, double t0, double t1,
+                                 bool split)
     : scene_(scene) {
   auto addPolygon = [](std::vector<VisibilityTriangle>& out, const Polygon& p, uint32_t id) {
     out.push_back({{p.v[0], p.v[1], p.v[2]}, id});
@@ -781,15 +782,20 @@ SceneVisibility::SceneVisibility(const Scene& scene, const PatchHierarchy& h, do
     }
   }
   vis_ = std::make_unique<VisibilityScene>(statics);
+  if (split) moving_ = std::make_unique<VisibilityScene>(std::vector<VisibilityTriangle>());
+  VisibilityScene& withInstances = moving_ ? *moving_ : *vis_;
   for (int node : dynamicNodes)
-    instances_.emplace_back(node, vis_->addInstance(local[node], scene.worldTransform(node, t0)));
+    instances_.emplace_back(node,
+                            withInstances.addInstance(local[node], scene.worldTransform(node, t0)));
   vis_->commit();
+  if (moving_) moving_->commit();
 }
 
 void SceneVisibility::setTime(double t) {
+  VisibilityScene& withInstances = moving_ ? *moving_ : *vis_;
   for (auto& [node, id] : instances_)
-    vis_->setInstanceTransform(id, scene_.worldTransform(node, t));
-  vis_->commit();
+    withInstances.setInstanceTransform(id, scene_.worldTransform(node, t));
+  withInstances.commit();
 }
 
 bool shaftMeetsBox(const Polygon& a, const Polygon& b, const glm::dvec3& lo, const glm::dvec3& hi) {

@@ -383,6 +383,43 @@ double VisibilityScene::weightedVisibilityFrom(
   return weight > 0.0 ? weighted / weight : static_cast<double>(unoccluded) / k;
 }
 
+std::uint64_t VisibilityScene::openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,
+                                        std::uint32_t ignoreA, std::uint32_t ignoreB,
+                                        std::uint64_t candidates) const {
+  std::uint64_t open = 0;
+  const int k = std::min(int(bPoints.size()), kMaxRecordedPairs);
+  for (int i = 0; i < k; ++i)
+    if (((candidates >> i) & 1u) && !occluded(x, bPoints[size_t(i)], ignoreA, ignoreB))
+      open |= std::uint64_t(1) << i;
+  return open;
+}
+
+double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
+                       const std::vector<glm::dvec3>& bPoints, const glm::dvec3& bNormal,
+                       std::uint64_t open, const double* weight) {
+  const int k = std::min(int(bPoints.size()), VisibilityScene::kMaxRecordedPairs);
+  if (k == 0) return 1.0;
+  const std::uint64_t all = k == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << k) - 1;
+  open &= all;
+  if (open == all) return 1.0;  // the common cases, exact whatever the weights
+  if (open == 0) return 0.0;
+  double weighted = 0.0, total = 0.0;
+  for (int i = 0; i < k; ++i) {
+    const glm::dvec3 d = bPoints[size_t(i)] - x;
+    const double r2 = glm::dot(d, d);
+    double w =
+        r2 > 0.0 ? std::max(0.0, glm::dot(n, d)) * std::max(0.0, -glm::dot(bNormal, d)) / (r2 * r2)
+                 : 0.0;
+    if (weight) w *= std::max(0.0, weight[i]);
+    total += w;
+    weighted += ((open >> i) & 1u) ? w : 0.0;
+  }
+  if (total > 0.0) return weighted / total;
+  int count = 0;
+  for (int i = 0; i < k; ++i) count += int((open >> i) & 1u);
+  return double(count) / k;
+}
+
 std::uint32_t VisibilityScene::firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
                                         std::uint32_t ignore) const {
   RTCRayHit rh;

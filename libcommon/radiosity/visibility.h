@@ -103,6 +103,11 @@ class VisibilityScene {
                                 const std::function<double(const glm::dvec3&)>& weightAtB,
                                 std::uint64_t* openPairs = nullptr) const;
   static constexpr int kMaxRecordedPairs = 64;
+  // Which of the segments from x to bPoints[i] (i < kMaxRecordedPairs) are unoccluded: bit i,
+  // tested only where `candidates` has it (the others stay 0). Thread-safe after commit().
+  std::uint64_t openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,
+                         std::uint32_t ignoreA = kNoSurface, std::uint32_t ignoreB = kNoSurface,
+                         std::uint64_t candidates = ~std::uint64_t(0)) const;
   // k stratified, area-uniform points on p (the strata of visibility()), from `seed`.
   static std::vector<glm::dvec3> samplePoints(const Polygon& p, int k, std::uint64_t seed);
   // The surface id of the first triangle that the ray origin + t direction, t in
@@ -121,6 +126,15 @@ class VisibilityScene {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The visibility of b's points bPoints from the point x (normal n) through the unoccluded ones
+// (openFrom's bits), each weighted by the kernel cos cos / r^2 (0 behind either plane) and by
+// weight[i] (a shooter's radiosity at its point; null: 1):
+//   $V = \sum_i K_i w_i o_i / \sum_i K_i w_i$,
+// the unweighted share of open bits when no point carries energy. No rays: pure arithmetic.
+double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
+                       const std::vector<glm::dvec3>& bPoints, const glm::dvec3& bNormal,
+                       std::uint64_t open, const double* weight = nullptr);
 
 // Counter-based random numbers (Steele, Lea, Flood 2014, splitmix64 finaliser).
 std::uint64_t splitMix64(std::uint64_t x);

@@ -586,6 +586,65 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
   EXPECT_LT(worst, 0.01) << "step across the edge";
 }
 
+// Per-texel visibility of the gathered links (--gather-rays): a floor z = 0 under an emitting
+// ceiling z = 1, a black slab at z = 0.5 over x < 1 hiding part of the ceiling from every floor
+// point, every link good. The exact irradiance at x is B times the form factor of the part of
+// the ceiling whose segment to x passes beside the slab (summed over 128 x 64 cells, the cut
+// at z = 0.5 is exact). With 16 rays per texel the gather's mean error is a fraction of the
+// one V per receiver node's (--gather-rays 0), whose steps where two receiver nodes meet showed
+// on the bundled scene's walls.
+TEST(TextureMovieBaker, GatheredVisibilityFollowsThePenumbraPerTexel) {
+  Scene s;
+  Material white, lamp, black;
+  white.reflectance = glm::dvec3(0.5);
+  lamp.emission = glm::dvec3(1.0);  // B = pi
+  lamp.reflectance = glm::dvec3(0.0);
+  black.reflectance = glm::dvec3(0.0);
+  s.materials = {white, lamp, black};
+  const int floor = addQuadNode(s, {0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, 0);
+  addQuadNode(s, {0, 0, 1}, {0, 1, 1}, {2, 1, 1}, {2, 0, 1}, 1);              // ceiling, down
+  addQuadNode(s, {-1, -1, 0.5}, {-1, 2, 0.5}, {1, 2, 0.5}, {1, -1, 0.5}, 2);  // slab, down
+  SpaceTimeOptions so;
+  so.badLinks = BadLinkRule::kNone;
+  so.radiosity.eps = 1e-3;
+  GlobalSolution g = solveSpaceTime(s, {0.0}, so);
+  const int floorTop = topOfNode(g, floor);
+  auto exact = [](const glm::dvec3& x, bool occluded) {
+    const int nu = 128, nv = 64;
+    double f = 0.0;
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nu; ++i) {
+        const double u0 = 2.0 * i / nu, u1 = 2.0 * (i + 1) / nu;
+        const double v0 = double(j) / nv, v1 = double(j + 1) / nv;
+        const double cx = 0.5 * (u0 + u1);
+        if (occluded && 0.5 * (x.x + cx) < 1.0) continue;  // the segment meets the slab
+        Polygon cell;
+        cell.count = 4;
+        cell.v = {glm::dvec3(u0, v0, 1), glm::dvec3(u0, v1, 1), glm::dvec3(u1, v1, 1),
+                  glm::dvec3(u1, v0, 1)};
+        f += pointToPolygonFormFactor(x, {0, 0, 1}, cell);
+      }
+    return M_PI * f;
+  };
+  std::vector<std::pair<double, double>> reference;  // per texel: occluded, unoccluded
+  auto meanError = [&](int rays) {
+    TextureMovieBakerOptions o;
+    o.gatherRays = rays;
+    const std::vector<BakedTexel> baked = bakeTop(s, g, floorTop, 32, 16, o);
+    if (reference.empty())
+      for (const BakedTexel& t : baked) reference.emplace_back(exact(t.x, true), exact(t.x, false));
+    double sum = 0.0;
+    for (size_t x = 0; x < baked.size(); ++x)
+      sum += std::abs(baked[x].h - reference[x].first) / reference[x].second;
+    return sum / double(baked.size());
+  };
+  const double perTexel = meanError(16), perNode = meanError(0);
+  std::printf("mean error / unoccluded irradiance: %.4f per texel, %.4f per node\n", perTexel,
+              perNode);
+  EXPECT_LT(perTexel, 0.01);
+  EXPECT_LT(perTexel, 0.5 * perNode) << "one V per receiver node: " << perNode;
+}
+
 // Smooth shading (glTF NORMAL): two facets of a bent sheet meet at a 22-degree crease, lit from
 // the side. With the vertex normals of a smooth surface (the crease's normal the mean of the two
 // facets'), the baked irradiance of both facets, extrapolated to the crease, agrees within 1 %;

@@ -128,6 +128,10 @@ int main(int argc, char** argv) {
                  "gather: split a link's shooter into the parts of its sub-tree larger than "
                  "this times their distance to the receiver (0: no split)")
       ->capture_default_str();
+  app.add_option("--gather-rays", b.gatherRays,
+                 "gather: shadow rays from each texel to a partly occluded link's shooter, "
+                 "1..64 (0: the link's one visibility over its receiver)")
+      ->capture_default_str();
   app.add_flag_callback(
       "--no-coherence", [&b] { b.coherence = false; },
       "re-render every blocker and recompute every form factor at every key, store every "
