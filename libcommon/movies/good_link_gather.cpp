@@ -157,6 +157,9 @@ void GoodLinkGather::shooterParts(const Polygon& receiver, uint32_t shooter, dou
 void GoodLinkGather::planWeights(const std::vector<char>& needed) {
   const int K = solution_.keyCount();
   const bool storedVisibility = !solution_.linkSampleVisibility.empty();
+  // Per link, over the needed keys: the irradiance it carries (channel sum of B_q F V) and, when
+  // partly occluded, what one V over the receiver can misplace, B_q F V (1 - V).
+  std::vector<double> carried(links_.size(), 0.0), risk(links_.size(), -1.0);
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
     Link& l = links_[j];
     const GlobalLink& g = solution_.links[l.row];
@@ -180,11 +183,36 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
       }
       // A receiver partly covered by a touching solid: V counts the covered sample points as
       // occluded towards shooters outside the solid; the texel is exposed.
-      if (visibility_ && storedVisibility && v > 0.0 && v < 1.0) l.partial = true;
+      const glm::dvec3 b = solution_.radiosityAtKey(int(l.shooter), k);
+      carried[j] = std::max(carried[j], (b.x + b.y + b.z) * fv);
+      if (visibility_ && storedVisibility && v > 0.0 && v < 1.0)
+        risk[j] = std::max(risk[j], (b.x + b.y + b.z) * fv * (1.0 - v));
       const double e = solution_.exposureAtKey(int(g.receiver), k);
       v = e > 0.0 ? std::clamp(v / e, 0.0, 1.0) : 0.0;
-      l.weight[size_t(k)] = solution_.radiosityAtKey(int(l.shooter), k) * v;
+      l.weight[size_t(k)] = b * v;
     }
+  });
+  if (!visibility_) return;
+  // Per texel visibility where it matters: a partial link whose risk is at least
+  // kPartialShare of what its receiver node and the node's ancestors carry (a texel gathers at
+  // least that); the others keep the link's V, an error below that share each.
+  const PatchHierarchy& h = solution_.hierarchy;
+  std::map<int, double> chain;  // receiver node -> what it and its ancestors carry
+  for (size_t j = 0; j < links_.size(); ++j)
+    chain[int(solution_.links[links_[j].row].receiver)] += carried[j];
+  std::map<int, double> total;
+  for (const auto& [node, own] : chain) {
+    double sum = 0.0;
+    for (int a = node; a >= 0; a = h.node(a).parent) {
+      auto it = chain.find(a);
+      if (it != chain.end()) sum += it->second;
+    }
+    total[node] = sum;
+  }
+  tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
+    Link& l = links_[j];
+    const int r = int(solution_.links[l.row].receiver);
+    l.partial = risk[j] >= 0.0 && risk[j] >= kPartialShare * total.at(r);
     if (l.partial) planVisibility(l, needed);
   });
 }
