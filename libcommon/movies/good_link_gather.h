@@ -168,6 +168,7 @@ class GoodLinkGather {
     glm::dvec3 normal(const glm::dvec3& local) const { return glm::normalize(normalMap * local); }
   };
   TexelFrame texelFrame(double t) const;
+  std::vector<char> coveredTiles() const;
   void planVisibility(Link& l, const std::vector<char>& neededKeys) const;
   uint64_t openRays(const VisibilityScene& blockers, const glm::dvec3& x, const Link& l,
                     const std::vector<glm::dvec3>& points,
