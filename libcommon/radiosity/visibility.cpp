@@ -357,7 +357,8 @@ double VisibilityScene::weightedVisibilityFrom(
   const std::vector<glm::dvec3> bPoints = pairedPoints(b, k, seed);
   const glm::dvec3 bNormal = b.normal();
   const bool known = knownOpenPairs && k <= kMaxRecordedPairs;
-  double weighted = 0.0, weight = 0.0;
+  double weighted = 0.0, weight = 0.0;        // kernel x weightAtB
+  double kernelOpen = 0.0, kernelTotal = 0.0;  // kernel alone
   int unoccluded = 0;
   std::uint64_t open = 0;
   for (int i = 0; i < k; ++i) {
@@ -374,13 +375,17 @@ double VisibilityScene::weightedVisibilityFrom(
     double w = r2 > 0.0 ? std::max(0.0, glm::dot(aNormal, d)) *
                               std::max(0.0, -glm::dot(bNormal, d)) / (r2 * r2)
                         : 0.0;
+    kernelTotal += w;
+    kernelOpen += isOpen ? w : 0.0;
     if (weightAtB) w *= std::max(0.0, weightAtB(pb));
     weight += w;
     weighted += isOpen ? w : 0.0;
   }
   if (openPairs) *openPairs = open;
-  // No pair that exchanges energy among the samples: the area-uniform fraction.
-  return weight > 0.0 ? weighted / weight : static_cast<double>(unoccluded) / k;
+  // No weight at any pair that exchanges energy (a shooter still dark, before the first solve):
+  // the kernel's fraction; no pair that exchanges energy: the area-uniform fraction.
+  if (weight > 0.0) return weighted / weight;
+  return kernelTotal > 0.0 ? kernelOpen / kernelTotal : static_cast<double>(unoccluded) / k;
 }
 
 std::uint64_t VisibilityScene::openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,
