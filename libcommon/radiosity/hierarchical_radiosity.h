@@ -69,6 +69,7 @@ struct RadiosityOptions {
   double tol = 1e-4;           // relative change, scaled by (1 - rho_max)
   int maxIterations = 200000;  // Gauss-Seidel sweeps per solve (a safety net)
   int maxRefineRounds = 8;     // refine / solve rounds
+  bool shooterShape = true;    // gather B_q x SolverLink::shooterShape (false: B_q alone)
   int quadratureOrder = kAutoOrder;  // of polygonToPolygonFormFactor; kAutoOrder = per pair
   // Relative tolerance of the adaptive near-contact form factor. 1e-5 instead of 1e-7 halves
   // rad-global's time on the table scene and moves no radiosity by more than 3e-7 relative.
@@ -99,13 +100,16 @@ std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
 
 // One link of a key-time solve.
 struct SolverLink {
-  int receiver = 0;             // dense node index (gathers)
-  int shooter = 0;              // dense node index (shoots)
-  double formFactor = 0;        // unoccluded F(receiver -> shooter); the estimate until `accurate`
-  double visibility = 0;        // V in [0, 1] as gathered: rayVisibility weighted by the
-                                // shooter's radiosity at the rays' ends (weightVisibility...)
-  double rayVisibility = 0;     // V of the shadow rays, kernel-weighted (visibilityFrom)
-  uint64_t openPairs = 0;       // which of those ray pairs were unoccluded (bit i: pair i < 64)
+  int receiver = 0;          // dense node index (gathers)
+  int shooter = 0;           // dense node index (shoots)
+  double formFactor = 0;     // unoccluded F(receiver -> shooter); the estimate until `accurate`
+  double visibility = 0;     // V in [0, 1] as gathered: rayVisibility weighted by the
+                             // shooter's radiosity at the rays' ends (weightVisibility...)
+  double rayVisibility = 0;  // V of the shadow rays, kernel-weighted (visibilityFrom)
+  uint64_t openPairs = 0;    // which of those ray pairs were unoccluded (bit i: pair i < 64)
+  // The shooter's radiosity as the receiver sees it over its mean (weightVisibility...): the
+  // ray pairs' kernel-weighted mean of its leaves' B, divided by B_q; 1 for a leaf shooter.
+  double shooterShape = 1.0;
   double estimate = 0;          // F~ of the oracle
   double spreadArea = 0;        // max(A_p dF(p -> q), A_q dF(q -> p)) of the error oracle (m^2)
   bool refined = false;         // kept for the hierarchy, not gathered

@@ -351,13 +351,13 @@ double VisibilityScene::weightedVisibilityFrom(
     const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal, const Polygon& b,
     std::uint64_t seed, std::uint32_t ignoreA, std::uint32_t ignoreB,
     const std::uint64_t* knownOpenPairs, const std::function<double(const glm::dvec3&)>& weightAtB,
-    std::uint64_t* openPairs) const {
+    std::uint64_t* openPairs, double* kernelMeanWeight) const {
   const int k = int(aPoints.size());
   if (k == 0) return 1.0;
   const std::vector<glm::dvec3> bPoints = pairedPoints(b, k, seed);
   const glm::dvec3 bNormal = b.normal();
   const bool known = knownOpenPairs && k <= kMaxRecordedPairs;
-  double weighted = 0.0, weight = 0.0;        // kernel x weightAtB
+  double weighted = 0.0, weight = 0.0;         // kernel x weightAtB
   double kernelOpen = 0.0, kernelTotal = 0.0;  // kernel alone
   int unoccluded = 0;
   std::uint64_t open = 0;
@@ -382,6 +382,7 @@ double VisibilityScene::weightedVisibilityFrom(
     weighted += isOpen ? w : 0.0;
   }
   if (openPairs) *openPairs = open;
+  if (kernelMeanWeight) *kernelMeanWeight = kernelTotal > 0.0 ? weight / kernelTotal : -1.0;
   // No weight at any pair that exchanges energy (a shooter still dark, before the first solve):
   // the kernel's fraction; no pair that exchanges energy: the area-uniform fraction.
   if (weight > 0.0) return weighted / weight;

@@ -97,11 +97,14 @@ class VisibilityScene {
   // arrives (a shooter bright where it is hidden, the ceiling above a lamp, is not averaged
   // with its visible part). The pairs are visibilityFrom's; `knownOpenPairs` (its openPairs of
   // the same arguments) spares the rays when k <= kMaxRecordedPairs. A null weightAtB: w = 1.
+  // kernelMeanWeight, when given, receives $\sum_i K_i w(y_i) / \sum_i K_i$ over all pairs, open
+  // or not (the shooter's radiosity as the receiver sees it; -1 when no pair carries energy).
   double weightedVisibilityFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
                                 const Polygon& b, std::uint64_t seed, std::uint32_t ignoreA,
                                 std::uint32_t ignoreB, const std::uint64_t* knownOpenPairs,
                                 const std::function<double(const glm::dvec3&)>& weightAtB,
-                                std::uint64_t* openPairs = nullptr) const;
+                                std::uint64_t* openPairs = nullptr,
+                                double* kernelMeanWeight = nullptr) const;
   static constexpr int kMaxRecordedPairs = 64;
   // Which of the segments from x to bPoints[i] (i < kMaxRecordedPairs) are unoccluded: bit i,
   // tested only where `candidates` has it (the others stay 0). Thread-safe after commit().

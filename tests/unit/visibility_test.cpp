@@ -264,6 +264,17 @@ TEST(Visibility, RadiosityWeightedVisibilityFollowsWhereTheShooterIsBright) {
   EXPECT_EQ(
       empty.weightedVisibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, &open, hiddenHalf),
       0.0);
+  // The shooter's weight as A's pairs see it, open or not (SolverLink::shooterShape): a uniform
+  // weight is itself; a weight linear across B is the kernel-weighted mean of its values, within
+  // the stratification's error of the exact one (1/2 by symmetry, squares facing each other).
+  double seen = -1.0;
+  scene.weightedVisibilityFrom(points, A.normal(), B, 5, kSurfA, kSurfB, &open, uniform, nullptr,
+                               &seen);
+  EXPECT_NEAR(seen, 2.0, 1e-12);
+  scene.weightedVisibilityFrom(
+      points, A.normal(), B, 5, kSurfA, kSurfB, &open, [](const glm::dvec3& y) { return y.x; },
+      nullptr, &seen);
+  EXPECT_NEAR(seen, 0.5, 0.1);
 }
 
 }  // namespace

@@ -80,6 +80,10 @@ void addOptions(CLI::App& app, Options& o) {
       "gather without the closure factor (each leaf's row sum its own; exact energy balance in "
       "closed rooms): the plain hierarchical gather, for comparison");
   app.add_flag_callback(
+      "--no-shooter-shape", [&r] { r.shooterShape = false; },
+      "gather each link's shooter at its mean radiosity, not as the receiver's ray pairs see its "
+      "leaves' radiosity");
+  app.add_flag_callback(
       "--no-coherence", [&g] { g.spaceTime.coherence = false; },
       "recompute every link at every key time (the baseline of the speed-up)");
   app.add_option("--report", o.report, "also write the run report as JSON to this file");
