@@ -41,6 +41,7 @@ KNOBS = [
     ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "2"]),
     ("movie-key-step", "movies", "--movie-key-step", ["24", "12", "3", "1"]),
     ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32"]),
+    ("gather-rays", "movies", "--gather-rays", ["0", "4", "32"]),
 ]
 TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
          "compose": "rad-compose"}

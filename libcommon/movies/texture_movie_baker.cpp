@@ -523,6 +523,7 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"good-layer", goodLayerName(goodLayer)},
           {"gather-shooter-ratio", gatherShooterRatio},
           {"gather-rays", gatherRays},
+          {"moving-shadow-key-step", movingShadowKeyStep},
           {"no-coherence", !coherence},
           {"max-texture-memory", maxTextureMemoryMiB}};
 }
@@ -671,6 +672,35 @@ SceneVisibility* TextureMovieBaker::sceneVisibility() {
   return visibility_.get();
 }
 
+// Whether a bad pair's shadows move during the movie: an end moves, or a moving node's swept
+// bounds meet the box around the receiver node and the shooter (the shaft's bounds).
+bool TextureMovieBaker::shadowsMove(const MovieExtent& req,
+                                    const std::vector<uint32_t>& badShooters) const {
+  if (badShooters.empty()) return false;
+  const double t0 = req.firstFrame / fps_, t1 = req.lastFrame / fps_;
+  const InputPolygon& receiverTop = tops_[req.patch.top];
+  if (scene_.isDynamic(receiverTop.node, t0, t1)) return true;
+  std::vector<std::array<glm::dvec3, 2>> swept;
+  std::vector<int> seen;
+  for (const InputPolygon& top : tops_) {
+    if (top.node < 0 || std::find(seen.begin(), seen.end(), top.node) != seen.end()) continue;
+    seen.push_back(top.node);
+    if (scene_.isDynamic(top.node, t0, t1)) swept.push_back(scene_.sweptBounds(top.node, t0, t1));
+  }
+  if (swept.empty()) return false;
+  Box receiver;
+  receiver.grow(nodeWorldPolygon(scene_, receiverTop, req.patch, t0));
+  for (uint32_t S : badShooters) {
+    if (S >= tops_.size()) continue;
+    if (scene_.isDynamic(tops_[S].node, t0, t1)) return true;
+    Box shaft = receiver;
+    shaft.grow(tops_[S].local.transformed(scene_.worldTransform(tops_[S].node, t0)));
+    for (const auto& b : swept)
+      if (shaft.overlaps(Box{b[0], b[1]})) return true;
+  }
+  return false;
+}
+
 BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
   const std::string where = "movie " + std::to_string(req.movie);
   if (req.patch.top >= tops_.size())
@@ -688,6 +718,9 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
 
   BakedMovie movie;
   movie.keyStep = options_.keyStep;
+  if (options_.movingShadowKeyStep > 0 && options_.movingShadowKeyStep < options_.keyStep &&
+      shadowsMove(req, badShooters))
+    movie.keyStep = options_.movingShadowKeyStep;
   movie.keyFrames = keyFrames(req.firstFrame, req.lastFrame, movie.keyStep);
   for (int f : movie.keyFrames) movie.keyTimes.push_back(f / fps_);
 

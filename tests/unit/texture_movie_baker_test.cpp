@@ -95,9 +95,11 @@ TestScene makeScene(bool wall, bool mover) {
 }
 
 // The hand-made solutions above carry the good layer as Gouraud vertex values and no links.
+// The key mechanics below are tested at one key step for every movie.
 TextureMovieBakerOptions gouraud() {
   TextureMovieBakerOptions o;
   o.goodLayer = GoodLayer::kGouraud;
+  o.movingShadowKeyStep = 0;
   return o;
 }
 
@@ -110,6 +112,24 @@ MovieExtent request(const TestScene& t, int w, int h, int f0 = 0, int f1 = 24) {
   r.width = w;
   r.height = h;
   return r;
+}
+
+// A movie whose shadows move (an occluder crosses the pair's shaft) takes the moving-shadow key
+// step; the same receiver with the occluder standing still keeps the movie key step.
+TEST(TextureMovieBaker, MovingShadowsTakeTheirOwnKeyStep) {
+  TextureMovieBakerOptions o = gouraud();
+  o.movingShadowKeyStep = 3;
+  TestScene moving = makeScene(false, true);
+  TextureMovieBaker a(moving.scene, moving.solution, kFps, o);
+  EXPECT_EQ(a.bake(request(moving, 8, 8, 0, 24)).keyFrames, keyFrames(0, 24, 3));
+  TestScene still = makeScene(true, false);
+  TextureMovieBakerOptions every = o;  // store every key (a still shadow is a constant movie)
+  every.coherence = false;
+  TextureMovieBaker b(still.scene, still.solution, kFps, every);
+  EXPECT_EQ(b.bake(request(still, 8, 8, 0, 24)).keyFrames, keyFrames(0, 24, 6));
+  o.movingShadowKeyStep = 0;
+  TextureMovieBaker c(moving.scene, moving.solution, kFps, o);
+  EXPECT_EQ(c.bake(request(moving, 8, 8, 0, 24)).keyFrames, keyFrames(0, 24, 6));
 }
 
 TEST(TextureMovieBaker, KeyFramesEveryStepAndTheLast) {
@@ -199,6 +219,7 @@ TEST(TextureMovieBaker, CoherentEqualsTheBaselineAndSavesRenders) {
   TestScene t = makeScene(true, true);
   TextureMovieBakerOptions coherentOptions, baselineOptions;
   baselineOptions.coherence = false;
+  coherentOptions.movingShadowKeyStep = baselineOptions.movingShadowKeyStep = 0;
   TextureMovieBaker coherent(t.scene, t.solution, kFps, coherentOptions);
   TextureMovieBaker baseline(t.scene, t.solution, kFps, baselineOptions);
   MovieExtent r = request(t, 20, 16, 0, 24);

@@ -105,6 +105,11 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->excludes(keyStep)
       ->group("Deprecated");
+  app.add_option("--moving-shadow-key-step", b.movingShadowKeyStep,
+                 "frames between key textures of a movie whose bad links' shadows move (a "
+                 "moving blocker in the shaft, or a moving end); 0: --movie-key-step")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--min-samples", b.minSamples,
                  "shooter samples per bad link, at least (at most --max-samples)")
       ->capture_default_str();
