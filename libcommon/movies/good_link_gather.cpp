@@ -49,8 +49,10 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
     for (const InputPolygon& top : solution.hierarchy.tops()) {
       if (top.node < 0 || std::find(seen.begin(), seen.end(), top.node) != seen.end()) continue;
       seen.push_back(top.node);
-      if (scene.isDynamic(top.node, keyTimes_.front(), keyTimes_.back()))
+      if (scene.isDynamic(top.node, keyTimes_.front(), keyTimes_.back())) {
         swept_.push_back(scene.sweptBounds(top.node, keyTimes_.front(), keyTimes_.back()));
+        movingNodes_.push_back(top.node);
+      }
     }
   }
   planLinks(byReceiver, request);
@@ -509,9 +511,9 @@ uint64_t GoodLinkGather::openRays(const VisibilityScene& blockers, const glm::dv
 double GoodLinkGather::visibilityAt(const glm::dvec3& x, const glm::dvec3& n, const Link& l,
                                     const std::vector<glm::dvec3>& points,
                                     const glm::dvec3& shooterNormal, const uint64_t* open,
-                                    const double* weight) const {
+                                    const double* weight, bool movingNow) const {
   uint64_t bits = open ? *open : openRays(visibility_->staticPart(), x, l, points);
-  if (l.movingBlockers && bits != 0 && visibility_->dynamicNodeCount() > 0)
+  if (movingNow && bits != 0 && visibility_->dynamicNodeCount() > 0)
     bits = openRays(visibility_->movingPart(), x, l, points, bits);
   return pointVisibility(x, n, points, shooterNormal, bits, weight);
 }
@@ -543,6 +545,23 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   auto pointsOf = [&](uint32_t j) -> const std::vector<glm::dvec3>& {
     return links_[j].moves ? points[j] : links_[j].points;
   };
+  // Per partial link with moving blockers: whether a moving node, where it is at t, meets the
+  // shaft (the convex hull of the movie's node and the shooter part, which holds every ray):
+  // the swept bounds over the whole movie say only that it may, at some key.
+  std::vector<char> movingNow(links_.size(), 0);
+  if (castNow) {
+    std::vector<std::array<glm::dvec3, 2>> now;
+    for (int node : movingNodes_) now.push_back(scene_.sweptBounds(node, t, t));
+    const Polygon receiver = nodeWorld(uint32_t(movieNode_), t);
+    tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
+      if (!links_[j].partial || !links_[j].movingBlockers) return;
+      for (const auto& box : now)
+        if (shaftMeetsBox(receiver, shooter[j], box[0], box[1])) {
+          movingNow[j] = 1;
+          return;
+        }
+    });
+  }
   const TexelFrame frame = texelFrame(t);
   const int width = texels_.width, height = texels_.height;
   auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
@@ -563,7 +582,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
         if (l.partial && f > 0.0)
           f *= visibilityAt(world(x), normal(x), l, pointsOf(j), shooter[j].normal(),
                             l.moves ? nullptr : &tile.open[k * 4 + size_t(c)],
-                            &pointWeight[j * rays]);
+                            &pointWeight[j * rays], movingNow[j] != 0);
         corner[c] += f * weight[j];
       }
     }
@@ -584,7 +603,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
           if (link.partial && f > 0.0)
             f *= visibilityAt(p, nx, link, pointsOf(l), shooter[l].normal(),
                               cached_ && !link.moves ? &texelOpen_[e] : nullptr,
-                              &pointWeight[l * rays]);
+                              &pointWeight[l * rays], movingNow[l] != 0);
           H += f * weight[l];
         }
         acc[x] = H;

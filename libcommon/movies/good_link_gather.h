@@ -152,6 +152,7 @@ class GoodLinkGather {
   bool cached_ = false;
   int movieNode_ = 0;
   std::vector<std::array<glm::dvec3, 2>> swept_;  // of the nodes that move during the movie
+  std::vector<int> movingNodes_;                  // those nodes
 
   Polygon nodeWorld(uint32_t node, double t) const;
   void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request);
@@ -178,7 +179,7 @@ class GoodLinkGather {
   // current time, weighted by the kernel and the shooter's B at their ends (`weight`).
   double visibilityAt(const glm::dvec3& x, const glm::dvec3& n, const Link& l,
                       const std::vector<glm::dvec3>& points, const glm::dvec3& shooterNormal,
-                      const uint64_t* open, const double* weight) const;
+                      const uint64_t* open, const double* weight, bool movingNow) const;
 };
 
 }  // namespace rad
