@@ -44,12 +44,18 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
       receiverTop_(int(request.patch.top)),
       visibility_(visibility),
       visibilityRays_(visibilityRays) {
-  if (visibility_) {  // the nodes that move during the movie (their swept bounds)
+  // The nodes in the moving part of the visibility scene, those that move anywhere in the
+  // solution's time range (SceneVisibility's split), with their bounds swept over the movie:
+  // one that rests during the movie still blocks. Only the nodes moving during the movie had
+  // been taken, and a one-frame movie (--no-coherence) saw no moving blocker at all: cubes-8's
+  // scratch frame 0 was 1.4 % brighter than the coherent one.
+  if (visibility_) {
     std::vector<int> seen;
+    const double s0 = solution.keyTimes.front(), s1 = solution.keyTimes.back();
     for (const InputPolygon& top : solution.hierarchy.tops()) {
       if (top.node < 0 || std::find(seen.begin(), seen.end(), top.node) != seen.end()) continue;
       seen.push_back(top.node);
-      if (scene.isDynamic(top.node, keyTimes_.front(), keyTimes_.back())) {
+      if (scene.isDynamic(top.node, s0, s1)) {
         swept_.push_back(scene.sweptBounds(top.node, keyTimes_.front(), keyTimes_.back()));
         movingNodes_.push_back(top.node);
       }
