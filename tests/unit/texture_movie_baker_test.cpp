@@ -744,6 +744,49 @@ TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderI
   EXPECT_LT(sum / count, 0.1);
 }
 
+// A moving blocker of the gathered links is a blocker in every movie, also one a frame long
+// (--no-coherence) or one during which it rests: a black slab moving over a floor under an
+// emitting ceiling. Key 0 of a 25-frame movie and a one-frame movie at frame 0 agree within
+// 1 % on the whole (+0.03 %); the one-frame movie had ignored the slab (+27 %).
+TEST(TextureMovieBaker, GatheredVisibilitySeesMovingBlockersInOneFrameMovies) {
+  Scene s;
+  Material white, lamp, black;
+  white.reflectance = glm::dvec3(0.5);
+  lamp.emission = glm::dvec3(1.0);
+  lamp.reflectance = glm::dvec3(0.0);
+  black.reflectance = glm::dvec3(0.0);
+  s.materials = {white, lamp, black};
+  const int floor = addQuadNode(s, {0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, 0);
+  addQuadNode(s, {0, 0, 1}, {0, 1, 1}, {2, 1, 1}, {2, 0, 1}, 1);  // ceiling, down
+  const int slab = addQuadNode(s, {-.3, -.3, 0}, {-.3, .3, 0}, {.3, .3, 0}, {.3, -.3, 0}, 2);
+  translate(s, slab, {0.6, 0.5, 0.5}, {1.4, 0.5, 0.5}, 0.0, 1.0);
+  SpaceTimeOptions so;
+  so.badLinks = BadLinkRule::kNone;
+  so.radiosity.eps = 1e-3;
+  GlobalSolution g = solveSpaceTime(s, {0.0, 1.0}, so);
+  const int top = topOfNode(g, floor);
+  auto bakeFrames = [&](int last, bool coherence) {
+    TextureMovieBakerOptions o;
+    o.coherence = coherence;
+    TextureMovieBaker baker(s, g, kFps, o);
+    MovieExtent r;
+    r.patch = PatchId{uint32_t(top), 1u};
+    r.firstFrame = 0;
+    r.lastFrame = last;
+    r.width = 32;
+    r.height = 16;
+    return baker.bake(r).keys[0];
+  };
+  const std::vector<float> movie = bakeFrames(24, true), single = bakeFrames(0, false);
+  double sum = 0.0, total = 0.0;
+  for (size_t i = 0; i < movie.size(); ++i) {
+    sum += double(single[i]) - movie[i];
+    total += movie[i];
+  }
+  std::printf("key 0 of a 25-frame movie against a one-frame movie: bias %+.4f\n", sum / total);
+  EXPECT_LT(std::abs(sum / total), 0.01);
+}
+
 // Smooth shading (glTF NORMAL): two facets of a bent sheet meet at a 22-degree crease, lit from
 // the side. With the vertex normals of a smooth surface (the crease's normal the mean of the two
 // facets'), the baked irradiance of both facets, extrapolated to the crease, agrees within 1 %;
