@@ -50,16 +50,10 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   // been taken, and a one-frame movie (--no-coherence) saw no moving blocker at all: cubes-8's
   // scratch frame 0 was 1.4 % brighter than the coherent one.
   if (visibility_) {
-    std::vector<int> seen;
-    const double s0 = solution.keyTimes.front(), s1 = solution.keyTimes.back();
-    for (const InputPolygon& top : solution.hierarchy.tops()) {
-      if (top.node < 0 || std::find(seen.begin(), seen.end(), top.node) != seen.end()) continue;
-      seen.push_back(top.node);
-      if (scene.isDynamic(top.node, s0, s1)) {
-        swept_.push_back(scene.sweptBounds(top.node, keyTimes_.front(), keyTimes_.back()));
-        movingNodes_.push_back(top.node);
-      }
-    }
+    movingNodes_ = movingNodesOf(scene, solution.hierarchy.tops(), solution.keyTimes.front(),
+                                 solution.keyTimes.back());
+    for (int node : movingNodes_)
+      swept_.push_back(scene.sweptBounds(node, keyTimes_.front(), keyTimes_.back()));
   }
   planLinks(byReceiver, request);
   // The global keys the movie's key times fall between.

@@ -681,12 +681,8 @@ bool TextureMovieBaker::shadowsMove(const MovieExtent& req,
   const InputPolygon& receiverTop = tops_[req.patch.top];
   if (scene_.isDynamic(receiverTop.node, t0, t1)) return true;
   std::vector<std::array<glm::dvec3, 2>> swept;
-  std::vector<int> seen;
-  for (const InputPolygon& top : tops_) {
-    if (top.node < 0 || std::find(seen.begin(), seen.end(), top.node) != seen.end()) continue;
-    seen.push_back(top.node);
-    if (scene_.isDynamic(top.node, t0, t1)) swept.push_back(scene_.sweptBounds(top.node, t0, t1));
-  }
+  for (int node : movingNodesOf(scene_, tops_, t0, t1))
+    swept.push_back(scene_.sweptBounds(node, t0, t1));
   if (swept.empty()) return false;
   Box receiver;
   receiver.grow(nodeWorldPolygon(scene_, receiverTop, req.patch, t0));

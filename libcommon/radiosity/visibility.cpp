@@ -154,6 +154,19 @@ std::vector<glm::dvec3> pairedPoints(const Polygon& b, int k, std::uint64_t seed
   return out;
 }
 
+// A ray pair's weight in F: cos(theta_a) cos(theta_b) / r^2 (unnormalised normals times d,
+// over r^4), 0 where either point is behind the other's plane: those pairs carry no energy, but
+// an area-uniform count let them darken the link (a box face gathering from a floor patch half
+// behind it read V = 0.5).
+double pairKernel(const glm::dvec3& a, const glm::dvec3& aNormal, const glm::dvec3& b,
+                  const glm::dvec3& bNormal) {
+  const glm::dvec3 d = b - a;
+  const double r2 = glm::dot(d, d);
+  return r2 > 0.0 ? std::max(0.0, glm::dot(aNormal, d)) * std::max(0.0, -glm::dot(bNormal, d)) /
+                        (r2 * r2)
+                  : 0.0;
+}
+
 }  // namespace
 
 struct VisibilityScene::Impl {
@@ -367,14 +380,7 @@ double VisibilityScene::weightedVisibilityFrom(
         known ? ((*knownOpenPairs >> i) & 1u) != 0 : !occluded(pa, pb, ignoreA, ignoreB);
     unoccluded += isOpen ? 1 : 0;
     if (isOpen && i < kMaxRecordedPairs) open |= std::uint64_t(1) << i;
-    // The pair's weight in F: cos(theta_a) cos(theta_b) / r^2, 0 where either point is behind
-    // the other's plane (those pairs carry no energy, but an area-uniform count would let them
-    // darken the link: a box face gathering from a floor patch half behind it read V = 0.5).
-    const glm::dvec3 d = pb - pa;
-    const double r2 = glm::dot(d, d);
-    double w = r2 > 0.0 ? std::max(0.0, glm::dot(aNormal, d)) *
-                              std::max(0.0, -glm::dot(bNormal, d)) / (r2 * r2)
-                        : 0.0;
+    double w = pairKernel(pa, aNormal, pb, bNormal);
     kernelTotal += w;
     kernelOpen += isOpen ? w : 0.0;
     if (weightAtB) w *= std::max(0.0, weightAtB(pb));
@@ -411,11 +417,7 @@ double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
   if (open == 0) return 0.0;
   double weighted = 0.0, total = 0.0;
   for (int i = 0; i < k; ++i) {
-    const glm::dvec3 d = bPoints[size_t(i)] - x;
-    const double r2 = glm::dot(d, d);
-    double w =
-        r2 > 0.0 ? std::max(0.0, glm::dot(n, d)) * std::max(0.0, -glm::dot(bNormal, d)) / (r2 * r2)
-                 : 0.0;
+    double w = pairKernel(x, n, bPoints[size_t(i)], bNormal);
     if (weight) w *= std::max(0.0, weight[i]);
     total += w;
     weighted += ((open >> i) & 1u) ? w : 0.0;

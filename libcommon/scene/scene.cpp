@@ -545,4 +545,15 @@ CameraView Scene::cameraAt(int node, double t) const {
   return view;
 }
 
+std::vector<int> movingNodesOf(const Scene& scene, const std::vector<InputPolygon>& polygons,
+                               double t0, double t1) {
+  std::vector<int> seen, moving;
+  for (const InputPolygon& p : polygons) {
+    if (p.node < 0 || std::find(seen.begin(), seen.end(), p.node) != seen.end()) continue;
+    seen.push_back(p.node);
+    if (scene.isDynamic(p.node, t0, t1)) moving.push_back(p.node);
+  }
+  return moving;
+}
+
 }  // namespace rad

@@ -117,6 +117,7 @@ struct InputPolygon {
 // the interpolation degenerates or faces away from the flat normal's side.
 glm::dvec3 shadingNormalAt(const InputPolygon& p, glm::dvec2 uv);
 
+
 class Scene {
  public:
   std::string path;  // file it was read from (for messages)
@@ -169,5 +170,10 @@ class Scene {
   int cameraNode(const std::string& name) const;
   CameraView cameraAt(int node, double t) const;
 };
+
+// The distinct mesh nodes of `polygons` that move somewhere in [t0, t1] (Scene::isDynamic),
+// in first-appearance order.
+std::vector<int> movingNodesOf(const Scene& scene, const std::vector<InputPolygon>& polygons,
+                               double t0, double t1);
 
 }  // namespace rad

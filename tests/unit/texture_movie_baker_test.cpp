@@ -607,6 +607,54 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
   EXPECT_LT(worst, 0.01) << "step across the edge";
 }
 
+// The scenes of the per-texel visibility tests: a floor [0,2] x [0,1] at z = 0 (white, up)
+// under an emitting, non-reflecting ceiling at z = 1 (B = pi, down); material 2 is black, for
+// blockers that reflect nothing.
+struct FloorUnderCeiling {
+  Scene scene;
+  int floor = -1;
+};
+FloorUnderCeiling floorUnderCeiling() {
+  FloorUnderCeiling f;
+  Material white, lamp, black;
+  white.reflectance = glm::dvec3(0.5);
+  lamp.emission = glm::dvec3(1.0);  // B = pi
+  lamp.reflectance = glm::dvec3(0.0);
+  black.reflectance = glm::dvec3(0.0);
+  f.scene.materials = {white, lamp, black};
+  f.floor = addQuadNode(f.scene, {0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, 0);
+  addQuadNode(f.scene, {0, 0, 1}, {0, 1, 1}, {2, 1, 1}, {2, 0, 1}, 1);
+  return f;
+}
+
+// Every link good (the per-texel visibility is the gather's), at the given key times.
+GlobalSolution solveWithGoodLinksOnly(const Scene& s, const std::vector<double>& keyTimes) {
+  SpaceTimeOptions so;
+  so.badLinks = BadLinkRule::kNone;
+  so.radiosity.eps = 1e-3;
+  return solveSpaceTime(s, keyTimes, so);
+}
+
+// The exact irradiance at floor point x from that ceiling: B times the point form factors of
+// its 128 x 64 cells whose centre's segment to x is not blocked(x, centre).
+template <class Blocked>
+double ceilingIrradiance(const glm::dvec3& x, Blocked&& blocked) {
+  const int nu = 128, nv = 64;
+  double f = 0.0;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double u0 = 2.0 * i / nu, u1 = 2.0 * (i + 1) / nu;
+      const double v0 = double(j) / nv, v1 = double(j + 1) / nv;
+      if (blocked(x, glm::dvec3(0.5 * (u0 + u1), 0.5 * (v0 + v1), 1.0))) continue;
+      Polygon cell;
+      cell.count = 4;
+      cell.v = {glm::dvec3(u0, v0, 1), glm::dvec3(u0, v1, 1), glm::dvec3(u1, v1, 1),
+                glm::dvec3(u1, v0, 1)};
+      f += pointToPolygonFormFactor(x, {0, 0, 1}, cell);
+    }
+  return M_PI * f;
+}
+
 // Per-texel visibility of the gathered links (--gather-rays): a floor z = 0 under an emitting
 // ceiling z = 1, a black slab at z = 0.5 over x < 1 hiding part of the ceiling from every floor
 // point, every link good. The exact irradiance at x is B times the form factor of the part of
@@ -615,37 +663,15 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
 // one V per receiver node's (--gather-rays 0), whose steps where two receiver nodes meet showed
 // on the bundled scene's walls.
 TEST(TextureMovieBaker, GatheredVisibilityFollowsThePenumbraPerTexel) {
-  Scene s;
-  Material white, lamp, black;
-  white.reflectance = glm::dvec3(0.5);
-  lamp.emission = glm::dvec3(1.0);  // B = pi
-  lamp.reflectance = glm::dvec3(0.0);
-  black.reflectance = glm::dvec3(0.0);
-  s.materials = {white, lamp, black};
-  const int floor = addQuadNode(s, {0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, 0);
-  addQuadNode(s, {0, 0, 1}, {0, 1, 1}, {2, 1, 1}, {2, 0, 1}, 1);              // ceiling, down
+  FloorUnderCeiling f = floorUnderCeiling();
+  Scene& s = f.scene;
   addQuadNode(s, {-1, -1, 0.5}, {-1, 2, 0.5}, {1, 2, 0.5}, {1, -1, 0.5}, 2);  // slab, down
-  SpaceTimeOptions so;
-  so.badLinks = BadLinkRule::kNone;
-  so.radiosity.eps = 1e-3;
-  GlobalSolution g = solveSpaceTime(s, {0.0}, so);
-  const int floorTop = topOfNode(g, floor);
-  auto exact = [](const glm::dvec3& x, bool occluded) {
-    const int nu = 128, nv = 64;
-    double f = 0.0;
-    for (int j = 0; j < nv; ++j)
-      for (int i = 0; i < nu; ++i) {
-        const double u0 = 2.0 * i / nu, u1 = 2.0 * (i + 1) / nu;
-        const double v0 = double(j) / nv, v1 = double(j + 1) / nv;
-        const double cx = 0.5 * (u0 + u1);
-        if (occluded && 0.5 * (x.x + cx) < 1.0) continue;  // the segment meets the slab
-        Polygon cell;
-        cell.count = 4;
-        cell.v = {glm::dvec3(u0, v0, 1), glm::dvec3(u0, v1, 1), glm::dvec3(u1, v1, 1),
-                  glm::dvec3(u1, v0, 1)};
-        f += pointToPolygonFormFactor(x, {0, 0, 1}, cell);
-      }
-    return M_PI * f;
+  GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
+  const int floorTop = topOfNode(g, f.floor);
+  auto exact = [](const glm::dvec3& x, bool occluded) {  // the segment meets the slab at z 0.5
+    return ceilingIrradiance(x, [&](const glm::dvec3& a, const glm::dvec3& c) {
+      return occluded && 0.5 * (a.x + c.x) < 1.0;
+    });
   };
   std::vector<std::pair<double, double>> reference;  // per texel: occluded, unoccluded
   auto meanError = [&](int rays) {
@@ -674,25 +700,15 @@ TEST(TextureMovieBaker, GatheredVisibilityFollowsThePenumbraPerTexel) {
 // over 128 x 64 ceiling cells): mean error 5.6 %, bias +2.7 %; interpolated from the covered
 // corners, 20.7 % and -8.3 %.
 TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderIt) {
-  Scene s;
-  Material white, lamp, black;
-  white.reflectance = glm::dvec3(0.5);
-  lamp.emission = glm::dvec3(1.0);  // B = pi
-  lamp.reflectance = glm::dvec3(0.0);
-  black.reflectance = glm::dvec3(0.0);
-  s.materials = {white, lamp, black};
-  const int floor = addQuadNode(s, {0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, 0);
-  addQuadNode(s, {0, 0, 1}, {0, 1, 1}, {2, 1, 1}, {2, 0, 1}, 1);  // ceiling, down
-  const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);      // the box, faces outward
+  FloorUnderCeiling f = floorUnderCeiling();
+  Scene& s = f.scene;
+  const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);  // the box, faces outward
   addQuadNode(s, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}, 2);
   addQuadNode(s, {lo.x, lo.y, 0}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, 0}, 2);
   addQuadNode(s, {hi.x, lo.y, 0}, {hi.x, hi.y, 0}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z}, 2);
   addQuadNode(s, {lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z}, 2);
   addQuadNode(s, {lo.x, hi.y, 0}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, 0}, 2);
-  SpaceTimeOptions so;
-  so.badLinks = BadLinkRule::kNone;
-  so.radiosity.eps = 1e-3;
-  GlobalSolution g = solveSpaceTime(s, {0.0}, so);
+  GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
   auto blocked = [&](const glm::dvec3& a, const glm::dvec3& b) {  // segment meets the box
     double t0 = 0.0, t1 = 1.0;
     for (int k = 0; k < 3; ++k) {
@@ -707,25 +723,9 @@ TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderI
     }
     return t0 < t1;
   };
-  auto exact = [&](const glm::dvec3& x) {
-    const int nu = 128, nv = 64;
-    double f = 0.0;
-    for (int j = 0; j < nv; ++j)
-      for (int i = 0; i < nu; ++i) {
-        const double u0 = 2.0 * i / nu, u1 = 2.0 * (i + 1) / nu;
-        const double v0 = double(j) / nv, v1 = double(j + 1) / nv;
-        if (blocked(x, {0.5 * (u0 + u1), 0.5 * (v0 + v1), 1.0})) continue;
-        Polygon cell;
-        cell.count = 4;
-        cell.v = {glm::dvec3(u0, v0, 1), glm::dvec3(u0, v1, 1), glm::dvec3(u1, v1, 1),
-                  glm::dvec3(u1, v0, 1)};
-        f += pointToPolygonFormFactor(x, {0, 0, 1}, cell);
-      }
-    return M_PI * f;
-  };
   const int w = 64, h = 32;
   const double texel = 2.0 / w;
-  const std::vector<BakedTexel> baked = bakeTop(s, g, topOfNode(g, floor), w, h);
+  const std::vector<BakedTexel> baked = bakeTop(s, g, topOfNode(g, f.floor), w, h);
   double sum = 0.0, signedSum = 0.0;
   int count = 0;
   for (const BakedTexel& t : baked) {
@@ -733,7 +733,7 @@ TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderI
     const double dx = std::max({lo.x - t.x.x, t.x.x - hi.x, 0.0});
     const double dy = std::max({lo.y - t.x.y, t.x.y - hi.y, 0.0});
     if (under || std::max(dx, dy) > 2.0 * texel) continue;
-    const double e = exact(t.x);
+    const double e = ceilingIrradiance(t.x, blocked);
     sum += std::abs(t.h - e) / e;
     signedSum += (t.h - e) / e;
     ++count;
@@ -749,22 +749,12 @@ TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderI
 // emitting ceiling. Key 0 of a 25-frame movie and a one-frame movie at frame 0 agree within
 // 1 % on the whole (+0.03 %); the one-frame movie had ignored the slab (+27 %).
 TEST(TextureMovieBaker, GatheredVisibilitySeesMovingBlockersInOneFrameMovies) {
-  Scene s;
-  Material white, lamp, black;
-  white.reflectance = glm::dvec3(0.5);
-  lamp.emission = glm::dvec3(1.0);
-  lamp.reflectance = glm::dvec3(0.0);
-  black.reflectance = glm::dvec3(0.0);
-  s.materials = {white, lamp, black};
-  const int floor = addQuadNode(s, {0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}, 0);
-  addQuadNode(s, {0, 0, 1}, {0, 1, 1}, {2, 1, 1}, {2, 0, 1}, 1);  // ceiling, down
+  FloorUnderCeiling f = floorUnderCeiling();
+  Scene& s = f.scene;
   const int slab = addQuadNode(s, {-.3, -.3, 0}, {-.3, .3, 0}, {.3, .3, 0}, {.3, -.3, 0}, 2);
   translate(s, slab, {0.6, 0.5, 0.5}, {1.4, 0.5, 0.5}, 0.0, 1.0);
-  SpaceTimeOptions so;
-  so.badLinks = BadLinkRule::kNone;
-  so.radiosity.eps = 1e-3;
-  GlobalSolution g = solveSpaceTime(s, {0.0, 1.0}, so);
-  const int top = topOfNode(g, floor);
+  GlobalSolution g = solveWithGoodLinksOnly(s, {0.0, 1.0});
+  const int top = topOfNode(g, f.floor);
   auto bakeFrames = [&](int last, bool coherence) {
     TextureMovieBakerOptions o;
     o.coherence = coherence;
