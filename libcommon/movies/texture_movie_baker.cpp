@@ -116,8 +116,10 @@ class MovieGeometry {
     const size_t K = keyTimes_.size();
     receiverWorld_.resize(K);
     receiverTransform_.resize(K);
+    receiverNormalMap_.resize(K);
     for (size_t k = 0; k < K; ++k) {
       receiverTransform_[k] = scene_.worldTransform(receiverTop_.node, keyTimes_[k]);
+      receiverNormalMap_[k] = glm::transpose(glm::inverse(glm::dmat3(receiverTransform_[k])));
       receiverWorld_[k] = nodeWorldPolygon(scene_, receiverTop_, req.patch, keyTimes_[k]);
     }
   }
@@ -162,6 +164,18 @@ class MovieGeometry {
         f[x] = pointToPolygonFormFactor(pt, glm::normalize(normalMap * localNormal_[x]), sw);
       }
     });
+  }
+  // The texel's transmittance at key k from its occluded samples (kernelWeightedTransmittance).
+  double texelTransmittance(int k, size_t x, const std::vector<glm::dvec3>& samples,
+                            const glm::dvec3& shooterNormal, SampleMask occluded,
+                            SampleMask valid) const {
+    const SampleMask open = valid & ~occluded;
+    if (open == valid) return 1.0;  // most texels: no point or normal needed
+    if (open == 0) return 0.0;
+    const glm::dmat4& m = receiverTransform_[size_t(k)];
+    const glm::dvec3 pt(m * glm::dvec4(localPoint_[x], 1.0));
+    const glm::dvec3 n = glm::normalize(receiverNormalMap_[size_t(k)] * localNormal_[x]);
+    return kernelWeightedTransmittance(pt, n, samples, shooterNormal, occluded, valid);
   }
   std::vector<glm::dvec3> samplesAt(const Pair& p, int k) const {
     std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
@@ -228,21 +242,25 @@ class MovieGeometry {
   bool receiverDynamic_ = false;
   std::vector<Polygon> receiverWorld_;
   std::vector<glm::dmat4> receiverTransform_;
+  std::vector<glm::dmat3> receiverNormalMap_;  // of the shading normals, per key
   std::unordered_map<long long, glm::dmat4> nodeWorldAtKey_;
 };
 
 // Merge (paper §5): a coherent pair's transmittance at one key from its static-blocker mask
 // (empty: no static blocker) and the key's dynamic-blocker mask. kExact ORs the masks (the
-// same bits as rendering all blockers together); the others merge the two transmittances.
+// same bits as rendering all blockers together) and weights the open samples by the texel's
+// kernel (`exact(x, occluded)`, kernelWeightedTransmittance); the others merge the two
+// popcount transmittances.
+template <class Exact>
 void mergeOcclusion(MergeMode merge, const std::vector<SampleMask>& staticMask,
-                    const std::vector<SampleMask>& keyMask, SampleMask valid,
+                    const std::vector<SampleMask>& keyMask, SampleMask valid, Exact&& exact,
                     std::vector<float>& transmittance) {
   const size_t texels = transmittance.size();
   const bool noStatic = staticMask.empty();
   if (merge == MergeMode::kExact) {
-    for (size_t x = 0; x < texels; ++x)
-      transmittance[x] = float(
-          transmittanceFromMask((noStatic ? SampleMask(0) : staticMask[x]) | keyMask[x], valid));
+    tbb::parallel_for(size_t(0), texels, [&](size_t x) {
+      transmittance[x] = float(exact(x, (noStatic ? SampleMask(0) : staticMask[x]) | keyMask[x]));
+    });
   } else {
     for (size_t x = 0; x < texels; ++x)
       transmittance[x] = float(mergeTransmittance(
@@ -339,7 +357,13 @@ class MovieBake {
                                                    : geo_.blockersAt(p, p.dynamicList, k);
     gl.render(geo_.receiverWorld(0), geo_.width(), geo_.height(), p.keyZeroSamples, dynamicTris,
               keyMask_);
-    mergeOcclusion(options_.merge, p.staticMask, keyMask_, p.valid, transmittance_);
+    const glm::dvec3 shooterNormal = p.shooterWorld[0].normal();
+    mergeOcclusion(
+        options_.merge, p.staticMask, keyMask_, p.valid,
+        [&](size_t x, SampleMask occluded) {
+          return geo_.texelTransmittance(0, x, p.keyZeroSamples, shooterNormal, occluded, p.valid);
+        },
+        transmittance_);
     stats_.secondsTransmittance += secondsSince(clock);
     return p.formFactor;
   }
@@ -352,8 +376,11 @@ class MovieBake {
     const SampleMask valid = frontSampleMask(geo_.receiverWorld(k), samples);
     gl.render(geo_.receiverWorld(k), geo_.width(), geo_.height(), samples,
               geo_.blockersAt(p, p.candidates, k), keyMask_);
-    for (size_t x = 0; x < texels_; ++x)
-      transmittance_[x] = float(transmittanceFromMask(keyMask_[x], valid));
+    const glm::dvec3 shooterNormal = p.shooterWorld[size_t(k)].normal();
+    tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
+      transmittance_[x] =
+          float(geo_.texelTransmittance(k, x, samples, shooterNormal, keyMask_[x], valid));
+    });
     stats_.secondsTransmittance += secondsSince(clock);
     clock = SteadyClock::now();
     keyFormFactor_.resize(texels_);
@@ -413,7 +440,10 @@ bool MovieBake::planPair(uint32_t S, Pair& p) {
   p.samples = transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
                                        options_.maxSamples);
   stats_.samples += p.samples;
-  const uint32_t seed = mix32(req_.patch.packed() * 0x9e3779b97f4a7c15ull ^ S);
+  // Seeded by the receiver's top-level patch, not the movie's node: the movies of one surface
+  // (a parent's and its children's, neighbours at one level) then take the same sample points
+  // when they take as many, and their kernel-weighted penumbrae meet without a step.
+  const uint32_t seed = mix32(uint64_t(req_.patch.top) * 0x9e3779b97f4a7c15ull ^ S);
   p.unitSamples = multiJitteredPoints(p.samples, seed);
 
   std::vector<int> candidates = blockerCandidates(S);

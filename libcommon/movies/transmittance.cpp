@@ -236,6 +236,28 @@ double transmittanceFromMask(SampleMask occluded, SampleMask valid) {
   return double(std::bitset<64>(valid & ~occluded).count()) / n;
 }
 
+double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
+                                   const std::vector<glm::dvec3>& samples,
+                                   const glm::dvec3& shooterNormal, SampleMask occluded,
+                                   SampleMask valid) {
+  const SampleMask open = valid & ~occluded;
+  if (open == valid) return 1.0;
+  if (open == 0) return 0.0;
+  double total = 0.0, seen = 0.0;
+  const size_t count = std::min(samples.size(), size_t(kMaxTransmittanceSamples));
+  for (size_t s = 0; s < count; ++s) {
+    if (!((valid >> s) & 1u)) continue;
+    const glm::dvec3 d = samples[s] - x;
+    const double r2 = glm::dot(d, d);
+    if (!(r2 > 0.0)) continue;
+    const double k =
+        std::max(0.0, glm::dot(n, d)) * std::abs(glm::dot(shooterNormal, d)) / (r2 * r2);
+    total += k;
+    if ((open >> s) & 1u) seen += k;
+  }
+  return total > 0.0 ? seen / total : transmittanceFromMask(occluded, valid);
+}
+
 const char* mergeModeName(MergeMode m) {
   switch (m) {
     case MergeMode::kExact:

@@ -62,6 +62,20 @@ SampleMask frontSampleMask(const Polygon& receiver, const std::vector<glm::dvec3
 // no sample is valid.
 double transmittanceFromMask(SampleMask occluded, SampleMask valid);
 
+// The transmittance as the texel receives it: each valid sample s weighted by the kernel
+// cos(theta_x) cos(theta_s) / r^2 of the point-to-area form factor (the texel at x, normal n;
+// the shooter's normal taken either way, as a planar shooter lies wholly on one side of x):
+//   T(x) = sum_{s open} K(x, s) / sum_s K(x, s),
+// the quadrature of F(x -> S, visible) / F(x -> S) by the samples, where the popcount fraction
+// weights every part of the shooter alike. A large light near a receiver varies K by 2x over
+// itself (the Cornell box's lamp seen from the foot of a side wall), and there a box's penumbra
+// came out up to 10 % wrong. Fully open or fully occluded: exactly 1 or 0 whatever the weights;
+// no weight at any valid sample: the popcount fraction.
+double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
+                                   const std::vector<glm::dvec3>& samples,
+                                   const glm::dvec3& shooterNormal, SampleMask occluded,
+                                   SampleMask valid);
+
 // Approximate merge operators for transmittances of two disjoint blocker sets (paper §5,
 // Figure 7): occlusions a = 1 - Ts and b = 1 - Td merge to max(a, b) (blockers overlap),
 // min(1, a + b) (disjoint) or 1 - (1 - a)(1 - b) (independent). kExact ORs the sample masks.

@@ -182,7 +182,13 @@ TEST(TextureMovieBaker, HalfPlaneShadowGivesUmbraAndAnalyticPenumbra) {
     double f = pointToPolygonFormFactor(x, {0, 0, 1}, light);
     double got = m.keys[0][size_t(i) * 3 + 1];
     double transmittance = (got - t.good.y) / (t.lightB.y * f);
-    double expected = std::clamp(0.5 + x.x, 0.0, 1.0);
+    // The light seen past the half-plane: its part s.x >= -x.x (the segment crosses z = 1 at
+    // (x + s) / 2), weighted by the kernel as the texel receives it: F(x -> that part) / F.
+    const double edge = std::clamp(-x.x, -0.5, 0.5);
+    Polygon seen = light;
+    for (glm::dvec3& v : seen.v)
+      if (v.x < 0.0) v.x = edge;
+    double expected = edge >= 0.5 ? 0.0 : pointToPolygonFormFactor(x, {0, 0, 1}, seen) / f;
     EXPECT_NEAR(transmittance, expected, 1.0 / n + 1e-5) << "texel " << i << " x " << x.x;
     if (x.x < -0.5) {
       EXPECT_NEAR(got, t.good.y, 1e-6) << "umbra: only the good layer";

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "libcommon/core/error.h"
+#include "libcommon/radiosity/form_factor.h"
 #include "libcommon/scene/patch_hierarchy.h"
 
 namespace rad {
@@ -124,6 +125,31 @@ TEST(Transmittance, MergeOperatorsOnHalfOccludedLayers) {
   EXPECT_THROW(parseMergeMode("mean"), Error);
   EXPECT_DOUBLE_EQ(transmittanceFromMask(0b0101, 0b1111), 0.5);
   EXPECT_DOUBLE_EQ(transmittanceFromMask(0b1111, 0), 1.0);
+}
+
+// A wall point beside a large light sees the light's near half under a larger kernel than its
+// far half: with the far half occluded, the texel receives F(x -> near half) / F(x -> light),
+// not the half that the popcount of the samples says.
+TEST(Transmittance, KernelWeightedTransmittanceIsTheVisibleFormFactorShare) {
+  const glm::dvec3 x(0.7, 0.0, 1.6), n(-1.0, 0.0, 0.0);  // on a wall at x = 0.7 facing -x
+  const Polygon light = ceilingLight();
+  const Polygon nearHalf = quad({0, -0.5, 2}, {0, 0.5, 2}, {0.5, 0.5, 2}, {0.5, -0.5, 2});
+  const double exact =
+      pointToPolygonFormFactor(x, n, nearHalf) / pointToPolygonFormFactor(x, n, light);
+  ASSERT_GT(exact, 0.6);  // far from the popcount's 0.5: the test can tell the two apart
+  const std::vector<glm::dvec3> samples = lightSamples(64);
+  SampleMask occluded = 0, valid = 0;
+  for (size_t s = 0; s < samples.size(); ++s) {
+    valid |= SampleMask(1) << s;
+    if (samples[s].x < 0.0) occluded |= SampleMask(1) << s;
+  }
+  EXPECT_NEAR(transmittanceFromMask(occluded, valid), 0.5, 1.0 / 64);
+  const double t = kernelWeightedTransmittance(x, n, samples, light.normal(), occluded, valid);
+  EXPECT_NEAR(t, exact, 0.02) << "popcount " << transmittanceFromMask(occluded, valid);
+  // Fully open and fully occluded stay exact; the shooter's facing does not matter.
+  EXPECT_EQ(kernelWeightedTransmittance(x, n, samples, light.normal(), 0, valid), 1.0);
+  EXPECT_EQ(kernelWeightedTransmittance(x, n, samples, light.normal(), valid, valid), 0.0);
+  EXPECT_EQ(kernelWeightedTransmittance(x, n, samples, -light.normal(), occluded, valid), t);
 }
 
 TEST(Transmittance, NoBlockersLeaveEverythingLit) {
