@@ -14,6 +14,18 @@
 
 namespace rad {
 
+bool coveredBySolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
+                    uint32_t top, const glm::dvec3& p, const glm::dvec3& d, double t) {
+  const uint32_t hit = blockers.firstHit(p, d, top);
+  if (hit == VisibilityScene::kNoSurface || hit >= uint32_t(h.topCount())) return false;
+  const InputPolygon& surface = h.top(int(hit));
+  const int m = surface.material;
+  if (m >= 0 && m < int(scene.materials.size()) && scene.materials[size_t(m)].doubleSided)
+    return false;
+  return glm::dot(surface.local.transformed(scene.worldTransform(surface.node, t)).normal(), d) >
+         0.0;
+}
+
 GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
   const size_t N = size_t(s.hierarchy.size());
   auto gathers = [N](const GlobalLink& l) {
@@ -424,18 +436,13 @@ std::vector<char> GoodLinkGather::coveredTiles() const {
   const int w = texels_.width;
   auto test = [&](const VisibilityScene& blockers, double t) {
     const TexelFrame frame = texelFrame(t);
+    const double size = polygonSize(nodeWorld(uint32_t(movieNode_), t));
     tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
       if (covered[ti]) return;
       for (size_t x : tiles_[ti].cornerTexels(w)) {
         const glm::dvec3 p = frame.point(texels_.localPoint[x]);
-        const glm::dvec3 d =
-            frame.normal(texels_.localNormal[x]) * polygonSize(nodeWorld(uint32_t(movieNode_), t));
-        const uint32_t hit = blockers.firstHit(p, d, uint32_t(receiverTop_));
-        if (hit == VisibilityScene::kNoSurface || hit >= uint32_t(h.topCount())) continue;
-        const int m = h.top(int(hit)).material;
-        const bool doubleSided =
-            m >= 0 && m < int(scene_.materials.size()) && scene_.materials[size_t(m)].doubleSided;
-        if (!doubleSided && glm::dot(nodeWorld(hit, t).normal(), d) > 0.0) {
+        const glm::dvec3 d = frame.normal(texels_.localNormal[x]) * size;
+        if (coveredBySolid(blockers, scene_, h, uint32_t(receiverTop_), p, d, t)) {
           covered[ti] = 1;
           return;
         }

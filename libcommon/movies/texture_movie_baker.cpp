@@ -165,6 +165,12 @@ class MovieGeometry {
       }
     });
   }
+  glm::dvec3 texelPoint(int k, size_t x) const {
+    return glm::dvec3(receiverTransform_[size_t(k)] * glm::dvec4(localPoint_[x], 1.0));
+  }
+  glm::dvec3 texelNormal(int k, size_t x) const {
+    return glm::normalize(receiverNormalMap_[size_t(k)] * localNormal_[x]);
+  }
   // The texel's transmittance at key k from its occluded samples (kernelWeightedTransmittance).
   double texelTransmittance(int k, size_t x, const std::vector<glm::dvec3>& samples,
                             const glm::dvec3& shooterNormal, SampleMask occluded,
@@ -172,10 +178,8 @@ class MovieGeometry {
     const SampleMask open = valid & ~occluded;
     if (open == valid) return 1.0;  // most texels: no point or normal needed
     if (open == 0) return 0.0;
-    const glm::dmat4& m = receiverTransform_[size_t(k)];
-    const glm::dvec3 pt(m * glm::dvec4(localPoint_[x], 1.0));
-    const glm::dvec3 n = glm::normalize(receiverNormalMap_[size_t(k)] * localNormal_[x]);
-    return kernelWeightedTransmittance(pt, n, samples, shooterNormal, occluded, valid);
+    return kernelWeightedTransmittance(texelPoint(k, x), texelNormal(k, x), samples, shooterNormal,
+                                       occluded, valid);
   }
   std::vector<glm::dvec3> samplesAt(const Pair& p, int k) const {
     std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
@@ -275,7 +279,8 @@ class MovieBake {
   MovieBake(const GlobalSolution& solution, const std::vector<InputPolygon>& tops,
             const TextureMovieBakerOptions& options, TextureMovieBakerStats& stats,
             const std::function<OcclusionMaskRenderer&()>& renderer, FormFactorSpill& spill,
-            const MovieExtent& req, MovieGeometry& geometry, const GoodLinkGather* gather)
+            const MovieExtent& req, MovieGeometry& geometry, const GoodLinkGather* gather,
+            SceneVisibility* visibility)
       : solution_(solution),
         tops_(tops),
         options_(options),
@@ -285,10 +290,92 @@ class MovieBake {
         req_(req),
         geo_(geometry),
         gather_(gather),
+        visibility_(visibility),
         texels_(geometry.texels()),
         acc_(texels_),
         transmittance_(texels_),
         texture_(texels_ * 3) {}
+
+  // Texels under a touching solid at key k (a box's foot on the floor, coveredBySolid) are never
+  // seen, and gather nothing: ~0. A pixel between such a texel's centre and an exposed one's
+  // (the floor just beside the box) interpolated the two, and came out up to 4x too dark: the
+  // largest single errors of the Cornell box's frame. Each covered texel next to an exposed one
+  // takes the mean of its exposed 8-neighbours, twice outwards (lightmap dilation), so that
+  // the bilinear lookup meets exposed values only. Static blockers are tested once per movie,
+  // moving ones at each key where their swept bounds meet the receiver.
+  void fillCoveredTexels(int k, double t) {
+    auto clock = SteadyClock::now();
+    const int w = geo_.width(), h = geo_.height();
+    const PatchHierarchy& hierarchy = solution_.hierarchy;
+    const uint32_t top = req_.patch.top;
+    const Polygon& receiver = geo_.receiverWorld(k);
+    const double size = polygonSize(receiver);
+    auto test = [&](const VisibilityScene& blockers, double at, std::vector<char>& covered) {
+      tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
+        if (covered[x]) return;
+        // Inside a solid every way: along the normal and tilted 88 degrees to four sides (nearly
+        // along the surface). The normal alone also took the ceiling above a lamp panel hung
+        // 1 mm under it, which the camera sees, dark, through the gap; rays 88 degrees from the
+        // normal leave through a gap g from every point within g / tan(2 deg) = 28.6 g of the
+        // panel's edge, and under a box they meet its sides from inside.
+        const glm::dvec3 p = geo_.texelPoint(k, x), n = geo_.texelNormal(k, x);
+        glm::dvec3 u = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+        u = glm::normalize(glm::cross(u, n));
+        const glm::dvec3 v = glm::cross(n, u);
+        const double c = std::cos(88.0 * M_PI / 180.0), sn = std::sin(88.0 * M_PI / 180.0);
+        const glm::dvec3 dirs[5] = {n, c * n + sn * u, c * n - sn * u, c * n + sn * v,
+                                    c * n - sn * v};
+        for (const glm::dvec3& d : dirs)
+          if (!coveredBySolid(blockers, geo_.scene(), hierarchy, top, p, d * size, at)) return;
+        covered[x] = 1;
+      });
+    };
+    const bool receiverMoves = geo_.receiverDynamic();
+    if (staticCovered_.empty() || receiverMoves) {
+      staticCovered_.assign(texels_, 0);
+      test(visibility_->staticPart(), t, staticCovered_);
+      Box box;
+      box.grow(receiver);
+      for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
+                                    solution_.keyTimes.back())) {
+        const auto b =
+            geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
+        if (box.overlaps(Box{b[0], b[1]})) movingNear_ = true;
+      }
+    }
+    covered_ = staticCovered_;
+    if ((movingNear_ || receiverMoves) && visibility_->dynamicNodeCount() > 0) {
+      visibility_->setTime(t);
+      test(visibility_->movingPart(), t, covered_);
+    }
+    std::vector<char> exposed(texels_);
+    for (size_t x = 0; x < texels_; ++x) exposed[x] = covered_[x] ? 0 : 1;
+    long filled = 0;
+    for (int ring = 0; ring < 2; ++ring) {
+      std::vector<char> next = exposed;
+      for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i) {
+          const size_t x = size_t(j) * w + i;
+          if (exposed[x]) continue;
+          float sum[3] = {0, 0, 0};
+          int n = 0;
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int a = i + di, b = j + dj;
+              if (a < 0 || b < 0 || a >= w || b >= h || !exposed[size_t(b) * w + a]) continue;
+              for (int c = 0; c < 3; ++c) sum[c] += texture_[3 * (size_t(b) * w + a) + size_t(c)];
+              ++n;
+            }
+          if (n == 0) continue;
+          for (int c = 0; c < 3; ++c) texture_[3 * x + size_t(c)] = sum[c] / float(n);
+          next[x] = 1;
+          ++filled;
+        }
+      exposed.swap(next);
+    }
+    stats_.coveredTexelsFilled += filled;
+    stats_.secondsCombine += secondsSince(clock);
+  }
 
   // Planning: the per-movie part of every bad pair, in badShooters order.
   void plan(const std::vector<uint32_t>& badShooters) {
@@ -319,6 +406,7 @@ class MovieBake {
         texture_[3 * x + size_t(c)] = std::isfinite(v) ? float(std::max(v, 0.0)) : 0.0f;
       }
     stats_.secondsCombine += secondsSince(clock);
+    if (options_.fillCovered && visibility_) fillCoveredTexels(k, t);
     sink.key(size_t(k), texture_);
   }
 
@@ -406,6 +494,7 @@ class MovieBake {
   const MovieExtent& req_;
   MovieGeometry& geo_;
   const GoodLinkGather* gather_;  // null: Gouraud
+  SceneVisibility* visibility_;   // null: covered texels are left as they are
   const size_t texels_;
   int saturatedSamples_ = 0;
   std::vector<Pair> pairs_;
@@ -414,6 +503,9 @@ class MovieBake {
   std::vector<float> transmittance_, texture_;
   std::vector<SampleMask> keyMask_;
   std::vector<double> keyFormFactor_;  // also the scan's scratch
+  // fillCoveredTexels: under static solids (once per movie), and at the current key.
+  std::vector<char> staticCovered_, covered_;
+  bool movingNear_ = false;  // a moving node's swept bounds meet the receiver
 };
 
 // One bad pair's per-movie part; false when the shooter cannot reach the patch.
@@ -553,6 +645,7 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"good-layer", goodLayerName(goodLayer)},
           {"gather-shooter-ratio", gatherShooterRatio},
           {"gather-rays", gatherRays},
+          {"no-fill-covered", !fillCovered},
           {"moving-shadow-key-step", movingShadowKeyStep},
           {"no-coherence", !coherence},
           {"max-texture-memory", maxTextureMemoryMiB}};
@@ -579,6 +672,7 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
             {"tile_entries", gather.tileEntries},
             {"partial_links", gather.partialLinks},
             {"partial_links_moving_blockers", gather.partialLinksMovingBlockers}}},
+          {"covered_texels_filled", coveredTexelsFilled},
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
@@ -692,7 +786,6 @@ void TextureMovieBaker::checkRequest(const MovieExtent& req, size_t badShooters)
 }
 
 SceneVisibility* TextureMovieBaker::sceneVisibility() {
-  if (options_.gatherRays <= 0) return nullptr;
   if (!visibility_) {  // once per baker: Embree's BVH of the whole scene
     const std::vector<double>& k = solution_.keyTimes;
     visibility_ = std::make_unique<SceneVisibility>(scene_, solution_.hierarchy, k.front(),
@@ -763,10 +856,11 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     gather = std::make_unique<GoodLinkGather>(
         scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
         options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather,
-        sceneVisibility(), options_.gatherRays);
+        options_.gatherRays > 0 ? sceneVisibility() : nullptr, options_.gatherRays);
     stats_.secondsGood += secondsSince(clock);
   }
-  MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry, gather.get());
+  MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry, gather.get(),
+                 options_.fillCovered ? sceneVisibility() : nullptr);
   bake.plan(badShooters);
   sink.begin(movie);
   for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);

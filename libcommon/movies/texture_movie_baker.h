@@ -86,6 +86,9 @@ struct TextureMovieBakerOptions {
   // (good_link_gather.h); 0: the link's one V over its receiver node, whose steps showed where
   // two receiver nodes met (the bundled scene's back wall, 4.3 %).
   int gatherRays = 16;
+  // --no-fill-covered: false leaves the texels under a touching solid as they come out (~0),
+  // which darkens the pixels beside the solid's foot (fillCoveredTexels).
+  bool fillCovered = true;
   bool coherence = true;  // false: the per-key baseline
   // Working memory of one movie (one key's buffers plus the per-pair buffers, see
   // movieWorkingBytes); a movie that needs more is refused with an environment error.
@@ -137,7 +140,9 @@ struct TextureMovieBakerStats {
   long staticBlockers = 0, dynamicBlockers = 0;  // per pair, in the pair's (swept) shaft
   long passes = 0, samplePasses = 0;             // transmittance renders
   long passesSavedByCoherence = 0;               // static-blocker renders not repeated
-  GoodLinkGatherStats gather;                    // --good-layer gather
+  long coveredTexelsFilled = 0;  // texels under a touching solid given their exposed neighbours'
+
+  GoodLinkGatherStats gather;  // --good-layer gather
   double secondsGood = 0, secondsFormFactor = 0, secondsTransmittance = 0, secondsCombine = 0;
   // Moving pairs' form factors computed ahead of the keys only to find their largest value
   // (which fixes N): the price of baking key by key without every key's form factors held.
@@ -182,7 +187,7 @@ class TextureMovieBaker {
   std::vector<InputPolygon> tops_;
   std::unique_ptr<OcclusionMaskRenderer> renderer_;
   std::unique_ptr<GoodLinksByReceiver> goodLinks_;  // --good-layer gather
-  std::unique_ptr<SceneVisibility> visibility_;     // the gather's per-texel visibility
+  std::unique_ptr<SceneVisibility> visibility_;     // the gather's rays and the covered texels
   SceneVisibility* sceneVisibility();
   TextureMovieBakerStats stats_;
 

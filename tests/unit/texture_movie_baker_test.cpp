@@ -750,6 +750,67 @@ TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderI
   EXPECT_LT(sum / count, 0.1);
 }
 
+// The texels under a box's foot are never seen, but a pixel between one of them and the exposed
+// texel beside it interpolates both: the floor's first pixel row beside the Cornell box's tall
+// block came out 2-4x too dark. Each covered texel next to an exposed one takes its exposed
+// neighbours' mean (two rings outwards); the texels deeper under the foot keep what they
+// gathered (nothing). Without the fill (--no-fill-covered) the ring under the edge is ~0.
+TEST(TextureMovieBaker, CoveredTexelsBesideAFootTakeTheirExposedNeighbours) {
+  FloorUnderCeiling f = floorUnderCeiling();
+  Scene& s = f.scene;
+  const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);  // the box, faces outward
+  addQuadNode(s, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}, 2);
+  addQuadNode(s, {lo.x, lo.y, 0}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, 0}, 2);
+  addQuadNode(s, {hi.x, lo.y, 0}, {hi.x, hi.y, 0}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z}, 2);
+  addQuadNode(s, {lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z}, 2);
+  addQuadNode(s, {lo.x, hi.y, 0}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, 0}, 2);
+  GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
+  const int w = 64, h = 32, top = topOfNode(g, f.floor);
+  const double texel = 2.0 / w;
+  auto under = [&](const glm::dvec3& x) {  // depth under the foot in texels (<= 0: outside)
+    return std::min({x.x - lo.x, hi.x - x.x, x.y - lo.y, hi.y - x.y}) / texel;
+  };
+  for (bool fill : {true, false}) {
+    TextureMovieBakerOptions o;
+    o.fillCovered = fill;
+    const std::vector<BakedTexel> baked = bakeTop(s, g, top, w, h, o);
+    double edgeRatio = 0.0, deep = 0.0;
+    int edgeCount = 0, deepCount = 0;
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i) {
+        const BakedTexel& t = baked[size_t(j) * w + i];
+        const double depth = under(t.x);
+        if (depth > 0.0 && depth < 1.0) {  // the ring under the foot's edge
+          double sum = 0.0;
+          int n = 0;
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int a = i + di, b = j + dj;
+              if (a < 0 || b < 0 || a >= w || b >= h) continue;
+              const BakedTexel& e = baked[size_t(b) * w + a];
+              if (under(e.x) < 0.0) sum += e.h, ++n;
+            }
+          ASSERT_GT(n, 0);
+          edgeRatio += t.h / (sum / n);
+          ++edgeCount;
+        } else if (depth > 3.0) {
+          deep += t.h;
+          ++deepCount;
+        }
+      }
+    ASSERT_GT(edgeCount, 40);
+    ASSERT_GT(deepCount, 20);
+    std::printf("fill %d: covered edge texels / exposed neighbours %.4f (%d texels), deep %.3g\n",
+                int(fill), edgeRatio / edgeCount, edgeCount, deep / deepCount);
+    if (fill) {
+      EXPECT_NEAR(edgeRatio / edgeCount, 1.0, 0.02);
+    } else {
+      EXPECT_LT(edgeRatio / edgeCount, 0.2) << "the covered ring gathers ~nothing";
+    }
+    EXPECT_LT(deep / deepCount, 1e-3) << "deep under the foot: not filled";
+  }
+}
+
 // A moving blocker of the gathered links is a blocker in every movie, also one a frame long
 // (--no-coherence) or one during which it rests: a black slab moving over a floor under an
 // emitting ceiling. Key 0 of a 25-frame movie and a one-frame movie at frame 0 agree within

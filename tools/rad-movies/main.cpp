@@ -138,6 +138,10 @@ int main(int argc, char** argv) {
                  "1..64 (0: the link's one visibility over its receiver)")
       ->capture_default_str();
   app.add_flag_callback(
+      "--no-fill-covered", [&b] { b.fillCovered = false; },
+      "leave the texels under a touching solid as they come out (~0) instead of giving them "
+      "their exposed neighbours' values (the pixels beside a box's foot interpolate both)");
+  app.add_flag_callback(
       "--no-coherence", [&b] { b.coherence = false; },
       "re-render every blocker and recompute every form factor at every key, store every "
       "key (the per-frame baseline)");
