@@ -30,8 +30,11 @@ struct GlobalRun {
 GlobalRun runGlobal(const fs::path& dir, const std::string& frames) {
   fs::create_directories(dir);
   const std::string g = (dir / "global.rlh").string(), report = (dir / "global.json").string();
+  // --eps 1e-3: the compact result (every key's link intervals) grows with the animation as it
+  // must; at the default eps (2e-4) it is a larger share of the peak (+10.8 % over 48 more
+  // frames) and hides what this test is about, that no key's working links are kept.
   CommandResult r = runCommand(tool("rad-global") + " " + kScene + " -o " + g + " --frames " +
-                               frames + " --threads 1 --report " + report);
+                               frames + " --threads 1 --eps 1e-3 --report " + report);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   GlobalRun run;
   if (r.exitCode != 0) return run;

@@ -26,7 +26,7 @@ TEST(ToolsCli, EveryExpectedToolIsBuilt) {
 TEST(ToolsCli, PrintDefaultsIsOneJsonObject) {
   // One option per tool whose default the tool documents in --help.
   const std::map<std::string, std::pair<std::string, nlohmann::json>> known = {
-      {"rad-global", {"eps", 0.001}},      {"rad-intervals", {"size", "352x240"}},
+      {"rad-global", {"eps", 0.0002}},     {"rad-intervals", {"size", "352x240"}},
       {"rad-movies", {"max-samples", 64}}, {"rad-compose", {"compression", "none"}},
       {"rad-inspect", {"json", false}},    {"rad-reference", {"spp", 256}},
       {"rad-diff", {"json", false}}};
@@ -57,7 +57,7 @@ TEST(ToolsCli, PrintDefaultsIsOneJsonObject) {
   // The defaults, not the values given on the same command line.
   const nlohmann::json global =
       nlohmann::json::parse(runCommand(tool("rad-global") + " --eps 0.5 --print-defaults").out);
-  EXPECT_EQ(global.at("eps"), 0.001);
+  EXPECT_EQ(global.at("eps"), 0.0002);
 }
 
 TEST(ToolsCli, HelpGoesToStdoutWithExitCodes) {
