@@ -46,6 +46,7 @@ struct Box {
     return lo.x <= o.hi.x && o.lo.x <= hi.x && lo.y <= o.hi.y && o.lo.y <= hi.y && lo.z <= o.hi.z &&
            o.lo.z <= hi.z;
   }
+  bool contains(const glm::dvec3& p) const { return overlaps(Box{p, p}); }
 };
 
 // The reversed copy a doubleSided material adds is the same surface: never its own blocker.
@@ -310,9 +311,15 @@ class MovieBake {
     const uint32_t top = req_.patch.top;
     const Polygon& receiver = geo_.receiverWorld(k);
     const double size = polygonSize(receiver);
-    auto test = [&](const VisibilityScene& blockers, double at, std::vector<char>& covered) {
+    // `inside`: when given, only texels inside one of these boxes can be covered (the moving
+    // nodes' bounds at t: a texel under a moving box lies in the box's bounds).
+    auto test = [&](const VisibilityScene& blockers, double at, std::vector<char>& covered,
+                    const std::vector<Box>* inside) {
       tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
         if (covered[x]) return;
+        if (inside && std::none_of(inside->begin(), inside->end(),
+                                   [&](const Box& b) { return b.contains(geo_.texelPoint(k, x)); }))
+          return;
         // Inside a solid every way: along the normal and tilted 88 degrees to four sides (nearly
         // along the surface). The normal alone also took the ceiling above a lamp panel hung
         // 1 mm under it, which the camera sees, dark, through the gap; rays 88 degrees from the
@@ -333,20 +340,27 @@ class MovieBake {
     const bool receiverMoves = geo_.receiverDynamic();
     if (staticCovered_.empty() || receiverMoves) {
       staticCovered_.assign(texels_, 0);
-      test(visibility_->staticPart(), t, staticCovered_);
+      test(visibility_->staticPart(), t, staticCovered_, nullptr);
       Box box;
       box.grow(receiver);
+      movingNear_.clear();
       for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
                                     solution_.keyTimes.back())) {
         const auto b =
             geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
-        if (box.overlaps(Box{b[0], b[1]})) movingNear_ = true;
+        if (box.overlaps(Box{b[0], b[1]})) movingNear_.push_back(node);
       }
     }
     covered_ = staticCovered_;
-    if ((movingNear_ || receiverMoves) && visibility_->dynamicNodeCount() > 0) {
+    if (!movingNear_.empty() && visibility_->dynamicNodeCount() > 0) {
+      std::vector<Box> now;
+      for (int node : movingNear_) {
+        const auto b = geo_.scene().sweptBounds(node, t, t);
+        const glm::dvec3 pad(1e-9 * std::max(size, glm::length(b[1] - b[0])));
+        now.push_back(Box{b[0] - pad, b[1] + pad});
+      }
       visibility_->setTime(t);
-      test(visibility_->movingPart(), t, covered_);
+      test(visibility_->movingPart(), t, covered_, &now);
     }
     std::vector<char> exposed(texels_);
     for (size_t x = 0; x < texels_; ++x) exposed[x] = covered_[x] ? 0 : 1;
@@ -505,7 +519,7 @@ class MovieBake {
   std::vector<double> keyFormFactor_;  // also the scan's scratch
   // fillCoveredTexels: under static solids (once per movie), and at the current key.
   std::vector<char> staticCovered_, covered_;
-  bool movingNear_ = false;  // a moving node's swept bounds meet the receiver
+  std::vector<int> movingNear_;  // moving nodes whose bounds over the movie meet the receiver
 };
 
 // One bad pair's per-movie part; false when the shooter cannot reach the patch.
