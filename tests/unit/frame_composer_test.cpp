@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "formats/texture_movie.h"
 #include "tests/unit/compose_fixture.h"
@@ -19,7 +20,9 @@ constexpr ImageSize kSize{64, 48};
 class FrameComposerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    std::string dir = ::testing::TempDir() + "/frame_composer_test";
+    // One folder per process: ctest -j runs this suite's tests as concurrent processes, which
+    // wrote the same files at once (a test was seen skipped by its suite's failed set-up).
+    std::string dir = ::testing::TempDir() + "/frame_composer_test_" + std::to_string(::getpid());
     scene = new Scene(readGltfScene(test::writeComposeScene(dir)));
   }
   static void TearDownTestSuite() { delete scene; }

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "formats/form_factor_scratch_file.h"
+#include "formats/gltf_scene.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/radiosity/space_time_radiosity.h"
@@ -808,6 +809,50 @@ TEST(TextureMovieBaker, CoveredTexelsBesideAFootTakeTheirExposedNeighbours) {
       EXPECT_LT(edgeRatio / edgeCount, 0.2) << "the covered ring gathers ~nothing";
     }
     EXPECT_LT(deep / deepCount, 1e-3) << "deep under the foot: not filled";
+  }
+}
+
+// A triangle's texture is the half square u + v <= 1; a square texture puts a diagonal of
+// texel centres exactly on the long edge. The Cornell box of tests/data/external has a twisted
+// left wall, two triangles, whose long edge is the seam with the back wall: there the texels
+// on the edge came out at 15 % of their neighbours, a dark line in the frame. The texels on
+// and beyond the edge take their inside neighbours' mean, so the edge's row is within a few %
+// of the row inside it (the light varies slowly across the seam); without the fill
+// (--no-fill-covered) it is far below.
+TEST(TextureMovieBaker, TexelsOnATrianglesLongEdgeTakeTheirInsideNeighbours) {
+  const Scene s = readGltfScene(RAD_TEST_DATA "/external/cornell_box/cornell_box.gltf");
+  SpaceTimeOptions so;
+  so.radiosity.eps = 1e-3;
+  const GlobalSolution g = solveSpaceTime(s, {0.0}, so);
+  int wall = -1;  // the triangle with an edge on the back wall's plane z = 0.5592
+  for (int i = 0; i < g.hierarchy.topCount(); ++i) {
+    const Polygon& p = g.hierarchy.top(i).local;
+    if (p.count == 3 && std::abs(p.v[1].z - 0.5592) < 1e-4 && std::abs(p.v[2].z - 0.5592) < 1e-4)
+      wall = i;
+  }
+  ASSERT_GE(wall, 0) << "the left wall's triangle along the back wall";
+  const int w = 64;
+  for (bool fill : {true, false}) {
+    TextureMovieBakerOptions o;
+    o.fillCovered = fill;
+    TextureMovieBaker baker(s, g, kFps, o);
+    MovieExtent r;
+    r.patch = PatchId{uint32_t(wall), 1u};
+    r.firstFrame = r.lastFrame = 0;
+    r.width = r.height = w;
+    const std::vector<float> key = baker.bake(r).keys[0];
+    double edge = 0.0, inside = 0.0;
+    for (int i = 4; i < w - 5; ++i) {  // texel (i, w - 1 - i) is on the edge: u + v = 1
+      edge += key[(size_t(w - 1 - i) * w + i) * 3];
+      inside += key[(size_t(w - 3 - i) * w + i) * 3];  // two texels further in
+    }
+    std::printf("fill %d: the texels on the long edge at %.4f of those inside\n", int(fill),
+                edge / inside);
+    if (fill) {
+      EXPECT_NEAR(edge / inside, 1.0, 0.1);
+    } else {
+      EXPECT_LT(edge / inside, 0.6) << "the edge's texels as they were gathered";
+    }
   }
 }
 
