@@ -35,7 +35,7 @@ import bench  # noqa: E402
 # "default") and belongs to every knob's curve; its value comes from the tool itself
 # (`--print-defaults`), not from a copy here.
 KNOBS = [
-    ("eps", "global", "--eps", ["0.5", "0.1", "0.02", "0.005", "0.0005"]),
+    ("eps", "global", "--eps", ["0.5", "0.1", "0.02", "0.005", "0.001", "0.0001"]),
     ("key-step", "global", "--key-step", ["16", "12", "4", "2"]),
     ("bad-links", "global", "--bad-links", ["none", "partial", "all"]),
     ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "2"]),
