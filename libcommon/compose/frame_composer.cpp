@@ -204,6 +204,7 @@ struct FrameComposer::Impl {
   int cameraNode;
   std::vector<InputPolygon> tops;
   std::vector<int> objectNodes;        // mesh node of each item object
+  std::vector<size_t> topObject;       // per top, its item object (index into transforms)
   std::vector<glm::dmat4> transforms;  // per object, at the current time
   std::vector<Material> materials;     // per top (default material where -1)
   ItemBufferRenderer renderer;
@@ -237,6 +238,7 @@ struct FrameComposer::Impl {
         objects.emplace_back();
         objectNodes.push_back(node);
       }
+      topObject.push_back(it->second);
       objects[it->second].addPolygon(tops[i].local, uint32_t(i + 1));
       int m = tops[i].material;
       materials.push_back(m >= 0 && m < int(s.materials.size()) ? s.materials[m] : Material{});
@@ -304,7 +306,7 @@ void FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
     const Ray ray = rays.pixelCentre(int(p % size_t(w)), int(p / size_t(w)));
     const uint32_t hit = rayScene->visibility().firstHit(ray.origin, ray.direction);
     if (hit == VisibilityScene::kNoSurface || hit >= uint32_t(tops.size())) return;
-    const Polygon world = tops[hit].local.transformed(scene.worldTransform(tops[hit].node, t));
+    const Polygon world = tops[hit].local.transformed(transforms[topObject[hit]]);
     // A double-sided material is two one-sided patches at the same place (the reversed copy):
     // only the one facing the camera is what the rasterizer shows.
     if (glm::dot(world.normal(), ray.direction) < 0.0) decided[e] = hit + 1;
@@ -320,11 +322,9 @@ void FrameComposer::Impl::placeVisibleTops(VisibleTops& v) const {
   std::vector<char> seen(topCount, 0);
   for (uint32_t id : items.id)
     if (id != kNoItem) seen[id - 1] = 1;
-  std::unordered_map<int, size_t> objectOfNode;
-  for (size_t k = 0; k < objectNodes.size(); ++k) objectOfNode[objectNodes[k]] = k;
   for (int i = 0; i < topCount; ++i)
     if (seen[i]) {
-      v.world[i] = tops[i].local.transformed(transforms[objectOfNode[tops[i].node]]);
+      v.world[i] = tops[i].local.transformed(transforms[topObject[size_t(i)]]);
       v.normals[i] = v.world[i].normal();
       v.uvMaps[i] = PolygonUvMap(v.world[i]);
     }

@@ -341,6 +341,16 @@ class MovieBake {
     if (staticCovered_.empty() || receiverMoves) {
       staticCovered_.assign(texels_, 0);
       test(visibility_->staticPart(), t, staticCovered_, nullptr);
+      // A triangle's texture is the half square u + v <= 1 of its (u,v) map; the texels beyond
+      // its long edge lie outside the patch, and those on it (a square texture puts a diagonal of
+      // texel centres exactly on the edge) are half-shadowed by whatever touches the edge there.
+      // A pixel inside near the edge interpolated them: the Cornell box's left wall (two
+      // triangles) showed a dark line along its seam with the back wall, the texels on the edge
+      // at 15 % of their inside neighbours. Both are filled as the covered ones are.
+      if (tops_[top].local.count == 3)
+        for (int j = 0; j < h; ++j)
+          for (int i = 0; i < w; ++i)
+            if ((i + 0.5) / w + (j + 0.5) / h >= 1.0 - 1e-9) staticCovered_[size_t(j) * w + i] = 1;
       Box box;
       box.grow(receiver);
       movingNear_.clear();
@@ -362,16 +372,6 @@ class MovieBake {
       visibility_->setTime(t);
       test(visibility_->movingPart(), t, covered_, &now);
     }
-    // A triangle's texture is the half square u + v <= 1 of its (u,v) map; the texels beyond
-    // its long edge lie outside the patch, and those on it (a square texture puts a diagonal of
-    // texel centres exactly on the edge) are half-shadowed by whatever touches the edge there.
-    // A pixel inside near the edge interpolated them: the Cornell box's left wall (two
-    // triangles) showed a dark line along its seam with the back wall, the texels on the edge
-    // at 15 % of their inside neighbours. Both are filled as the covered ones are.
-    if (tops_[top].local.count == 3)
-      for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i)
-          if ((i + 0.5) / w + (j + 0.5) / h >= 1.0 - 1e-9) covered_[size_t(j) * w + i] = 1;
     std::vector<char> exposed(texels_);
     for (size_t x = 0; x < texels_; ++x) exposed[x] = covered_[x] ? 0 : 1;
     long filled = 0;

@@ -634,6 +634,16 @@ FloorUnderCeiling floorUnderCeiling() {
   return f;
 }
 
+// A black box [lo, hi] standing on the floor (z = lo.z = 0): its top and four sides, faces
+// outward, no bottom.
+void addBoxOnFloor(Scene& s, const glm::dvec3& lo, const glm::dvec3& hi) {
+  addQuadNode(s, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}, 2);
+  addQuadNode(s, {lo.x, lo.y, 0}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, 0}, 2);
+  addQuadNode(s, {hi.x, lo.y, 0}, {hi.x, hi.y, 0}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z}, 2);
+  addQuadNode(s, {lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z}, 2);
+  addQuadNode(s, {lo.x, hi.y, 0}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, 0}, 2);
+}
+
 // Every link good (the per-texel visibility is the gather's), at the given key times.
 GlobalSolution solveWithGoodLinksOnly(const Scene& s, const std::vector<double>& keyTimes) {
   SpaceTimeOptions so;
@@ -709,12 +719,8 @@ TEST(TextureMovieBaker, GatheredVisibilityFollowsThePenumbraPerTexel) {
 TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderIt) {
   FloorUnderCeiling f = floorUnderCeiling();
   Scene& s = f.scene;
-  const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);  // the box, faces outward
-  addQuadNode(s, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}, 2);
-  addQuadNode(s, {lo.x, lo.y, 0}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, 0}, 2);
-  addQuadNode(s, {hi.x, lo.y, 0}, {hi.x, hi.y, 0}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z}, 2);
-  addQuadNode(s, {lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z}, 2);
-  addQuadNode(s, {lo.x, hi.y, 0}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, 0}, 2);
+  const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);
+  addBoxOnFloor(s, lo, hi);
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
   auto blocked = [&](const glm::dvec3& a, const glm::dvec3& b) {  // segment meets the box
     double t0 = 0.0, t1 = 1.0;
@@ -759,12 +765,8 @@ TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderI
 TEST(TextureMovieBaker, CoveredTexelsBesideAFootTakeTheirExposedNeighbours) {
   FloorUnderCeiling f = floorUnderCeiling();
   Scene& s = f.scene;
-  const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);  // the box, faces outward
-  addQuadNode(s, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}, 2);
-  addQuadNode(s, {lo.x, lo.y, 0}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, 0}, 2);
-  addQuadNode(s, {hi.x, lo.y, 0}, {hi.x, hi.y, 0}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z}, 2);
-  addQuadNode(s, {lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z}, 2);
-  addQuadNode(s, {lo.x, hi.y, 0}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, 0}, 2);
+  const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);
+  addBoxOnFloor(s, lo, hi);
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
   const int w = 64, h = 32, top = topOfNode(g, f.floor);
   const double texel = 2.0 / w;
