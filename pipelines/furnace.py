@@ -28,12 +28,12 @@ import bench  # noqa: E402
 EMISSION = 0.5
 
 
-def run_one(bin_dir, out_root, rho, size, flags):
+def run_one(bin_dir, out_root, rho, size, flags, scene_args=()):
     out = os.path.join(out_root, "rho%g" % rho)
     os.makedirs(out, exist_ok=True)
     scene = os.path.join(out, "furnace.gltf")
     subprocess.run([sys.executable, os.path.join(HERE, "scenes", "make_furnace.py"), scene,
-                    repr(rho), "--emission", repr(EMISSION)], check=True,
+                    repr(rho), "--emission", repr(EMISSION)] + list(scene_args), check=True,
                    stderr=subprocess.DEVNULL)
     log = os.path.join(out, "pipeline.log")
     open(log, "w").close()
@@ -69,6 +69,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "furnace"))
     ap.add_argument("--flags", action="append", default=[],
                     help="STAGE=ARGS, e.g. global='--eps 1e-4' (repeatable)")
+    ap.add_argument("--partition", choices=["open", "closed", "floating"],
+                    help="a slab inside the cube (make_furnace.py --partition)")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--goals", action="store_true",
                     help="exit 1 unless every frame mean is within DESIGN.md §8's goal")
@@ -77,7 +79,8 @@ def main():
     for f in a.flags:
         stage, _, args = f.partition("=")
         flags[stage] = shlex.split(args)
-    rows = [run_one(a.bin, a.out, float(r), a.size, flags) for r in a.rho.split(",")]
+    scene_args = ["--partition", a.partition] if a.partition else []
+    rows = [run_one(a.bin, a.out, float(r), a.size, flags, scene_args) for r in a.rho.split(",")]
     print("%-7s %12s %12s %9s %8s %8s  %s" % ("rho", "frame mean", "exact", "error", "s",
                                             "peak MiB", "note"))
     silent = []

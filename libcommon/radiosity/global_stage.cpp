@@ -21,6 +21,7 @@ nlohmann::json GlobalOptions::toJson() const {
           {"partial-threshold", spaceTime.partialThreshold},
           {"max-links", r.maxLinks},
           {"no-closure", !r.closure},
+          {"no-closed-rooms", !r.closedRooms},
           {"no-shooter-shape", !r.shooterShape},
           {"no-coherence", !spaceTime.coherence}};
 }

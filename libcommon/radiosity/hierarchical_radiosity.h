@@ -90,6 +90,10 @@ struct RadiosityOptions {
   // the .cpp): exact energy balance in closed rooms whatever the refinement. false: the plain
   // hierarchical gather (HSA'91), for comparison.
   bool closure = true;
+  // Part of the closure: a leaf from which no ray escapes the scene (inside a closed room) has
+  // its whole row sum made exactly 1, occluded links included (computeClosure). false: only the
+  // unoccluded tops' share is corrected, as in open scenes.
+  bool closedRooms = true;
 };
 
 // Diffuse reflectance and emitted radiosity B_e = pi L_e (W/m^2) of one top-level patch.

@@ -10,8 +10,11 @@ well the pipeline conserves energy. The camera stands at the centre looking at a
 walls in view, and their edges, where form factors are hardest); the scene is static, so it has
 one frame.
 
-usage: make_furnace.py OUT.gltf RHO [--emission L_E] [--walls-split N]
-       (--walls-split N: each wall as N x N quads, so the first pass starts from more patches)
+usage: make_furnace.py OUT.gltf RHO [--emission L_E] [--walls-split N] [--partition]
+       (--walls-split N: each wall as N x N quads, so the first pass starts from more patches;
+        --partition: a 10 cm slab standing from floor to ceiling, open at both ends as the cubic
+        scene's partition walls are, so part of the floor and ceiling is covered by a solid.
+        The closed form still holds on every surface that can be seen)
 
 Only the Python standard library is used; the output is deterministic.
 """
@@ -21,7 +24,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_paper_scenes import Gltf, quat_look  # noqa: E402
+from make_paper_scenes import Gltf, box, quat_look  # noqa: E402
 
 
 def walls(half, n):
@@ -52,11 +55,20 @@ def main():
     ap.add_argument("rho", type=float)
     ap.add_argument("--emission", type=float, default=0.5, help="L_e of every wall, W/m^2/sr")
     ap.add_argument("--walls-split", type=int, default=1)
+    ap.add_argument("--partition", choices=["open", "closed", "floating"], nargs="?",
+                    const="open", default=None)
     a = ap.parse_args()
     if not (0.0 <= a.rho < 1.0):
         sys.exit("make_furnace.py: rho %g: must be in [0, 1)" % a.rho)
     g = Gltf("furnace rho=%g" % a.rho)
     g.node("walls", mesh=g.mesh("walls", walls(1.0, max(1, a.walls_split)), 0))
+    if a.partition:
+        # Touches the floor and the ceiling, and leaves a 0.6 m door at the back (+z).
+        y0, y1 = (-0.8, 0.8) if a.partition == "floating" else (-1.0, 1.0)
+        faces = box(0.45, y0, -1.0, 0.55, y1, 0.4, bottom=a.partition != "open")
+        if a.partition == "open":
+            faces = faces[1:]  # no top either
+        g.node("partition", mesh=g.mesh("partition", faces, 0))
     eye, corner = (0.0, 0.0, 0.0), (1.0, -1.0, 1.0)
     g.node("camera", camera=g.camera(yfov=1.2), translation=eye, rotation=quat_look(eye, corner))
     g.write(a.out, a.emission, materials=[("wall", (a.rho,) * 3, (1.0, 1.0, 1.0))])

@@ -343,6 +343,9 @@ TEST(SpaceTimeRadiosity, CoarseCeilingGathersTheWallsAsItSeesThem) {
     SpaceTimeOptions o;
     o.radiosity.eps = eps;
     o.radiosity.shooterShape = shape;
+    // The shape alone: the closed-room rows (the bundled room is closed) also take the coarse
+    // ceiling's row to 1, which moves its mean-B error from 3 % to 2.1 %.
+    o.radiosity.closedRooms = false;
     const GlobalSolution g = solveSpaceTime(scene, {0.0}, o);
     for (int t = 0; t < g.hierarchy.topCount(); ++t)
       if (scene.nodes[size_t(g.hierarchy.top(t).node)].name == "ceiling") {

@@ -80,6 +80,10 @@ void addOptions(CLI::App& app, Options& o) {
       "gather without the closure factor (each leaf's row sum its own; exact energy balance in "
       "closed rooms): the plain hierarchical gather, for comparison");
   app.add_flag_callback(
+      "--no-closed-rooms", [&r] { r.closedRooms = false; },
+      "do not scale the row sums of leaves inside a closed room (no escaping ray) to exactly 1; "
+      "only the unoccluded tops' share is corrected, as in open scenes");
+  app.add_flag_callback(
       "--no-shooter-shape", [&r] { r.shooterShape = false; },
       "gather each link's shooter at its mean radiosity, not as the receiver's ray pairs see its "
       "leaves' radiosity");
