@@ -502,6 +502,22 @@ class KeyTimeSolver {
     tbb::parallel_for(size_t(0), leaves.size(), [&](size_t li) { closeLeaf(leaves[li]); });
   }
 
+  // Cosine-distributed directions about a node's normal (Malley's method), the k-th from two
+  // counter-based numbers of `seed`: the exposure's rays and the closed-room test's.
+  struct CosineRays {
+    glm::dvec3 normal, t, b;
+    explicit CosineRays(const glm::dvec3& n) : normal(n) {
+      t = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+      t = glm::normalize(glm::cross(t, n));
+      b = glm::cross(n, t);
+    }
+    glm::dvec3 operator()(uint64_t seed, size_t k) const {
+      const double u = uniformOpen01(seed, 2 * k), v = uniformOpen01(seed, 2 * k + 1);
+      const double r = std::sqrt(u), phi = 2.0 * M_PI * v;
+      return r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1.0 - u) * normal;
+    }
+  };
+
   // Whether leaf r is inside a closed room: none of kEscapeRays cosine-distributed rays from
   // its points leaves the scene. A room's opening of form factor f goes unseen with probability
   // (1 - f)^64 (f = 5 %: 4 %), and then brightens that leaf by at most f.
@@ -512,17 +528,13 @@ class KeyTimeSolver {
     const Polygon& P = s_.world[size_t(r)];
     const glm::dvec3 normal = P.normal();
     if (normal == glm::dvec3(0.0)) return false;
-    glm::dvec3 t = std::abs(normal.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-    t = glm::normalize(glm::cross(t, normal));
-    const glm::dvec3 b = glm::cross(normal, t);
+    const CosineRays direction(normal);
     const uint64_t seed = splitMix64(receiverSeed(n.id) ^ 0x636c6f736564ull);  // "closed"
     const std::vector<glm::dvec3> points = VisibilityScene::samplePoints(P, kEscapeRays, seed);
     const double size = polygonSize(P);
     const glm::dvec3 centroid = P.centroid();
     for (size_t k = 0; k < points.size(); ++k) {
-      double u = uniformOpen01(seed, 2 * k), v = uniformOpen01(seed, 2 * k + 1);
-      double rr = std::sqrt(u), phi = 2.0 * M_PI * v;
-      glm::dvec3 d = rr * std::cos(phi) * t + rr * std::sin(phi) * b + std::sqrt(1.0 - u) * normal;
+      const glm::dvec3 d = direction(seed, k);
       // A ray that escapes is cast again from 1 % of the way to the leaf's centroid and 1e-3 of
       // its size above it: a point 2e-5 m from the wall that the leaf's edge meets, whose ray
       // into that wall started within the ray's tnear of it, passed through (a floor leaf of a
@@ -671,20 +683,14 @@ class KeyTimeSolver {
     const Polygon& P = s_.world[size_t(i)];
     const glm::dvec3 normal = P.normal();
     if (normal == glm::dvec3(0.0)) return 1.0;
-    glm::dvec3 t = std::abs(normal.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-    t = glm::normalize(glm::cross(t, normal));
-    const glm::dvec3 b = glm::cross(normal, t);
+    const CosineRays direction(normal);
     const std::vector<glm::dvec3> points =
         VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(n.id));
     const uint64_t seed = splitMix64(receiverSeed(n.id));
     const double size = polygonSize(P);
     int exposed = 0;
     for (size_t k = 0; k < points.size(); ++k) {
-      // Cosine-distributed direction (Malley's method) from two counter-based numbers.
-      double u = uniformOpen01(seed, 2 * k), v = uniformOpen01(seed, 2 * k + 1);
-      double r = std::sqrt(u), phi = 2.0 * M_PI * v;
-      glm::dvec3 d = r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1.0 - u) * normal;
-      d *= size;  // firstHit's tnear is relative to |d|: scale-free
+      const glm::dvec3 d = direction(seed, k) * size;  // firstHit's tnear is relative to |d|
       uint32_t hit = input_.visibility->firstHit(points[k], d, n.id.top);
       bool covered = hit != VisibilityScene::kNoSurface && hit < uint32_t(h_.topCount()) &&
                      !surfaces_[hit].doubleSided && glm::dot(s_.world[hit].normal(), d) > 0.0;
