@@ -182,6 +182,7 @@ TEST_F(RadCompose, FramesHaveRadianceFallbackWarningsAndProvenance) {
   EXPECT_EQ(rep["movies_read"], 3);
   EXPECT_EQ(rep["peak_loaded_movies"], 2);  // movies 0 and 1 evicted before movie 2 loads
   EXPECT_GE(rep["frames"][0]["seconds"].get<double>(), 0.0);
+  EXPECT_GT(rep["peak_memory_mb"].get<double>(), 1.0);
 }
 
 TEST_F(RadCompose, PngIsSrgbOfExposureScaledRadiance) {

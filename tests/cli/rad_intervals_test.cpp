@@ -40,6 +40,7 @@ TEST(RadIntervalsCli, WritesIntervalsReportAndItemBuffers) {
   EXPECT_EQ(rep["movies"], iv.movies.size());
   EXPECT_GT(rep["item_buffer_ms_per_frame"].get<double>(), 0.0);
   EXPECT_GT(rep["texels_per_frame"].get<double>(), 0.0);
+  EXPECT_GT(rep["peak_memory_mb"].get<double>(), 1.0);
   for (int f = 0; f < 12; ++f) {
     char name[16];
     std::snprintf(name, sizeof name, "%04d.exr", f);

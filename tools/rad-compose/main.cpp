@@ -123,6 +123,7 @@ int run(const rad::ComposeOptions& given, int argc, char** argv) {
   if (!o.report.empty()) {
     nlohmann::json j = report.toJson();
     j["provenance"] = provenance.toJson();
+    j["peak_memory_mb"] = rad::peakMemoryMb();  // of the process (getrusage), issue 16
     rad::writeTextFile(o.report, j.dump(1) + "\n");
   }
   return 0;

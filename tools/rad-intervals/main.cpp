@@ -62,7 +62,8 @@ int run(const rad::IntervalsOptions& given, int argc, char** argv) {
   rad::writeTextureIntervals(o.output, sequence.intervals, provenance, sequence.metadata);
 
   // The report summarises what was written (read back: also checks the file).
-  const nlohmann::json report = rad::intervalSequenceReport(sequence, o.output);
+  nlohmann::json report = rad::intervalSequenceReport(sequence, o.output);
+  report["peak_memory_mb"] = rad::peakMemoryMb();  // of the process (getrusage), issue 16
   if (!o.report.empty()) rad::writeTextFile(o.report, report.dump(1) + "\n");
   printSummary(report, sequence.intervals.movies.size());
   return 0;
