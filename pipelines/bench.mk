@@ -9,6 +9,10 @@
 #   make -f pipelines/bench.mk tradeoff [TRADEOFF_FRAMES=0-47] [TRADEOFF_SIZE=176x120] [TRADEOFF_SPP=128] [TRADEOFF_REPEAT=3]
 #       each accuracy knob swept against a converged rad-reference render: time per frame vs
 #       RMSE, Pareto front; out/tradeoff/tradeoff.csv and tradeoff.png (gnuplot)
+#   make -f pipelines/bench.mk scale [SCALE_TRIANGLES=1000,3000,10000,30000,100000] [SCALE_FRAMES=0-95] [SCALE_MAX_SECONDS=1800] [SCALE_MOVING_LIGHT=1]
+#       the lecture hall of make_hall.py at each triangle count through the four stages: each
+#       stage's time and peak memory, rad-global's links, the log-log slopes of links and
+#       rad-global's time against the triangle count; out/scale/scale.csv and scale.png
 #   make -f pipelines/bench.mk furnace [FURNACE_RHO=0.5,0.9,0.99,0.999] [FURNACE_FLAGS="global=--eps 1e-4"]
 #       the closed furnace through the whole pipeline at each rho: frame mean against the exact
 #       L_e / (1 - rho), time and peak memory; out/furnace/
@@ -24,10 +28,15 @@ TRADEOFF_SIZE ?= 176x120
 TRADEOFF_SPP ?= 128
 TRADEOFF_REPEAT ?= 3
 
+SCALE_TRIANGLES ?= 1000,3000,10000,30000,100000
+SCALE_FRAMES ?= 0-95
+SCALE_MAX_SECONDS ?= 1800
+SCALE_MOVING_LIGHT ?=
+
 FURNACE_RHO ?= 0.5,0.9,0.99,0.999
 FURNACE_FLAGS ?=
 
-.PHONY: tables tradeoff furnace contact
+.PHONY: tables tradeoff furnace contact scale
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -38,6 +47,11 @@ tradeoff:
 
 contact:
 	python3 pipelines/contact.py --bin $(BIN) --out out/contact
+
+scale:
+	python3 pipelines/scale.py --bin $(BIN) --triangles $(SCALE_TRIANGLES) --frames $(SCALE_FRAMES) \
+	  --size $(BENCH_SIZE) --max-seconds $(SCALE_MAX_SECONDS) $(if $(SCALE_MOVING_LIGHT),--moving-light) \
+	  --out out/scale$(if $(SCALE_MOVING_LIGHT),-moving-light)
 
 furnace:
 	python3 pipelines/furnace.py --bin $(BIN) --rho $(FURNACE_RHO) --out out/furnace \

@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+"""How the pipeline scales with the scene (issue 16): the lecture hall of
+pipelines/scenes/make_hall.py at several triangle counts through the four stages of
+animation.mk, each stage timed and its peak memory measured from the child process.
+
+Prints per size the stages' seconds and peak MiB, rad-global's links and nodes, and the log-log
+slope of links and of rad-global's time against the triangle count over the sizes that
+finished (a linear fit of log y on log x). A stage that runs past --max-seconds is killed and
+reported; the larger sizes are then skipped (they would take longer still). Writes
+OUT/scale.csv and, with gnuplot, OUT/scale.png.
+
+usage: scale.py [--triangles 1000,3000,10000,30000,100000] [--frames 0-95] [--size 352x240]
+                [--moving-light] [--max-seconds 1800] [--bin DIR] [--out DIR] [--check]
+  --check   exit 1 unless every size finished, each hall has its requested triangle count to
+            within 10 % (requests of 1000 or more) and every stage reported its peak memory
+            (the ctest pipeline_scale_runs, on small halls)
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import bench  # noqa: E402
+
+STAGES = ("global", "intervals", "movies", "compose")
+
+
+def run_limited(argv, log, limit):
+    """Runs argv, output appended to log; returns (seconds, peak MiB, status) with status "ok",
+    "failed" or "timeout" (killed after `limit` seconds)."""
+    t0 = time.monotonic()
+    with open(log, "ab") as f:
+        f.write(("$ " + " ".join(argv) + "\n").encode())
+        f.flush()
+        p = subprocess.Popen(argv, stdout=f, stderr=f)
+        status = None
+        while status is None:
+            pid, st, usage = os.wait4(p.pid, os.WNOHANG)
+            if pid:
+                status = "ok" if os.waitstatus_to_exitcode(st) == 0 else "failed"
+                break
+            if time.monotonic() - t0 > limit:
+                p.kill()
+                _, st, usage = os.wait4(p.pid, 0)
+                status = "timeout"
+                break
+            time.sleep(0.2)
+    return time.monotonic() - t0, usage.ru_maxrss / 1024.0, status
+
+
+def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit):
+    name = "hall-%d%s" % (triangles, "-moving-light" if moving_light else "")
+    out = os.path.join(out_root, name)
+    requested = triangles
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(out)
+    scene = os.path.join(out, name + ".gltf")
+    made = subprocess.run([sys.executable, os.path.join(HERE, "scenes", "make_hall.py"), scene,
+                           "--triangles", str(triangles)] +
+                          (["--moving-light"] if moving_light else []),
+                          check=True, capture_output=True, text=True)
+    actual = int(made.stderr.split(":")[2].split()[0])
+    log = os.path.join(out, "pipeline.log")
+    row = {"scene": name, "triangles": actual, "requested": requested, "status": "ok"}
+    left = limit
+    flags = {"compose": ["--no-png"]}
+    for stage, argv in bench.stage_commands(bin_dir, scene, out, frames, size, flags):
+        seconds, mib, status = run_limited(argv, log, left)
+        row[stage + "_s"], row[stage + "_mib"] = seconds, mib
+        left -= seconds
+        if status != "ok":
+            row["status"] = "%s %s" % (stage, status)
+            break
+    try:
+        with open(os.path.join(out, "global-report.json")) as f:
+            g = json.load(f)
+        keys = g.get("key_times") or []
+        row["links"] = max(k.get("links", 0) for k in keys) if keys else None
+        row["nodes"] = max(k.get("nodes", 0) for k in keys) if keys else None
+        row["link_cap"] = any(k.get("link_cap_reached") for k in keys)
+    except (OSError, ValueError):
+        pass
+    row["reported_memory"] = all(
+        _reported_peak(os.path.join(out, stage + "-report.json")) for stage in STAGES
+        if stage + "_s" in row)
+    shutil.rmtree(os.path.join(out, "movies"), ignore_errors=True)  # large; not needed after
+    return row
+
+
+def _reported_peak(path):
+    try:
+        with open(path) as f:
+            return json.load(f).get("peak_memory_mb", 0) > 0
+    except (OSError, ValueError):
+        return False
+
+
+def slope(points):
+    """Least-squares slope of log y against log x."""
+    pts = [(math.log(x), math.log(y)) for x, y in points if x > 0 and y and y > 0]
+    if len(pts) < 2:
+        return None
+    mx = sum(p[0] for p in pts) / len(pts)
+    my = sum(p[1] for p in pts) / len(pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx if sxx > 0 else None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--triangles", default="1000,3000,10000,30000,100000")
+    ap.add_argument("--frames", default="0-95")
+    ap.add_argument("--size", default="352x240")
+    ap.add_argument("--moving-light", action="store_true")
+    ap.add_argument("--max-seconds", type=float, default=1800.0,
+                    help="per size, for the four stages together")
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "scale"))
+    ap.add_argument("--check", action="store_true")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    rows = []
+    for n in [int(x) for x in a.triangles.split(",")]:
+        print("scale: hall of %d triangles, frames %s at %s ..." % (n, a.frames, a.size),
+              file=sys.stderr, flush=True)
+        row = one_size(a.bin, a.out, n, a.frames, a.size, a.moving_light, a.max_seconds)
+        rows.append(row)
+        print("scale:   %s" % row["status"], file=sys.stderr, flush=True)
+        if row["status"] != "ok":
+            break  # the larger sizes would run longer still
+    print("%-26s %8s %9s %8s  %s  %s" % ("scene", "tris", "links", "nodes",
+                                         " ".join("%16s" % s for s in STAGES), "total s  status"))
+    for r in rows:
+        cells = " ".join("%7.1fs %6.0fM" % (r.get(s + "_s", 0), r.get(s + "_mib", 0))
+                         if s + "_s" in r else "%16s" % "-" for s in STAGES)
+        total = sum(r.get(s + "_s", 0) for s in STAGES)
+        print("%-26s %8d %9s %8s  %s  %7.1f  %s%s" % (
+            r["scene"], r["triangles"], r.get("links", "-"), r.get("nodes", "-"), cells, total,
+            r["status"], " (link bound reached)" if r.get("link_cap") else ""))
+    done = [r for r in rows if r["status"] == "ok"]
+    sl = slope([(r["triangles"], r.get("links")) for r in done])
+    st = slope([(r["triangles"], r.get("global_s")) for r in done])
+    print("log-log slope against triangles: links %s, rad-global time %s (goal for links: <= 1.2)"
+          % ("%.2f" % sl if sl is not None else "-", "%.2f" % st if st is not None else "-"))
+    path = os.path.join(a.out, "scale.csv")
+    fields = ["scene", "triangles", "links", "nodes", "link_cap", "status"] + \
+        [s + k for s in STAGES for k in ("_s", "_mib")]
+    with open(path + ".tmp", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(path + ".tmp", path)
+    print("scale: %s" % path, file=sys.stderr)
+    if shutil.which("gnuplot") and len(done) >= 2:
+        data = os.path.join(a.out, "scale.dat")
+        with open(data, "w") as f:
+            for r in done:
+                f.write("%d %d %.3f\n" % (r["triangles"], r["links"], r["global_s"]))
+        png = os.path.join(a.out, "scale.png")
+        script = ("set terminal png size 800,500; set output '%s'; set logscale xy;"
+                  "set xlabel 'triangles'; set ylabel 'links'; set y2label 'rad-global seconds';"
+                  "set y2tics; set logscale y2; set key left top;"
+                  "plot '%s' using 1:2 with linespoints title 'links (largest key)',"
+                  " '' using 1:3 axes x1y2 with linespoints title 'rad-global seconds'"
+                  % (png, data))
+        subprocess.run(["gnuplot", "-e", script], check=False)
+        print("scale: %s" % png, file=sys.stderr)
+    if a.check:
+        bad = [r["scene"] + ": " + r["status"] for r in rows if r["status"] != "ok"]
+        bad += [r["scene"] + ": %d triangles" % r["triangles"] for r in rows
+                if r["requested"] >= 1000 and abs(r["triangles"] / r["requested"] - 1) > 0.1]
+        bad += [r["scene"] + ": a stage's report has no peak_memory_mb" for r in rows
+                if not r.get("reported_memory")]
+        for b in bad:
+            print("scale.py: %s" % b, file=sys.stderr)
+        sys.exit(1 if bad else 0)
+
+
+if __name__ == "__main__":
+    main()
