@@ -495,6 +495,7 @@ class KeyTimeSolver {
     s_.closure.assign(N, 1.0);
     s_.goodClosure.assign(N, 1.0);
     goodFactor_.assign(N, 1.0);
+    closed_.resize(N, -1);  // kept from the rounds before: a node's rays do not change
     leafTopFormFactor_.resize(N);
     std::vector<int> leaves;
     for (size_t i = 0; i < N; ++i)
@@ -522,7 +523,15 @@ class KeyTimeSolver {
   // its points leaves the scene. A room's opening of form factor f goes unseen with probability
   // (1 - f)^64 (f = 5 %: 4 %), and then brightens that leaf by at most f.
   static constexpr int kEscapeRays = 64;
-  bool closedAt(int r) const {
+  bool closedAt(int r) {
+    // Once per node and key: the refinement rounds ask again for the leaves they keep.
+    if (size_t(r) < closed_.size() && closed_[size_t(r)] >= 0) return closed_[size_t(r)] != 0;
+    const bool closed = castEscapeRays(r);
+    if (size_t(r) < closed_.size()) closed_[size_t(r)] = closed ? 1 : 0;
+    return closed;
+  }
+
+  bool castEscapeRays(int r) const {
     if (!input_.visibility) return false;
     const PatchNode& n = h_.node(r);
     const Polygon& P = s_.world[size_t(r)];
@@ -825,6 +834,7 @@ class KeyTimeSolver {
   // Per dense node: the closure factor of a leaf's links to shooters that do not emit (its
   // closure factor, or the closed-room one).
   std::vector<double> goodFactor_;
+  std::vector<int8_t> closed_;         // per dense node: closedAt once cast (0 or 1), else -1
   std::vector<uint8_t> shooterEmits_;  // per link: its shooter's top-level patch emits
   std::vector<double> shooterRange_;   // per dense node: measureShooterRanges
   // Per dense node: F(node -> top-level patch) computed for the closure in this key's solve.
