@@ -38,6 +38,7 @@ KNOBS = [
     ("eps", "global", "--eps", ["0.5", "0.1", "0.02", "0.005", "0.001", "0.0001"]),
     ("key-step", "global", "--key-step", ["16", "12", "4", "2"]),
     ("bad-links", "global", "--bad-links", ["none", "partial", "all"]),
+    ("rays", "global", "--rays", ["4", "64"]),
     ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "2"]),
     ("movie-key-step", "movies", "--movie-key-step", ["24", "12", "3", "1"]),
     ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32"]),
