@@ -524,9 +524,14 @@ class KeyTimeSolver {
   // (1 - f)^64 (f = 5 %: 4 %), and then brightens that leaf by at most f.
   static constexpr int kEscapeRays = 64;
   bool closedAt(int r) {
-    // Once per node and key: the refinement rounds ask again for the leaves they keep.
+    // Once per node and key: the refinement rounds ask again for the leaves they keep. A static
+    // node's answer is the same at every key (the static geometry alone decides it), so it is
+    // also taken over from the keys before (coherence).
     if (size_t(r) < closed_.size() && closed_[size_t(r)] >= 0) return closed_[size_t(r)] != 0;
-    const bool closed = castEscapeRays(r);
+    const ClosedNodeCache* before = moves(h_.node(r).id.top) ? nullptr : input_.reuseClosed;
+    const auto known =
+        before ? before->find(h_.node(r).id.packed()) : ClosedNodeCache::const_iterator();
+    const bool closed = before && known != before->end() ? known->second : castEscapeRays(r);
     if (size_t(r) < closed_.size()) closed_[size_t(r)] = closed ? 1 : 0;
     return closed;
   }
@@ -548,9 +553,9 @@ class KeyTimeSolver {
       // its size above it: a point 2e-5 m from the wall that the leaf's edge meets, whose ray
       // into that wall started within the ray's tnear of it, passed through (a floor leaf of a
       // closed cube); from there it meets the wall.
-      if (input_.visibility->firstHit(points[k], d * size, n.id.top) ==
+      if (input_.visibility->firstStaticHit(points[k], d * size, n.id.top) ==
               VisibilityScene::kNoSurface &&
-          input_.visibility->firstHit(
+          input_.visibility->firstStaticHit(
               points[k] + 0.01 * (centroid - points[k]) + normal * (1e-3 * size), d * size,
               n.id.top) == VisibilityScene::kNoSurface)
         return false;
@@ -809,6 +814,9 @@ class KeyTimeSolver {
     }
     s_.radiosity = std::move(B_);
     s_.leafTopFormFactor = std::move(leafTopFormFactor_);
+    for (size_t i = 0; i < closed_.size(); ++i)
+      if (closed_[i] >= 0 && !moves(h_.node(int(i)).id.top))
+        s_.closedNodes.push_back({h_.node(int(i)).id.packed(), closed_[i] != 0});
     s_.exposure = std::move(exposure_);
     s_.exposure.resize(size_t(h_.size()), 1.0);
     for (double& e : s_.exposure)

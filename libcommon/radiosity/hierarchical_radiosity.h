@@ -151,12 +151,16 @@ using LinkCache = std::unordered_map<std::pair<uint64_t, uint64_t>, CachedLink, 
 // The closure's leaf-to-top form factors F(leaf -> top-level patch) a key-time solve may take
 // over (both static): keyed by (leaf id, top index).
 using LeafFormFactorCache = std::unordered_map<std::pair<uint64_t, uint64_t>, double, LinkKeyHash>;
+// Whether a node of a static top-level patch is inside a closed room (its escape rays all meet
+// the static geometry), keyed by node id: the same at every key time.
+using ClosedNodeCache = std::unordered_map<uint64_t, bool>;
 
 struct KeySolveInput {
   std::vector<glm::dmat4> topToWorld;           // per top-level patch: its node's world transform
   const VisibilityScene* visibility = nullptr;  // null: every link fully visible
   const LinkCache* reuse = nullptr;             // coherence: values to take over
   const LeafFormFactorCache* reuseLeafFormFactors = nullptr;  // coherence: the closure's
+  const ClosedNodeCache* reuseClosed = nullptr;               // coherence: closed-room tests
   // Per top-level patch: it moves at some time of the animation. The closure corrects only
   // pairs of patches that never move (empty: none moves).
   std::vector<char> movingTops;
@@ -177,6 +181,8 @@ struct KeySolution {
   std::vector<double> exposure;
   // Per dense node: the (top, F(node -> top)) the closure computed or took over at this key.
   std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor;
+  // The closed-room tests of static nodes cast or taken over at this key: (node id, closed).
+  std::vector<std::pair<uint64_t, bool>> closedNodes;
   std::vector<Polygon> world;  // per dense node: world polygon at this key
   std::vector<double> area;    // per dense node: world area
   int iterations = 0;          // Gauss-Seidel sweeps, all rounds

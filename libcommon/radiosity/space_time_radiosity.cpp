@@ -353,9 +353,12 @@ class KeyTimePass {
       in.reuse = &cache;
       leafCache = reusableLeafFormFactors(prev, h_);
       in.reuseLeafFormFactors = &leafCache;
+      in.reuseClosed = &closedCache_;
       secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);
+    if (opt_.coherence)
+      for (const auto& [id, closed] : s.closedNodes) closedCache_.emplace(id, closed);
     rep_.keys.push_back(keyTimeReportOf(s, h_, t, secondsCoherence));
     if (opt_.onKeySolved) opt_.onKeySolved();
     return s;
@@ -387,6 +390,7 @@ class KeyTimePass {
   LinkIntervals intervals_;
   std::vector<char> badPair_;
   std::vector<char> movingTops_;  // per top: moves during the key times (KeySolveInput)
+  ClosedNodeCache closedCache_;   // coherence: static nodes' closed-room tests, all keys so far
 };
 
 // Merge: radiosity per node and key; nodes created after key k take their ancestor's value

@@ -428,23 +428,40 @@ double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
   return double(count) / k;
 }
 
-std::uint32_t VisibilityScene::firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
-                                        std::uint32_t ignore) const {
+namespace {
+// The surface id of the first triangle of `scene` the ray hits (kNoSurface: none); `child` is the
+// instanced scene for a hit without an instance (the static scene traversed directly).
+std::uint32_t firstHitIn(RTCScene scene, const glm::dvec3& origin, const glm::dvec3& direction,
+                         std::uint32_t ignore, unsigned child,
+                         const std::vector<const std::vector<std::uint32_t>*>& childSurfaces) {
   RTCRayHit rh;
   rh.ray = rayOf(origin, direction, std::numeric_limits<double>::infinity());
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  if (!(rh.ray.dir_x != 0.0f || rh.ray.dir_y != 0.0f || rh.ray.dir_z != 0.0f)) return kNoSurface;
+  if (!(rh.ray.dir_x != 0.0f || rh.ray.dir_y != 0.0f || rh.ray.dir_z != 0.0f))
+    return VisibilityScene::kNoSurface;
   FilterContext fc;
   rtcInitIntersectContext(&fc.context);
   fc.ignoreA = ignore;
   fc.ignoreB = ignore;
-  rtcIntersect1(impl_->top, &fc.context, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return kNoSurface;
-  const unsigned child = rh.hit.instID[0];
-  if (child >= impl_->childSurfaces.size() || !impl_->childSurfaces[child]) return kNoSurface;
-  const std::vector<std::uint32_t>& ids = *impl_->childSurfaces[child];
-  return rh.hit.primID < ids.size() ? ids[rh.hit.primID] : kNoSurface;
+  rtcIntersect1(scene, &fc.context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return VisibilityScene::kNoSurface;
+  if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) child = rh.hit.instID[0];
+  if (child >= childSurfaces.size() || !childSurfaces[child]) return VisibilityScene::kNoSurface;
+  const std::vector<std::uint32_t>& ids = *childSurfaces[child];
+  return rh.hit.primID < ids.size() ? ids[rh.hit.primID] : VisibilityScene::kNoSurface;
+}
+}  // namespace
+
+std::uint32_t VisibilityScene::firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
+                                        std::uint32_t ignore) const {
+  return firstHitIn(impl_->top, origin, direction, ignore, RTC_INVALID_GEOMETRY_ID,
+                    impl_->childSurfaces);
+}
+
+std::uint32_t VisibilityScene::firstStaticHit(const glm::dvec3& origin, const glm::dvec3& direction,
+                                              std::uint32_t ignore) const {
+  return firstHitIn(impl_->children[0], origin, direction, ignore, 0, impl_->childSurfaces);
 }
 
 std::vector<double> VisibilityScene::visibilityBatch(const std::vector<VisibilityQuery>& queries,

@@ -118,6 +118,10 @@ class VisibilityScene {
   // it hits nothing. Thread-safe after commit().
   std::uint32_t firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
                          std::uint32_t ignore = kNoSurface) const;
+  // firstHit against the static geometry alone, without the dynamic objects: the same at every
+  // time (rad-global's closed-room test, which moving objects inside a room cannot open).
+  std::uint32_t firstStaticHit(const glm::dvec3& origin, const glm::dvec3& direction,
+                               std::uint32_t ignore = kNoSurface) const;
 
   // Many queries in parallel (TBB); results in input order, identical to calling visibility()
   // on each query in turn.
