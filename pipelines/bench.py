@@ -51,14 +51,32 @@ TABLE5 = ["cubic"]
 BUNDLED = {"cornell-moving": os.path.join(HERE, "scenes", "cornell-moving.gltf")}
 
 
-def run(cmd, log):
-    """Runs cmd; returns (seconds, peak RSS in MiB, CPU seconds). Raises on failure."""
+class Timeout(RuntimeError):
+    """run()'s command ran past its limit and was killed: its seconds and peak MiB until then."""
+
+    def __init__(self, message, seconds, peak_mib):
+        super().__init__(message)
+        self.seconds, self.peak_mib = seconds, peak_mib
+
+
+def run(cmd, log, limit=None):
+    """Runs cmd, its output appended to log; returns (seconds, peak RSS in MiB, CPU seconds).
+    Raises RuntimeError on failure, Timeout (killed) after `limit` seconds if given."""
     t0 = time.monotonic()
     with open(log, "ab") as f:
         f.write(("$ " + " ".join(cmd) + "\n").encode())
         f.flush()
         p = subprocess.Popen(cmd, stdout=f, stderr=f)
-        _, status, usage = os.wait4(p.pid, 0)
+        while True:
+            pid, status, usage = os.wait4(p.pid, 0 if limit is None else os.WNOHANG)
+            if pid:
+                break
+            if time.monotonic() - t0 > limit:
+                p.kill()
+                _, _, usage = os.wait4(p.pid, 0)
+                raise Timeout("%s ran past %g s (see %s)" % (os.path.basename(cmd[0]), limit, log),
+                              time.monotonic() - t0, usage.ru_maxrss / 1024.0)
+            time.sleep(0.2)
     dt = time.monotonic() - t0
     if os.waitstatus_to_exitcode(status) != 0:
         raise RuntimeError("%s failed (see %s)" % (os.path.basename(cmd[0]), log))

@@ -33,29 +33,6 @@ import bench  # noqa: E402
 STAGES = ("global", "intervals", "movies", "compose")
 
 
-def run_limited(argv, log, limit):
-    """Runs argv, output appended to log; returns (seconds, peak MiB, status) with status "ok",
-    "failed" or "timeout" (killed after `limit` seconds)."""
-    t0 = time.monotonic()
-    with open(log, "ab") as f:
-        f.write(("$ " + " ".join(argv) + "\n").encode())
-        f.flush()
-        p = subprocess.Popen(argv, stdout=f, stderr=f)
-        status = None
-        while status is None:
-            pid, st, usage = os.wait4(p.pid, os.WNOHANG)
-            if pid:
-                status = "ok" if os.waitstatus_to_exitcode(st) == 0 else "failed"
-                break
-            if time.monotonic() - t0 > limit:
-                p.kill()
-                _, st, usage = os.wait4(p.pid, 0)
-                status = "timeout"
-                break
-            time.sleep(0.2)
-    return time.monotonic() - t0, usage.ru_maxrss / 1024.0, status
-
-
 def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit):
     name = "hall-%d%s" % (triangles, "-moving-light" if moving_light else "")
     out = os.path.join(out_root, name)
@@ -73,12 +50,18 @@ def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit):
     left = limit
     flags = {"compose": ["--no-png"]}
     for stage, argv in bench.stage_commands(bin_dir, scene, out, frames, size, flags):
-        seconds, mib, status = run_limited(argv, log, left)
+        t0 = time.monotonic()
+        try:
+            seconds, mib, _ = bench.run(argv, log, limit=max(left, 1.0))
+        except bench.Timeout as killed:
+            row[stage + "_s"], row[stage + "_mib"] = killed.seconds, killed.peak_mib
+            row["status"] = stage + " timeout"
+            break
+        except RuntimeError:
+            row[stage + "_s"], row["status"] = time.monotonic() - t0, stage + " failed"
+            break
         row[stage + "_s"], row[stage + "_mib"] = seconds, mib
         left -= seconds
-        if status != "ok":
-            row["status"] = "%s %s" % (stage, status)
-            break
     try:
         with open(os.path.join(out, "global-report.json")) as f:
             g = json.load(f)

@@ -4,10 +4,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
-#include <mutex>
 
 #include <tbb/parallel_for.h>
 
@@ -527,12 +525,12 @@ class KeyTimeSolver {
     // Once per node and key: the refinement rounds ask again for the leaves they keep. A static
     // node's answer is the same at every key (the static geometry alone decides it), so it is
     // also taken over from the keys before (coherence).
-    if (size_t(r) < closed_.size() && closed_[size_t(r)] >= 0) return closed_[size_t(r)] != 0;
+    if (closed_[size_t(r)] >= 0) return closed_[size_t(r)] != 0;
     const ClosedNodeCache* before = moves(h_.node(r).id.top) ? nullptr : input_.reuseClosed;
     const auto known =
         before ? before->find(h_.node(r).id.packed()) : ClosedNodeCache::const_iterator();
     const bool closed = before && known != before->end() ? known->second : castEscapeRays(r);
-    if (size_t(r) < closed_.size()) closed_[size_t(r)] = closed ? 1 : 0;
+    closed_[size_t(r)] = closed ? 1 : 0;
     return closed;
   }
 
@@ -653,10 +651,8 @@ class KeyTimeSolver {
     for (int a = r; a >= 0; a = h_.node(a).parent) {
       const double e = exposure_[size_t(a)];
       if (!(e > 0.0)) continue;
-      for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k) {
-        const SolverLink& l = s_.links[adj_[k]];
-        (surfaces_[h_.node(l.shooter).id.top].isEmitter() ? coef.x : coef.y) += l.fv() / e;
-      }
+      for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k)
+        (shooterEmits_[adj_[k]] ? coef.x : coef.y) += s_.links[adj_[k]].fv() / e;
     }
     if (!(coef.x + coef.y > 0.0) || !closedAt(r)) return;
     const double good = coef.y > 0.0 ? (1.0 - s_.closure[size_t(r)] * coef.x) / coef.y : 0.0;
@@ -714,7 +710,7 @@ class KeyTimeSolver {
   }
 
   // Per receiving node, its gathered (unrefined) links in link order: adj_[adjStart_[i] ..
-  // adjStart_[i + 1]).
+  // adjStart_[i + 1]); per link, whether its shooter emits (shooterEmits_).
   void buildGatherLists() {
     size_t N = size_t(h_.size());
     adjStart_.assign(N + 1, 0);
@@ -725,6 +721,9 @@ class KeyTimeSolver {
     std::vector<size_t> fill(adjStart_.begin(), adjStart_.end() - 1);
     for (size_t li = 0; li < s_.links.size(); ++li)
       if (!s_.links[li].refined) adj_[fill[size_t(s_.links[li].receiver)]++] = li;
+    shooterEmits_.resize(s_.links.size());
+    for (size_t k = 0; k < s_.links.size(); ++k)
+      shooterEmits_[k] = surfaces_[h_.node(s_.links[k].shooter).id.top].isEmitter() ? 1 : 0;
   }
 
   // What a node gives its parent's pull: its exposed area e A and e A B.
@@ -788,9 +787,6 @@ class KeyTimeSolver {
   // change of B is below the stop rule (or maxIterations).
   void solve() {
     buildGatherLists();
-    shooterEmits_.resize(s_.links.size());
-    for (size_t k = 0; k < s_.links.size(); ++k)
-      shooterEmits_[k] = surfaces_[h_.node(s_.links[k].shooter).id.top].isEmitter() ? 1 : 0;
     irr_.assign(size_t(h_.size()), glm::dvec3(0.0));
     for (int it = 0; it < opt_.maxIterations; ++it) {
       maxDelta_ = maxB_ = 0;

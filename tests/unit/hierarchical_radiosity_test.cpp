@@ -45,6 +45,17 @@ PatchHierarchy hierarchyOf(const std::vector<Polygon>& polys) {
   return PatchHierarchy(tops);
 }
 
+// The quads as Embree triangles, each tagged with its index (the top-level patch id).
+std::vector<VisibilityTriangle> visibilityTrianglesOf(const std::vector<Polygon>& quads) {
+  std::vector<VisibilityTriangle> tris;
+  for (size_t i = 0; i < quads.size(); ++i) {
+    const Polygon& p = quads[i];
+    tris.push_back({{p.v[0], p.v[1], p.v[2]}, uint32_t(i)});
+    tris.push_back({{p.v[0], p.v[2], p.v[3]}, uint32_t(i)});
+  }
+  return tris;
+}
+
 std::vector<Polygon> geometry(const std::string& name) {
   std::vector<Polygon> out;
   for (const Json& p : furnace()["geometries"][name]["patches"]) out.push_back(polygonOf(p));
@@ -373,13 +384,7 @@ TEST(HierarchicalRadiosity, ExtremesStayFiniteLinearAndScaleFree) {
 TEST(HierarchicalRadiosity, VisibilityInsideEnclosure) {
   std::vector<Polygon> polys = geometry("unit_cube_6");
   PatchHierarchy h = hierarchyOf(polys);
-  std::vector<VisibilityTriangle> tris;
-  for (int t = 0; t < h.topCount(); ++t) {
-    const Polygon& p = polys[size_t(t)];
-    tris.push_back({{p.v[0], p.v[1], p.v[2]}, uint32_t(t)});
-    tris.push_back({{p.v[0], p.v[2], p.v[3]}, uint32_t(t)});
-  }
-  VisibilityScene vis(tris);
+  VisibilityScene vis(visibilityTrianglesOf(polys));
   KeySolveInput in = identityInput(h);
   in.visibility = &vis;
   std::vector<SurfaceProperties> surf(6);
@@ -509,37 +514,13 @@ TEST(HierarchicalRadiosity, RefinedFurnaceConservesEnergy) {
 // 18 % too dark). Inside a closed room a leaf's row sum is exactly 1, and the closure makes it
 // so: every leaf within 1 % of L_e / (1 - rho); without the closed-room rows, more than 5 % off.
 TEST(HierarchicalRadiosity, OccludedFurnaceRowsSumToOneInAClosedRoom) {
-  auto quad = [](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
-    Polygon p;
-    p.count = 4;
-    p.v = {a, b, c, d};
-    return p;
-  };
   // A 2 m cube facing inwards, and a slab 0.1 x 1.6 x 1.4 facing outwards, 0.2 m from the floor
-  // and the ceiling.
-  auto box = [&](glm::dvec3 lo, glm::dvec3 hi, bool inwards) {
-    std::vector<Polygon> f = {
-        quad({lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z}),
-        quad({lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}, {hi.x, hi.y, lo.z}),
-        quad({lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z}, {lo.x, hi.y, lo.z}),
-        quad({hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, hi.y, hi.z}, {hi.x, lo.y, hi.z}),
-        quad({lo.x, lo.y, lo.z}, {lo.x, hi.y, lo.z}, {hi.x, hi.y, lo.z}, {hi.x, lo.y, lo.z}),
-        quad({lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z})};
-    if (inwards)
-      for (Polygon& p : f) std::swap(p.v[1], p.v[3]);
-    return f;
-  };
-  std::vector<Polygon> polys = box({0, 0, 0}, {2, 2, 2}, true);
-  for (const Polygon& p : box({1.45, 0.2, 0.3}, {1.55, 1.8, 1.7}, false)) polys.push_back(p);
-  ASSERT_GT(glm::dot(polys[0].normal(), glm::dvec3(0, 1, 0)), 0.0) << "the floor faces inwards";
-  ASSERT_LT(glm::dot(polys[6].normal(), glm::dvec3(0, 1, 0)), 0.0) << "the slab faces outwards";
-  std::vector<VisibilityTriangle> tris;
-  for (size_t i = 0; i < polys.size(); ++i) {
-    const Polygon& p = polys[i];
-    tris.push_back({{p.v[0], p.v[1], p.v[2]}, uint32_t(i)});
-    tris.push_back({{p.v[0], p.v[2], p.v[3]}, uint32_t(i)});
-  }
-  VisibilityScene vis(tris);
+  // and the ceiling and 0.3 m from the walls.
+  std::vector<Polygon> polys = boxFaces({0, 0, 0}, {2, 2, 2}, true);
+  for (const Polygon& p : boxFaces({1.45, 0.2, 0.3}, {1.55, 1.8, 1.7}, false)) polys.push_back(p);
+  ASSERT_GT(glm::dot(polys[2].normal(), glm::dvec3(0, 1, 0)), 0.0) << "the floor faces inwards";
+  ASSERT_LT(glm::dot(polys[8].normal(), glm::dvec3(0, 1, 0)), 0.0) << "the slab faces outwards";
+  VisibilityScene vis(visibilityTrianglesOf(polys));
   const double rho = 0.99;
   PatchHierarchy h = hierarchyOf(polys);
   std::vector<SurfaceProperties> surf = furnaceSurfaces(h, rho);
@@ -586,13 +567,7 @@ TEST(HierarchicalRadiosity, CoveredAreaDoesNotDarkenWhatIsExposed) {
   std::vector<SurfaceProperties> surf(polys.size());
   for (auto& sp : surf) sp.reflectance = glm::dvec3(0.5);
   surf[1].emission = glm::dvec3(1.0);
-  std::vector<VisibilityTriangle> tris;
-  for (size_t i = 0; i < polys.size(); ++i) {
-    const Polygon& p = polys[i];
-    tris.push_back({{p.v[0], p.v[1], p.v[2]}, uint32_t(i)});
-    tris.push_back({{p.v[0], p.v[2], p.v[3]}, uint32_t(i)});
-  }
-  VisibilityScene vis(tris);
+  VisibilityScene vis(visibilityTrianglesOf(polys));
   KeySolveInput in = identityInput(h);
   in.visibility = &vis;
   KeySolution s = solveKeyTime(h, surf, in, RadiosityOptions());
