@@ -69,13 +69,16 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
     pairs.push_back(p.second);
   }
   w.addArray("bad_pairs", pairs, {s.badPairs.size(), 2});
+  if (!s.topClusterIrradiance.empty())  // since 1.3
+    w.addRawView("top_cluster_irradiance", DType::kF32, {size_t(s.hierarchy.topCount()), K, 3},
+                 s.topClusterIrradiance.data(), s.topClusterIrradiance.size() * sizeof(glm::vec3));
   w.write(path);
 }
 
 namespace {
 
 // radiosityOnly: keyTimes, hierarchy, nodeRadiosity and leafRow only (links, link samples,
-// good irradiance and bad pairs stay empty; readLinkHierarchyRadiosity).
+// good irradiance, bad pairs and cluster irradiance stay empty; readLinkHierarchyRadiosity).
 GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool radiosityOnly) {
   const std::string& where = r.path();
   r.requireKind(kLinkHierarchyKind, kLinkHierarchyMajor);
@@ -134,6 +137,15 @@ GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool r
   std::vector<uint32_t> pairs = r.array<uint32_t>("bad_pairs");
   if (pairs.size() % 2) throw inputError(where, "bad_pairs has an odd size");
   for (size_t i = 0; i < pairs.size(); i += 2) s.badPairs.emplace_back(pairs[i], pairs[i + 1]);
+  if (r.has("top_cluster_irradiance")) {  // since 1.3
+    std::vector<float> h = r.array<float>("top_cluster_irradiance");
+    if (h.size() != tops * K * 3)
+      throw inputError(where, "top_cluster_irradiance has " + std::to_string(h.size()) +
+                                  " values; expected " + std::to_string(tops * K * 3) + " (" +
+                                  std::to_string(tops) + " tops x " + std::to_string(K) +
+                                  " keys x 3)");
+    s.topClusterIrradiance = unflatten(h);
+  }
   s.validate(where);
   return s;
 }
@@ -190,6 +202,26 @@ nlohmann::json summarizeLinkHierarchy(const ContainerReader& r) {
     }
   }
   j["radiosity"] = {{"max", maxB}, {"non_finite", nonFinite}, {"negative", negative}};
+  if (r.has("top_cluster_irradiance")) {  // since 1.3; the mean is over the finite values
+    std::vector<float> h = r.array<float>("top_cluster_irradiance");
+    size_t nonFiniteH = 0, negativeH = 0, finiteH = 0;
+    double sumH = 0.0;
+    float maxH = 0.0f;
+    for (float x : h) {
+      if (!std::isfinite(x)) {
+        ++nonFiniteH;
+        continue;
+      }
+      if (x < 0) ++negativeH;
+      ++finiteH;
+      sumH += x;
+      maxH = std::max(maxH, x);
+    }
+    j["cluster_irradiance"] = {{"max", maxH},
+                               {"mean", finiteH ? sumH / double(finiteH) : 0.0},
+                               {"non_finite", nonFiniteH},
+                               {"negative", negativeH}};
+  }
   return j;
 }
 

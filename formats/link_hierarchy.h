@@ -14,7 +14,7 @@ namespace rad {
 
 constexpr const char* kLinkHierarchyKind = "linkhier";
 constexpr int kLinkHierarchyMajor = 1;
-constexpr int kLinkHierarchyMinor = 2;
+constexpr int kLinkHierarchyMinor = 3;
 
 // Writes `solution` atomically. `metadata` (an object) is stored as the kind's metadata; the
 // writer adds key_count, node_count, link_count, top_count.
@@ -26,10 +26,10 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& solution,
 // must form the hierarchy in subdivision order. Errors are rad::inputError(path, ...).
 GlobalSolution readLinkHierarchy(const ContainerReader& reader, const Scene& scene);
 GlobalSolution readLinkHierarchy(const std::string& path, const Scene& scene);
-// The same checks and content without the links, their F·V samples, the good irradiance and
-// the bad pairs (left empty): keyTimes, hierarchy, nodeRadiosity and leafRow, all rad-compose
-// reads (radiosity(), leafAtTopUv, autoExposureEV). The container's checksums still cover the
-// arrays not copied. Saves rad-compose ~45 MB on the 32-cube scene.
+// The same checks and content without the links, their F·V samples, the good irradiance, the
+// bad pairs and the cluster irradiance (left empty): keyTimes, hierarchy, nodeRadiosity and
+// leafRow, all rad-compose reads (radiosity(), leafAtTopUv, autoExposureEV). The container's
+// checksums still cover the arrays not copied. Saves rad-compose ~45 MB on the 32-cube scene.
 GlobalSolution readLinkHierarchyRadiosity(const ContainerReader& reader, const Scene& scene);
 
 // rad-inspect's content summary of a linkhier container (no scene needed).

@@ -569,6 +569,8 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
         }
     });
   }
+  // The receiver top's cluster light, uniform over it, linear in t between the keys as `weight`.
+  const glm::dvec3 cluster = solution_.clusterIrradiance(receiverTop_, t);
   const TexelFrame frame = texelFrame(t);
   const int width = texels_.width, height = texels_.height;
   auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
@@ -613,7 +615,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
                               &pointWeight[l * rays], movingNow[l] != 0);
           H += f * weight[l];
         }
-        acc[x] = H;
+        acc[x] = H + cluster;
       }
   });
 }

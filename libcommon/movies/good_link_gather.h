@@ -4,10 +4,13 @@
 //
 // At texel centre x of a receiver whose union leaf chain (leaf and ancestors) is c(x), at key k,
 //
-//   G(x, k) = \sum_{l = (p <- q) good, p \in c(x), active at k}  B_q(k) \, \bar V_l(k) \, F(x \to
-//   q)
+//   G(x, k) = H_c(k) + \sum_{l = (p <- q) good, p \in c(x), active at k}  B_q(k) \, \bar V_l(k)
+//   \, F(x \to q)
 //
-// with F(x -> q) the exact point-to-polygon form factor at the texel, about its shading normal,
+// with H_c(k) the irradiance the receiver's top gathers through rad-global's cluster links
+// (GlobalSolution::topClusterIrradiance, linkhier 1.3; 0 in older files), uniform over the top
+// (the Gouraud layer's vertex values include it, so both layers carry the same cluster light),
+// F(x -> q) the exact point-to-polygon form factor at the texel, about its shading normal,
 // and \bar V_l = V_l / e_p clamped to [0, 1]: the link's stored visibility (linkhier 1.2; older
 // files: F·V / \bar F, the area-average form factor) over the receiver's exposure e_p (the share
 // of it not covered by a touching solid, whose sample points count as occluded; rad-global
@@ -96,7 +99,7 @@ class GoodLinkGather {
                  double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
                  SceneVisibility* visibility = nullptr, int visibilityRays = 16);
 
-  // acc[x] = G(x, t).
+  // acc[x] = G(x, t), the cluster irradiance of the receiver's top included (every texel).
   void gather(double t, std::vector<glm::dvec3>& acc) const;
 
  private:

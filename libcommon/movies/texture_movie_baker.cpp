@@ -441,7 +441,8 @@ class MovieBake {
   void planCoherentBlockers(Pair& p, const std::vector<int>& candidates);
 
   // Good layer: gathered per texel over the good links, or (paper §3.1) Gouraud over the patch
-  // from the global solution.
+  // from the global solution. Both carry the top's cluster light (topClusterIrradiance): the
+  // gather adds it, the Gouraud vertex values hold it already.
   void goodLayer(double t) {
     auto clock = SteadyClock::now();
     if (gather_) {

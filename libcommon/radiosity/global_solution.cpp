@@ -138,6 +138,16 @@ glm::dvec3 GlobalSolution::goodIrradiance(int top, glm::dvec2 uv, double t) cons
   return (1.0 - w) * a + w * goodIrradianceAtKey(top, uv, k1);
 }
 
+glm::dvec3 GlobalSolution::clusterIrradiance(int top, double t) const {
+  if (topClusterIrradiance.empty()) return glm::dvec3(0.0);
+  int k0, k1;
+  double w;
+  keyWeights(t, k0, k1, w);
+  glm::dvec3 a = clusterIrradianceAtKey(top, k0);
+  if (k1 == k0 || w == 0.0) return a;
+  return (1.0 - w) * a + w * clusterIrradianceAtKey(top, k1);
+}
+
 namespace {
 // A row's samples (keys[0..n), values) at key k: piecewise linear, held outside.
 double sampleAtKey(const uint32_t* keys, const float* values, uint32_t n, int key) {
@@ -229,6 +239,14 @@ void GlobalSolution::validate(const std::string& where) const {
         badPairs[i].second >= uint32_t(hierarchy.topCount()))
       bad("bad pair names a top-level patch out of range");
     if (i && !(badPairs[i - 1] < badPairs[i])) bad("bad pairs are not sorted and unique");
+  }
+  if (!topClusterIrradiance.empty()) {
+    if (topClusterIrradiance.size() != size_t(hierarchy.topCount()) * K)
+      bad("top_cluster_irradiance has the wrong size");
+    for (const glm::vec3& h : topClusterIrradiance)
+      for (int c = 0; c < 3; ++c)
+        if (!(std::isfinite(h[c]) && h[c] >= 0.0f))
+          bad("top cluster irradiance is negative or not finite");
   }
 }
 

@@ -3,11 +3,14 @@
 // their activity intervals and F·V samples, the radiosity of every node at every key time, and
 // what rad-movies needs per receiver: the good-link irradiance as vertex values over the union
 // leaves (Gouraud) and the bad (receiver top, shooter top) pairs.
+// The light of rad-global's cluster links (above the top-level patches) comes per top:
+// topClusterIrradiance.
 //
 // Good and bad (paper §3.1): a link p <- q is *bad* when the pair (top of p, top of q) is in
 // badPairs; everything else is good. The good-link irradiance excludes every link of a bad
 // pair at every key time, so  H(x, t) = goodIrradiance(x, t) + sum over bad shooters S of the
-// receiver top of  B_S(t) F(x -> S(t)) T(x, S, t)  with nothing counted twice.
+// receiver top of  B_S(t) F(x -> S(t)) T(x, S, t)  with nothing counted twice. Cluster light is
+// good light: goodIrradiance() includes it.
 //
 // Times: values are given at key times; between two key times everything is linear in t, and
 // before the first / after the last key the end value is held.
@@ -66,6 +69,13 @@ class GlobalSolution {
   std::vector<float> linkSampleVisibility;
   // Bad (receiver top, shooter top) pairs, sorted, unique.
   std::vector<std::pair<uint32_t, uint32_t>> badPairs;
+  // Irradiance H_cluster (W/m^2, RGB) that top-level patch t gathers through rad-global's cluster
+  // links (Smits et al. 1994; Sillion 1995: links above the top-level patches, not hierarchy
+  // nodes) at key k, of its exposed part (already divided by the top's exposure), uniform over
+  // the top and not scaled by any closure factor. Good light: never part of a bad pair.
+  // leafVertexGoodIrradiance already includes it; the per-texel gather adds it itself.
+  // [T * K]: top t at key k at t * K + k; empty = none (files before linkhier 1.3).
+  std::vector<glm::vec3> topClusterIrradiance;
 
   int keyCount() const { return int(keyTimes.size()); }
   // Fractional key position of time t: k0, k1 and weight w of k1 (held outside the range).
@@ -80,6 +90,14 @@ class GlobalSolution {
   // Gouraud-interpolated over the union leaf that contains the point.
   glm::dvec3 goodIrradianceAtKey(int top, glm::dvec2 uv, int key) const;
   glm::dvec3 goodIrradiance(int top, glm::dvec2 uv, double t) const;
+  // H_cluster of top-level patch `top` at key k (0 when the solution has none), and at time t
+  // (linear between keys, held outside).
+  glm::dvec3 clusterIrradianceAtKey(int top, int key) const {
+    return topClusterIrradiance.empty()
+               ? glm::dvec3(0.0)
+               : glm::dvec3(topClusterIrradiance[size_t(top) * keyCount() + key]);
+  }
+  glm::dvec3 clusterIrradiance(int top, double t) const;
   double exposureAtKey(int node, int key) const {
     return nodeExposure.empty() ? 1.0 : double(nodeExposure[size_t(node) * keyCount() + key]);
   }

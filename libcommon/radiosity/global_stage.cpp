@@ -22,6 +22,8 @@ nlohmann::json GlobalOptions::toJson() const {
           {"max-links", r.maxLinks},
           {"no-closure", !r.closure},
           {"no-closed-rooms", !r.closedRooms},
+          {"no-clustering", !r.clustering},
+          {"cluster-separation", r.clusterSeparation},
           {"no-shooter-shape", !r.shooterShape},
           {"no-coherence", !spaceTime.coherence}};
 }
@@ -46,7 +48,7 @@ namespace {
 
 // Sums of the per-key figures.
 struct KeyTotals {
-  size_t recomputed = 0, reused = 0, links = 0, visibilityOnly = 0;
+  size_t recomputed = 0, reused = 0, links = 0, visibilityOnly = 0, clusterLinks = 0;
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
   long iterations = 0;
 };
@@ -58,6 +60,7 @@ KeyTotals totalsOf(const std::vector<KeyTimeReport>& keys) {
     t.reused += r.reused;
     t.visibilityOnly += r.visibilityOnly;
     t.links += r.links;
+    t.clusterLinks += r.clusterLinks;
     t.secondsLinks += r.secondsLinks;
     t.secondsSolve += r.secondsSolve;
     t.secondsCoherence += r.secondsCoherence;
@@ -82,6 +85,7 @@ nlohmann::json GlobalReport::toJson() const {
                     {"iterations", r.iterations},
                     {"refine_rounds", r.refineRounds},
                     {"link_cap_reached", r.linkCapReached},
+                    {"cluster_links", r.clusterLinks},
                     {"seconds_links", r.secondsLinks},
                     {"seconds_solve", r.secondsSolve},
                     {"seconds_coherence", r.secondsCoherence}});
@@ -90,6 +94,7 @@ nlohmann::json GlobalReport::toJson() const {
   return {{"key_times", keys},
           {"totals",
            {{"links", t.links},
+            {"cluster_links", t.clusterLinks},
             {"recomputed", t.recomputed},
             {"reused", t.reused},
             {"visibility_only", t.visibilityOnly},
@@ -138,9 +143,10 @@ std::string GlobalReport::table(const std::string& tool) const {
         << r.secondsLinks << std::setw(9) << r.secondsSolve << "\n";
   }
   const KeyTotals t = totalsOf(solve.keys);
-  out << "  total: " << t.links << " links, " << t.recomputed << " recomputed (" << t.visibilityOnly
-      << " of them visibility only), " << t.reused << " reused; " << solve.unionNodes
-      << " union nodes, " << solve.linkRows << " link rows, " << solve.badPairs << " bad pairs\n"
+  out << "  total: " << t.links << " links (and " << t.clusterLinks << " cluster links), "
+      << t.recomputed << " recomputed (" << t.visibilityOnly << " of them visibility only), "
+      << t.reused << " reused; " << solve.unionNodes << " union nodes, " << solve.linkRows
+      << " link rows, " << solve.badPairs << " bad pairs\n"
       << "  seconds: links " << t.secondsLinks << ", solve " << t.secondsSolve << ", merge "
       << solve.secondsMerge << ", write " << secondsWrite << ", total " << secondsTotal
       << "; peak memory " << std::setprecision(1) << peakMemoryMb << " MB\n";

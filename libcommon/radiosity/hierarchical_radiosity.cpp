@@ -11,6 +11,7 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "libcommon/radiosity/cluster_links.h"
 #include "libcommon/radiosity/global_solution.h"
 
 namespace rad {
@@ -175,12 +176,21 @@ class KeyTimeSolver {
   }
 
   KeySolution run() {
-    s_.links = linkTopLevel(s_.world, s_.area, h_.topCount());
+    if (input_.clusters && !input_.clusters->empty()) {
+      topEmits_.resize(size_t(h_.topCount()));
+      for (int t = 0; t < h_.topCount(); ++t)
+        topEmits_[size_t(t)] = surfaces_[size_t(t)].isEmitter();
+      clusters_ =
+          std::make_unique<ClusterLinks>(*input_.clusters, s_.world, s_.area, topEmits_,
+                                         input_.visibility, opt_.rays, opt_.clusterSeparation);
+    } else {
+      s_.links = linkTopLevel(s_.world, s_.area, h_.topCount());
+    }
     for (int round = 0;; ++round) {
       auto tl = std::chrono::steady_clock::now();
-      size_t refined = 0;
+      size_t refined = clusters_ ? refineClusterLinks() : 0;
       if (refineOn_)
-        refined = refine(unrefinedLinks());
+        refined += refine(unrefinedLinks());
       else
         evaluateNewLinks();
       if (round > 0 && refined == 0) {
@@ -249,6 +259,29 @@ class KeyTimeSolver {
     glm::dvec3 carried(0.0);
     for (int t = 0; t < h_.topCount(); ++t) carried += s_.area[size_t(t)] * B_[size_t(t)];
     epsAbs_ = std::max(epsAbs_, opt_.eps * maxComponent(carried));
+  }
+
+  // Cluster links (cluster_links.h): one round of their refinement with this round's B and
+  // threshold (all the way down to patch pairs when refinement is off: the all-pairs linking);
+  // the pairs of top-level patches reached become patch links, appended in the order reached.
+  size_t refineClusterLinks() {
+    std::vector<std::pair<int, int>> pairs;
+    const size_t held = s_.links.size() + clusters_->size();
+    const size_t budget = opt_.maxLinks > held ? opt_.maxLinks - held : 0;
+    const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs);
+    if (s_.links.size() + clusters_->size() + pairs.size() > opt_.maxLinks)
+      s_.linkCapReached = true;
+    for (const auto& [r, q] : pairs)
+      if (s_.area[size_t(r)] > 0 && s_.area[size_t(q)] > 0 &&
+          mutuallyFacing(s_.world[size_t(r)], s_.world[size_t(q)])) {
+        SolverLink l;
+        l.receiver = r;
+        l.shooter = q;
+        s_.links.push_back(l);
+      }
+    clusters_->evaluate();
+    clusterRow_ = clusters_->rowSums();
+    return refined;
   }
 
   // Per node of this key's tree: the range (max - min over the colour channel of largest
@@ -655,11 +688,17 @@ class KeyTimeSolver {
         (shooterEmits_[adj_[k]] ? coef.x : coef.y) += s_.links[adj_[k]].fv() / e;
     }
     if (!(coef.x + coef.y > 0.0) || !closedAt(r)) return;
-    const double good = coef.y > 0.0 ? (1.0 - s_.closure[size_t(r)] * coef.x) / coef.y : 0.0;
+    // The cluster links' share (gathered at the top, over its exposure) is taken as it is.
+    const uint32_t top = h_.node(r).id.top;
+    const double cluster =
+        clusterRow_.empty() || !(exposure_[top] > 0.0) ? 0.0 : clusterRow_[top] / exposure_[top];
+    if (!(cluster < 1.0)) return;
+    const double good =
+        coef.y > 0.0 ? (1.0 - cluster - s_.closure[size_t(r)] * coef.x) / coef.y : 0.0;
     if (good > 0.5 && good < 2.0) {
       goodFactor_[size_t(r)] = good;
     } else {
-      s_.closure[size_t(r)] = 1.0 / (coef.x + coef.y);
+      s_.closure[size_t(r)] = (1.0 - cluster) / (coef.x + coef.y);
       goodFactor_[size_t(r)] = s_.closure[size_t(r)];
     }
     s_.goodClosure[size_t(r)] = goodFactor_[size_t(r)];
@@ -740,6 +779,7 @@ class KeyTimeSolver {
   // scales them by different closure factors (closeLeaf).
   struct Gathered {
     glm::dvec3 light{0.0}, good{0.0};
+    glm::dvec3 cluster{0.0};  // through cluster links, at the top (no closure factor)
   };
 
   Pulled gatherPushPull(int i, const Gathered& down) {
@@ -753,8 +793,9 @@ class KeyTimeSolver {
       }
     if (!s_.split[size_t(i)]) {
       const glm::dvec3 irradiance =
-          s_.closure.empty() ? H.light + H.good
-                             : s_.closure[size_t(i)] * H.light + goodFactor_[size_t(i)] * H.good;
+          H.cluster + (s_.closure.empty()
+                           ? H.light + H.good
+                           : s_.closure[size_t(i)] * H.light + goodFactor_[size_t(i)] * H.good);
       irr_[size_t(i)] = irradiance;
       const SurfaceProperties& sp = surfaces_[h_.node(i).id.top];
       glm::dvec3 b = sp.emission + sp.reflectance * irradiance;
@@ -765,7 +806,7 @@ class KeyTimeSolver {
       const double exposedArea = e * s_.area[size_t(i)];
       return {b * exposedArea, exposedArea};
     }
-    irr_[size_t(i)] = H.light + H.good;
+    irr_[size_t(i)] = H.light + H.good + H.cluster;
     int first = h_.node(i).firstChild;
     Pulled sum;
     double areaSum = 0;
@@ -790,7 +831,15 @@ class KeyTimeSolver {
     irr_.assign(size_t(h_.size()), glm::dvec3(0.0));
     for (int it = 0; it < opt_.maxIterations; ++it) {
       maxDelta_ = maxB_ = 0;
-      for (int t = 0; t < h_.topCount(); ++t) gatherPushPull(t, Gathered{});
+      // Cluster links gather from the B of the sweep before (Jacobi for them, Gauss-Seidel
+      // for the patch links).
+      if (clusters_) clusters_->gather(B_, clusterH_);
+      for (int t = 0; t < h_.topCount(); ++t) {
+        Gathered top;
+        if (clusters_ && exposure_[size_t(t)] > 0.0)
+          top.cluster = clusterH_[size_t(t)] / exposure_[size_t(t)];
+        gatherPushPull(t, top);
+      }
       ++s_.iterations;
       if (nonFinite_ || maxB_ > radiosityBound_)
         throw Error(ExitCode::kInternal, "",
@@ -807,6 +856,14 @@ class KeyTimeSolver {
     for (const SolverLink& l : s_.links) {
       (l.reused ? s_.linksReused : s_.linksComputed)++;
       s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
+    }
+    if (clusters_) {  // at the final B, as the merge gathers the patch links
+      clusters_->gather(B_, clusterH_);
+      s_.topClusterIrradiance.assign(size_t(h_.topCount()), glm::dvec3(0.0));
+      for (int t = 0; t < h_.topCount(); ++t)
+        if (exposure_[size_t(t)] > 0.0)
+          s_.topClusterIrradiance[size_t(t)] = clusterH_[size_t(t)] / exposure_[size_t(t)];
+      s_.clusterLinks = clusters_->activeCount();
     }
     s_.radiosity = std::move(B_);
     s_.leafTopFormFactor = std::move(leafTopFormFactor_);
@@ -846,6 +903,10 @@ class KeyTimeSolver {
   double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
   bool nonFinite_ = false;          // a sweep produced NaN or Inf
   double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges
+  std::unique_ptr<ClusterLinks> clusters_;  // null: all-pairs linking
+  std::vector<char> topEmits_;              // per top: emits (clusters_)
+  std::vector<glm::dvec3> clusterH_;        // per top: irradiance through cluster links
+  std::vector<double> clusterRow_;          // per top: its cluster links' form factor sum
 };
 
 }  // namespace
@@ -868,6 +929,14 @@ std::vector<char> movingTopsOf(const Scene& scene, const PatchHierarchy& hierarc
     out[size_t(t)] = it != dynamic.end() && it->second;
   }
   return out;
+}
+
+ClusterTree clusterTreeOf(const Scene& scene, const PatchHierarchy& h, double t0, double t1) {
+  const std::vector<glm::dmat4> m = topTransforms(scene, h, t0);
+  std::vector<Polygon> world(size_t(h.topCount()));
+  for (int t = 0; t < h.topCount(); ++t)
+    world[size_t(t)] = h.top(t).local.transformed(m[size_t(t)]);
+  return ClusterTree(h, world, movingTopsOf(scene, h, t0, t1));
 }
 
 std::vector<glm::dmat4> topTransforms(const Scene& scene, const PatchHierarchy& hierarchy,

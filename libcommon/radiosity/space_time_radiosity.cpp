@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
@@ -27,6 +28,9 @@ struct KeyRecord {
   // Per node of the union hierarchy: the good-link closure factor of the key-tree leaf it is
   // in or under (KeySolution::goodClosure; 1 for nodes above the leaves, or closure off).
   std::vector<float> goodClosure;
+  // Per top: the irradiance it gathered through cluster links (KeySolution::
+  // topClusterIrradiance); empty without cluster links.
+  std::vector<glm::vec3> clusterIrradiance;
 };
 
 // The links' activity intervals (paper §4.2), built incrementally as each key time finishes so
@@ -290,6 +294,7 @@ KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, dou
   kr.iterations = s.iterations;
   kr.refineRounds = s.refineRounds;
   kr.linkCapReached = s.linkCapReached;
+  kr.clusterLinks = s.clusterLinks;
   kr.secondsLinks = s.secondsLinks;
   kr.secondsSolve = s.secondsSolve;
   for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
@@ -311,11 +316,12 @@ class KeyTimePass {
     T_ = size_t(h_.topCount());
     surfaces_ = surfacePropertiesOf(scene, h_);
     vis_ = std::make_unique<SceneVisibility>(scene, h_, keyTimes.front(), keyTimes.back());
-    rep_.secondsSetup = secondsSince(tSetup);
     rep_.topPatches = T_;
     records_.resize(keyTimes.size());
     movingTops_ = movingTopsOf(scene, h_, keyTimes.front(), keyTimes.back());
-    badPair_.assign(T_ * T_, 0);
+    if (opt_.radiosity.clustering)
+      clusters_ = clusterTreeOf(scene, h_, keyTimes.front(), keyTimes.back());
+    rep_.secondsSetup = secondsSince(tSetup);
   }
 
   void run() {
@@ -327,13 +333,16 @@ class KeyTimePass {
       records_[k].radiosity.assign(b.begin(), b.end());
       records_[k].exposure.assign(s.exposure.begin(), s.exposure.end());  // one per node
       records_[k].goodClosure = pushedDownClosure(s, h_);
+      records_[k].clusterIrradiance.assign(s.topClusterIrradiance.begin(),
+                                           s.topClusterIrradiance.end());
       prev = std::move(s);
     }
   }
 
   PatchHierarchy& hierarchy() { return h_; }
   LinkIntervals& intervals() { return intervals_; }
-  const std::vector<char>& badPairs() const { return badPair_; }  // T x T, receiver-major
+  // The bad pairs, receiver top << 32 | shooter top.
+  const std::unordered_set<uint64_t>& badPairs() const { return badPairs_; }
   const std::vector<KeyRecord>& records() const { return records_; }
 
  private:
@@ -344,6 +353,7 @@ class KeyTimePass {
     in.topToWorld = topTransforms(scene_, h_, t);
     in.movingTops = movingTops_;
     in.visibility = &vis_->visibility();
+    in.clusters = &clusters_;
     LinkCache cache;
     LeafFormFactorCache leafCache;
     double secondsCoherence = 0;
@@ -371,8 +381,9 @@ class KeyTimePass {
       intervals_.add((uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter), k, float(l.fv()),
                      float(l.visibility), l.refined);
       uint32_t rt = h_.node(l.receiver).id.top, st = h_.node(l.shooter).id.top;
-      markBadPair(badPair_[size_t(rt) * T_ + st], opt_.badLinks, l, surfaces_[st].isEmitter(),
-                  opt_.partialThreshold);
+      char bad = 0;
+      markBadPair(bad, opt_.badLinks, l, surfaces_[st].isEmitter(), opt_.partialThreshold);
+      if (bad) badPairs_.insert((uint64_t(rt) << 32) | st);
     }
   }
 
@@ -388,9 +399,10 @@ class KeyTimePass {
   // The activity intervals so far, compacted as each key time finishes (memory: the compact
   // result, not every key's links).
   LinkIntervals intervals_;
-  std::vector<char> badPair_;
-  std::vector<char> movingTops_;  // per top: moves during the key times (KeySolveInput)
-  ClosedNodeCache closedCache_;   // coherence: static nodes' closed-room tests, all keys so far
+  std::unordered_set<uint64_t> badPairs_;  // receiver top << 32 | shooter top
+  ClusterTree clusters_;                   // empty without clustering
+  std::vector<char> movingTops_;           // per top: moves during the key times (KeySolveInput)
+  ClosedNodeCache closedCache_;  // coherence: static nodes' closed-room tests, all keys so far
 };
 
 // Merge: radiosity per node and key; nodes created after key k take their ancestor's value
@@ -410,10 +422,10 @@ void mergeNodeRadiosity(const std::vector<KeyRecord>& records, const PatchHierar
   }
 }
 
-void mergeBadPairs(const std::vector<char>& badPair, size_t T, GlobalSolution& g) {
-  for (uint32_t r = 0; r < uint32_t(T); ++r)
-    for (uint32_t s = 0; s < uint32_t(T); ++s)
-      if (badPair[size_t(r) * T + s]) g.badPairs.emplace_back(r, s);
+void mergeBadPairs(const std::unordered_set<uint64_t>& badPairs, GlobalSolution& g) {
+  std::vector<uint64_t> sorted(badPairs.begin(), badPairs.end());
+  std::sort(sorted.begin(), sorted.end());
+  for (uint64_t p : sorted) g.badPairs.emplace_back(uint32_t(p >> 32), uint32_t(p & 0xffffffffu));
 }
 
 // One activity interval as a GlobalLink, its samples appended to g.linkSample*.
@@ -447,10 +459,11 @@ GlobalLink globalLinkOf(const LinkIntervals& intervals, const LinkIntervals::Row
 // good-link irradiance $H_i = \sum_j F_{ij} V_{ij} B_j$ gathered at each node i at each key
 // (N x K, key-major), summed in that link order (the same whatever the thread count or the
 // coherence). Ends the adding of `intervals`.
-std::vector<glm::dvec3> mergeLinks(LinkIntervals& intervals, const std::vector<char>& badPair,
+std::vector<glm::dvec3> mergeLinks(LinkIntervals& intervals,
+                                   const std::unordered_set<uint64_t>& badPairs,
                                    const std::vector<KeyRecord>& records, const PatchHierarchy& h,
                                    GlobalSolution& g) {
-  const size_t N = size_t(h.size()), K = records.size(), T = size_t(h.topCount());
+  const size_t N = size_t(h.size()), K = records.size();
   std::vector<glm::dvec3> goodH(N * K, glm::dvec3(0.0));
   const std::vector<std::pair<uint64_t, uint32_t>> linkKeys = intervals.takeSortedLinks();
   size_t sampleTotal = 0;
@@ -462,7 +475,7 @@ std::vector<glm::dvec3> mergeLinks(LinkIntervals& intervals, const std::vector<c
   g.linkSampleVisibility.reserve(sampleTotal);
   for (const auto& [key, firstRow] : linkKeys) {
     uint32_t rcv = uint32_t(key >> 32), sh = uint32_t(key & 0xffffffffu);
-    bool bad = badPair[size_t(h.node(int(rcv)).id.top) * T + h.node(int(sh)).id.top];
+    bool bad = badPairs.count((uint64_t(h.node(int(rcv)).id.top) << 32) | h.node(int(sh)).id.top);
     for (uint32_t ri = firstRow; ri != LinkIntervals::kNone; ri = intervals.row(ri).nextRow) {
       const LinkIntervals::Row& r = intervals.row(ri);
       if (!bad && !r.refined)
@@ -663,6 +676,8 @@ void mergeLeafVertexIrradiance(const std::vector<glm::dvec3>& goodH,
       while (size_t(inKey) >= records[k].goodClosure.size()) inKey = h.node(inKey).parent;
       H *= double(records[k].goodClosure[size_t(inKey)]);
       const PatchNode& n = h.node(leaves[li]);
+      if (!records[k].clusterIrradiance.empty())  // cluster links: no closure factor
+        H += glm::dvec3(records[k].clusterIrradiance[n.id.top]);
       for (int c = 0; c < (n.local.count == 3 ? 3 : 4); ++c)
         vertexSum[size_t(lv.leafVertex[li][size_t(c)])] += H;
     }
@@ -689,6 +704,20 @@ void mergeNodeExposure(const std::vector<KeyRecord>& records, const PatchHierarc
       g.nodeExposure[i * K + k] = records[k].exposure[i];
 }
 
+// Merge: per top and key, the irradiance gathered through cluster links; left empty when no key
+// has any (no clustering, or every cluster link refined down to patch links).
+void mergeClusterIrradiance(const std::vector<KeyRecord>& records, size_t T, GlobalSolution& g) {
+  const size_t K = records.size();
+  bool any = false;
+  for (const KeyRecord& r : records)
+    for (const glm::vec3& h : r.clusterIrradiance) any = any || h != glm::vec3(0.0f);
+  if (!any) return;
+  g.topClusterIrradiance.assign(T * K, glm::vec3(0.0f));
+  for (size_t k = 0; k < K; ++k)
+    for (size_t t = 0; t < std::min(T, records[k].clusterIrradiance.size()); ++t)
+      g.topClusterIrradiance[t * K + k] = records[k].clusterIrradiance[t];
+}
+
 }  // namespace
 
 GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
@@ -704,7 +733,8 @@ GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& key
   g.keyTimes = keyTimes;
   mergeNodeRadiosity(pass.records(), pass.hierarchy(), g);
   mergeNodeExposure(pass.records(), pass.hierarchy(), g);
-  mergeBadPairs(pass.badPairs(), size_t(pass.hierarchy().topCount()), g);
+  mergeBadPairs(pass.badPairs(), g);
+  mergeClusterIrradiance(pass.records(), size_t(pass.hierarchy().topCount()), g);
   std::vector<glm::dvec3> goodH =
       mergeLinks(pass.intervals(), pass.badPairs(), pass.records(), pass.hierarchy(), g);
   pass.intervals() = LinkIntervals();  // its memory back before the leaf arrays

@@ -49,6 +49,7 @@ struct KeyTimeReport {
   int iterations = 0;         // Gauss-Seidel sweeps
   int refineRounds = 0;
   bool linkCapReached = false;  // refinement stopped at the link bound (RadiosityOptions)
+  size_t clusterLinks = 0;      // cluster links gathered (clustering)
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
 };
 

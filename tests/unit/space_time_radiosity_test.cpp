@@ -191,9 +191,11 @@ TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
     bool refined;
   };
   std::map<std::pair<uint32_t, uint32_t>, std::vector<Sample>> perLink;
+  const ClusterTree clusters = clusterTreeOf(scene, h, keys.front(), keys.back());
   for (size_t k = 0; k < keys.size(); ++k) {
     vis.setTime(keys[k]);
     KeySolveInput in;
+    in.clusters = &clusters;
     in.topToWorld = topTransforms(scene, h, keys[k]);
     in.visibility = &vis.visibility();
     in.movingTops = movingTopsOf(scene, h, keys.front(), keys.back());

@@ -891,6 +891,76 @@ TEST(TextureMovieBaker, GatheredVisibilitySeesMovingBlockersInOneFrameMovies) {
   EXPECT_LT(std::abs(sum / total), 0.01);
 }
 
+// The cluster light (GlobalSolution::topClusterIrradiance, linkhier 1.3) reaches the gathered
+// good layer per texel, with the gathered links' time handling: a black slab moving over a floor
+// under an emitting ceiling (so the gathered links change from key to key), baked over two
+// global keys with and without cluster irradiance on the floor's top. Constant c at both keys:
+// every texel of every movie key rises by c. c at key 0 and 3c at key 1: by (1 + 2t) c at movie
+// time t, linear as the links are. The other tops carry 100x as much, which the floor must not
+// see. The Gouraud layer does not change: rad-global folds the cluster light into its vertices.
+TEST(TextureMovieBaker, ClusterIrradianceRaisesTheGatheredLayerByItsValueAtEveryTexel) {
+  FloorUnderCeiling f = floorUnderCeiling();
+  Scene& s = f.scene;
+  const int slab = addQuadNode(s, {-.3, -.3, 0}, {-.3, .3, 0}, {.3, .3, 0}, {.3, -.3, 0}, 2);
+  translate(s, slab, {0.6, 0.5, 0.5}, {1.4, 0.5, 0.5}, 0.0, 1.0);
+  GlobalSolution g = solveWithGoodLinksOnly(s, {0.0, 1.0});
+  g.topClusterIrradiance.clear();  // the baseline: no cluster light
+  const int top = topOfNode(g, f.floor), T = g.hierarchy.topCount(), K = g.keyCount();
+  ASSERT_EQ(K, 2);
+  const glm::vec3 c(0.125f, 0.25f, 0.0625f);
+  auto withCluster = [&](const glm::vec3& key0, const glm::vec3& key1) {
+    GlobalSolution out = g;
+    out.topClusterIrradiance.assign(size_t(T) * size_t(K), 100.0f * c);
+    out.topClusterIrradiance[size_t(top) * K] = key0;
+    out.topClusterIrradiance[size_t(top) * K + 1] = key1;
+    out.validate("test");
+    return out;
+  };
+  const GlobalSolution constant = withCluster(c, c), ramp = withCluster(c, 3.0f * c);
+  auto bake = [&](const GlobalSolution& solution, GoodLayer layer) {
+    TextureMovieBakerOptions o;
+    o.goodLayer = layer;
+    TextureMovieBaker baker(s, solution, kFps, o);
+    MovieExtent r;
+    r.patch = PatchId{uint32_t(top), 1u};
+    r.firstFrame = 0;
+    r.lastFrame = 24;
+    r.width = 32;
+    r.height = 16;
+    return baker.bake(r);
+  };
+  const BakedMovie plain = bake(g, GoodLayer::kGather);
+  ASSERT_GT(plain.keys.size(), 2u) << "the slab moves: a movie of several keys";
+  auto expectRaisedBy = [&](const BakedMovie& m, const glm::vec3& key0, const glm::vec3& key1) {
+    ASSERT_EQ(m.keyFrames, plain.keyFrames);
+    ASSERT_EQ(m.keys.size(), plain.keys.size());
+    double worst = 0.0;
+    for (size_t k = 0; k < m.keys.size(); ++k) {
+      const double t = m.keyTimes[k];  // = the weight of global key 1 (keys at 0 and 1 s)
+      ASSERT_EQ(m.keys[k].size(), plain.keys[k].size());
+      for (size_t i = 0; i < m.keys[k].size(); ++i) {
+        const int ch = int(i % 3);
+        const double expected = (1.0 - t) * key0[ch] + t * key1[ch];
+        const double got = double(m.keys[k][i]) - double(plain.keys[k][i]);
+        // Float texels: the difference of two rounded values.
+        worst = std::max(worst, std::abs(got - expected) / (1.0 + std::abs(m.keys[k][i])));
+      }
+    }
+    EXPECT_LT(worst, 1e-6);
+  };
+  {
+    SCOPED_TRACE("constant");
+    expectRaisedBy(bake(constant, GoodLayer::kGather), c, c);
+  }
+  {
+    SCOPED_TRACE("ramp");
+    expectRaisedBy(bake(ramp, GoodLayer::kGather), c, 3.0f * c);
+  }
+  const BakedMovie gouraud = bake(g, GoodLayer::kGouraud);
+  EXPECT_EQ(bake(constant, GoodLayer::kGouraud).keys, gouraud.keys);
+  EXPECT_EQ(bake(ramp, GoodLayer::kGouraud).keys, gouraud.keys);
+}
+
 // Smooth shading (glTF NORMAL): two facets of a bent sheet meet at a 22-degree crease, lit from
 // the side. With the vertex normals of a smooth surface (the crease's normal the mean of the two
 // facets'), the baked irradiance of both facets, extrapolated to the crease, agrees within 1 %;

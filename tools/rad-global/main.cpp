@@ -83,6 +83,15 @@ void addOptions(CLI::App& app, Options& o) {
       "--no-closed-rooms", [&r] { r.closedRooms = false; },
       "do not scale the row sums of leaves inside a closed room (no escaping ray) to exactly 1; "
       "only the unoccluded tops' share is corrected, as in open scenes");
+  app.add_option("--cluster-separation", r.clusterSeparation,
+                 "keep a cluster link only while its ends' centres are at least this many times "
+                 "the sum of their bounding radii apart; larger is more accurate and slower")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1e6));
+  app.add_flag_callback(
+      "--no-clustering", [&r] { r.clustering = false; },
+      "link every pair of top-level patches (the baseline) instead of starting from the root "
+      "cluster's self-link of a cluster hierarchy over them");
   app.add_flag_callback(
       "--no-shooter-shape", [&r] { r.shooterShape = false; },
       "gather each link's shooter at its mean radiosity, not as the receiver's ray pairs see its "

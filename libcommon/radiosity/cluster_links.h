@@ -1,0 +1,113 @@
+// Cluster links of one key-time solve (Smits, Arvo, Greenberg 1994; Sillion 1995): the links
+// between clusters, and between a cluster and a top-level patch, that rad-global's linking
+// starts from instead of pairing every top-level patch with every other.
+//
+// Linking starts from the root cluster's self-link. A self-link is replaced by the links
+// between every ordered pair of the cluster's children (and the children's self-links); a link
+// R <- S is refined, by splitting the larger of its two clusters (a top-level patch end is not
+// split here), while
+//  * S holds an emitter: links to lights end as patch links, which the second pass recomputes
+//    per texel (the bad links) and the closure keeps exact;
+//  * the two bounding spheres come closer than their radii (the point approximation below
+//    does not hold): near geometry ends as patch links;
+//  * or its power bound exceeds eps Phi: $\max B_S \, V \, \min(A_R \tilde F, A_S)$ with
+//    $\tilde F = \min(1, A_S / (\pi d_{min}^2))$, d_min the gap between the spheres (Smits et
+//    al. §3's bound on a cluster-to-cluster transfer).
+// A link whose two ends are top-level patches becomes a patch link (SolverLink), and the patch
+// hierarchy's refinement takes it from there.
+//
+// Transfer (oriented emission and reception, Sillion 1995 §4.2): at a member patch i of R, the
+// irradiance from S is
+//   $H_i = B_S \, V_{RS} \, \frac{P_S(\omega) \max(0, n_i \cdot \omega)}{\pi r^2}$,
+// $P_S(\omega) = \sum_{j \in S} A_j \max(0, -n_j \cdot \omega)$ the area S shows towards R, ω
+// the unit direction from R's centre to S's, r their distance, B_S the area average of S's
+// radiosity and V_RS the kernel-weighted share of k shadow-ray pairs between area-uniform
+// points of R's and S's patches that are unoccluded. The irradiance is pushed down to every
+// member top of R with its own cosine, so the gather goes through the clusters.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcommon/radiosity/cluster_tree.h"
+#include "libcommon/radiosity/visibility.h"
+
+namespace rad {
+
+struct ClusterLink {
+  ClusterRef receiver = 0, shooter = 0;
+  glm::dvec3 direction{0.0};  // unit, from the receiver's centre towards the shooter's
+  double transfer = 0;        // V P_S / pi: H_i = transfer max(0, n_i . omega_i) B_S / r_i^2
+  double visibility = 1;      // V_RS (1 until evaluated)
+  bool evaluated = false;
+  bool refined = false;  // replaced by its children's links (then dropped: compact())
+};
+
+class ClusterLinks {
+ public:
+  // `world`, `area`: per top-level patch at this key; `emits`: per top.
+  ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
+               const std::vector<double>& area, const std::vector<char>& emits,
+               const VisibilityScene* visibility, int rays, double separation);
+
+  // One round of refinement (see the top of this file) with eps Phi = epsAbs (refineAll: every
+  // link is refined down to patch pairs, the all-pairs linking). The pairs of top-level
+  // patches reached go to `patchPairs` (receiver, shooter). Stops once `budget` new links
+  // were made. Returns the number of links refined.
+  size_t refine(double epsAbs, bool refineAll, size_t budget,
+                std::vector<std::pair<int, int>>& patchPairs);
+  // Transfer and visibility of the links made since the last call (parallel, deterministic).
+  void evaluate();
+  // Per top: its irradiance through the cluster links from the tops' radiosity `topB` (B_S of a
+  // cluster: the area average of its tops'), summed in link order.
+  void gather(const std::vector<glm::dvec3>& topB, std::vector<glm::dvec3>& out);
+  // Per top: the sum of its cluster links' form factors $\sum V P_S \max(0, n_i \cdot \omega) /
+  // (\pi r^2)$ (its row sum's cluster part).
+  std::vector<double> rowSums() const;
+
+  size_t size() const { return links_.size(); }
+  size_t activeCount() const;
+  const std::vector<ClusterLink>& links() const { return links_; }
+
+ private:
+  void link(ClusterRef r, ClusterRef s, std::vector<size_t>& next);
+  bool wantsRefinement(const ClusterLink& l, double epsAbs) const;
+  const ClusterBounds& bounds(ClusterRef r) const {
+    return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];
+  }
+  bool emits(ClusterRef r) const {
+    return isCluster(r) ? clusterEmits_[size_t(clusterIndex(r))] != 0 : emits_[size_t(r)] != 0;
+  }
+  double maxRadiosity(ClusterRef r) const {
+    return isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)];
+  }
+  // The member tops of r: [first, last) in tree_.members() (a top: itself).
+  std::pair<const uint32_t*, const uint32_t*> membersOf(ClusterRef r) const;
+  void evaluateLink(ClusterLink& l) const;
+  void compact();
+  double formFactor(const ClusterLink& l, uint32_t top) const;
+  void buildReceiverLists();
+
+  const ClusterTree& tree_;
+  const std::vector<Polygon>& world_;
+  const std::vector<double>& area_;
+  const std::vector<char>& emits_;
+  const VisibilityScene* visibility_;
+  int rays_;
+  double separation_;
+  std::vector<glm::dvec3> centroid_, normal_;  // per top
+  std::vector<ClusterBounds> clusterBounds_, topBounds_;
+  std::vector<char> clusterEmits_;
+  std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
+  std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
+  std::vector<ClusterLink> links_;
+  std::vector<glm::dvec3> linkB_;  // per link: its shooter's B towards its receiver (gather)
+  // Per receiver (top, then cluster): its active links, in link order.
+  std::vector<std::vector<uint32_t>> atTop_, atCluster_;
+  bool listsValid_ = false;
+};
+
+}  // namespace rad
