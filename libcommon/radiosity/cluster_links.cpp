@@ -38,14 +38,16 @@ uint64_t clusterLinkSeed(ClusterRef r, ClusterRef s) {
 
 ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
                            const std::vector<double>& area, const std::vector<char>& emits,
-                           const VisibilityScene* visibility, int rays, double separation)
+                           const VisibilityScene* visibility, int rays, double separation,
+                           const ClusterLinkCache* reuse)
     : tree_(tree),
       world_(world),
       area_(area),
       emits_(emits),
       visibility_(visibility),
       rays_(std::max(1, rays)),
-      separation_(separation) {
+      separation_(separation),
+      reuse_(reuse) {
   const size_t T = emits.size();
   topBounds_.resize(T);
   centroid_.resize(T);
@@ -186,8 +188,18 @@ void ClusterLinks::evaluate() {
   listsValid_ = false;
 }
 
-void ClusterLinks::evaluateLink(ClusterLink& l) const {
+void ClusterLinks::evaluateLink(ClusterLink& l) {
   l.evaluated = true;
+  if (reuse_) {  // the values recomputing would give (static ends, no moving object near)
+    auto it = reuse_->find({l.receiver, l.shooter});
+    if (it != reuse_->end()) {
+      l.direction = it->second.direction;
+      l.transfer = it->second.transfer;
+      l.visibility = it->second.visibility;
+      ++reused_;
+      return;
+    }
+  }
   const ClusterBounds& R = bounds(l.receiver);
   const ClusterBounds& S = bounds(l.shooter);
   const glm::dvec3 d = S.centre() - R.centre();

@@ -26,7 +26,9 @@
 // member top of R with its own cosine, so the gather goes through the clusters.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -46,12 +48,29 @@ struct ClusterLink {
   bool refined = false;  // replaced by its children's links (then dropped: compact())
 };
 
+// A cluster link's values that the next key time may take over (coherence, paper §4.2), keyed
+// by (receiver, shooter) as clusterLinkKey: valid while both ends are static and no moving
+// object's swept bounds meet the box around both.
+struct CachedClusterLink {
+  glm::dvec3 direction{0.0};
+  double transfer = 0, visibility = 1;
+};
+struct ClusterLinkKeyHash {
+  size_t operator()(const std::pair<int, int>& k) const {
+    return size_t(
+        splitMix64(uint64_t(uint32_t(k.first)) ^ splitMix64(uint64_t(uint32_t(k.second)))));
+  }
+};
+using ClusterLinkCache =
+    std::unordered_map<std::pair<int, int>, CachedClusterLink, ClusterLinkKeyHash>;
+
 class ClusterLinks {
  public:
   // `world`, `area`: per top-level patch at this key; `emits`: per top.
   ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
                const std::vector<double>& area, const std::vector<char>& emits,
-               const VisibilityScene* visibility, int rays, double separation);
+               const VisibilityScene* visibility, int rays, double separation,
+               const ClusterLinkCache* reuse = nullptr);
 
   // One round of refinement (see the top of this file) with eps Phi = epsAbs (refineAll: every
   // link is refined down to patch pairs, the all-pairs linking). The pairs of top-level
@@ -69,6 +88,8 @@ class ClusterLinks {
   std::vector<double> rowSums() const;
 
   size_t size() const { return links_.size(); }
+  size_t reusedCount() const { return reused_; }
+  const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
   size_t activeCount() const;
   const std::vector<ClusterLink>& links() const { return links_; }
 
@@ -86,7 +107,7 @@ class ClusterLinks {
   }
   // The member tops of r: [first, last) in tree_.members() (a top: itself).
   std::pair<const uint32_t*, const uint32_t*> membersOf(ClusterRef r) const;
-  void evaluateLink(ClusterLink& l) const;
+  void evaluateLink(ClusterLink& l);
   void compact();
   double formFactor(const ClusterLink& l, uint32_t top) const;
   void buildReceiverLists();
@@ -98,6 +119,8 @@ class ClusterLinks {
   const VisibilityScene* visibility_;
   int rays_;
   double separation_;
+  const ClusterLinkCache* reuse_;
+  std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
   std::vector<ClusterBounds> clusterBounds_, topBounds_;
   std::vector<char> clusterEmits_;

@@ -86,6 +86,7 @@ nlohmann::json GlobalReport::toJson() const {
                     {"refine_rounds", r.refineRounds},
                     {"link_cap_reached", r.linkCapReached},
                     {"cluster_links", r.clusterLinks},
+                    {"cluster_links_reused", r.clusterLinksReused},
                     {"seconds_links", r.secondsLinks},
                     {"seconds_solve", r.secondsSolve},
                     {"seconds_coherence", r.secondsCoherence}});

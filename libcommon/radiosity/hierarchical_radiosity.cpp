@@ -180,9 +180,9 @@ class KeyTimeSolver {
       topEmits_.resize(size_t(h_.topCount()));
       for (int t = 0; t < h_.topCount(); ++t)
         topEmits_[size_t(t)] = surfaces_[size_t(t)].isEmitter();
-      clusters_ =
-          std::make_unique<ClusterLinks>(*input_.clusters, s_.world, s_.area, topEmits_,
-                                         input_.visibility, opt_.rays, opt_.clusterSeparation);
+      clusters_ = std::make_unique<ClusterLinks>(*input_.clusters, s_.world, s_.area, topEmits_,
+                                                 input_.visibility, opt_.rays,
+                                                 opt_.clusterSeparation, input_.reuseClusterLinks);
     } else {
       s_.links = linkTopLevel(s_.world, s_.area, h_.topCount());
     }
@@ -864,6 +864,9 @@ class KeyTimeSolver {
         if (exposure_[size_t(t)] > 0.0)
           s_.topClusterIrradiance[size_t(t)] = clusterH_[size_t(t)] / exposure_[size_t(t)];
       s_.clusterLinks = clusters_->activeCount();
+      s_.clusterLinksReused = clusters_->reusedCount();
+      s_.clusterLinkValues = clusters_->links();
+      s_.clusterBounds = clusters_->clusterBounds();
     }
     s_.radiosity = std::move(B_);
     s_.leafTopFormFactor = std::move(leafTopFormFactor_);
@@ -929,6 +932,40 @@ std::vector<char> movingTopsOf(const Scene& scene, const PatchHierarchy& hierarc
     out[size_t(t)] = it != dynamic.end() && it->second;
   }
   return out;
+}
+
+ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree& tree,
+                                      const PatchHierarchy& h, const Scene& scene, double t0,
+                                      double t1) {
+  const std::vector<char> moving = movingTopsOf(scene, h, t0, t1);
+  std::vector<std::array<glm::dvec3, 2>> swept;
+  for (int node : scene.meshNodes())
+    if (scene.isDynamic(node, t0, t1)) swept.push_back(scene.sweptBounds(node, t0, t1));
+  // A cluster below the root holds one mesh node's patches (or only static ones).
+  auto isStatic = [&](ClusterRef r) {
+    if (!isCluster(r)) return !moving[size_t(r)];
+    const ClusterNode& n = tree.node(clusterIndex(r));
+    return clusterIndex(r) != tree.root() && !moving[tree.members()[n.first]];
+  };
+  auto box = [&](ClusterRef r) {
+    return isCluster(r) ? prev.clusterBounds[size_t(clusterIndex(r))]
+                        : polygonBounds(prev.world[size_t(r)]);
+  };
+  ClusterLinkCache cache;
+  cache.reserve(prev.clusterLinkValues.size());
+  for (const ClusterLink& l : prev.clusterLinkValues) {
+    if (!l.evaluated || !isStatic(l.receiver) || !isStatic(l.shooter)) continue;
+    const ClusterBounds a = box(l.receiver), b = box(l.shooter);
+    const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
+    bool hit = false;
+    for (const auto& s : swept)
+      hit =
+          hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
+    if (!hit)
+      cache.emplace(std::make_pair(l.receiver, l.shooter),
+                    CachedClusterLink{l.direction, l.transfer, l.visibility});
+  }
+  return cache;
 }
 
 ClusterTree clusterTreeOf(const Scene& scene, const PatchHierarchy& h, double t0, double t1) {

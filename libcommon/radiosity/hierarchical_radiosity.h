@@ -3,9 +3,11 @@
 // §4.2; DESIGN.md §6).
 //
 // One key-time solve, as named passes (solveKeyTime runs them in this order):
-//  * link top level (linkTopLevel): links p <- q between every mutually facing pair of
-//    top-level patches (a pair where one lies wholly on or behind the other's plane is never
-//    linked). All pairs today; the step a clustering method replaces;
+//  * link top level: with a cluster hierarchy (KeySolveInput::clusters), cluster links from the
+//    root's self-link (cluster_links.h), refined each round like the patch links, whose pairs
+//    of top-level patches become patch links; without one (--no-clustering), linkTopLevel:
+//    links p <- q between every mutually facing pair of top-level patches (a pair where one
+//    lies wholly on or behind the other's plane is never linked);
 //  * evaluate: every new link gets the cheap estimate F~ (formFactorEstimate, both
 //    directions) and its visibility V from k stratified shadow-ray pairs (VisibilityScene),
 //    seeded from (receiver id, shooter id);
@@ -40,6 +42,7 @@
 
 #include <glm/glm.hpp>
 
+#include "libcommon/radiosity/cluster_links.h"
 #include "libcommon/radiosity/cluster_tree.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/radiosity/visibility.h"
@@ -177,6 +180,7 @@ struct KeySolveInput {
   std::vector<char> movingTops;
   // The cluster hierarchy to link from (cluster_links.h); null or empty: linkTopLevel.
   const ClusterTree* clusters = nullptr;
+  const ClusterLinkCache* reuseClusterLinks = nullptr;  // coherence: cluster link values
 };
 
 struct KeySolution {
@@ -199,7 +203,12 @@ struct KeySolution {
   // Per top-level patch: the irradiance it gathers through cluster links at the final B, over
   // its exposure (uniform over the top; no closure factor). Empty without cluster links.
   std::vector<glm::dvec3> topClusterIrradiance;
-  size_t clusterLinks = 0;     // cluster links gathered (not refined)
+  size_t clusterLinks = 0;        // cluster links gathered (not refined)
+  size_t clusterLinksReused = 0;  // of them: values taken over (reuseClusterLinks)
+  // The cluster links gathered, with their values, and the clusters' bounds at this key (for
+  // the next key's coherence).
+  std::vector<ClusterLink> clusterLinkValues;
+  std::vector<ClusterBounds> clusterBounds;
   std::vector<Polygon> world;  // per dense node: world polygon at this key
   std::vector<double> area;    // per dense node: world area
   int iterations = 0;          // Gauss-Seidel sweeps, all rounds
@@ -230,8 +239,7 @@ KeySolution solveKeyTime(PatchHierarchy& hierarchy, const std::vector<SurfacePro
 // The top-level links of a key-time solve (first pass above): receiver p <- shooter q for
 // every ordered pair of distinct top-level patches p, q < topCount with positive area that are
 // mutuallyFacing, in (p, q) order. `world` and `area` are per dense node (the top-level patches
-// first). O(topCount^2): the door for clustering (Smits, Arvo, Greenberg 1994), which would
-// link clusters here and leave the other passes as they are.
+// first). O(topCount^2): the baseline of clustering (RadiosityOptions::clustering).
 std::vector<SolverLink> linkTopLevel(const std::vector<Polygon>& world,
                                      const std::vector<double>& area, int topCount);
 
@@ -282,6 +290,13 @@ class SceneVisibility {
 // Per top-level patch: its node moves somewhere in [t0, t1] (KeySolveInput::movingTops).
 std::vector<char> movingTopsOf(const Scene& scene, const PatchHierarchy& hierarchy, double t0,
                                double t1);
+
+// Values of `previous`'s cluster links (solved at t0) that stay valid until t1: both ends static
+// over [t0, t1] and no moving node's swept bounds meeting the box around both ends (the convex
+// hull of the two lies in it).
+ClusterLinkCache reusableClusterLinks(const KeySolution& previous, const ClusterTree& tree,
+                                      const PatchHierarchy& hierarchy, const Scene& scene,
+                                      double t0, double t1);
 
 // The cluster hierarchy of the animation [t0, t1] (KeySolveInput::clusters): static patches
 // placed at t0, each moving node's in its own frame.

@@ -295,6 +295,7 @@ KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, dou
   kr.refineRounds = s.refineRounds;
   kr.linkCapReached = s.linkCapReached;
   kr.clusterLinks = s.clusterLinks;
+  kr.clusterLinksReused = s.clusterLinksReused;
   kr.secondsLinks = s.secondsLinks;
   kr.secondsSolve = s.secondsSolve;
   for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
@@ -356,6 +357,7 @@ class KeyTimePass {
     in.clusters = &clusters_;
     LinkCache cache;
     LeafFormFactorCache leafCache;
+    ClusterLinkCache clusterCache;
     double secondsCoherence = 0;
     if (opt_.coherence && k > 0) {
       auto tc = std::chrono::steady_clock::now();
@@ -363,6 +365,10 @@ class KeyTimePass {
       in.reuse = &cache;
       leafCache = reusableLeafFormFactors(prev, h_);
       in.reuseLeafFormFactors = &leafCache;
+      if (!clusters_.empty()) {
+        clusterCache = reusableClusterLinks(prev, clusters_, h_, scene_, keyTimes_[k - 1], t);
+        in.reuseClusterLinks = &clusterCache;
+      }
       in.reuseClosed = &closedCache_;
       secondsCoherence = secondsSince(tc);
     }

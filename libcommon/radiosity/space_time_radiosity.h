@@ -48,8 +48,9 @@ struct KeyTimeReport {
   size_t nodes = 0;           // nodes of this key's tree
   int iterations = 0;         // Gauss-Seidel sweeps
   int refineRounds = 0;
-  bool linkCapReached = false;  // refinement stopped at the link bound (RadiosityOptions)
-  size_t clusterLinks = 0;      // cluster links gathered (clustering)
+  bool linkCapReached = false;    // refinement stopped at the link bound (RadiosityOptions)
+  size_t clusterLinks = 0;        // cluster links gathered (clustering)
+  size_t clusterLinksReused = 0;  // of them: values taken over from the previous key
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
 };
 

@@ -71,6 +71,44 @@ TEST(RadGlobal, CoherentFileEqualsNoCoherenceFile) {
   fs::remove_all(d);
 }
 
+// Issue 16: with clustering, on a generated 1k-triangle lecture hall whose car moves, the
+// cluster links between static clusters away from the car keep their values from key to key,
+// and the coherent file is still what --no-coherence computes, cluster irradiance included;
+// --no-clustering links every pair and has no cluster irradiance.
+TEST(RadGlobal, ClusteredHallCoherentEqualsNoCoherence) {
+  fs::path d = scratchDir();
+  const std::string hall = (d / "hall.gltf").string();
+  ASSERT_EQ(runCommand("python3 " + std::string(RAD_SOURCE_DIR) +
+                       "/pipelines/scenes/make_hall.py " + hall + " --triangles 1000")
+                .exitCode,
+            0);
+  const std::string base = tool("rad-global") + " " + hall + " --frames 0-8 --key-step 8";
+  auto c =
+      runCommand(base + " -o " + (d / "c.rlh").string() + " --report " + (d / "c.json").string());
+  ASSERT_EQ(c.exitCode, 0) << c.err;
+  ASSERT_EQ(runCommand(base + " --no-coherence -o " + (d / "n.rlh").string()).exitCode, 0);
+  ASSERT_EQ(runCommand(base + " --no-clustering -o " + (d / "a.rlh").string()).exitCode, 0);
+  nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "c.json").string()));
+  EXPECT_GT(rep["key_times"][0]["cluster_links"].get<size_t>(), 0u);
+  EXPECT_EQ(rep["key_times"][0]["cluster_links_reused"].get<size_t>(), 0u);
+  EXPECT_GT(rep["key_times"][1]["cluster_links_reused"].get<size_t>(), 0u);
+  EXPECT_LT(rep["key_times"][1]["cluster_links_reused"].get<size_t>(),
+            rep["key_times"][1]["cluster_links"].get<size_t>())
+      << "links near the car's path are recomputed";
+  Scene scene = readGltfScene(hall);
+  GlobalSolution gc = readLinkHierarchy((d / "c.rlh").string(), scene);
+  GlobalSolution gn = readLinkHierarchy((d / "n.rlh").string(), scene);
+  GlobalSolution ga = readLinkHierarchy((d / "a.rlh").string(), scene);
+  EXPECT_FALSE(gc.topClusterIrradiance.empty());
+  EXPECT_TRUE(gc.topClusterIrradiance == gn.topClusterIrradiance);
+  EXPECT_TRUE(gc.nodeRadiosity == gn.nodeRadiosity);
+  EXPECT_TRUE(gc.leafVertexGoodIrradiance == gn.leafVertexGoodIrradiance);
+  EXPECT_TRUE(gc.linkSampleValues == gn.linkSampleValues);
+  EXPECT_TRUE(ga.topClusterIrradiance.empty());
+  EXPECT_GT(ga.links.size(), gc.links.size());
+  fs::remove_all(d);
+}
+
 // Same command line on one core and on every core: the same bytes (provenance included).
 TEST(RadGlobal, SameBytesOnOneCoreAndOnAll) {
   if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one core only";
