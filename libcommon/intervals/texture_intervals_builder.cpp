@@ -166,7 +166,11 @@ struct TextureIntervalsBuilder::Impl {
     else if (openBelow[i])
       theta += options.levelHysteresis;
     bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
-    if (enough || hierarchy.isLeaf(i)) {
+    // A node seen on fewer pixels than its four children's smallest textures hold (4 minSize^2)
+    // keeps one texture: splitting it adds movies, not resolution (the 10k-triangle hall's
+    // partly hidden chair triangles made 67,660 of its 75,727 movies at levels 1 and 2).
+    const bool tiny = double(visible[i]) < 4.0 * options.minSize * options.minSize;
+    if (enough || tiny || hierarchy.isLeaf(i)) {
       chosen.push_back(i);
       return;
     }

@@ -14,8 +14,11 @@
 //    children, whose parts outside the frustum then need no texture;
 //  * representation (§4.3): a top-level patch stands for itself when its visible fraction is
 //    >= minVisibleFraction (theta), else its children do, recursively down to maxLevel; nodes
-//    without visible pixels get no movie. Every visible pixel is therefore covered by exactly
-//    one chosen node (the ancestor-or-self of its leaf where the descent stopped);
+//    without visible pixels get no movie. A node seen on fewer than 4 minSize^2 pixels stands
+//    for itself whatever its fraction (beyond the paper): its four children's smallest
+//    textures would hold more texels than it covers, so splitting it only adds movies. Every
+//    visible pixel is therefore covered by exactly one chosen node (the ancestor-or-self of its
+//    leaf where the descent stopped);
 //  * texture size: n = sqrt(whole projected area x texelDensity) texels per side (at least one
 //    texel per covered pixel: the texture spans the whole patch, so its texels per pixel are
 //    n^2 / whole area wherever the patch is on screen), rounded up to a power of two and

@@ -258,6 +258,30 @@ TEST(TextureIntervalsBuilder, PatchHalfOutsideTheFrustumIsRepresentedByChildren)
   EXPECT_EQ(chosen[0], topOfNode(b2.hierarchy(), r2));
 }
 
+// Issue 16: the same rectangle, 60 % outside the frustum, but far away and small, covers fewer
+// pixels than its children's smallest textures would hold (4 x 4^2): it keeps one texture, one
+// movie, instead of going down to its children (what made the 10k-triangle hall's 75,727
+// movies).
+TEST(TextureIntervalsBuilder, TinyPartlyVisiblePatchKeepsOneTexture) {
+  TestScene s;
+  const double z = -20.0, edge = -z * std::tan(0.4) * kSize.aspect(), w = 0.4;
+  int rect = s.addRect("rect", edge - 0.4 * w, -0.2, edge + 0.6 * w, 0.2, z);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 1;
+  TextureIntervalsBuilder b(s.scene, s.camera, o);
+  std::vector<int> chosen;
+  long visiblePixels = 0;
+  b.addFrame(0, [&](const IntervalFrame& f) {
+    chosen = *f.chosen;
+    visiblePixels = (*f.visiblePixels)[size_t(topOfNode(b.hierarchy(), rect))];
+  });
+  ASSERT_GT(visiblePixels, 0) << "it is on screen";
+  ASSERT_LT(visiblePixels, 64) << "and small";
+  ASSERT_EQ(chosen.size(), 1u);
+  EXPECT_EQ(chosen[0], topOfNode(b.hierarchy(), rect));
+}
+
 // A rectangle straddling the right image edge while the camera sways: its visible fraction
 // swings between 0.6 and 0.4 around theta = 0.5. The paper's rule switches level at every
 // swing; with a level hysteresis of 0.15 it keeps its first (top-level) movie throughout.
