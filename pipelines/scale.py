@@ -66,7 +66,9 @@ def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit):
         with open(os.path.join(out, "global-report.json")) as f:
             g = json.load(f)
         keys = g.get("key_times") or []
-        row["links"] = max(k.get("links", 0) for k in keys) if keys else None
+        # Patch links and cluster links (issue 16: clustering), the largest key.
+        row["links"] = max(k.get("links", 0) + k.get("cluster_links", 0)
+                           for k in keys) if keys else None
         row["nodes"] = max(k.get("nodes", 0) for k in keys) if keys else None
         row["link_cap"] = any(k.get("link_cap_reached") for k in keys)
     except (OSError, ValueError):
