@@ -194,6 +194,20 @@ class MovieGeometry {
     box.grow(p.shooterWorld[size_t(k)]);
     return box;
   }
+  // The convex hull of the shooter and the receiver's texture domain (a triangle's (u,v) square
+  // is the parallelogram v0, v1, v1 + v2 - v0, v2): every segment from a shooter sample to a
+  // texel centre lies in it, so a blocker whose box misses it covers no texel, and culling it
+  // changes no mask. The box shaft alone kept, on the 10k-triangle hall, every table and chair
+  // in the box spanned by a floor patch and a ceiling light.
+  Shaft hullAt(const Pair& p, int k) const {
+    Polygon domain = receiverWorld_[size_t(k)];
+    if (domain.count == 3) {
+      domain.v[3] = domain.v[2];
+      domain.v[2] = domain.v[1] + domain.v[3] - domain.v[0];
+      domain.count = 4;
+    }
+    return Shaft(domain, p.shooterWorld[size_t(k)]);
+  }
   // World polygon of top-level patch b at key k. The node's world transform is computed once
   // per movie and key: the blockers of every pair at every key are placed with it, several
   // polygons per node.
@@ -208,12 +222,13 @@ class MovieGeometry {
   // Blockers of candidate list `list` in the pair's shaft at key k, as world triangles.
   std::vector<BlockerTriangle> blockersAt(const Pair& p, const std::vector<int>& list, int k) {
     Box shaft = shaftAt(p, k);
+    const Shaft hull = hullAt(p, k);
     std::vector<BlockerTriangle> tris;
     for (int b : list) {
       Polygon poly = worldPolygon(b, k);
       Box pb;
       pb.grow(poly);
-      if (pb.overlaps(shaft)) appendTriangles(poly, tris);
+      if (pb.overlaps(shaft) && hull.meets(pb.lo, pb.hi)) appendTriangles(poly, tris);
     }
     return tris;
   }
@@ -623,13 +638,14 @@ std::vector<int> MovieBake::blockerCandidates(uint32_t S) const {
 // the pair's static mask, and dynamic ones (in the shaft swept over the movie), rendered per key.
 void MovieBake::planCoherentBlockers(Pair& p, const std::vector<int>& candidates) {
   Box shaft = geo_.shaftAt(p, 0);
+  const Shaft hull = geo_.hullAt(p, 0);
   std::vector<int> staticList;
   for (int b : candidates) {
     int node = tops_[size_t(b)].node;
     if (!geo_.movesDuringMovie(node)) {
       Box pb;
       pb.grow(geo_.worldPolygon(b, 0));  // t0 is key 0's time
-      if (pb.overlaps(shaft)) staticList.push_back(b);
+      if (pb.overlaps(shaft) && hull.meets(pb.lo, pb.hi)) staticList.push_back(b);
     } else {
       const std::array<glm::dvec3, 2>& sb = geo_.sweptDuringMovie(node);
       Box swept{sb[0], sb[1]};

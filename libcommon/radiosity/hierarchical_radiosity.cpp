@@ -1033,36 +1033,47 @@ void SceneVisibility::setTime(double t) {
 }
 
 bool shaftMeetsBox(const Polygon& a, const Polygon& b, const glm::dvec3& lo, const glm::dvec3& hi) {
+  return Shaft(a, b).meets(lo, hi);
+}
+
+Shaft::Shaft(const Polygon& a, const Polygon& b) {
   std::vector<glm::dvec3> pts;
   for (int i = 0; i < a.count; ++i) pts.push_back(a.v[i]);
   for (int i = 0; i < b.count; ++i) pts.push_back(b.v[i]);
-  glm::dvec3 plo(pts[0]), phi(pts[0]);
-  for (const glm::dvec3& p : pts) plo = glm::min(plo, p), phi = glm::max(phi, p);
-  for (int k = 0; k < 3; ++k)
-    if (hi[k] < plo[k] || lo[k] > phi[k]) return false;
-  double scale = glm::length(phi - plo) + glm::length(hi - lo);
+  lo_ = hi_ = pts[0];
+  for (const glm::dvec3& p : pts) lo_ = glm::min(lo_, p), hi_ = glm::max(hi_, p);
+  scale_ = glm::length(hi_ - lo_);
   for (int k = 0; k < 3; ++k) {
     int i = (k + 1) % 3, j = (k + 2) % 3;
     std::vector<glm::dvec2> p2;
     for (const glm::dvec3& p : pts) p2.push_back({p[i], p[j]});
     std::vector<glm::dvec2> hull = convexHull2d(p2);
     if (hull.size() < 2) continue;
-    glm::dvec2 corners[4] = {{lo[i], lo[j]}, {hi[i], lo[j]}, {hi[i], hi[j]}, {lo[i], hi[j]}};
     for (size_t e = 0; e < hull.size(); ++e) {
       glm::dvec2 p0 = hull[e], p1 = hull[(e + 1) % hull.size()];
       glm::dvec2 d = p1 - p0;
       glm::dvec2 outward(d.y, -d.x);  // right of a CCW edge
       double len = glm::length(outward);
       if (len == 0) continue;
-      outward /= len;
-      bool allOutside = true;
-      for (const glm::dvec2& c : corners)
-        if (glm::dot(outward, c - p0) <= 1e-12 * scale) {
-          allOutside = false;
-          break;
-        }
-      if (allOutside) return false;
+      edges_.push_back({k, p0, outward / len});
     }
+  }
+}
+
+bool Shaft::meets(const glm::dvec3& lo, const glm::dvec3& hi) const {
+  for (int k = 0; k < 3; ++k)
+    if (hi[k] < lo_[k] || lo[k] > hi_[k]) return false;
+  const double tol = 1e-12 * (scale_ + glm::length(hi - lo));
+  for (const Edge& e : edges_) {
+    const int i = (e.axis + 1) % 3, j = (e.axis + 2) % 3;
+    const glm::dvec2 corners[4] = {{lo[i], lo[j]}, {hi[i], lo[j]}, {hi[i], hi[j]}, {lo[i], hi[j]}};
+    bool allOutside = true;
+    for (const glm::dvec2& c : corners)
+      if (glm::dot(e.out, c - e.p0) <= tol) {
+        allOutside = false;
+        break;
+      }
+    if (allOutside) return false;
   }
   return true;
 }

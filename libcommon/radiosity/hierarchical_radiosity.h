@@ -314,4 +314,21 @@ std::vector<glm::dmat4> topTransforms(const Scene& scene, const PatchHierarchy& 
 // exact, a `true` may be conservative.
 bool shaftMeetsBox(const Polygon& a, const Polygon& b, const glm::dvec3& lo, const glm::dvec3& hi);
 
+// The same shaft built once, for testing many boxes against one pair of polygons (rad-movies'
+// blockers of one receiver and one light).
+class Shaft {
+ public:
+  Shaft(const Polygon& a, const Polygon& b);
+  bool meets(const glm::dvec3& lo, const glm::dvec3& hi) const;
+
+ private:
+  struct Edge {
+    int axis;            // the projection drops this axis
+    glm::dvec2 p0, out;  // a hull edge's start and outward unit normal
+  };
+  glm::dvec3 lo_{0.0}, hi_{0.0};
+  double scale_ = 0;
+  std::vector<Edge> edges_;
+};
+
 }  // namespace rad
