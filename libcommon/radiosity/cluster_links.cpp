@@ -58,6 +58,10 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
     normal_[t] = world[t].normal();
   }
   clusterBounds_ = clusterBoundsOf(tree, world);
+  // The bounding spheres as (centre, radius), read by the gather's inner loop.
+  auto sphereOf = [](const ClusterBounds& b) { return glm::dvec4(b.centre(), b.radius()); };
+  for (const ClusterBounds& b : clusterBounds_) clusterSphere_.push_back(sphereOf(b));
+  for (const ClusterBounds& b : topBounds_) topSphere_.push_back(sphereOf(b));
   clusterEmits_.assign(size_t(tree.size()), 0);
   for (int c = tree.size(); c-- > 0;)
     for (ClusterRef r : tree.node(c).children)
@@ -260,12 +264,14 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
 // F(top t <- S) of a link at t's centroid: V P_S / (pi r^2) max(0, n_t . omega), with r and
 // omega from t's centroid to S's centre (P_S from the receiver's centre).
 double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
-  const glm::dvec3 d = bounds(l.shooter).centre() - centroid_[t];
+  const glm::dvec4& sphere = isCluster(l.shooter) ? clusterSphere_[size_t(clusterIndex(l.shooter))]
+                                                  : topSphere_[size_t(l.shooter)];
+  const glm::dvec3 d = glm::dvec3(sphere) - centroid_[t];
   const double r = glm::length(d);
   if (!(r > 0.0)) return 0.0;
-  // A near link (kept because it carries little) has receivers within S's reach; S's patches are
-  // spread over its bounding sphere, so the distance is taken as at least its radius.
-  const double rs = std::max(r, bounds(l.shooter).radius());
+  // A link kept at the link bound may have receivers within S's reach; S's patches are spread
+  // over its bounding sphere, so the distance is taken as at least its radius.
+  const double rs = std::max(r, sphere.w);
   return l.transfer * std::max(0.0, glm::dot(normal_[t], d)) / (r * rs * rs);
 }
 

@@ -123,6 +123,7 @@ class ClusterLinks {
   std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
   std::vector<ClusterBounds> clusterBounds_, topBounds_;
+  std::vector<glm::dvec4> clusterSphere_, topSphere_;  // (centre, radius) of the bounds
   std::vector<char> clusterEmits_;
   std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
