@@ -14,21 +14,6 @@ double maxComponent(const glm::dvec3& v) {
   return std::max(v.x, std::max(v.y, v.z));
 }
 
-// An area-uniform point of p from two numbers in (0, 1) (a quad as its two triangles).
-glm::dvec3 pointOn(const Polygon& p, double u, double v) {
-  auto onTriangle = [](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, double s,
-                       double t) {
-    const double r = std::sqrt(s);
-    return (1.0 - r) * a + r * (1.0 - t) * b + r * t * c;
-  };
-  if (p.count == 3) return onTriangle(p.v[0], p.v[1], p.v[2], u, v);
-  const double a1 = 0.5 * glm::length(glm::cross(p.v[1] - p.v[0], p.v[2] - p.v[0]));
-  const double a2 = 0.5 * glm::length(glm::cross(p.v[2] - p.v[0], p.v[3] - p.v[0]));
-  const double split = a1 + a2 > 0.0 ? a1 / (a1 + a2) : 0.5;
-  if (u < split) return onTriangle(p.v[0], p.v[1], p.v[2], u / split, v);
-  return onTriangle(p.v[0], p.v[2], p.v[3], (u - split) / (1.0 - split), v);
-}
-
 uint64_t clusterLinkSeed(ClusterRef r, ClusterRef s) {
   return splitMix64(splitMix64(uint64_t(int64_t(r)) ^ 0x636c757374657221ull) ^
                     uint64_t(int64_t(s)));
@@ -241,9 +226,9 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
       const uint32_t a = pick(l.receiver, uniformOpen01(seed, c));
       const uint32_t b = pick(l.shooter, uniformOpen01(seed, c + 1));
       const glm::dvec3 x =
-          pointOn(world_[a], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
+          pointOnPolygon(world_[a], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
       const glm::dvec3 y =
-          pointOn(world_[b], uniformOpen01(seed, c + 4), uniformOpen01(seed, c + 5));
+          pointOnPolygon(world_[b], uniformOpen01(seed, c + 4), uniformOpen01(seed, c + 5));
       const glm::dvec3 xy = y - x;
       const double len2 = glm::dot(xy, xy);
       const double kernel = len2 > 0.0 ? std::max(0.0, glm::dot(world_[a].normal(), xy)) *

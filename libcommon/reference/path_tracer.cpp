@@ -53,22 +53,6 @@ glm::dvec3 cosineDirection(const glm::dvec3& n, double u1, double u2) {
   return glm::normalize(x * b1 + y * b2 + z * n);
 }
 
-// Area-uniform point on a triangle or convex quad (quad split along v0-v2, halves chosen by
-// area).
-glm::dvec3 pointOnPolygon(const Polygon& p, double u1, double u2) {
-  auto onTriangle = [](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, double u,
-                       double v) {
-    const double su = std::sqrt(u);
-    return (1.0 - su) * a + su * (1.0 - v) * b + su * v * c;
-  };
-  if (p.count == 3) return onTriangle(p.v[0], p.v[1], p.v[2], u1, u2);
-  const double a0 = glm::length(glm::cross(p.v[1] - p.v[0], p.v[2] - p.v[0]));
-  const double a1 = glm::length(glm::cross(p.v[2] - p.v[0], p.v[3] - p.v[0]));
-  const double w = a0 + a1 > 0.0 ? a0 / (a0 + a1) : 0.5;
-  if (u1 < w) return onTriangle(p.v[0], p.v[1], p.v[2], u1 / w, u2);
-  return onTriangle(p.v[0], p.v[2], p.v[3], std::min((u1 - w) / (1.0 - w), 1.0), u2);
-}
-
 double maxComponent(const glm::dvec3& v) {
   return std::max(v.x, std::max(v.y, v.z));
 }

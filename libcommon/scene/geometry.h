@@ -24,4 +24,8 @@ struct Polygon {
   std::string toString() const;
 };
 
+// Area-uniform point on a triangle or convex quad from two numbers in [0, 1) (the quad split
+// along v0-v2, the halves chosen by area).
+glm::dvec3 pointOnPolygon(const Polygon& p, double u1, double u2);
+
 }  // namespace rad

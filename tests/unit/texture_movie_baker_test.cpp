@@ -858,6 +858,23 @@ TEST(TextureMovieBaker, TexelsOnATrianglesLongEdgeTakeTheirInsideNeighbours) {
   }
 }
 
+// A black slab moving over the floor of floorUnderCeiling() during [0, 1] s.
+void addMovingSlab(Scene& s) {
+  const int slab = addQuadNode(s, {-.3, -.3, 0}, {-.3, .3, 0}, {.3, .3, 0}, {.3, -.3, 0}, 2);
+  translate(s, slab, {0.6, 0.5, 0.5}, {1.4, 0.5, 0.5}, 0.0, 1.0);
+}
+
+// The movie of the whole top-level patch `top` from frame 0 to `last`, 32 x 16 texels.
+MovieExtent wholeTopMovie(int top, int last) {
+  MovieExtent r;
+  r.patch = PatchId{uint32_t(top), 1u};
+  r.firstFrame = 0;
+  r.lastFrame = last;
+  r.width = 32;
+  r.height = 16;
+  return r;
+}
+
 // A moving blocker of the gathered links is a blocker in every movie, also one a frame long
 // (--no-coherence) or one during which it rests: a black slab moving over a floor under an
 // emitting ceiling. Key 0 of a 25-frame movie and a one-frame movie at frame 0 agree within
@@ -865,21 +882,14 @@ TEST(TextureMovieBaker, TexelsOnATrianglesLongEdgeTakeTheirInsideNeighbours) {
 TEST(TextureMovieBaker, GatheredVisibilitySeesMovingBlockersInOneFrameMovies) {
   FloorUnderCeiling f = floorUnderCeiling();
   Scene& s = f.scene;
-  const int slab = addQuadNode(s, {-.3, -.3, 0}, {-.3, .3, 0}, {.3, .3, 0}, {.3, -.3, 0}, 2);
-  translate(s, slab, {0.6, 0.5, 0.5}, {1.4, 0.5, 0.5}, 0.0, 1.0);
+  addMovingSlab(s);
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0, 1.0});
   const int top = topOfNode(g, f.floor);
   auto bakeFrames = [&](int last, bool coherence) {
     TextureMovieBakerOptions o;
     o.coherence = coherence;
     TextureMovieBaker baker(s, g, kFps, o);
-    MovieExtent r;
-    r.patch = PatchId{uint32_t(top), 1u};
-    r.firstFrame = 0;
-    r.lastFrame = last;
-    r.width = 32;
-    r.height = 16;
-    return baker.bake(r).keys[0];
+    return baker.bake(wholeTopMovie(top, last)).keys[0];
   };
   const std::vector<float> movie = bakeFrames(24, true), single = bakeFrames(0, false);
   double sum = 0.0, total = 0.0;
@@ -901,8 +911,7 @@ TEST(TextureMovieBaker, GatheredVisibilitySeesMovingBlockersInOneFrameMovies) {
 TEST(TextureMovieBaker, ClusterIrradianceRaisesTheGatheredLayerByItsValueAtEveryTexel) {
   FloorUnderCeiling f = floorUnderCeiling();
   Scene& s = f.scene;
-  const int slab = addQuadNode(s, {-.3, -.3, 0}, {-.3, .3, 0}, {.3, .3, 0}, {.3, -.3, 0}, 2);
-  translate(s, slab, {0.6, 0.5, 0.5}, {1.4, 0.5, 0.5}, 0.0, 1.0);
+  addMovingSlab(s);
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0, 1.0});
   g.topClusterIrradiance.clear();  // the baseline: no cluster light
   const int top = topOfNode(g, f.floor), T = g.hierarchy.topCount(), K = g.keyCount();
@@ -921,13 +930,7 @@ TEST(TextureMovieBaker, ClusterIrradianceRaisesTheGatheredLayerByItsValueAtEvery
     TextureMovieBakerOptions o;
     o.goodLayer = layer;
     TextureMovieBaker baker(s, solution, kFps, o);
-    MovieExtent r;
-    r.patch = PatchId{uint32_t(top), 1u};
-    r.firstFrame = 0;
-    r.lastFrame = 24;
-    r.width = 32;
-    r.height = 16;
-    return baker.bake(r);
+    return baker.bake(wholeTopMovie(top, 24));
   };
   const BakedMovie plain = bake(g, GoodLayer::kGather);
   ASSERT_GT(plain.keys.size(), 2u) << "the slab moves: a movie of several keys";
