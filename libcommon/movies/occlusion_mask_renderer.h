@@ -7,10 +7,11 @@
 // exactly by OR, which is what lets the baker render a pair's static blockers once per movie
 // and its dynamic ones per key (§5).
 //
-// Today's implementation is TransmittanceRenderer (transmittance.h: OSMesa projective
-// shadows into integer bit masks). A second shadow method (ray-cast masks with Embree, say)
-// or a layer that adds to the masks is a new subclass handed to the baker through
-// TextureMovieBakerBackends::maskRenderer; bake() is not edited.
+// Implementations: TransmittanceRenderer (transmittance.h: OSMesa projective shadows into
+// integer bit masks), RayCastMaskRenderer (ray_cast_masks.h: the same masks by exact segment
+// tests on the CPU) and AdaptiveMaskRenderer, the default, which picks one of the two by the
+// mask's size. A further method, or a layer that adds to the masks, is a new subclass handed to
+// the baker through TextureMovieBakerBackends::maskRenderer; bake() is not edited.
 #pragma once
 
 #include <array>

@@ -26,7 +26,9 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "libcommon/movies/ray_cast_masks.h"
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/scene/box_tree.h"
 #include "libcommon/scene/frame_range.h"
 
 namespace rad {
@@ -289,6 +291,52 @@ void mergeOcclusion(MergeMode merge, const std::vector<SampleMask>& staticMask,
   }
 }
 
+}  // namespace
+
+// Where a pair's blocker candidates come from: the top-level patches of nodes that never move,
+// in a box tree of their world bounds, and the few of nodes that move somewhere in the
+// animation, in a list. Scanning every top for every pair had been rad-movies' largest cost on
+// the 10k-triangle hall after the masks themselves (349k pairs x 5,051 tops, each placed in
+// the world and tested against the shaft).
+struct BlockerIndex {
+  BoxTree fixedTops;
+  std::vector<int> movableTops;  // ascending
+
+  BlockerIndex(const Scene& scene, const std::vector<InputPolygon>& tops) {
+    std::vector<AxisBox> boxes(tops.size(), AxisBox{glm::dvec3(1.0), glm::dvec3(-1.0)});
+    std::unordered_map<int, glm::dmat4> world;
+    for (size_t b = 0; b < tops.size(); ++b) {
+      const int node = tops[b].node;
+      if (scene.isDynamic(node, scene.startTime(), scene.endTime())) {
+        movableTops.push_back(int(b));
+        continue;
+      }
+      auto it = world.find(node);
+      if (it == world.end())
+        it = world.emplace(node, scene.worldTransform(node, scene.startTime())).first;
+      const Polygon p = tops[b].local.transformed(it->second);
+      boxes[b] = {p.v[0], p.v[0]};
+      for (int k = 1; k < p.count; ++k) {
+        boxes[b][0] = glm::min(boxes[b][0], p.v[k]);
+        boxes[b][1] = glm::max(boxes[b][1], p.v[k]);
+      }
+    }
+    fixedTops = BoxTree(boxes);
+  }
+
+  // Every top whose box may meet [lo, hi], ascending.
+  std::vector<int> near(const glm::dvec3& lo, const glm::dvec3& hi) const {
+    std::vector<int> out;
+    fixedTops.query(lo, hi, out);
+    const size_t fixed = out.size();
+    out.insert(out.end(), movableTops.begin(), movableTops.end());
+    std::inplace_merge(out.begin(), out.begin() + long(fixed), out.end());
+    return out;
+  }
+};
+
+namespace {
+
 // One movie's bake: plan() once, then bakeKey(k) for k = 0 .. K-1.
 class MovieBake {
  public:
@@ -296,9 +344,10 @@ class MovieBake {
             const TextureMovieBakerOptions& options, TextureMovieBakerStats& stats,
             const std::function<OcclusionMaskRenderer&()>& renderer, FormFactorSpill& spill,
             const MovieExtent& req, MovieGeometry& geometry, const GoodLinkGather* gather,
-            SceneVisibility* visibility)
+            SceneVisibility* visibility, const BlockerIndex& blockers)
       : solution_(solution),
         tops_(tops),
+        blockers_(blockers),
         options_(options),
         stats_(stats),
         renderer_(renderer),
@@ -452,7 +501,7 @@ class MovieBake {
  private:
   bool planPair(uint32_t S, Pair& p);
   double scanFormFactors(Pair& p);
-  std::vector<int> blockerCandidates(uint32_t S) const;
+  std::vector<int> blockerCandidates(uint32_t S, const Pair& p);
   void planCoherentBlockers(Pair& p, const std::vector<int>& candidates);
 
   // Good layer: gathered per texel over the good links, or (paper §3.1) Gouraud over the patch
@@ -527,6 +576,7 @@ class MovieBake {
 
   const GlobalSolution& solution_;
   const std::vector<InputPolygon>& tops_;
+  const BlockerIndex& blockers_;
   const TextureMovieBakerOptions& options_;
   TextureMovieBakerStats& stats_;
   const std::function<OcclusionMaskRenderer&()>& renderer_;
@@ -578,7 +628,7 @@ bool MovieBake::planPair(uint32_t S, Pair& p) {
   const uint32_t seed = mix32(uint64_t(req_.patch.top) * 0x9e3779b97f4a7c15ull ^ S);
   p.unitSamples = multiJitteredPoints(p.samples, seed);
 
-  std::vector<int> candidates = blockerCandidates(S);
+  std::vector<int> candidates = blockerCandidates(S, p);
   if (p.coherent) {
     planCoherentBlockers(p, candidates);
   } else {
@@ -621,15 +671,26 @@ double MovieBake::scanFormFactors(Pair& p) {
   return maxF;
 }
 
-// Blocker candidates: every top-level patch but the two ends (and their reversed copies).
-std::vector<int> MovieBake::blockerCandidates(uint32_t S) const {
+// Blocker candidates: the top-level patches whose box may meet the pair's shaft box at some
+// key (all keys' for a pair that moves, key 0's for a static one: planCoherentBlockers places
+// blockers at key 0), but the two ends and their reversed copies. Each list is filtered again
+// against the shafts where it is used; this only keeps far patches out.
+std::vector<int> MovieBake::blockerCandidates(uint32_t S, const Pair& p) {
   const uint32_t R = req_.patch.top;
   const InputPolygon &receiverTop = tops_[R], &shooterTop = tops_[S];
+  Box shaft = geo_.shaftAt(p, 0);
+  if (!p.coherent)
+    for (int k = 1; k < geo_.keys(); ++k) {
+      Box b = geo_.shaftAt(p, k);
+      shaft.grow(b.lo);
+      shaft.grow(b.hi);
+    }
   std::vector<int> candidates;
-  for (size_t b = 0; b < tops_.size(); ++b) {
-    if (b == R || b == S || sameSurface(tops_[b], receiverTop) || sameSurface(tops_[b], shooterTop))
+  for (int b : blockers_.near(shaft.lo, shaft.hi)) {
+    if (b == int(R) || b == int(S) || sameSurface(tops_[size_t(b)], receiverTop) ||
+        sameSurface(tops_[size_t(b)], shooterTop))
       continue;
-    candidates.push_back(int(b));
+    candidates.push_back(b);
   }
   return candidates;
 }
@@ -683,6 +744,7 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"max-samples", maxSamples},
           {"samples-per-form-factor", samplesPerFormFactor},
           {"merge", mergeModeName(merge)},
+          {"ray-cast-budget", rayCastBudget},
           {"good-layer", goodLayerName(goodLayer)},
           {"gather-shooter-ratio", gatherShooterRatio},
           {"gather-rays", gatherRays},
@@ -704,6 +766,7 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"blockers_static", staticBlockers},
           {"blockers_dynamic", dynamicBlockers},
           {"render_passes", passes},
+          {"ray_cast_passes", rayCastPasses},
           {"sample_passes", samplePasses},
           {"render_passes_saved_by_coherence", passesSavedByCoherence},
           {"good_layer_gather",
@@ -760,8 +823,13 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
     throw Error(ExitCode::kUsage, "--max-texture-memory", "must be > 0");
   if (!(fps_ > 0.0) || !std::isfinite(fps_))
     throw Error(ExitCode::kBadInput, "", "frames per second must be positive");
+  if (!(options_.rayCastBudget >= 0.0) || !std::isfinite(options_.rayCastBudget))
+    throw Error(ExitCode::kUsage, "--ray-cast-budget", "must be a finite number >= 0");
   if (!backends_.maskRenderer)
-    backends_.maskRenderer = [] { return std::make_unique<TransmittanceRenderer>(); };
+    backends_.maskRenderer = [budget = options_.rayCastBudget] {
+      return std::make_unique<AdaptiveMaskRenderer>(
+          budget, [] { return std::make_unique<TransmittanceRenderer>(); });
+    };
   if (!backends_.formFactorSpill)
     backends_.formFactorSpill = [] { return std::make_unique<NoFormFactorSpill>(); };
 }
@@ -900,8 +968,9 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
         options_.gatherRays > 0 ? sceneVisibility() : nullptr, options_.gatherRays);
     stats_.secondsGood += secondsSince(clock);
   }
+  if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);
   MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry, gather.get(),
-                 options_.fillCovered ? sceneVisibility() : nullptr);
+                 options_.fillCovered ? sceneVisibility() : nullptr, *blockers_);
   bake.plan(badShooters);
   sink.begin(movie);
   for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);
@@ -910,6 +979,8 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
   if (renderer_) {
     stats_.passes = renderer_->passes();
     stats_.samplePasses = renderer_->samplePasses();
+    if (auto* adaptive = dynamic_cast<const AdaptiveMaskRenderer*>(renderer_.get()))
+      stats_.rayCastPasses = adaptive->rayCastPasses();
   }
   ++stats_.movies;
   if (stored == 1) ++stats_.constantMovies;

@@ -74,9 +74,13 @@ struct TextureMovieBakerOptions {
   // got 4-8 samples (256 x its form factor), and its penumbrae showed as straight-edged bands,
   // one hard shadow per sample; at 16 the bands are gone and rad-movies' time hardly moves.
   int minSamples = 16;
-  int maxSamples = 64;                       // upper bound (<= 64)
-  double samplesPerFormFactor = 256.0;       // N = ceil(this * max texel form factor), then clamped
-  MergeMode merge = MergeMode::kExact;       // static/dynamic occlusion merge
+  int maxSamples = 64;                  // upper bound (<= 64)
+  double samplesPerFormFactor = 256.0;  // N = ceil(this * max texel form factor), then clamped
+  MergeMode merge = MergeMode::kExact;  // static/dynamic occlusion merge
+  // --ray-cast-budget: a pair's occlusion masks are ray cast on the CPU while they cost at most
+  // this many texel-samples (texels x samples), else rendered with OSMesa
+  // (ray_cast_masks.h); 0: always OSMesa.
+  double rayCastBudget = 16384.0;
   GoodLayer goodLayer = GoodLayer::kGather;  // --good-layer
   // --gather-shooter-ratio: a gathered link's shooter is split into the parts of its sub-tree
   // larger than this times their distance to the receiver (good_link_gather.h); 0: no split.
@@ -99,8 +103,8 @@ struct TextureMovieBakerOptions {
 // The parts of the bake a new method replaces without editing it (the doors). Empty members
 // take the defaults.
 struct TextureMovieBakerBackends {
-  // The occlusion masks (default: TransmittanceRenderer, OSMesa projective shadows), made on
-  // the first render the baker needs.
+  // The occlusion masks (default: AdaptiveMaskRenderer, ray-cast masks for small ones and OSMesa
+  // projective shadows for the rest), made on the first render the baker needs.
   OcclusionMaskRendererFactory maskRenderer;
   // One store per movie for moving pairs' scanned form factors (default: NoFormFactorSpill,
   // every set recomputed; rad-movies passes formats/form_factor_scratch_file.h's).
@@ -139,6 +143,7 @@ struct TextureMovieBakerStats {
   long samples = 0;                              // shooter samples over all bad pairs
   long staticBlockers = 0, dynamicBlockers = 0;  // per pair, in the pair's (swept) shaft
   long passes = 0, samplePasses = 0;             // transmittance renders
+  long rayCastPasses = 0;                        // of them, ray cast (ray_cast_masks.h)
   long passesSavedByCoherence = 0;               // static-blocker renders not repeated
   long coveredTexelsFilled = 0;  // texels under a touching solid given their exposed neighbours'
 
@@ -150,6 +155,8 @@ struct TextureMovieBakerStats {
   std::vector<std::string> warnings;
   nlohmann::json toJson() const;
 };
+
+struct BlockerIndex;
 
 class TextureMovieBaker {
  public:
@@ -186,6 +193,7 @@ class TextureMovieBaker {
   TextureMovieBakerBackends backends_;
   std::vector<InputPolygon> tops_;
   std::unique_ptr<OcclusionMaskRenderer> renderer_;
+  std::unique_ptr<BlockerIndex> blockers_;          // made on the first bake
   std::unique_ptr<GoodLinksByReceiver> goodLinks_;  // --good-layer gather
   std::unique_ptr<SceneVisibility> visibility_;     // the gather's rays and the covered texels
   SceneVisibility* sceneVisibility();

@@ -305,9 +305,26 @@ glm::dmat4 projectiveShadowMatrix(const Polygon& receiver, const glm::dvec3& sam
   return m;
 }
 
-glm::dvec2 receiverPlaneUv(const Polygon& receiver, const glm::dvec3& x) {
+ReceiverTextureMap::ReceiverTextureMap(const Polygon& receiver) {
   PlaneFrame f = planeFrame(receiver);
-  glm::dvec3 h = uvFromPlane(receiver, f) * glm::dvec3(f.toPlane(x), 1.0);
+  origin_ = f.o;
+  e1_ = f.e1;
+  e2_ = f.e2;
+  uvFromPlane_ = uvFromPlane(receiver, f);
+  planeFromUv_ = glm::inverse(uvFromPlane_);
+}
+
+glm::dvec3 ReceiverTextureMap::uvHomogeneous(const glm::dvec3& x) const {
+  return uvFromPlane_ * glm::dvec3(glm::dot(e1_, x - origin_), glm::dot(e2_, x - origin_), 1.0);
+}
+
+glm::dvec3 ReceiverTextureMap::planePoint(glm::dvec2 uv) const {
+  glm::dvec3 q = planeFromUv_ * glm::dvec3(uv, 1.0);
+  return origin_ + (q.x / q.z) * e1_ + (q.y / q.z) * e2_;
+}
+
+glm::dvec2 receiverPlaneUv(const Polygon& receiver, const glm::dvec3& x) {
+  glm::dvec3 h = ReceiverTextureMap(receiver).uvHomogeneous(x);
   return {h.x / h.z, h.y / h.z};
 }
 

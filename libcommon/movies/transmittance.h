@@ -91,6 +91,20 @@ double mergeTransmittance(MergeMode mode, double staticT, double dynamicT);
 glm::dmat4 projectiveShadowMatrix(const Polygon& receiver, const glm::dvec3& sample);
 // (u,v) of a point of the receiver's plane under the render's homography.
 glm::dvec2 receiverPlaneUv(const Polygon& receiver, const glm::dvec3& pointOnPlane);
+// The render's map between the receiver's plane and its texture (u,v) (the homography above),
+// both ways: what receiverPlaneUv computes, made once per receiver.
+class ReceiverTextureMap {
+ public:
+  explicit ReceiverTextureMap(const Polygon& receiver);
+  // Homogeneous (U, V, C) of a point of the receiver's plane; C > 0 inside the polygon.
+  glm::dvec3 uvHomogeneous(const glm::dvec3& pointOnPlane) const;
+  // The point of the plane that maps to uv.
+  glm::dvec3 planePoint(glm::dvec2 uv) const;
+
+ private:
+  glm::dvec3 origin_, e1_, e2_;
+  glm::dmat3 uvFromPlane_, planeFromUv_;
+};
 
 // OSMesa renderer of occlusion masks (projective shadows, see above): the baker's default
 // OcclusionMaskRenderer. Owns its GL context (gl_context.h threading rules: one renderer per

@@ -1,6 +1,7 @@
-// Transmittance by projective shadows into sample masks (libcommon/movies/transmittance.h): the
-// projection, the sample pattern, occlusion against hand-computed visible fractions and the
-// exact OR merge.
+// Transmittance by projective shadows into sample masks (libcommon/movies/transmittance.h) and
+// by ray-cast segment tests (ray_cast_masks.h): the projection, the sample pattern, occlusion
+// against hand-computed visible fractions and the exact OR merge for both, their agreement, and
+// the adaptive choice between them.
 #include "libcommon/movies/transmittance.h"
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "libcommon/core/error.h"
+#include "libcommon/movies/ray_cast_masks.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/scene/patch_hierarchy.h"
 
@@ -152,8 +154,21 @@ TEST(Transmittance, KernelWeightedTransmittanceIsTheVisibleFormFactorShare) {
   EXPECT_EQ(kernelWeightedTransmittance(x, n, samples, -light.normal(), occluded, valid), t);
 }
 
-TEST(Transmittance, NoBlockersLeaveEverythingLit) {
-  TransmittanceRenderer r;
+// The occlusion-mask tests run on both methods: OSMesa projective shadows and CPU ray casting.
+template <class Renderer>
+class MaskRenderers : public ::testing::Test {};
+using Renderers = ::testing::Types<TransmittanceRenderer, RayCastMaskRenderer>;
+class RendererNames {
+ public:
+  template <class T>
+  static std::string GetName(int) {
+    return std::is_same_v<T, TransmittanceRenderer> ? "Projective" : "RayCast";
+  }
+};
+TYPED_TEST_SUITE(MaskRenderers, Renderers, RendererNames);
+
+TYPED_TEST(MaskRenderers, NoBlockersLeaveEverythingLit) {
+  TypeParam r;
   std::vector<SampleMask> mask;
   r.render(floorReceiver(), 8, 8, lightSamples(16), {}, mask);
   ASSERT_EQ(mask.size(), 64u);
@@ -164,9 +179,9 @@ TEST(Transmittance, NoBlockersLeaveEverythingLit) {
 // A half-plane occluder x < 0 at z = 1 between the light (z = 2, x in [-.5,.5]) and the floor:
 // the ray from floor point (px, *, 0) to light point (sx, *, 2) crosses z = 1 at (px + sx) / 2,
 // so it is blocked when sx < -px and the visible fraction is clamp(0.5 + px, 0, 1).
-TEST(Transmittance, HalfPlaneOccluderMatchesTheAnalyticVisibleFraction) {
+TYPED_TEST(MaskRenderers, HalfPlaneOccluderMatchesTheAnalyticVisibleFraction) {
   const int n = 64, w = 32, h = 8;
-  TransmittanceRenderer r;
+  TypeParam r;
   std::vector<SampleMask> mask;
   Polygon occluder = quad({-10, -10, 1}, {0, -10, 1}, {0, 10, 1}, {-10, 10, 1});
   std::vector<glm::dvec3> samples = lightSamples(n);
@@ -193,11 +208,11 @@ TEST(Transmittance, HalfPlaneOccluderMatchesTheAnalyticVisibleFraction) {
       }
     }
   EXPECT_EQ(penumbra, 16 * h);
-  RecordProperty("penumbra_max_error", std::to_string(worst));
+  this->RecordProperty("penumbra_max_error", std::to_string(worst));
 }
 
-TEST(Transmittance, BlockersBehindThePlaneOrBeyondTheSampleCastNothing) {
-  TransmittanceRenderer r;
+TYPED_TEST(MaskRenderers, BlockersBehindThePlaneOrBeyondTheSampleCastNothing) {
+  TypeParam r;
   std::vector<SampleMask> mask;
   // Under the floor, above the light, and lying in the receiver's own plane next to it.
   std::vector<BlockerTriangle> tris;
@@ -219,8 +234,8 @@ TEST(Transmittance, BlockersBehindThePlaneOrBeyondTheSampleCastNothing) {
   EXPECT_LT(touched, 256);
 }
 
-TEST(Transmittance, StaticAndDynamicMasksOrToTheMaskOfAllBlockers) {
-  TransmittanceRenderer r;
+TYPED_TEST(MaskRenderers, StaticAndDynamicMasksOrToTheMaskOfAllBlockers) {
+  TypeParam r;
   const int w = 24, h = 20;
   std::vector<glm::dvec3> samples = lightSamples(64, 3);
   // Two overlapping sets of slanted triangles between light and floor.
@@ -249,6 +264,80 @@ TEST(Transmittance, StaticAndDynamicMasksOrToTheMaskOfAllBlockers) {
   std::vector<SampleMask> again;
   r.render(floorReceiver(), w, h, samples, all, again);
   EXPECT_EQ(again, mall);
+}
+
+// Random slanted blockers over a tilted planar quad that is not a parallelogram (the homography's
+// texel points) and over a triangle: the ray-cast masks are the projective render's but for
+// texel centres within the rasterizer's snapping of a projected edge.
+TEST(RayCastMasks, AgreeWithTheProjectiveRender) {
+  TransmittanceRenderer gl;
+  RayCastMaskRenderer rays;
+  Polygon tilted = quad({-1, -1, -0.3}, {1.2, -0.9, -0.27}, {0.8, 1.1, 0.33},
+                        {-0.9, 0.7, 0.21});  // planar: z = 0.3 y
+  Polygon tri;
+  tri.count = 3;
+  tri.v = {glm::dvec3(-1, -1, 0), glm::dvec3(1, -1, 0), glm::dvec3(-1, 1, 0)};
+  uint32_t state = 12345;
+  auto next = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return double(state >> 8) / double(1u << 24);
+  };
+  long bits = 0, differing = 0, partialTexels = 0;
+  for (const Polygon& receiver : {tilted, tri}) {
+    for (int trial = 0; trial < 8; ++trial) {
+      std::vector<BlockerTriangle> blockers;
+      for (int b = 0; b < 5; ++b) {
+        glm::dvec3 c(2.0 * next() - 1.0, 2.0 * next() - 1.0, 0.3 + 1.4 * next());
+        blockers.push_back({c + glm::dvec3(-0.4 * next(), -0.4 * next(), 0.2 * next() - 0.1),
+                            c + glm::dvec3(0.4 * next(), -0.2 * next(), 0.2 * next() - 0.1),
+                            c + glm::dvec3(0.1 * next(), 0.4 * next(), 0.2 * next() - 0.1)});
+      }
+      std::vector<glm::dvec3> samples = lightSamples(64, uint32_t(trial));
+      std::vector<SampleMask> a, b;
+      gl.render(receiver, 24, 16, samples, blockers, a);
+      rays.render(receiver, 24, 16, samples, blockers, b);
+      ASSERT_EQ(a.size(), b.size());
+      for (size_t x = 0; x < a.size(); ++x) {
+        bits += __builtin_popcountll(a[x] | b[x]);
+        differing += __builtin_popcountll(a[x] ^ b[x]);
+        partialTexels += b[x] != 0 && b[x] != ~SampleMask(0);
+      }
+    }
+  }
+  EXPECT_GT(partialTexels, 500) << "the test needs penumbrae to mean anything";
+  EXPECT_GT(bits, 10000);
+  EXPECT_LE(double(differing), 2e-3 * double(bits)) << differing << " of " << bits;
+  RecordProperty("differing_bits", std::to_string(differing) + " of " + std::to_string(bits));
+}
+
+// The adaptive renderer ray casts within its budget and renders beyond it, and never opens
+// the projective renderer for masks within the budget.
+TEST(RayCastMasks, AdaptiveRendererChoosesByCost) {
+  int made = 0;
+  AdaptiveMaskRenderer r(16.0 * 16.0 * 16.0, [&made] {
+    ++made;
+    return std::make_unique<TransmittanceRenderer>();
+  });
+  Polygon chip =
+      quad({-0.05, -0.05, 1.9}, {0.05, -0.05, 1.9}, {0.05, 0.05, 1.9}, {-0.05, 0.05, 1.9});
+  std::vector<SampleMask> small, large, reference;
+  r.render(floorReceiver(), 16, 16, lightSamples(16), quadTriangles(chip),
+           small);  // 16 x 16 texels x 16 samples
+  EXPECT_EQ(made, 0);
+  EXPECT_EQ(r.rayCastPasses(), 1);
+  EXPECT_EQ(r.rendererName(), "ray cast");
+  r.render(floorReceiver(), 32, 16, lightSamples(16), quadTriangles(chip), large);  // twice that
+  EXPECT_EQ(made, 1);
+  EXPECT_EQ(r.rayCastPasses(), 1);
+  EXPECT_EQ(r.passes(), 2);
+  EXPECT_EQ(r.samplePasses(), 32);
+  RayCastMaskRenderer rays;
+  rays.render(floorReceiver(), 16, 16, lightSamples(16), quadTriangles(chip), reference);
+  EXPECT_EQ(small, reference);
+  AdaptiveMaskRenderer never(0.0, [] { return std::make_unique<TransmittanceRenderer>(); });
+  never.render(floorReceiver(), 4, 4, lightSamples(16), quadTriangles(chip), small);
+  EXPECT_EQ(never.rayCastPasses(), 0);
+  EXPECT_EQ(never.passes(), 1);
 }
 
 }  // namespace

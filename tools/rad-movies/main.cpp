@@ -123,6 +123,10 @@ int main(int argc, char** argv) {
                  "max, sum, independent")
       ->capture_default_str()
       ->check(CLI::IsMember({"exact", "max", "sum", "independent"}));
+  app.add_option("--ray-cast-budget", b.rayCastBudget,
+                 "ray cast a pair's occlusion masks on the CPU while texels x samples is at most "
+                 "this, else render them with OSMesa; 0: always OSMesa")
+      ->capture_default_str();
   app.add_option("--good-layer", o.goodLayer,
                  "indirect light of the good links: gather (per texel, exact point form factors "
                  "to each link's shooter) or gouraud (the global solution's vertex values, paper "
