@@ -271,6 +271,30 @@ void ClusterLinks::buildReceiverLists() {
                            : atTop_[size_t(l.receiver)])
         .push_back(i);
   }
+  const size_t T = emits_.size();
+  std::vector<std::vector<std::pair<uint32_t, double>>> perTop(T);
+  tbb::parallel_for(size_t(0), T, [&](size_t t) {
+    auto add = [&](const std::vector<uint32_t>& list) {
+      for (uint32_t i : list) {
+        const double f = formFactor(links_[i], uint32_t(t));
+        if (f > 0.0) perTop[t].emplace_back(i, f);
+      }
+    };
+    add(atTop_[t]);
+    for (int c = tree_.parentOfTop(int(t)); c >= 0; c = tree_.node(c).parent)
+      add(atCluster_[size_t(c)]);
+  });
+  gatherStart_.assign(T + 1, 0);
+  for (size_t t = 0; t < T; ++t) gatherStart_[t + 1] = gatherStart_[t] + perTop[t].size();
+  gatherLink_.resize(gatherStart_[T]);
+  gatherFormFactor_.resize(gatherStart_[T]);
+  for (size_t t = 0; t < T; ++t) {
+    for (size_t k = 0; k < perTop[t].size(); ++k) {
+      gatherLink_[gatherStart_[t] + k] = perTop[t][k].first;
+      gatherFormFactor_[gatherStart_[t] + k] = perTop[t][k].second;
+    }
+    std::vector<std::pair<uint32_t, double>>().swap(perTop[t]);
+  }
   listsValid_ = true;
 }
 
@@ -333,15 +357,8 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, std::vector<glm::
   out.assign(T, glm::dvec3(0.0));
   tbb::parallel_for(size_t(0), T, [&](size_t t) {
     glm::dvec3 h(0.0);
-    auto add = [&](const std::vector<uint32_t>& list) {
-      for (uint32_t i : list) {
-        const double f = formFactor(links_[i], uint32_t(t));
-        if (f > 0.0) h += f * linkB_[i];
-      }
-    };
-    add(atTop_[t]);
-    for (int c = tree_.parentOfTop(int(t)); c >= 0; c = tree_.node(c).parent)
-      add(atCluster_[size_t(c)]);
+    for (size_t e = gatherStart_[t]; e < gatherStart_[t + 1]; ++e)
+      h += gatherFormFactor_[e] * linkB_[gatherLink_[e]];
     out[t] = h;
   });
 }
