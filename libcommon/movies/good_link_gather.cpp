@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
+#include <tuple>
 #include <unordered_map>
 
 #include <tbb/blocked_range.h>
@@ -41,6 +43,40 @@ GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
     const GlobalLink& l = s.links[r];
     if (gathers(l)) rows[next[l.receiver]++] = r;
   }
+  smoothClusterIrradiance(s);
+}
+
+void GoodLinksByReceiver::smoothClusterIrradiance(const GlobalSolution& s) {
+  const std::vector<InputPolygon>& tops = s.hierarchy.tops();
+  const size_t T = tops.size(), K = size_t(s.keyCount());
+  if (s.topClusterIrradiance.size() != T * K || K == 0) return;
+  // Corners by mesh node and exact local position (the tiles of one mesh share vertices).
+  std::map<std::tuple<int, double, double, double>, std::vector<uint32_t>> atCorner;
+  auto key = [&](size_t t, int c) {
+    const glm::dvec3& v = tops[t].local.v[size_t(c)];
+    return std::make_tuple(tops[t].node, v.x + 0.0, v.y + 0.0, v.z + 0.0);  // -0 as +0
+  };
+  std::vector<glm::dvec3> normal(T);
+  for (size_t t = 0; t < T; ++t) {
+    normal[t] = tops[t].local.normal();
+    for (int c = 0; c < tops[t].local.count; ++c) atCorner[key(t, c)].push_back(uint32_t(t));
+  }
+  const double sameFacing = std::cos(8.0 * M_PI / 180.0);
+  clusterCorners.assign(T * K * 4, glm::vec3(0.0f));
+  for (size_t t = 0; t < T; ++t)
+    for (int c = 0; c < tops[t].local.count; ++c) {
+      const std::vector<uint32_t>& shared = atCorner.at(key(t, c));
+      for (size_t k = 0; k < K; ++k) {
+        glm::dvec3 sum(0.0);
+        int n = 0;
+        for (uint32_t o : shared)
+          if (glm::dot(normal[o], normal[t]) >= sameFacing) {
+            sum += glm::dvec3(s.topClusterIrradiance[size_t(o) * K + k]);
+            ++n;
+          }
+        clusterCorners[(t * K + k) * 4 + size_t(c)] = glm::vec3(sum / double(n));
+      }
+    }
 }
 
 GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
@@ -50,6 +86,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
                                SceneVisibility* visibility, int visibilityRays)
     : scene_(scene),
       solution_(solution),
+      clusterCorners_(byReceiver.clusterCorners),
       shooterRatio_(shooterRatio),
       texels_(texels),
       keyTimes_(movieKeyTimes),
@@ -569,8 +606,29 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
         }
     });
   }
-  // The receiver top's cluster light, uniform over it, linear in t between the keys as `weight`.
-  const glm::dvec3 cluster = solution_.clusterIrradiance(receiverTop_, t);
+  // The receiver top's cluster light at its corners, linear in t between the keys as `weight`,
+  // interpolated over the top by the texels' (u,v) (bilinear on a quad, barycentric on a
+  // triangle).
+  glm::dvec3 clusterCorner[4] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0),
+                                 glm::dvec3(0.0)};
+  const bool triangleTop = solution_.hierarchy.top(receiverTop_).local.count == 3;
+  if (!clusterCorners_.empty()) {
+    int k0, k1;
+    double w;
+    solution_.keyWeights(t, k0, k1, w);
+    const size_t K = size_t(solution_.keyCount());
+    for (size_t c = 0; c < 4; ++c)
+      clusterCorner[c] =
+          (1.0 - w) * glm::dvec3(clusterCorners_[(size_t(receiverTop_) * K + size_t(k0)) * 4 + c]) +
+          w * glm::dvec3(clusterCorners_[(size_t(receiverTop_) * K + size_t(k1)) * 4 + c]);
+  }
+  auto cluster = [&](size_t x) {
+    const double u = texels_.topUv[x].x, v = texels_.topUv[x].y;
+    if (triangleTop)
+      return (1.0 - u - v) * clusterCorner[0] + u * clusterCorner[1] + v * clusterCorner[2];
+    return (1.0 - u) * (1.0 - v) * clusterCorner[0] + u * (1.0 - v) * clusterCorner[1] +
+           u * v * clusterCorner[2] + (1.0 - u) * v * clusterCorner[3];
+  };
   const TexelFrame frame = texelFrame(t);
   const int width = texels_.width, height = texels_.height;
   auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
@@ -615,7 +673,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
                               &pointWeight[l * rays], movingNow[l] != 0);
           H += f * weight[l];
         }
-        acc[x] = H + cluster;
+        acc[x] = H + cluster(x);
       }
   });
 }

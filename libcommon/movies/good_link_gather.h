@@ -8,8 +8,10 @@
 //   \, F(x \to q)
 //
 // with H_c(k) the irradiance the receiver's top gathers through rad-global's cluster links
-// (GlobalSolution::topClusterIrradiance, linkhier 1.3; 0 in older files), uniform over the top
-// (the Gouraud layer's vertex values include it, so both layers carry the same cluster light),
+// (GlobalSolution::topClusterIrradiance, linkhier 1.3; 0 in older files), averaged at the
+// top's corners over the coplanar tops that share them and interpolated over the top
+// (GoodLinksByReceiver::clusterCorners; the Gouraud layer's vertex values include it the same
+// way, so both layers carry the same cluster light),
 // F(x -> q) the exact point-to-polygon form factor at the texel, about its shading normal,
 // and \bar V_l = V_l / e_p clamped to [0, 1]: the link's stored visibility (linkhier 1.2; older
 // files: F·V / \bar F, the area-average form factor) over the receiver's exposure e_p (the share
@@ -67,6 +69,15 @@ struct GoodLinksByReceiver {
   explicit GoodLinksByReceiver(const GlobalSolution& solution);
   std::vector<uint32_t> start;  // per node: its links are rows[start[i] .. start[i + 1])
   std::vector<uint32_t> rows;   // indices into solution.links
+  // The cluster irradiance at each top's corners, [(top * K + k) * 4 + c] (empty without
+  // cluster links): the mean of topClusterIrradiance over the tops of the same mesh node that
+  // share the corner's position and face the same way (normals within 8 degrees). The gather
+  // interpolates it over the top, so that a wall of tiles whose clusters link differently shades
+  // smoothly instead of in steps of one value per tile (the 10k hall's back wall).
+  std::vector<glm::vec3> clusterCorners;
+
+ private:
+  void smoothClusterIrradiance(const GlobalSolution& solution);
 };
 
 // The texels of one movie: their (u,v) in the receiver's top-level patch and their points in
@@ -122,6 +133,7 @@ class GoodLinkGather {
   };
   const Scene& scene_;
   const GlobalSolution& solution_;
+  const std::vector<glm::vec3>& clusterCorners_;  // GoodLinksByReceiver::clusterCorners
   const double shooterRatio_;
   const MovieTexels texels_;
   const std::vector<double>& keyTimes_;

@@ -964,6 +964,56 @@ TEST(TextureMovieBaker, ClusterIrradianceRaisesTheGatheredLayerByItsValueAtEvery
   EXPECT_EQ(bake(ramp, GoodLayer::kGouraud).keys, gouraud.keys);
 }
 
+// The cluster light is continuous across tops: a floor of two tiles in one mesh, [0,1] and
+// [1,2] along x, whose tops gather c and 3c through cluster links. The gathered layer rises by
+// c (1 + x) at every texel of both movies: c at the left tile's outer edge, the tiles' mean 2c
+// on their shared edge, 3c at the right one's outer edge. Uniform per top, the shared edge had
+// a step of 2c.
+TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
+  FloorUnderCeiling f = floorUnderCeiling();
+  Scene& s = f.scene;
+  Mesh& floor = s.meshes[size_t(s.nodes[size_t(f.floor)].mesh)];
+  MeshTriangle a1, a2, b1, b2;
+  a1.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 0, 0), glm::dvec3(1, 1, 0)};
+  a2.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 1, 0), glm::dvec3(0, 1, 0)};
+  b1.p = {glm::dvec3(1, 0, 0), glm::dvec3(2, 0, 0), glm::dvec3(2, 1, 0)};
+  b2.p = {glm::dvec3(1, 0, 0), glm::dvec3(2, 1, 0), glm::dvec3(1, 1, 0)};
+  a1.material = a2.material = b1.material = b2.material = 0;
+  floor.triangles = {a1, a2, b1, b2};
+  GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
+  g.topClusterIrradiance.clear();
+  std::vector<int> tiles;
+  for (int t = 0; t < g.hierarchy.topCount(); ++t)
+    if (g.hierarchy.top(t).node == f.floor) tiles.push_back(t);
+  ASSERT_EQ(tiles.size(), 2u) << "two quads";
+  const glm::vec3 c(0.125f, 0.25f, 0.0625f);
+  GlobalSolution clustered = g;
+  clustered.topClusterIrradiance.assign(size_t(g.hierarchy.topCount()), glm::vec3(0.0f));
+  for (int t : tiles) {
+    const bool right = g.hierarchy.top(t).local.centroid().x > 1.0;
+    clustered.topClusterIrradiance[size_t(t)] = right ? 3.0f * c : c;
+  }
+  clustered.validate("test");
+  double worst = 0.0;
+  for (int t : tiles) {
+    MovieExtent r = wholeTopMovie(t, 0);
+    TextureMovieBaker plain(s, g, kFps, {}), with(s, clustered, kFps, {});
+    const BakedMovie a = plain.bake(r), b = with.bake(r);
+    ASSERT_EQ(a.keys.size(), 1u);
+    for (int j = 0; j < r.height; ++j)
+      for (int i = 0; i < r.width; ++i) {
+        const double x =
+            polygonPointAt(g.hierarchy.top(t).local, {(i + 0.5) / r.width, (j + 0.5) / r.height}).x;
+        for (int ch = 0; ch < 3; ++ch) {
+          const size_t at = (size_t(j) * size_t(r.width) + size_t(i)) * 3 + size_t(ch);
+          const double got = double(b.keys[0][at]) - double(a.keys[0][at]);
+          worst = std::max(worst, std::abs(got - c[ch] * (1.0 + x)) / (1.0 + b.keys[0][at]));
+        }
+      }
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
 // Smooth shading (glTF NORMAL): two facets of a bent sheet meet at a 22-degree crease, lit from
 // the side. With the vertex normals of a smooth surface (the crease's normal the mean of the two
 // facets'), the baked irradiance of both facets, extrapolated to the crease, agrees within 1 %;
