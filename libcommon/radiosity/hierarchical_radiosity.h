@@ -103,11 +103,16 @@ struct RadiosityOptions {
   // (linkTopLevel), the baseline. The space-time pass builds the tree (KeySolveInput::clusters).
   bool clustering = true;
   // A cluster link is kept only while the distance of its ends' centres is at least this many
-  // times the sum of their bounding radii (the opening criterion of the point approximation);
-  // closer ones are refined. 3, not 1 or 2: on the 3k-triangle hall (make_hall.py, frame 48)
-  // frames with clustering differ from all-pairs ones by 0.84 % RMSE / mean (1: 1.95 %, 2:
-  // 1.71 %) at 32 s of rad-global against 71 s all-pairs (1: 19 s, 2: 25 s).
-  double clusterSeparation = 3.0;
+  // times the sum of their bounding radii (the opening criterion of the point approximation,
+  // whose 1/r^2 at the shooter's centre is a second-order error in radius / distance); closer
+  // ones are refined. One key, rad-global time on one core: the 10k-triangle hall (make_hall.py,
+  // frame 48) against 4096-spp references (RMSE / mean, bias over non-emitters): 3: 3.16 %,
+  // -1.43 %, 21.3 s, 365 MB; 4: 2.84 %, -1.00 %, 34.4 s, 480 MB; all pairs: 2.84 %, -1.09 %,
+  // 81.4 s, 1.3 GB. Against all pairs (RMSE / mean): the 3k hall 0.90 % at 3 (7.0 s), 0.56 % at
+  // 4 (8.6 s; all pairs 12.7 s); table-static-static 0.60 -> 0.06 %, cubes-8 0.11 -> 0.03 %
+  // (same time). 2 and 1 gave 1.71 and 1.95 % on the 3k hall.
+  // ClusterLinks.ExposedFloorMatchesAllPairsAtTheDefaultSeparation: 3 is 2.2 % dark there.
+  double clusterSeparation = 4.0;
 };
 
 // Diffuse reflectance and emitted radiosity B_e = pi L_e (W/m^2) of one top-level patch.
