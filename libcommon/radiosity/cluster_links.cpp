@@ -115,7 +115,7 @@ bool ClusterLinks::wantsRefinement(const ClusterLink& l, double epsAbs) const {
 }
 
 size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
-                            std::vector<std::pair<int, int>>& patchPairs) {
+                            std::vector<std::pair<int, int>>& patchPairs, bool& overBudget) {
   std::vector<size_t> work;
   for (size_t i = 0; i < links_.size(); ++i)
     if (!links_[i].refined) work.push_back(i);
@@ -132,12 +132,12 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
   while (!work.empty()) {
     std::vector<size_t> next;
     for (size_t li : work) {
-      if (links_.size() - start + patchPairs.size() > budget) {
-        compact();
-        return count;
-      }
+      // Past the link bound only the lights' links go on: a light left inside a cluster link
+      // would reach its receivers without shadows (the 30k-triangle hall lost 92 % of its
+      // bad pairs so). They are bounded by the top-level patches times the lights.
+      if (links_.size() - start + patchPairs.size() > budget) overBudget = true;
       const ClusterLink l = links_[li];  // a copy: link() may move links_
-      if (l.refined) continue;
+      if (l.refined || (overBudget && !emits(l.shooter))) continue;
       if (l.receiver == l.shooter) {  // a cluster's self-link: its children's pairs
         const std::vector<ClusterRef>& ch = tree_.node(clusterIndex(l.receiver)).children;
         for (ClusterRef a : ch)

@@ -74,10 +74,12 @@ class ClusterLinks {
 
   // One round of refinement (see the top of this file) with eps Phi = epsAbs (refineAll: every
   // link is refined down to patch pairs, the all-pairs linking). The pairs of top-level
-  // patches reached go to `patchPairs` (receiver, shooter). Stops once `budget` new links
-  // were made. Returns the number of links refined.
+  // patches reached go to `patchPairs` (receiver, shooter). Once `budget` new links were made
+  // only the links whose shooter holds a light are refined further (down to patch pairs, so
+  // that every light keeps its per-texel shadows in the second pass), and `overBudget` is set.
+  // Returns the number of links refined.
   size_t refine(double epsAbs, bool refineAll, size_t budget,
-                std::vector<std::pair<int, int>>& patchPairs);
+                std::vector<std::pair<int, int>>& patchPairs, bool& overBudget);
   // Transfer and visibility of the links made since the last call (parallel, deterministic).
   void evaluate();
   // Per top: its irradiance through the cluster links from the tops' radiosity `topB` (B_S of a

@@ -268,8 +268,9 @@ class KeyTimeSolver {
     std::vector<std::pair<int, int>> pairs;
     const size_t held = s_.links.size() + clusters_->size();
     const size_t budget = opt_.maxLinks > held ? opt_.maxLinks - held : 0;
-    const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs);
-    if (s_.links.size() + clusters_->size() + pairs.size() > opt_.maxLinks)
+    bool overBudget = false;
+    const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs, overBudget);
+    if (overBudget || s_.links.size() + clusters_->size() + pairs.size() > opt_.maxLinks)
       s_.linkCapReached = true;
     for (const auto& [r, q] : pairs)
       if (s_.area[size_t(r)] > 0 && s_.area[size_t(q)] > 0 &&
