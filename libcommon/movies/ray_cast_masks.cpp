@@ -39,7 +39,7 @@ bool crosses(const PreparedTriangle& tri, const glm::dvec3& p, const glm::dvec3&
 // The shadow of a convex polygon between the plane and the sample is the convex polygon of its
 // vertices' shadows, and the homography keeps it one while C > 0 at its corners.
 void coverConvex(const glm::dvec2* uv, int count, int s, int width, int height,
-                 std::vector<SampleMask>& out, long& tests) {
+                 std::vector<SampleMask>& out) {
   double area = 0.0;
   for (int e = 0; e < count; ++e) {
     const glm::dvec2 &a = uv[e], &b = uv[(e + 1) % count];
@@ -80,7 +80,6 @@ void coverConvex(const glm::dvec2* uv, int count, int s, int width, int height,
         std::min(i1, int(std::clamp(std::floor(uHi * width - 0.5), -1.0, double(width))));
     SampleMask* row = &out[size_t(j) * size_t(width)];
     for (int i = first; i <= last; ++i) row[i] |= bit;
-    tests += count;
   }
 }
 
@@ -123,27 +122,15 @@ void RayCastMaskRenderer::render(const Polygon& receiver, int width, int height,
   const SampleMask valid = frontSampleMask(receiver, samples);
   if (blockers.empty() || valid == 0) return;
 
-  // The projective render's clip planes: strictly in front of the receiver plane by delta (its
-  // coplanar neighbours do not shadow it), and not beyond the sample.
-  const glm::dvec3 centre = receiver.centroid();
-  double size = 0.0;
-  for (int k = 0; k < receiver.count; ++k)
-    size = std::max(size, glm::length(receiver.v[k] - centre));
-  const double delta = 1e-6 * size;
+  // The projective render's clip planes: strictly in front of the receiver plane by delta, and
+  // not beyond the sample.
+  const double delta = receiverFrontOffset(receiver);
   const glm::dvec3 n = receiver.normal();
-  std::vector<double> sampleHeight(samples.size(), 0.0), tMin(samples.size(), 2.0);
+  std::vector<double> sampleHeight(samples.size(), 0.0);
   for (size_t s = 0; s < samples.size(); ++s)
-    if (valid >> s & 1) {
-      sampleHeight[s] = glm::dot(n, samples[s] - receiver.v[0]);
-      tMin[s] = delta / sampleHeight[s];
-    }
-
+    if (valid >> s & 1) sampleHeight[s] = glm::dot(n, samples[s] - receiver.v[0]);
   const ReceiverTextureMap map(receiver);
-  points_.resize(out.size());
-  for (int j = 0; j < height; ++j)
-    for (int i = 0; i < width; ++i)
-      points_[size_t(j) * size_t(width) + size_t(i)] =
-          map.planePoint({(i + 0.5) / width, (j + 0.5) / height});
+  points_.clear();  // the texel centres' plane points, made for the fallback only
 
   for (const BlockerTriangle& b : blockers) {
     double hv[3];
@@ -175,17 +162,19 @@ void RayCastMaskRenderer::render(const Polygon& receiver, int width, int height,
         uv[c] = glm::dvec2(h.x, h.y) / h.z;
       }
       if (projectable) {
-        coverConvex(uv, count, s, width, height, out, segmentTests_);
+        coverConvex(uv, count, s, width, height, out);
         continue;
       }
       // Else (a quad receiver's homography turns over within the shadow): the segment test at
       // every texel.
+      if (points_.empty())
+        for (int j = 0; j < height; ++j)
+          for (int i = 0; i < width; ++i)
+            points_.push_back(map.planePoint({(i + 0.5) / width, (j + 0.5) / height}));
       const SampleMask bit = SampleMask(1) << s;
-      for (size_t x = 0; x < out.size(); ++x) {
-        if (out[x] & bit) continue;
-        ++segmentTests_;
-        if (crosses(tri, points_[x], eye - points_[x], tMin[size_t(s)])) out[x] |= bit;
-      }
+      for (size_t x = 0; x < out.size(); ++x)
+        if (!(out[x] & bit) && crosses(tri, points_[x], eye - points_[x], delta / ds))
+          out[x] |= bit;
     }
   }
   ++passes_;

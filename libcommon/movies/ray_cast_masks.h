@@ -31,11 +31,9 @@ class RayCastMaskRenderer final : public OcclusionMaskRenderer {
   long passes() const override { return passes_; }
   long samplePasses() const override { return samplePasses_; }
   std::string rendererName() const override { return "ray cast"; }
-  // Segment-triangle tests made so far.
-  long segmentTests() const { return segmentTests_; }
 
  private:
-  long passes_ = 0, samplePasses_ = 0, segmentTests_ = 0;
+  long passes_ = 0, samplePasses_ = 0;
   std::vector<glm::dvec3> points_;
 };
 

@@ -314,12 +314,9 @@ struct BlockerIndex {
       auto it = world.find(node);
       if (it == world.end())
         it = world.emplace(node, scene.worldTransform(node, scene.startTime())).first;
-      const Polygon p = tops[b].local.transformed(it->second);
-      boxes[b] = {p.v[0], p.v[0]};
-      for (int k = 1; k < p.count; ++k) {
-        boxes[b][0] = glm::min(boxes[b][0], p.v[k]);
-        boxes[b][1] = glm::max(boxes[b][1], p.v[k]);
-      }
+      Box box;
+      box.grow(tops[b].local.transformed(it->second));
+      boxes[b] = {box.lo, box.hi};
     }
     fixedTops = BoxTree(boxes);
   }

@@ -68,6 +68,14 @@ glm::dvec4 shiftRow(const glm::dvec4& row, const glm::dvec3& origin) {
   return {row.x, row.y, row.z, row.w + glm::dot(glm::dvec3(row), origin)};
 }
 
+// The largest distance of a vertex from the centroid.
+double receiverRadius(const Polygon& r) {
+  const glm::dvec3 centre = r.centroid();
+  double size = 0.0;
+  for (int k = 0; k < r.count; ++k) size = std::max(size, glm::length(r.v[k] - centre));
+  return size;
+}
+
 // Plane basis of a receiver: origin v0, unit e1 along v0->v1, e2 = n x e1.
 struct PlaneFrame {
   glm::dvec3 o, n, e1, e2;
@@ -323,6 +331,10 @@ glm::dvec3 ReceiverTextureMap::planePoint(glm::dvec2 uv) const {
   return origin_ + (q.x / q.z) * e1_ + (q.y / q.z) * e2_;
 }
 
+double receiverFrontOffset(const Polygon& receiver) {
+  return 1e-6 * receiverRadius(receiver);
+}
+
 glm::dvec2 receiverPlaneUv(const Polygon& receiver, const glm::dvec3& x) {
   glm::dvec3 h = ReceiverTextureMap(receiver).uvHomogeneous(x);
   return {h.x / h.z, h.y / h.z};
@@ -433,9 +445,7 @@ void TransmittanceRenderer::render(const Polygon& receiver, int width, int heigh
 
   // Coordinates relative to the receiver's centroid keep float precision at any scene scale.
   const glm::dvec3 origin = receiver.centroid();
-  double size = 0.0;
-  for (int k = 0; k < receiver.count; ++k)
-    size = std::max(size, glm::length(receiver.v[k] - origin));
+  const double size = receiverRadius(receiver);
   const glm::dvec3 n = receiver.normal();
 
   // Per-sample transforms (std140: mat4[64] then vec4[64]).
@@ -461,9 +471,8 @@ void TransmittanceRenderer::render(const Polygon& receiver, int width, int heigh
     glm::dvec4 eyeRow = shiftRow(glm::dvec4(-n, ds + glm::dot(n, receiver.v[0])), origin) / ds;
     for (int c = 0; c < 4; ++c) eye[c] = float(eyeRow[c]);
   }
-  // d(y) > delta: strictly in front of the receiver plane (touching geometry such as the
-  // receiver's coplanar neighbours does not shadow it).
-  const double delta = 1e-6 * size;
+  // d(y) > delta: strictly in front of the receiver plane.
+  const double delta = receiverFrontOffset(receiver);
   glm::dvec4 planeRow = shiftRow(glm::dvec4(n, -glm::dot(n, receiver.v[0]) - delta), origin);
   planeRow /= std::max(size, 1e-300);
 

@@ -91,6 +91,11 @@ double mergeTransmittance(MergeMode mode, double staticT, double dynamicT);
 glm::dmat4 projectiveShadowMatrix(const Polygon& receiver, const glm::dvec3& sample);
 // (u,v) of a point of the receiver's plane under the render's homography.
 glm::dvec2 receiverPlaneUv(const Polygon& receiver, const glm::dvec3& pointOnPlane);
+// How far in front of the receiver's plane a blocker must be to cast (1e-6 of the receiver's
+// radius about its centroid), in both mask methods: touching geometry such as the receiver's
+// coplanar neighbours does not shadow it.
+double receiverFrontOffset(const Polygon& receiver);
+
 // The render's map between the receiver's plane and its texture (u,v) (the homography above),
 // both ways: what receiverPlaneUv computes, made once per receiver.
 class ReceiverTextureMap {

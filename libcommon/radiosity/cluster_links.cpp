@@ -262,13 +262,13 @@ double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
 
 void ClusterLinks::buildReceiverLists() {
   if (listsValid_) return;
-  atTop_.assign(emits_.size(), {});
-  atCluster_.assign(size_t(tree_.size()), {});
+  // Per receiver (top, then cluster): its active links, in link order.
+  std::vector<std::vector<uint32_t>> atTop(emits_.size()), atCluster(size_t(tree_.size()));
   for (uint32_t i = 0; i < uint32_t(links_.size()); ++i) {
     const ClusterLink& l = links_[i];
     if (l.refined || !l.evaluated) continue;
-    (isCluster(l.receiver) ? atCluster_[size_t(clusterIndex(l.receiver))]
-                           : atTop_[size_t(l.receiver)])
+    (isCluster(l.receiver) ? atCluster[size_t(clusterIndex(l.receiver))]
+                           : atTop[size_t(l.receiver)])
         .push_back(i);
   }
   const size_t T = emits_.size();
@@ -280,9 +280,9 @@ void ClusterLinks::buildReceiverLists() {
         if (f > 0.0) perTop[t].emplace_back(i, f);
       }
     };
-    add(atTop_[t]);
+    add(atTop[t]);
     for (int c = tree_.parentOfTop(int(t)); c >= 0; c = tree_.node(c).parent)
-      add(atCluster_[size_t(c)]);
+      add(atCluster[size_t(c)]);
   });
   gatherStart_.assign(T + 1, 0);
   for (size_t t = 0; t < T; ++t) gatherStart_[t + 1] = gatherStart_[t] + perTop[t].size();

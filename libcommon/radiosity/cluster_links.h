@@ -131,8 +131,6 @@ class ClusterLinks {
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<ClusterLink> links_;
   std::vector<glm::dvec3> linkB_;  // per link: its shooter's B towards its receiver (gather)
-  // Per receiver (top, then cluster): its active links, in link order.
-  std::vector<std::vector<uint32_t>> atTop_, atCluster_;
   // Per top, what the gather sums at every sweep: the links at the top and at its ancestor
   // clusters, in that order, with their form factor to the top where it is > 0; top t's are
   // [gatherStart_[t], gatherStart_[t + 1]). The geometry is fixed within a key time, and

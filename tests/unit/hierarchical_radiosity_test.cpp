@@ -665,21 +665,19 @@ TEST(ClusterTree, CoversEveryTopOnceAndNeverMixesStaticAndMoving) {
 
 KeySolution solveTiled(PatchHierarchy& h, const std::vector<Polygon>& polys,
                        const std::vector<SurfaceProperties>& surf, const VisibilityScene& vis,
-                       bool clustering, double eps) {
+                       bool clustering, const RadiosityOptions& o = {}) {
   ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
   KeySolveInput in = identityInput(h);
   in.visibility = &vis;
   if (clustering) in.clusters = &tree;
-  RadiosityOptions o;
-  o.eps = eps;
   return solveKeyTime(h, surf, in, o);
 }
 
 KeySolution solveTiled(const std::vector<Polygon>& polys,
                        const std::vector<SurfaceProperties>& surf, const VisibilityScene& vis,
-                       bool clustering, double eps = 2e-4) {
+                       bool clustering, const RadiosityOptions& o = {}) {
   PatchHierarchy h = hierarchyOf(polys);
-  return solveTiled(h, polys, surf, vis, clustering, eps);
+  return solveTiled(h, polys, surf, vis, clustering, o);
 }
 
 // Issue 16, energy: clustering must keep the closed-room balance. In a closed room every watt
@@ -698,7 +696,7 @@ TEST(ClusterLinks, ClosedRoomAbsorbsWhatItEmits) {
   surf[light].emission = glm::dvec3(10.0);
   for (bool clustering : {true, false}) {
     PatchHierarchy h = hierarchyOf(polys);
-    KeySolution s = solveTiled(h, polys, surf, vis, clustering, 2e-4);
+    KeySolution s = solveTiled(h, polys, surf, vis, clustering);
     if (clustering) {
       EXPECT_GT(s.clusterLinks, 100u) << "the far tiles are linked as clusters";
     }
@@ -779,14 +777,9 @@ TEST(ClusterLinks, ExposedFloorMatchesAllPairsAtTheDefaultSeparation) {
     return d / ref;
   };
   auto clustered = [&](double separation) {
-    PatchHierarchy h = hierarchyOf(polys);
-    ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
-    KeySolveInput in = identityInput(h);
-    in.visibility = &vis;
-    in.clusters = &tree;
     RadiosityOptions o;
     if (separation > 0.0) o.clusterSeparation = separation;
-    return solveKeyTime(h, surf, in, o);
+    return solveTiled(polys, surf, vis, true, o);
   };
   const KeySolution near = clustered(3.0), byDefault = clustered(0.0);
   std::cout << "exposed floor tiles against all pairs: separation 3: " << exposedBias(near) << " ("
@@ -813,13 +806,9 @@ TEST(ClusterLinks, LightsKeepTheirLinksAtTheLinkBound) {
   surf[size_t(light)].reflectance = glm::dvec3(0.0);
   auto lit = [&](size_t maxLinks, bool& capped) {
     PatchHierarchy h = hierarchyOf(polys);
-    ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
-    KeySolveInput in = identityInput(h);
-    in.visibility = &vis;
-    in.clusters = &tree;
     RadiosityOptions o;
     o.maxLinks = maxLinks;
-    KeySolution s = solveKeyTime(h, surf, in, o);
+    KeySolution s = solveTiled(h, polys, surf, vis, true, o);
     capped = s.linkCapReached;
     std::set<int> tops;
     for (const SolverLink& l : s.links)
