@@ -134,8 +134,9 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
     for (size_t li : work) {
       // Past the link bound only the lights' links go on: a light left inside a cluster link
       // would reach its receivers without shadows (the 30k-triangle hall lost 92 % of its
-      // bad pairs so). They are bounded by the top-level patches times the lights.
-      if (links_.size() - start + patchPairs.size() > budget) overBudget = true;
+      // bad pairs so). They are bounded by the top-level patches times the lights. A refined
+      // link is replaced by its children, so it no longer counts (`count` of them this call).
+      if (links_.size() - start + patchPairs.size() > budget + count) overBudget = true;
       const ClusterLink l = links_[li];  // a copy: link() may move links_
       if (l.refined || (overBudget && !emits(l.shooter))) continue;
       if (l.receiver == l.shooter) {  // a cluster's self-link: its children's pairs
