@@ -1,0 +1,105 @@
+# The production pipeline on a Slurm cluster, used like animation.mk (issue 17):
+#
+#   make -f pipelines/slurm.mk [SCENE=...] [FRAMES=0-95] [SHARDS=4] [PARTITION=...] [WAIT=1] ...
+#
+# Same variables, stamps and stage command lines as animation.mk (stages.mk). Each stage that is
+# not up to date is submitted with sbatch, in stage order, depending `afterok` on the jobs this
+# run submitted for its inputs; a stage that is up to date is not submitted, so a re-run after a
+# parameter change submits exactly what animation.mk would run:
+#   rad-global and rad-intervals     one job each, side by side
+#   rad-movies                       an array over `--shard i/SHARDS`
+#   rad-compose                      an array over SHARDS contiguous chunks of FRAMES
+#   the mp4 and the contact sheet    one job each
+# Every task logs to OUT/logs/STAGE_TASK.log. A split stage's pieces stamp themselves
+# (OUT/movies/.shard-I-of-N, OUT/frames/.chunk-I-of-N) and its done-stamp is written by a job
+# that runs only when every piece succeeded, so a re-run after a failure or a killed task
+# resubmits only the missing pieces. A failed task cancels the jobs that depend on it
+# (--kill-on-invalid-dep). WAIT=1 blocks until this run's jobs have left the queue and exits
+# non-zero with one line naming the first failed stage, task and log.
+#
+# PARTITION (default: the cluster's default one) and SBATCH_FLAGS (e.g. --account=...,
+# --time=..., --mem=...) go to every sbatch. OUT must be on a file system every node sees.
+
+HERE := $(dir $(lastword $(MAKEFILE_LIST)))
+include $(HERE)stages.mk
+.DEFAULT_GOAL := all
+
+SHARDS       ?= 4
+PARTITION    ?=
+WAIT         ?= 0
+SBATCH_FLAGS ?=
+
+LOGS = $(OUT)/logs
+JOBS = $(OUT)/slurm-jobs
+
+# This run's submissions (STAGE JOBID TASKS per line): dependencies and WAIT=1 read them.
+ifeq ($(filter clean stage-commands,$(MAKECMDGOALS))$(findstring n,$(firstword -$(MAKEFLAGS))),)
+$(shell mkdir -p $(OUT) && rm -f $(JOBS))
+endif
+
+ifneq ($(words $(subst -, ,$(FRAMES))) $(findstring x,$(FRAMES)),2 )
+$(error slurm.mk: FRAMES=$(FRAMES): give FIRST-LAST (a step is not split into chunks))
+endif
+# FRAMES split into at most SHARDS contiguous chunks, FIRST-LAST each.
+CHUNKS := $(shell awk -v a=$(word 1,$(subst -, ,$(FRAMES))) -v b=$(word 2,$(subst -, ,$(FRAMES))) \
+  -v n=$(SHARDS) 'BEGIN { c = b - a + 1; if (n > c) n = c; \
+  for (i = 0; i < n; ++i) printf "%d-%d ", a + int(c * i / n), a + int(c * (i + 1) / n) - 1 }')
+CHUNK_COUNT := $(words $(CHUNKS))
+
+quote = '$(subst ','\'',$(1))'
+
+# Submits stage $(1): array indices $(2) (a shell word; empty: one task, numbered 0), after the
+# jobs this run submitted for the stages $(3), running the command $(4).
+submit = mkdir -p $(LOGS) && \
+  tasks=$(or $(2),0) && \
+  for t in $$(echo $$tasks | tr , ' '); do rm -f $(LOGS)/$(1)_$$t.log $(LOGS)/$(1)_$$t.exit; done && \
+  deps=$$(awk -v want=" $(3) " 'index(want, " " $$1 " ") {printf ":%s", $$2}' $(JOBS) 2>/dev/null || true) && \
+  id=$$(sbatch --parsable --kill-on-invalid-dep=yes --job-name=rad-$(1) \
+    $(if $(PARTITION),--partition=$(PARTITION)) $(SBATCH_FLAGS) $(if $(2),--array=$(2)) \
+    $${deps:+--dependency=afterok$$deps} --output=$(LOGS)/$(1)_$(if $(2),%a,0).log \
+    $(HERE)slurm-task.sh $(LOGS) $(1) $(call quote,$(4))) && \
+  echo "$(1) $${id%%;*} $$tasks" >> $(JOBS) && \
+  echo "slurm.mk: $(1) submitted: job $${id%%;*}, tasks $$tasks$${deps:+, after job$$(echo $$deps | tr : ' ')}" >&2
+
+.PHONY: all frames clean stage-commands
+
+all: $(OUT)/movie.mp4 $(OUT)/contact-sheet.png
+ifeq ($(WAIT),1)
+	@$(HERE)slurm-wait.sh $(JOBS) $(LOGS)
+	@echo "slurm.mk: frames in $(OUT)/frames, $(OUT)/movie.mp4, $(OUT)/contact-sheet.png" >&2
+else
+	@echo "slurm.mk: submitted; logs in $(LOGS) (WAIT=1 blocks until the jobs end)" >&2
+endif
+
+frames: $(OUT)/frames/.done
+
+$(OUT)/global.rlh: $(SCENE) $(OUT)/global.params $(BIN)/rad-global
+	@$(call submit,global,,,$(GLOBAL_CMD))
+
+$(OUT)/intervals.rti: $(SCENE) $(OUT)/intervals.params $(BIN)/rad-intervals
+	@$(call submit,intervals,,,$(INTERVALS_CMD))
+
+$(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
+	@rm -f $@ && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies shard $(SHARDS) $(JOBS) "global intervals" $^) && \
+	if [ -n "$$missing" ]; then \
+	  $(call submit,movies,$$missing,global intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS)) \
+	    && touch $(OUT)/movies/.shard-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)) && \
+	  $(call submit,movies-done,,movies,touch $@); \
+	else touch $@; fi
+
+$(OUT)/frames/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
+                     $(BIN)/rad-compose
+	@rm -f $@ && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global intervals movies" $^) && \
+	if [ -n "$$missing" ]; then \
+	  $(call submit,compose,$$missing,global intervals movies,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
+	    $(call COMPOSE_CHUNK_CMD,$$1) && touch $(OUT)/frames/.chunk-$$SLURM_ARRAY_TASK_ID-of-$(CHUNK_COUNT)) && \
+	  $(call submit,frames-done,,compose,touch $@); \
+	else touch $@; fi
+
+$(OUT)/movie.mp4: $(OUT)/frames/.done
+	@$(call submit,mp4,,compose,$(MP4_CMD))
+
+$(OUT)/contact-sheet.png: $(OUT)/frames/.done
+	@$(call submit,contact-sheet,,compose,$(CONTACT_CMD))

@@ -1,0 +1,111 @@
+#!/usr/bin/env bash
+# The farm test (ctest label `farm`, issue 17): the bundled scene's 24 frames through
+# pipelines/slurm.mk on a real single-node Slurm cluster (tests/slurm/cluster.sh), SHARDS=4,
+# WAIT=1, against animation.mk's frames on this machine:
+#   1. every frame's pixels (EXR and PNG) are bit-identical to animation.mk's (the files differ
+#      only in their provenance, which records each task's own command line and paths);
+#   2. a movies task killed mid-run makes WAIT fail with one line naming the stage, the task and
+#      its log; the dependent jobs are cancelled; nothing downstream is marked done; the re-run
+#      submits only the killed shard and ends with the same frames;
+#   3. an up-to-date run submits nothing.
+# Needs root (it starts slurmctld/slurmd): without it, skipped with one line (exit 77).
+#
+#   tests/slurm/farm_test.sh BIN_DIR WORK_DIR
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+bin=$(cd "$1" && pwd)
+work=$2
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "farm_test: skipped: needs root to start a local Slurm cluster (running as uid $(id -u))"
+  exit 77
+fi
+
+fail() { echo "farm_test: FAIL: $*" >&2; exit 1; }
+
+# cluster.sh's ports are fixed: one such cluster per host.
+if pgrep -x slurmctld >/dev/null; then
+  fail "a slurmctld is already running on this host; stop it first (tests/slurm/cluster.sh down)"
+fi
+rm -rf "$work"
+mkdir -p "$work"
+export RAD_SLURM_DIR=$work/cluster
+started=0
+cleanup() { [ "$started" = 0 ] || "$here/cluster.sh" down >/dev/null 2>&1 || true; }
+trap cleanup EXIT
+"$here/cluster.sh" up >/dev/null
+started=1
+# shellcheck disable=SC1091
+. "$RAD_SLURM_DIR/env"
+
+cd "$root"
+common=(SCENE=pipelines/scenes/cornell-moving.gltf FRAMES=0-23 "BIN=$bin")
+make -s -f pipelines/animation.mk "${common[@]}" "OUT=$work/local" >/dev/null 2>&1 ||
+  fail "animation.mk failed"
+
+# The same pixels, frame by frame (oiiotool --diff with zero tolerance: any bit of any pixel).
+same_frames() {
+  local a=$1 b=$2 n=0
+  for f in "$a"/frames/*.exr "$a"/frames/*.png; do
+    local g
+    g=$b/frames/$(basename "$f")
+    [ -e "$g" ] || fail "$g is missing"
+    oiiotool --fail 0 --failpercent 0 --warn 0 "$f" "$g" --diff >/dev/null 2>&1 ||
+      fail "$g differs from $f"
+    n=$((n + 1))
+  done
+  [ "$n" -eq 48 ] || fail "$a has $n frame files, expected 48"
+}
+
+# 1. A whole run.
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 WAIT=1 2>"$work/farm.err" ||
+  fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
+same_frames "$work/local" "$work/farm"
+for f in movie.mp4 contact-sheet.png movies/.done frames/.done logs/movies_3.log logs/compose_3.log; do
+  [ -s "$work/farm/$f" ] || [ -e "$work/farm/$f" ] || fail "$work/farm/$f is missing"
+done
+echo "farm_test: 24 frames through slurm.mk (SHARDS=4) have animation.mk's pixels"
+
+# 3. Up to date: nothing is submitted.
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 WAIT=1 2>"$work/again.err" ||
+  fail "the up-to-date re-run failed"
+if grep -q submitted "$work/again.err"; then fail "an up-to-date run submitted: $(cat "$work/again.err")"; fi
+
+# 2. Kill movies task 1 mid-run: submit without waiting, kill its rad-movies once it runs.
+out=$work/kill
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$out" SHARDS=4 2>"$work/kill.err"
+killed=0
+for _ in $(seq 1 1200); do
+  if pids=$(pgrep -f -- "rad-movies .*-o $out/movies .*--shard 1/4"); then
+    echo "$pids" | xargs kill -9 && killed=1 && break
+  fi
+  sleep 0.05
+done
+[ "$killed" = 1 ] || fail "movies task 1 never ran"
+set +e
+"$root/pipelines/slurm-wait.sh" "$out/slurm-jobs" "$out/logs" 2>"$work/wait.err"
+rc=$?
+set -e
+[ "$rc" -ne 0 ] || fail "WAIT succeeded although a movies task was killed"
+# Besides its progress lines ("waiting (N s): stages"), one line: stage, task, log.
+grep -v '^slurm.mk: waiting (' "$work/wait.err" >"$work/wait.line" || true
+[ "$(wc -l <"$work/wait.line")" -eq 1 ] || fail "WAIT's failure is not one line: $(cat "$work/wait.err")"
+grep -q "^slurm.mk: movies task 1 .*$out/logs/movies_1.log" "$work/wait.line" ||
+  fail "WAIT's line does not name the stage, task and log: $(cat "$work/wait.line")"
+[ ! -e "$out/movies/.done" ] || fail "movies/.done written although a shard failed"
+[ ! -e "$out/frames/.done" ] || fail "frames/.done written although a shard failed"
+[ ! -e "$out/logs/compose_0.log" ] || fail "compose ran although a shard failed"
+squeue -h -o '%F' | grep -qxFf <(awk '{print $2}' "$out/slurm-jobs") &&
+  fail "jobs of the failed run are left in the queue"
+echo "farm_test: killed movies task 1: $(cat "$work/wait.line")"
+
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$out" SHARDS=4 WAIT=1 2>"$work/rerun.err" ||
+  fail "the re-run failed: $(tail -1 "$work/rerun.err")"
+grep -q "slurm.mk: movies submitted: job [0-9]*, tasks 1\(,\|$\)" "$work/rerun.err" ||
+  fail "the re-run did not submit exactly movies task 1: $(grep movies "$work/rerun.err")"
+if grep -q "global submitted\|intervals submitted" "$work/rerun.err"; then
+  fail "the re-run resubmitted an up-to-date stage"
+fi
+same_frames "$work/local" "$out"
+echo "farm_test: the re-run submitted only movies task 1 and gave the same frames"
