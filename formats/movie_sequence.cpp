@@ -89,6 +89,7 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
   MovieSequenceReport report;
   MovieFileSink sink(baker.options().coherence, report.secondsWrite);
   for (const MovieExtent* m : shardMovies(intervals, options.shard)) {
+    const auto movieStart = SteadyClock::now();
     sink.start(textureMovieOf(*m, provenanceJson), textureMoviePath(options.moviesDir, m->movie));
     try {
       baker.bake(*m, sink);
@@ -99,6 +100,7 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
       throw;
     }
     ++report.moviesBaked;
+    report.movieSeconds.emplace_back(m->movie, secondsSince(movieStart));
     if (progress) progress();
   }
   // One sync for all movies (AtomicFile::Durability::kDeferred) before the tool reports

@@ -6,8 +6,10 @@
 // working buffers whatever the animation's length.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "formats/provenance.h"
@@ -33,6 +35,9 @@ struct MovieSequenceOptions {
 struct MovieSequenceReport {
   long moviesBaked = 0;
   double secondsWrite = 0.0;  // movie files: open, write, commit, and the final sync
+  // Per movie baked, in id order: (movie id, seconds to bake and write it). The farm model
+  // (pipelines/farm_model.py) re-splits a run's movies into any number of shards from these.
+  std::vector<std::pair<uint32_t, double>> movieSeconds;
 };
 
 // The movies of `shard`, in id order.

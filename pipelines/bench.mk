@@ -13,6 +13,9 @@
 #       the lecture hall of make_hall.py at each triangle count through the four stages: each
 #       stage's time and peak memory, rad-global's links, the log-log slopes of links and
 #       rad-global's time against the triangle count; out/scale/scale.csv and scale.png
+#   make -f pipelines/bench.mk farm-model [FARM_SCENE=pipelines/scenes/cornell-moving.gltf] [FARM_FRAMES=0-95] [FARM_NODES=1,4,16,64] [FARM_FLAGS=--global-windows]
+#       one run of animation.mk on one core, then the wall time slurm.mk would take on N nodes
+#       of this machine's size, its critical path and the serial part (pipelines/farm_model.py)
 #   make -f pipelines/bench.mk furnace [FURNACE_RHO=0.5,0.9,0.99,0.999] [FURNACE_FLAGS="global=--eps 1e-4"]
 #       the closed furnace through the whole pipeline at each rho: frame mean against the exact
 #       L_e / (1 - rho), time and peak memory; out/furnace/
@@ -33,10 +36,15 @@ SCALE_FRAMES ?= 0-95
 SCALE_MAX_SECONDS ?= 1800
 SCALE_MOVING_LIGHT ?=
 
+FARM_SCENE ?= pipelines/scenes/cornell-moving.gltf
+FARM_FRAMES ?= 0-95
+FARM_NODES ?= 1,4,16,64
+FARM_FLAGS ?=
+
 FURNACE_RHO ?= 0.5,0.9,0.99,0.999
 FURNACE_FLAGS ?=
 
-.PHONY: tables tradeoff furnace contact scale
+.PHONY: tables tradeoff furnace contact scale farm-model
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -56,3 +64,7 @@ scale:
 furnace:
 	python3 pipelines/furnace.py --bin $(BIN) --rho $(FURNACE_RHO) --out out/furnace \
 	  $(if $(FURNACE_FLAGS),--flags "$(FURNACE_FLAGS)")
+
+farm-model:
+	python3 pipelines/farm_model.py --bin $(BIN) --scene $(FARM_SCENE) --frames $(FARM_FRAMES) \
+	  --size $(BENCH_SIZE) --nodes $(FARM_NODES) --out out/farm-model $(FARM_FLAGS)

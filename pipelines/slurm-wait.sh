@@ -41,7 +41,7 @@ while read -r stage job tasks; do
   for t in ${tasks//,/ }; do
     log=$logs/${stage}_$t.log exitfile=$logs/${stage}_$t.exit
     if [ -e "$exitfile" ]; then
-      rc=$(cat "$exitfile")
+      read -r rc _ <"$exitfile"
       [ "$rc" = 0 ] || { [ -n "$failed" ] || failed="$stage task $t failed (exit $rc): $log"; }
     elif [ -e "$log" ]; then
       [ -n "$failed" ] || failed="$stage task $t was killed before it finished (job $job): $log"

@@ -69,6 +69,7 @@ int run(Options o, int argc, char** argv) {
     report["seconds"]["read"] = secondsRead;
     report["seconds"]["write"] = written.secondsWrite;
     report["seconds"]["total"] = rad::secondsSince(start);
+    report["movie_seconds"] = written.movieSeconds;  // [[movie id, seconds], ...]
     report["peak_memory_mb"] = rad::peakMemoryMb();
     rad::writeTextFile(o.report, report.dump(1) + "\n");
   }
