@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "formats/key_window.h"
 #include "formats/link_hierarchy.h"
 #include "formats/texture_intervals.h"
 
@@ -11,6 +12,7 @@ nlohmann::json summarizeContainerContent(const ContainerReader& reader) {
   // Each kind's summary lives with its format.
   if (reader.kind() == kLinkHierarchyKind) return summarizeLinkHierarchy(reader);
   if (reader.kind() == kTextureIntervalsKind) return summarizeTextureIntervals(reader);
+  if (reader.kind() == kKeyWindowKind) return summarizeKeyWindow(reader);
   return nullptr;
 }
 

@@ -16,6 +16,34 @@ std::vector<glm::vec3> unflatten(const std::vector<float>& f) {
 
 }  // namespace
 
+PatchHierarchy hierarchyFromNodeIds(const std::vector<uint64_t>& ids, const Scene& scene,
+                                    int64_t topCount, const std::string& where) {
+  PatchHierarchy h(scene.inputPolygons());
+  const size_t tops = size_t(h.topCount());
+  if (ids.size() < tops || topCount != int64_t(tops))
+    throw inputError(where, "was computed for a scene with " + std::to_string(topCount) +
+                                " top-level patches; this scene has " + std::to_string(tops));
+  for (size_t i = 0; i < tops; ++i)
+    if (ids[i] != PatchId{uint32_t(i), 1}.packed())
+      throw inputError(
+          where, "node " + std::to_string(i) + " is not top-level patch " + std::to_string(i));
+  for (size_t i = tops; i < ids.size();) {
+    PatchId id = PatchId::fromPacked(ids[i]);
+    if (id.top >= tops || id.level() < 1 || id.level() > PatchId::kMaxLevel || id.childIndex() != 0)
+      throw inputError(where, "node " + std::to_string(i) + " has an invalid id");
+    int parent = h.find(id.parent());
+    if (parent < 0 || !h.isLeaf(parent) || i + 4 > ids.size())
+      throw inputError(where, "node ids are not in subdivision order at node " + std::to_string(i));
+    int first = h.subdivide(parent);
+    for (int k = 0; k < 4; ++k)
+      if (size_t(first + k) != i + k || h.node(first + k).id.packed() != ids[i + k])
+        throw inputError(where,
+                         "node ids are not in subdivision order at node " + std::to_string(i));
+    i += 4;
+  }
+  return h;
+}
+
 void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
                         const Provenance& provenance, const nlohmann::json& metadata) {
   s.validate(path);
@@ -85,31 +113,10 @@ GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool r
   GlobalSolution s;
   s.keyTimes = r.array<double>("key_times");
   size_t K = s.keyTimes.size();
-  s.hierarchy = PatchHierarchy(scene.inputPolygons());
   std::vector<uint64_t> ids = r.array<uint64_t>("node_ids");
-  size_t tops = size_t(s.hierarchy.topCount());
-  if (ids.size() < tops || r.metadata().value("top_count", -1) != int64_t(tops))
-    throw inputError(where, "was computed for a scene with " +
-                                std::to_string(r.metadata().value("top_count", -1)) +
-                                " top-level patches; this scene has " + std::to_string(tops));
-  for (size_t i = 0; i < tops; ++i)
-    if (ids[i] != PatchId{uint32_t(i), 1}.packed())
-      throw inputError(
-          where, "node " + std::to_string(i) + " is not top-level patch " + std::to_string(i));
-  for (size_t i = tops; i < ids.size();) {
-    PatchId id = PatchId::fromPacked(ids[i]);
-    if (id.top >= tops || id.level() < 1 || id.level() > PatchId::kMaxLevel || id.childIndex() != 0)
-      throw inputError(where, "node " + std::to_string(i) + " has an invalid id");
-    int parent = s.hierarchy.find(id.parent());
-    if (parent < 0 || !s.hierarchy.isLeaf(parent) || i + 4 > ids.size())
-      throw inputError(where, "node ids are not in subdivision order at node " + std::to_string(i));
-    int first = s.hierarchy.subdivide(parent);
-    for (int k = 0; k < 4; ++k)
-      if (size_t(first + k) != i + k || s.hierarchy.node(first + k).id.packed() != ids[i + k])
-        throw inputError(where,
-                         "node ids are not in subdivision order at node " + std::to_string(i));
-    i += 4;
-  }
+  s.hierarchy =
+      hierarchyFromNodeIds(ids, scene, r.metadata().value("top_count", int64_t(-1)), where);
+  const size_t tops = size_t(s.hierarchy.topCount());
   size_t N = ids.size();
   std::vector<float> b = r.array<float>("node_radiosity");
   if (b.size() != N * K * 3) throw inputError(where, "node_radiosity has the wrong size");

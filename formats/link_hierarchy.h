@@ -32,6 +32,12 @@ GlobalSolution readLinkHierarchy(const std::string& path, const Scene& scene);
 // checksums still cover the arrays not copied. Saves rad-compose ~45 MB on the 32-cube scene.
 GlobalSolution readLinkHierarchyRadiosity(const ContainerReader& reader, const Scene& scene);
 
+// The hierarchy whose dense node ids are `ids` (node_ids of linkhier and keywindow files): the
+// scene's top-level patches (`topCount`, from the file's metadata, must be their number), then
+// groups of 4 siblings in subdivision order. Errors are rad::inputError(where, ...).
+PatchHierarchy hierarchyFromNodeIds(const std::vector<uint64_t>& ids, const Scene& scene,
+                                    int64_t topCount, const std::string& where);
+
 // rad-inspect's content summary of a linkhier container (no scene needed).
 nlohmann::json summarizeLinkHierarchy(const ContainerReader& reader);
 

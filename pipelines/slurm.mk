@@ -6,7 +6,10 @@
 # not up to date is submitted with sbatch, in stage order, depending `afterok` on the jobs this
 # run submitted for its inputs; a stage that is up to date is not submitted, so a re-run after a
 # parameter change submits exactly what animation.mk would run:
-#   rad-global and rad-intervals     one job each, side by side
+#   rad-global and rad-intervals     one job each, side by side; with GLOBAL_WINDOWS=W, rad-global
+#                                    as an array over W time windows of FRAMES (`--window`) and
+#                                    a merge job (`--merge`), whose global.rlh is the one job's,
+#                                    byte for byte
 #   rad-movies                       an array over `--shard i/SHARDS`
 #   rad-compose                      an array over SHARDS contiguous chunks of FRAMES
 #   the mp4 and the contact sheet    one job each
@@ -24,7 +27,8 @@ HERE := $(dir $(lastword $(MAKEFILE_LIST)))
 include $(HERE)stages.mk
 .DEFAULT_GOAL := all
 
-SHARDS       ?= 4
+SHARDS         ?= 4
+GLOBAL_WINDOWS ?= 1
 PARTITION    ?=
 WAIT         ?= 0
 SBATCH_FLAGS ?=
@@ -40,11 +44,16 @@ endif
 ifneq ($(words $(subst -, ,$(FRAMES))) $(findstring x,$(FRAMES)),2 )
 $(error slurm.mk: FRAMES=$(FRAMES): give FIRST-LAST (a step is not split into chunks))
 endif
-# FRAMES split into at most SHARDS contiguous chunks, FIRST-LAST each.
-CHUNKS := $(shell awk -v a=$(word 1,$(subst -, ,$(FRAMES))) -v b=$(word 2,$(subst -, ,$(FRAMES))) \
-  -v n=$(SHARDS) 'BEGIN { c = b - a + 1; if (n > c) n = c; \
+# FRAMES split into at most $(1) contiguous chunks, FIRST-LAST each.
+split-frames = $(shell awk -v a=$(word 1,$(subst -, ,$(FRAMES))) -v b=$(word 2,$(subst -, ,$(FRAMES))) \
+  -v n=$(1) 'BEGIN { c = b - a + 1; if (n > c) n = c; \
   for (i = 0; i < n; ++i) printf "%d-%d ", a + int(c * i / n), a + int(c * (i + 1) / n) - 1 }')
+CHUNKS := $(call split-frames,$(SHARDS))
 CHUNK_COUNT := $(words $(CHUNKS))
+# rad-global's time windows, and the window files the merge joins.
+WINDOWS := $(call split-frames,$(GLOBAL_WINDOWS))
+WINDOW_COUNT := $(words $(WINDOWS))
+WINDOW_FILES := $(foreach i,$(shell seq 0 $$(($(WINDOW_COUNT) - 1))),$(OUT)/global-windows/w$(i).rkw)
 
 quote = '$(subst ','\'',$(1))'
 
@@ -73,17 +82,28 @@ endif
 
 frames: $(OUT)/frames/.done
 
+# One job, or GLOBAL_WINDOWS time windows side by side and their merge (the same bytes).
 $(OUT)/global.rlh: $(SCENE) $(OUT)/global.params $(BIN)/rad-global
+ifeq ($(WINDOW_COUNT),1)
 	@$(call submit,global,,,$(GLOBAL_CMD))
+else
+	@missing=$$($(HERE)slurm-pieces.sh $(OUT)/global-windows window $(WINDOW_COUNT) $(JOBS) "" $^) && \
+	if [ -n "$$missing" ]; then \
+	  $(call submit,global,$$missing,,set -- $(WINDOWS) && shift $${SLURM_ARRAY_TASK_ID} && \
+	    $(call GLOBAL_WINDOW_CMD,$$1,$(OUT)/global-windows/w$${SLURM_ARRAY_TASK_ID}.rkw) && \
+	    touch $(OUT)/global-windows/.window-$${SLURM_ARRAY_TASK_ID}-of-$(WINDOW_COUNT)); \
+	fi && \
+	$(call submit,global-merge,,global,$(call GLOBAL_MERGE_CMD,$(WINDOW_FILES)))
+endif
 
 $(OUT)/intervals.rti: $(SCENE) $(OUT)/intervals.params $(BIN)/rad-intervals
 	@$(call submit,intervals,,,$(INTERVALS_CMD))
 
 $(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
 	@rm -f $@ && \
-	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies shard $(SHARDS) $(JOBS) "global intervals" $^) && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies shard $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,movies,$$missing,global intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS)) \
+	  $(call submit,movies,$$missing,global global-merge intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS)) \
 	    && touch $(OUT)/movies/.shard-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)) && \
 	  $(call submit,movies-done,,movies,touch $@); \
 	else touch $@; fi
@@ -91,9 +111,9 @@ $(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movi
 $(OUT)/frames/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
 	@rm -f $@ && \
-	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global intervals movies" $^) && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals movies" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,compose,$$missing,global intervals movies,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
+	  $(call submit,compose,$$missing,global global-merge intervals movies,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
 	    $(call COMPOSE_CHUNK_CMD,$$1) && touch $(OUT)/frames/.chunk-$$SLURM_ARRAY_TASK_ID-of-$(CHUNK_COUNT)) && \
 	  $(call submit,frames-done,,compose,touch $@); \
 	else touch $@; fi

@@ -28,15 +28,19 @@ FIRST_FRAME = $(firstword $(subst -, ,$(FRAMES)))
 # The stage command lines, written once: the rules run them, `make -f animation.mk
 # stage-commands` prints them (one `STAGE<TAB>command` line each) for bench.py and tradeoff.py,
 # which time each stage themselves.
-GLOBAL_CMD    = $(strip $(BIN)/rad-global $(SCENE) -o $(OUT)/global.rlh $(GLOBAL_ARGS) \
-                  --report $(OUT)/global-report.json)
+GLOBAL_CMD    = $(call GLOBAL_RUN,$(OUT)/global.rlh,$(OUT)/global-report.json)
 INTERVALS_CMD = $(strip $(BIN)/rad-intervals $(SCENE) -o $(OUT)/intervals.rti $(INTERVALS_ARGS) \
                   --report $(OUT)/intervals-report.json)
 MOVIES_CMD    = $(call MOVIES_RUN,$(OUT)/movies-report.json)
 COMPOSE_CMD   = $(call COMPOSE_RUN,$(COMPOSE_ARGS),$(OUT)/compose-report.json)
-# The farm's pieces of a stage (slurm.mk): movie shard $(1) of $(2); the frames $(1) (FIRST-LAST).
+# The farm's pieces of a stage (slurm.mk): rad-global's time window $(1) (FIRST-LAST) into
+# window file $(2), and the merge of the window files $(1), which writes what GLOBAL_CMD writes,
+# byte for byte (it is GLOBAL_CMD plus --merge); movie shard $(1) of $(2); the frames $(1).
+GLOBAL_WINDOW_CMD = $(call GLOBAL_RUN,$(2),$(2:.rkw=-report.json)) --window $(1)
+GLOBAL_MERGE_CMD  = $(GLOBAL_CMD) --merge $(1)
 MOVIES_SHARD_CMD  = $(call MOVIES_RUN,$(OUT)/movies-report-$(1)of$(2).json) --shard $(1)/$(2)
 COMPOSE_CHUNK_CMD = $(call COMPOSE_RUN,--frames $(1) $(COMPOSE_FLAGS),$(OUT)/compose-report-$(1).json)
+GLOBAL_RUN  = $(strip $(BIN)/rad-global $(SCENE) -o $(1) $(GLOBAL_ARGS) --report $(2))
 MOVIES_RUN  = $(strip $(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti -o $(OUT)/movies \
                 $(MOVIES_ARGS) --report $(1))
 COMPOSE_RUN = $(strip $(BIN)/rad-compose $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies \

@@ -2,8 +2,11 @@
 #include "libcommon/radiosity/global_stage.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <iomanip>
 #include <sstream>
+
+#include "libcommon/core/error.h"
 
 namespace rad {
 
@@ -32,6 +35,46 @@ std::vector<double> keyTimesOf(const FrameRange& frames, int keyStep, double fps
   std::vector<double> times;
   for (int f : keyFrames(frames.first, frames.last, keyStep)) times.push_back(f / fps);
   return times;
+}
+
+KeyIndexRange windowKeys(const FrameRange& frames, int keyStep, const std::string& window) {
+  int first = 0, last = 0;
+  char dash = 0, rest = 0;
+  if (std::sscanf(window.c_str(), "%d %c %d %c", &first, &dash, &last, &rest) != 3 || dash != '-' ||
+      first < 0 || last < first)
+    throw Error(ExitCode::kUsage, "", "--window " + window + ": expected FIRST-LAST");
+  const FrameRange w{first, last};
+  if (!frames.covers(w))
+    throw Error(ExitCode::kUsage, "",
+                "--window " + window + " is not within the run's frames " + frames.toString());
+  const std::vector<int> keys = keyFrames(frames.first, frames.last, keyStep);
+  KeyIndexRange r{keys.size(), 0};
+  for (size_t k = 0; k < keys.size(); ++k)
+    if (keys[k] >= first && keys[k] <= last) r.first = std::min(r.first, k), r.last = k;
+  if (r.first == keys.size())
+    throw Error(ExitCode::kUsage, "",
+                "--window " + window + " holds no key frame of frames " + frames.toString() +
+                    " at --key-step " + std::to_string(keyStep));
+  return r;
+}
+
+std::vector<std::string> argumentsWithoutMerge(int argc, const char* const* argv,
+                                               const std::vector<std::string>& merged) {
+  std::vector<std::string> out;
+  size_t next = 0;  // merged[next] is the next value a "--merge" took (it may come again)
+  for (int i = 0; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.rfind("--merge=", 0) == 0) {
+      next += next < merged.size() && word.substr(8) == merged[next];
+      continue;
+    }
+    if (word == "--merge") {  // and the values CLI11 gave it, as many as follow in order
+      while (i + 1 < argc && next < merged.size() && argv[i + 1] == merged[next]) ++i, ++next;
+      continue;
+    }
+    out.push_back(word);
+  }
+  return out;
 }
 
 double resolveMinArea(const Scene& scene, double minArea, double t) {
@@ -74,22 +117,9 @@ KeyTotals totalsOf(const std::vector<KeyTimeReport>& keys) {
 nlohmann::json GlobalReport::toJson() const {
   nlohmann::json keys = nlohmann::json::array();
   for (size_t k = 0; k < solve.keys.size(); ++k) {
-    const KeyTimeReport& r = solve.keys[k];
-    keys.push_back({{"key", k},
-                    {"time", r.time},
-                    {"links", r.links},
-                    {"recomputed", r.recomputed},
-                    {"reused", r.reused},
-                    {"visibility_only", r.visibilityOnly},
-                    {"nodes", r.nodes},
-                    {"iterations", r.iterations},
-                    {"refine_rounds", r.refineRounds},
-                    {"link_cap_reached", r.linkCapReached},
-                    {"cluster_links", r.clusterLinks},
-                    {"cluster_links_reused", r.clusterLinksReused},
-                    {"seconds_links", r.secondsLinks},
-                    {"seconds_solve", r.secondsSolve},
-                    {"seconds_coherence", r.secondsCoherence}});
+    nlohmann::json key = solve.keys[k].toJson();
+    key["key"] = k;
+    keys.push_back(std::move(key));
   }
   const KeyTotals t = totalsOf(solve.keys);
   return {{"key_times", keys},

@@ -29,6 +29,14 @@ struct GlobalOptions {
   int keyStep = 8;
   // radiosity.minArea 0 (the default): resolveMinArea's 1e-4 of the largest top-level patch.
   SpaceTimeOptions spaceTime;
+  // The render farm (issue 17): `window` FIRST-LAST solves only the run's key times within
+  // those frames and writes them as a key window file; `merge` names such files, made by the
+  // same command line with other windows, to merge into the run's link hierarchy instead of
+  // solving. Neither is a parameter of the solution (the merged file is the whole run's, byte
+  // for byte, provenance included), so toJson leaves them out: a window file records its window
+  // in its metadata.
+  std::string window;
+  std::vector<std::string> merge;
 
   // The provenance parameters: every parameter under its flag's name ("frames", "fps",
   // "key-step", "eps", "oracle", "min-area", "rays", "tol", "bad-links", "partial-threshold",
@@ -36,6 +44,20 @@ struct GlobalOptions {
   // what ran.
   nlohmann::json toJson() const;
 };
+
+// The key indices (into keyTimesOf(frames, ...)) of the key frames within frames `window`
+// (FIRST-LAST, the --window syntax). Usage Error when the window is malformed, leaves the run's
+// frames or holds no key frame.
+struct KeyIndexRange {
+  size_t first = 0, last = 0;
+};
+KeyIndexRange windowKeys(const FrameRange& frames, int keyStep, const std::string& window);
+
+// The command line the whole run has that a --merge run stands for: argv without "--merge" and
+// the values it took (`merged`, in order), nor "--merge=VALUE". The merged file's provenance
+// records it, so it is the whole run's when the rest of the command line is.
+std::vector<std::string> argumentsWithoutMerge(int argc, const char* const* argv,
+                                               const std::vector<std::string>& merged);
 
 // The key times of frames first..last: keyFrames(first, last, keyStep) (the one key schedule,
 // frame_range.h), frame f at time f / fps (s).

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -102,6 +103,8 @@ class LinkIntervals {
   size_t rowCount() const { return rows_.size(); }
   // The samples a row contributes to GlobalSolution::linkSample*.
   static uint32_t sampleCount(const Row& r) { return r.constant ? 1 : r.valueCount; }
+  // Every key of the row has the bits of its first value (no per-key values kept).
+  static bool sameBitsThroughout(const Row& r) { return r.valueCount == 0; }
   // Calls f(key, fv, visibility) for every key of the row's run.
   template <class F>
   void forEachKey(const Row& r, F&& f) const {
@@ -302,15 +305,28 @@ KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, dou
   return kr;
 }
 
+// What the key-time pass leaves for the final merge: the union hierarchy, per key its record,
+// the links' activity intervals and the bad pairs (receiver top << 32 | shooter top); per key
+// the union's node count after its solve (for key windows).
+struct KeyPassResult {
+  PatchHierarchy hierarchy;
+  std::vector<KeyRecord> records;
+  LinkIntervals intervals;
+  std::unordered_set<uint64_t> badPairs;
+  std::vector<uint32_t> nodeCount;
+};
+
 // The key-time pass (paper §4.2): one hierarchical solve per key time on the shared union
 // hierarchy, each taking over what stays valid of the previous key's links (coherence), and
 // folded into the links' activity intervals, the bad pairs and the per-key radiosity as soon
-// as it is solved.
+// as it is solved. It solves keys first..last of `keyTimes` (a window; key k's record and
+// intervals index is k - first) and builds what depends on the whole animation from all of
+// `keyTimes`, so a window's keys come out as the whole run's.
 class KeyTimePass {
  public:
-  KeyTimePass(const Scene& scene, const std::vector<double>& keyTimes, const SpaceTimeOptions& opt,
-              SpaceTimeReport& rep)
-      : scene_(scene), keyTimes_(keyTimes), opt_(opt), rep_(rep) {
+  KeyTimePass(const Scene& scene, const std::vector<double>& keyTimes, size_t first, size_t last,
+              const SpaceTimeOptions& opt, SpaceTimeReport& rep)
+      : scene_(scene), keyTimes_(keyTimes), first_(first), last_(last), opt_(opt), rep_(rep) {
     auto tSetup = std::chrono::steady_clock::now();
     h_ = PatchHierarchy(scene.inputPolygons());
     if (h_.topCount() == 0) throw inputError(scene.path, "has no polygons");
@@ -318,7 +334,7 @@ class KeyTimePass {
     surfaces_ = surfacePropertiesOf(scene, h_);
     vis_ = std::make_unique<SceneVisibility>(scene, h_, keyTimes.front(), keyTimes.back());
     rep_.topPatches = T_;
-    records_.resize(keyTimes.size());
+    records_.resize(last - first + 1);
     movingTops_ = movingTopsOf(scene, h_, keyTimes.front(), keyTimes.back());
     if (opt_.radiosity.clustering)
       clusters_ = clusterTreeOf(scene, h_, keyTimes.front(), keyTimes.back());
@@ -327,24 +343,25 @@ class KeyTimePass {
 
   void run() {
     KeySolution prev;
-    for (size_t k = 0; k < keyTimes_.size(); ++k) {
+    for (size_t k = first_; k <= last_; ++k) {
       KeySolution s = solveKey(k, prev);
-      foldLinks(s, uint32_t(k));
+      const size_t r = k - first_;
+      foldLinks(s, uint32_t(r));
       std::vector<glm::dvec3> b = pushedDown(s, h_);
-      records_[k].radiosity.assign(b.begin(), b.end());
-      records_[k].exposure.assign(s.exposure.begin(), s.exposure.end());  // one per node
-      records_[k].goodClosure = pushedDownClosure(s, h_);
-      records_[k].clusterIrradiance.assign(s.topClusterIrradiance.begin(),
+      records_[r].radiosity.assign(b.begin(), b.end());
+      records_[r].exposure.assign(s.exposure.begin(), s.exposure.end());  // one per node
+      records_[r].goodClosure = pushedDownClosure(s, h_);
+      records_[r].clusterIrradiance.assign(s.topClusterIrradiance.begin(),
                                            s.topClusterIrradiance.end());
+      nodeCount_.push_back(uint32_t(h_.size()));
       prev = std::move(s);
     }
   }
 
-  PatchHierarchy& hierarchy() { return h_; }
-  LinkIntervals& intervals() { return intervals_; }
-  // The bad pairs, receiver top << 32 | shooter top.
-  const std::unordered_set<uint64_t>& badPairs() const { return badPairs_; }
-  const std::vector<KeyRecord>& records() const { return records_; }
+  KeyPassResult take() {
+    return {std::move(h_), std::move(records_), std::move(intervals_), std::move(badPairs_),
+            std::move(nodeCount_)};
+  }
 
  private:
   KeySolution solveKey(size_t k, const KeySolution& prev) {
@@ -359,7 +376,7 @@ class KeyTimePass {
     LeafFormFactorCache leafCache;
     ClusterLinkCache clusterCache;
     double secondsCoherence = 0;
-    if (opt_.coherence && k > 0) {
+    if (opt_.coherence && k > first_) {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
       in.reuse = &cache;
@@ -395,13 +412,15 @@ class KeyTimePass {
 
   const Scene& scene_;
   const std::vector<double>& keyTimes_;
+  size_t first_, last_;
   const SpaceTimeOptions& opt_;
   SpaceTimeReport& rep_;
   PatchHierarchy h_;
   size_t T_ = 0;
   std::vector<SurfaceProperties> surfaces_;
   std::unique_ptr<SceneVisibility> vis_;
-  std::vector<KeyRecord> records_;
+  std::vector<KeyRecord> records_;   // per key first..last
+  std::vector<uint32_t> nodeCount_;  // per key: h_.size() after its solve
   // The activity intervals so far, compacted as each key time finishes (memory: the compact
   // result, not every key's links).
   LinkIntervals intervals_;
@@ -411,27 +430,38 @@ class KeyTimePass {
   ClosedNodeCache closedCache_;  // coherence: static nodes' closed-room tests, all keys so far
 };
 
-// Merge: radiosity per node and key; nodes created after key k take their ancestor's value
-// there (a parent's index is below its children's, so it is filled first).
-void mergeNodeRadiosity(const std::vector<KeyRecord>& records, const PatchHierarchy& h,
-                        GlobalSolution& g) {
+// One per-node field of the key records as node i, key k at i * K + k (GlobalSolution's and
+// KeyWindow's layout). A node made after key k, beyond its record, takes `absent` or, without
+// it, its parent's value at k (a parent's index is below its children's: filled first).
+template <class T>
+std::vector<T> nodeByKey(const std::vector<KeyRecord>& records, std::vector<T> KeyRecord::*field,
+                         const PatchHierarchy& h, std::optional<T> absent = std::nullopt) {
   const size_t N = size_t(h.size()), K = records.size();
-  g.nodeRadiosity.assign(N * K, glm::vec3(0.0f));
+  std::vector<T> out(N * K);
   for (size_t k = 0; k < K; ++k) {
-    const KeyRecord& rec = records[k];
-    for (size_t i = 0; i < N; ++i) {
-      glm::vec3 b = i < rec.radiosity.size()
-                        ? rec.radiosity[i]
-                        : g.nodeRadiosity[size_t(h.node(int(i)).parent) * K + k];
-      g.nodeRadiosity[i * K + k] = b;
-    }
+    const std::vector<T>& v = records[k].*field;
+    for (size_t i = 0; i < N; ++i)
+      out[i * K + k] = i < v.size() ? v[i]
+                       : absent     ? *absent
+                                    : out[size_t(h.node(int(i)).parent) * K + k];
   }
+  return out;
 }
 
-void mergeBadPairs(const std::unordered_set<uint64_t>& badPairs, GlobalSolution& g) {
+// Merge: radiosity per node and key; nodes created after key k take their ancestor's value.
+void mergeNodeRadiosity(const std::vector<KeyRecord>& records, const PatchHierarchy& h,
+                        GlobalSolution& g) {
+  g.nodeRadiosity = nodeByKey(records, &KeyRecord::radiosity, h);
+}
+
+// Merge: the bad pairs as (receiver top, shooter top), sorted.
+std::vector<std::pair<uint32_t, uint32_t>> sortedBadPairs(
+    const std::unordered_set<uint64_t>& badPairs) {
   std::vector<uint64_t> sorted(badPairs.begin(), badPairs.end());
   std::sort(sorted.begin(), sorted.end());
-  for (uint64_t p : sorted) g.badPairs.emplace_back(uint32_t(p >> 32), uint32_t(p & 0xffffffffu));
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+  for (uint64_t p : sorted) out.emplace_back(uint32_t(p >> 32), uint32_t(p & 0xffffffffu));
+  return out;
 }
 
 // One activity interval as a GlobalLink, its samples appended to g.linkSample*.
@@ -703,11 +733,7 @@ void mergeLeafVertexIrradiance(const std::vector<glm::dvec3>& goodH,
 // per-texel gather of rad-movies (good_link_gather.h), which divides as the solve did.
 void mergeNodeExposure(const std::vector<KeyRecord>& records, const PatchHierarchy& h,
                        GlobalSolution& g) {
-  const size_t K = records.size(), N = size_t(h.size());
-  g.nodeExposure.assign(N * K, 1.0f);
-  for (size_t k = 0; k < K; ++k)
-    for (size_t i = 0; i < std::min(N, records[k].exposure.size()); ++i)
-      g.nodeExposure[i * K + k] = records[k].exposure[i];
+  g.nodeExposure = nodeByKey(records, &KeyRecord::exposure, h, std::optional<float>(1.0f));
 }
 
 // Merge: per top and key, the irradiance gathered through cluster links; left empty when no key
@@ -726,32 +752,382 @@ void mergeClusterIrradiance(const std::vector<KeyRecord>& records, size_t T, Glo
 
 }  // namespace
 
-GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
-                              const SpaceTimeOptions& opt, SpaceTimeReport* report) {
-  SpaceTimeReport localReport;
-  SpaceTimeReport& rep = report ? *report : localReport;
-  if (keyTimes.empty()) throw Error(ExitCode::kUsage, "", "no key times");
-  KeyTimePass pass(scene, keyTimes, opt, rep);
-  pass.run();
+namespace {
 
+// The final merge, the same whether the key-time pass ran whole (solveSpaceTime) or in windows
+// (mergeKeyWindows): node radiosity and exposure per key, bad pairs, cluster irradiance, link
+// rows with their F·V samples, the good-link irradiance at the union leaves' vertices.
+GlobalSolution mergeKeyTimes(KeyPassResult& pass, const std::vector<double>& keyTimes,
+                             SpaceTimeReport& rep) {
   auto tMerge = std::chrono::steady_clock::now();
   GlobalSolution g;
   g.keyTimes = keyTimes;
-  mergeNodeRadiosity(pass.records(), pass.hierarchy(), g);
-  mergeNodeExposure(pass.records(), pass.hierarchy(), g);
-  mergeBadPairs(pass.badPairs(), g);
-  mergeClusterIrradiance(pass.records(), size_t(pass.hierarchy().topCount()), g);
+  mergeNodeRadiosity(pass.records, pass.hierarchy, g);
+  mergeNodeExposure(pass.records, pass.hierarchy, g);
+  g.badPairs = sortedBadPairs(pass.badPairs);
+  mergeClusterIrradiance(pass.records, size_t(pass.hierarchy.topCount()), g);
   std::vector<glm::dvec3> goodH =
-      mergeLinks(pass.intervals(), pass.badPairs(), pass.records(), pass.hierarchy(), g);
-  pass.intervals() = LinkIntervals();  // its memory back before the leaf arrays
-  mergeLeafVertexIrradiance(goodH, pass.records(), pass.hierarchy(), g);
-  rep.unionNodes = size_t(pass.hierarchy().size());
-  g.hierarchy = std::move(pass.hierarchy());
+      mergeLinks(pass.intervals, pass.badPairs, pass.records, pass.hierarchy, g);
+  pass.intervals = LinkIntervals();  // its memory back before the leaf arrays
+  mergeLeafVertexIrradiance(goodH, pass.records, pass.hierarchy, g);
+  rep.unionNodes = size_t(pass.hierarchy.size());
+  g.hierarchy = std::move(pass.hierarchy);
   g.validate("rad-global");
   rep.secondsMerge = secondsSince(tMerge);
   rep.linkRows = g.links.size();
   rep.badPairs = g.badPairs.size();
   return g;
+}
+
+// A window's rows: its links' activity intervals in ascending (receiver, shooter) order, rows
+// in key order, each with one value when every key has the first one's bits, else one per key.
+// Ends the adding of `intervals`.
+void windowLinksOf(LinkIntervals& intervals, KeyWindow& w) {
+  for (const auto& [link, firstRow] : intervals.takeSortedLinks())
+    for (uint32_t ri = firstRow; ri != LinkIntervals::kNone; ri = intervals.row(ri).nextRow) {
+      const LinkIntervals::Row& r = intervals.row(ri);
+      GlobalLink l;
+      l.receiver = uint32_t(link >> 32);
+      l.shooter = uint32_t(link & 0xffffffffu);
+      l.firstKey = r.firstKey;
+      l.lastKey = r.lastKey;
+      l.sampleOffset = uint32_t(w.linkValues.size());
+      l.flags = r.refined ? kLinkRefined : 0;
+      auto keep = [&](uint32_t, float fv, float v) {
+        w.linkValues.push_back(fv);
+        w.linkVisibility.push_back(v);
+      };
+      if (LinkIntervals::sameBitsThroughout(r))
+        keep(r.firstKey, r.firstFv, r.firstVisibility);
+      else
+        intervals.forEachKey(r, keep);
+      l.sampleCount = uint32_t(w.linkValues.size()) - l.sampleOffset;
+      w.links.push_back(l);
+    }
+}
+
+// Which window each key of the run comes from: the first, in `order` (by first key), that holds
+// it. Throws naming the window beside a gap when a key is in none.
+std::vector<size_t> keyOwners(const std::vector<KeyWindow>& windows,
+                              const std::vector<size_t>& order,
+                              const std::vector<std::string>& names,
+                              const std::vector<double>& keyTimes) {
+  const size_t K = keyTimes.size();
+  constexpr size_t kNoWindow = ~size_t(0);
+  std::vector<size_t> owner(K, kNoWindow);
+  for (size_t w : order)
+    for (size_t k = windows[w].firstKey; k < windows[w].firstKey + windows[w].keyCount(); ++k)
+      if (owner[k] == kNoWindow) owner[k] = w;
+  for (size_t k = 0; k < K; ++k) {
+    if (owner[k] != kNoWindow) continue;
+    size_t end = k;
+    while (end + 1 < K && owner[end + 1] == kNoWindow) ++end;
+    const std::string missing =
+        (k == end ? "key " + std::to_string(k)
+                  : "keys " + std::to_string(k) + "-" + std::to_string(end)) +
+        " of the run's " + std::to_string(K) + " (t = " + std::to_string(keyTimes[k]) +
+        (k == end ? "" : " .. " + std::to_string(keyTimes[end])) + " s)";
+    // Named: the window before the gap, or the first one when the gap opens the run.
+    const size_t beside = k > 0 ? owner[k - 1] : order.front();
+    const KeyWindow& b = windows[beside];
+    throw inputError(names[beside],
+                     missing + (k == end ? " is" : " are") + " in none of the " +
+                         std::to_string(windows.size()) + " windows; this one " +
+                         (k > 0 ? "ends at key " + std::to_string(b.firstKey + b.keyCount() - 1)
+                                : "starts at key " + std::to_string(b.firstKey)));
+  }
+  return owner;
+}
+
+// Windows that share a key must hold the same solution there (the same run's windows do, bit
+// for bit): compared on the top-level patches' radiosity and exposure, which every solve change
+// reaches.
+void checkSharedKeys(const std::vector<KeyWindow>& windows, const std::vector<size_t>& owner,
+                     const std::vector<std::string>& names, size_t T) {
+  for (size_t w = 0; w < windows.size(); ++w) {
+    const KeyWindow& a = windows[w];
+    for (size_t ka = 0; ka < a.keyCount(); ++ka) {
+      const size_t k = a.firstKey + ka;
+      if (owner[k] == w) continue;
+      const KeyWindow& b = windows[owner[k]];
+      const size_t kb = k - b.firstKey;
+      for (size_t t = 0; t < T; ++t)
+        if (std::memcmp(&a.radiosity[t * a.keyCount() + ka], &b.radiosity[t * b.keyCount() + kb],
+                        sizeof(glm::vec3)) != 0 ||
+            std::memcmp(&a.exposure[t * a.keyCount() + ka], &b.exposure[t * b.keyCount() + kb],
+                        sizeof(float)) != 0)
+          throw inputError(names[w], "key " + std::to_string(k) +
+                                         " (t = " + std::to_string(a.keyTimes[ka]) +
+                                         " s) differs from " + names[owner[k]] +
+                                         "'s: the windows were not computed alike");
+    }
+  }
+}
+
+// Replays the windows' subdivisions key by key into `h` (the tops alone at first): key k's new
+// nodes, in the order its solve made them, are made where `h` does not have them yet, which is
+// the whole run's order (a key splits the same nodes in the same order whatever the union
+// before it). Returns per key the node count after it.
+std::vector<uint32_t> replaySubdivisions(const std::vector<KeyWindow>& windows,
+                                         const std::vector<size_t>& owner,
+                                         const std::vector<std::string>& names, PatchHierarchy& h) {
+  std::vector<uint32_t> count(owner.size());
+  for (size_t k = 0; k < owner.size(); ++k) {
+    const KeyWindow& w = windows[owner[k]];
+    const size_t kw = k - w.firstKey;
+    const uint32_t begin = kw > 0 ? w.nodeCount[kw - 1] : uint32_t(w.hierarchy.topCount());
+    for (uint32_t i = begin; i < w.nodeCount[kw]; i += 4) {
+      const int p = h.find(w.hierarchy.node(w.hierarchy.node(int(i)).parent).id);
+      if (p < 0)
+        throw inputError(names[owner[k]], "node " + std::to_string(i) + " made at key " +
+                                              std::to_string(k) +
+                                              " has a parent no key before it made");
+      if (h.isLeaf(p)) h.subdivide(p);
+    }
+    count[k] = uint32_t(h.size());
+  }
+  return count;
+}
+
+// Per node of `of`, its dense index in `in`, -1 where `in` has no such node.
+std::vector<int> nodeIndices(const PatchHierarchy& of, const PatchHierarchy& in) {
+  std::vector<int> out(size_t(of.size()));
+  for (int i = 0; i < of.size(); ++i) out[size_t(i)] = in.find(of.node(i).id);
+  return out;
+}
+
+// Key k's record over the merged hierarchy's first `count` nodes from window w's key kw: its
+// node's values where the window has the node; elsewhere (a node the window never made, not
+// in the key's tree) the parent's B and closure factor and exposure 1, as the whole run's.
+KeyRecord recordOf(const KeyWindow& w, size_t kw, const std::vector<int>& windowIndex,
+                   const PatchHierarchy& h, uint32_t count) {
+  const size_t K = w.keyCount();
+  KeyRecord r;
+  r.radiosity.resize(count);
+  r.exposure.resize(count);
+  r.goodClosure.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    const int wi = windowIndex[i];
+    const size_t parent = size_t(h.node(int(i)).parent);  // filled first (a lower index)
+    r.radiosity[i] = wi >= 0 ? w.radiosity[size_t(wi) * K + kw] : r.radiosity[parent];
+    r.exposure[i] = wi >= 0 ? w.exposure[size_t(wi) * K + kw] : 1.0f;
+    r.goodClosure[i] = wi >= 0 ? w.goodClosure[size_t(wi) * K + kw] : r.goodClosure[parent];
+  }
+  if (!w.clusterIrradiance.empty()) {
+    const size_t T = size_t(h.topCount());
+    r.clusterIrradiance.resize(T);
+    for (size_t t = 0; t < T; ++t) r.clusterIrradiance[t] = w.clusterIrradiance[t * K + kw];
+  }
+  return r;
+}
+
+// Re-adds window w's link values at the keys it owns to `intervals`, in key order per link
+// (the windows are taken in order of their first keys, so a link's keys keep increasing): the
+// rows that span windows join as in the whole run.
+void addWindowLinks(const KeyWindow& w, size_t self, const std::vector<size_t>& owner,
+                    const std::vector<int>& mergedIndex, const std::vector<uint32_t>& count,
+                    const std::string& name, LinkIntervals& intervals) {
+  for (size_t li = 0; li < w.links.size(); ++li) {
+    const GlobalLink& l = w.links[li];
+    const int rcv = mergedIndex[l.receiver], sh = mergedIndex[l.shooter];
+    for (uint32_t kw = l.firstKey; kw <= l.lastKey; ++kw) {
+      const size_t k = w.firstKey + kw;
+      if (owner[k] != self) continue;
+      if (rcv < 0 || sh < 0 || uint32_t(rcv) >= count[k] || uint32_t(sh) >= count[k])
+        throw inputError(name, "link row " + std::to_string(li) + " names a node key " +
+                                   std::to_string(k) + " does not have");
+      const uint32_t j = l.sampleOffset + (l.sampleCount == 1 ? 0 : kw - l.firstKey);
+      intervals.add((uint64_t(uint32_t(rcv)) << 32) | uint32_t(sh), uint32_t(k), w.linkValues[j],
+                    w.linkVisibility[j], (l.flags & kLinkRefined) != 0);
+    }
+  }
+}
+
+}  // namespace
+
+nlohmann::json KeyTimeReport::toJson() const {
+  return {{"time", time},
+          {"links", links},
+          {"recomputed", recomputed},
+          {"reused", reused},
+          {"visibility_only", visibilityOnly},
+          {"nodes", nodes},
+          {"iterations", iterations},
+          {"refine_rounds", refineRounds},
+          {"link_cap_reached", linkCapReached},
+          {"cluster_links", clusterLinks},
+          {"cluster_links_reused", clusterLinksReused},
+          {"seconds_links", secondsLinks},
+          {"seconds_solve", secondsSolve},
+          {"seconds_coherence", secondsCoherence}};
+}
+
+KeyTimeReport KeyTimeReport::fromJson(const nlohmann::json& j) {
+  KeyTimeReport r;
+  if (!j.is_object()) return r;
+  r.time = j.value("time", 0.0);
+  r.links = j.value("links", size_t(0));
+  r.recomputed = j.value("recomputed", size_t(0));
+  r.reused = j.value("reused", size_t(0));
+  r.visibilityOnly = j.value("visibility_only", size_t(0));
+  r.nodes = j.value("nodes", size_t(0));
+  r.iterations = j.value("iterations", 0);
+  r.refineRounds = j.value("refine_rounds", 0);
+  r.linkCapReached = j.value("link_cap_reached", false);
+  r.clusterLinks = j.value("cluster_links", size_t(0));
+  r.clusterLinksReused = j.value("cluster_links_reused", size_t(0));
+  r.secondsLinks = j.value("seconds_links", 0.0);
+  r.secondsSolve = j.value("seconds_solve", 0.0);
+  r.secondsCoherence = j.value("seconds_coherence", 0.0);
+  return r;
+}
+
+GlobalSolution solveSpaceTime(const Scene& scene, const std::vector<double>& keyTimes,
+                              const SpaceTimeOptions& opt, SpaceTimeReport* report) {
+  SpaceTimeReport localReport;
+  SpaceTimeReport& rep = report ? *report : localReport;
+  if (keyTimes.empty()) throw Error(ExitCode::kUsage, "", "no key times");
+  KeyTimePass pass(scene, keyTimes, 0, keyTimes.size() - 1, opt, rep);
+  pass.run();
+  KeyPassResult result = pass.take();
+  return mergeKeyTimes(result, keyTimes, rep);
+}
+
+KeyWindow solveKeyWindow(const Scene& scene, const std::vector<double>& keyTimes, size_t firstKey,
+                         size_t lastKey, const SpaceTimeOptions& opt, SpaceTimeReport* report) {
+  SpaceTimeReport localReport;
+  SpaceTimeReport& rep = report ? *report : localReport;
+  if (firstKey > lastKey || lastKey >= keyTimes.size())
+    throw Error(ExitCode::kUsage, "",
+                "key window " + std::to_string(firstKey) + "-" + std::to_string(lastKey) +
+                    " is not within the " + std::to_string(keyTimes.size()) + " key times");
+  KeyTimePass pass(scene, keyTimes, firstKey, lastKey, opt, rep);
+  pass.run();
+  KeyPassResult r = pass.take();
+  auto tPack = std::chrono::steady_clock::now();
+  KeyWindow w;
+  w.firstKey = uint32_t(firstKey);
+  w.keyTimes.assign(keyTimes.begin() + long(firstKey), keyTimes.begin() + long(lastKey) + 1);
+  w.nodeCount = std::move(r.nodeCount);
+  w.radiosity = nodeByKey(r.records, &KeyRecord::radiosity, r.hierarchy);
+  w.exposure = nodeByKey(r.records, &KeyRecord::exposure, r.hierarchy, std::optional<float>(1.0f));
+  w.goodClosure = nodeByKey(r.records, &KeyRecord::goodClosure, r.hierarchy);
+  const size_t T = size_t(r.hierarchy.topCount()), K = w.keyCount();
+  if (!r.records.front().clusterIrradiance.empty()) {  // the same at every key (the run's tree)
+    w.clusterIrradiance.assign(T * K, glm::vec3(0.0f));
+    for (size_t k = 0; k < K; ++k)
+      for (size_t t = 0; t < std::min(T, r.records[k].clusterIrradiance.size()); ++t)
+        w.clusterIrradiance[t * K + k] = r.records[k].clusterIrradiance[t];
+  }
+  windowLinksOf(r.intervals, w);
+  w.badPairs = sortedBadPairs(r.badPairs);
+  w.hierarchy = std::move(r.hierarchy);
+  w.reports = rep.keys;
+  rep.unionNodes = size_t(w.hierarchy.size());
+  rep.linkRows = w.links.size();
+  rep.badPairs = w.badPairs.size();
+  w.validate("rad-global");
+  rep.secondsMerge = secondsSince(tPack);
+  return w;
+}
+
+GlobalSolution mergeKeyWindows(const Scene& scene, const std::vector<double>& keyTimes,
+                               std::vector<KeyWindow> windows,
+                               const std::vector<std::string>& names, SpaceTimeReport* report) {
+  SpaceTimeReport localReport;
+  SpaceTimeReport& rep = report ? *report : localReport;
+  auto tMerge = std::chrono::steady_clock::now();
+  if (windows.empty() || names.size() != windows.size())
+    throw Error(ExitCode::kUsage, "", "no key windows to merge");
+  KeyPassResult pass;
+  pass.hierarchy = PatchHierarchy(scene.inputPolygons());
+  const size_t K = keyTimes.size(), T = size_t(pass.hierarchy.topCount());
+  for (size_t w = 0; w < windows.size(); ++w) {
+    const KeyWindow& win = windows[w];
+    win.validate(names[w]);
+    if (size_t(win.hierarchy.topCount()) != T)
+      throw inputError(names[w], "has " + std::to_string(win.hierarchy.topCount()) +
+                                     " top-level patches; this scene has " + std::to_string(T));
+    if (win.firstKey + win.keyCount() > K ||
+        !std::equal(win.keyTimes.begin(), win.keyTimes.end(), keyTimes.begin() + win.firstKey))
+      throw inputError(names[w], "its key times are not this run's keys " +
+                                     std::to_string(win.firstKey) +
+                                     ".. (another --frames, --fps "
+                                     "or --key-step?)");
+  }
+  std::vector<size_t> order(windows.size());
+  for (size_t w = 0; w < order.size(); ++w) order[w] = w;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return windows[a].firstKey < windows[b].firstKey; });
+  const std::vector<size_t> owner = keyOwners(windows, order, names, keyTimes);
+  checkSharedKeys(windows, owner, names, T);
+
+  const std::vector<uint32_t> count = replaySubdivisions(windows, owner, names, pass.hierarchy);
+  pass.records.resize(K);
+  for (size_t w : order) {
+    const KeyWindow& win = windows[w];
+    const std::vector<int> windowIndex = nodeIndices(pass.hierarchy, win.hierarchy);
+    for (size_t kw = 0; kw < win.keyCount(); ++kw)
+      if (owner[win.firstKey + kw] == w)
+        pass.records[win.firstKey + kw] =
+            recordOf(win, kw, windowIndex, pass.hierarchy, count[win.firstKey + kw]);
+    addWindowLinks(win, w, owner, nodeIndices(win.hierarchy, pass.hierarchy), count, names[w],
+                   pass.intervals);
+    for (const auto& [r, s] : win.badPairs) pass.badPairs.insert((uint64_t(r) << 32) | s);
+    for (size_t kw = 0; kw < win.keyCount() && win.reports.size() == win.keyCount(); ++kw)
+      if (owner[win.firstKey + kw] == w) rep.keys.push_back(win.reports[kw]);
+    windows[w] = KeyWindow();  // its memory back
+  }
+  rep.topPatches = T;
+  GlobalSolution g = mergeKeyTimes(pass, keyTimes, rep);
+  rep.secondsMerge = secondsSince(tMerge);
+  return g;
+}
+
+void KeyWindow::validate(const std::string& where) const {
+  const size_t K = keyCount(), N = size_t(hierarchy.size()), T = size_t(hierarchy.topCount());
+  auto fail = [&](const std::string& what) { throw inputError(where, what); };
+  if (K == 0) fail("has no key times");
+  for (size_t k = 0; k < K; ++k)
+    if (!std::isfinite(keyTimes[k]) || (k > 0 && !(keyTimes[k] > keyTimes[k - 1])))
+      fail("key times do not strictly increase at key " + std::to_string(k));
+  if (nodeCount.size() != K)
+    fail("has " + std::to_string(nodeCount.size()) + " node counts; expected one per key (" +
+         std::to_string(K) + ")");
+  for (size_t k = 0; k < K; ++k)
+    if (nodeCount[k] < (k > 0 ? nodeCount[k - 1] : T) || (nodeCount[k] - T) % 4 != 0 ||
+        nodeCount[k] > N || (k + 1 == K && nodeCount[k] != N))
+      fail("node count " + std::to_string(nodeCount[k]) + " of key " + std::to_string(k) +
+           " does not fit the " + std::to_string(N) + " nodes");
+  if (radiosity.size() != N * K || exposure.size() != N * K || goodClosure.size() != N * K)
+    fail("per-node arrays do not have nodes x keys = " + std::to_string(N * K) + " values");
+  for (size_t i = 0; i < N * K; ++i) {
+    const glm::vec3& b = radiosity[i];
+    if (!(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.z)))
+      fail("radiosity of node " + std::to_string(i / K) + " is not finite");
+    if (!(exposure[i] >= 0.0f && exposure[i] <= 1.0f))
+      fail("exposure of node " + std::to_string(i / K) + " is not in [0, 1]");
+    if (!std::isfinite(goodClosure[i]))
+      fail("closure factor of node " + std::to_string(i / K) + " is not finite");
+  }
+  if (!clusterIrradiance.empty() && clusterIrradiance.size() != T * K)
+    fail("cluster irradiance has " + std::to_string(clusterIrradiance.size()) +
+         " values; expected tops x keys = " + std::to_string(T * K));
+  if (linkValues.size() != linkVisibility.size())
+    fail("link values and visibilities differ in number");
+  for (size_t i = 0; i < links.size(); ++i) {
+    const GlobalLink& l = links[i];
+    const uint64_t span = uint64_t(l.lastKey) - l.firstKey + 1;
+    if (l.receiver >= N || l.shooter >= N || l.firstKey > l.lastKey || l.lastKey >= K ||
+        l.receiver >= nodeCount[l.firstKey] || l.shooter >= nodeCount[l.firstKey] ||
+        (l.sampleCount != 1 && l.sampleCount != span) ||
+        uint64_t(l.sampleOffset) + l.sampleCount > linkValues.size())
+      fail("link row " + std::to_string(i) + " is out of range");
+  }
+  for (size_t i = 0; i < badPairs.size(); ++i)
+    if (badPairs[i].first >= T || badPairs[i].second >= T ||
+        (i > 0 && !(badPairs[i - 1] < badPairs[i])))
+      fail("bad pair " + std::to_string(i) + " names no top or is out of order");
 }
 
 }  // namespace rad

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -163,6 +164,75 @@ TEST(RadGlobal, LinkBoundWarnsAndIsReported) {
     EXPECT_LE(k["links"].get<size_t>(), 1000u);
   }
   EXPECT_EQ(ContainerReader::open(out).metadata().at("parameters").at("max-links"), 1000);
+  fs::remove_all(d);
+}
+
+// The render farm (issue 17): windows of the run's key times solved apart (on any number of
+// threads, overlapping or not) and merged give the bytes of the run itself, provenance
+// included: the merge is the run's command line plus --merge. Keys of frames 0-12 at key step
+// 4: 0, 4, 8, 12.
+TEST(RadGlobal, WindowsMergeToTheRunsBytes) {
+  fs::path d = scratchDir();
+  const std::string run = "cd " + d.string() + " && " + tool("rad-global") + " " + kScene + kFlags;
+  ASSERT_EQ(runCommand(run + " -o global.rlh --report report.json").exitCode, 0);
+  fs::rename(d / "global.rlh", d / "single.rlh");
+  const std::string single = readWholeFile((d / "single.rlh").string());
+  ASSERT_GT(single.size(), 1000u);
+  const std::vector<std::vector<std::string>> sets = {
+      {"0-5", "6-12"}, {"0-3", "4-8", "9-12"}, {"8-12", "0-8", "2-6"}};  // 3rd: overlaps
+  for (const auto& set : sets) {
+    std::string files;
+    for (size_t i = 0; i < set.size(); ++i) {
+      const std::string w = "w" + std::to_string(i) + ".rkw";
+      auto r = runCommand(run + " -o " + w + " --window " + set[i] + " --threads " +
+                          std::to_string(1 + i % 2));
+      ASSERT_EQ(r.exitCode, 0) << set[i] << ": " << r.err;
+      files += " " + w;
+    }
+    auto m = runCommand(run + " -o global.rlh --report report.json --merge" + files);
+    ASSERT_EQ(m.exitCode, 0) << m.err;
+    EXPECT_TRUE(readWholeFile((d / "global.rlh").string()) == single) << set.front();
+    nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "report.json").string()));
+    EXPECT_EQ(rep["key_times"].size(), 4u) << "every key's figures, from the windows";
+    fs::remove(d / "global.rlh");
+  }
+  // rad-inspect knows the window file.
+  auto inspect = runCommand(tool("rad-inspect") + " " + (d / "w0.rkw").string());
+  EXPECT_EQ(inspect.exitCode, 0) << inspect.err;
+  EXPECT_NE(inspect.out.find("keywindow"), std::string::npos) << inspect.out;
+  fs::remove_all(d);
+}
+
+// A window missing, a window of another run, a corrupted window, a window outside the frames:
+// one line `rad-global: path: what is wrong`, and no output.
+TEST(RadGlobal, MergeOfWindowsThatDoNotMakeTheRunIsOneLineError) {
+  fs::path d = scratchDir();
+  const std::string run = tool("rad-global") + " " + kScene + kFlags;
+  const std::string w0 = (d / "w0.rkw").string(), w2 = (d / "w2.rkw").string();
+  const std::string other = (d / "other.rkw").string(), out = (d / "g.rlh").string();
+  ASSERT_EQ(runCommand(run + " -o " + w0 + " --window 0-5").exitCode, 0);
+  ASSERT_EQ(runCommand(run + " -o " + w2 + " --window 9-12").exitCode, 0);
+  auto expectError = [&](const std::string& cmd, int code, const std::string& what) {
+    auto r = runCommand(cmd);
+    EXPECT_EQ(r.exitCode, code) << cmd << "\n" << r.err;
+    EXPECT_EQ(test::countLines(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("rad-global: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << cmd;
+  };
+  expectError(run + " -o " + out + " --merge " + w0 + " " + w2, 1, w0 + ": key 2 of the run's 4");
+  ASSERT_EQ(runCommand(tool("rad-global") + " " + kScene +
+                       " --frames 0-12 --key-step 4 --eps 1e-2 -o " + other + " --window 6-8")
+                .exitCode,
+            0);
+  expectError(run + " -o " + out + " --merge " + w0 + " " + other + " " + w2, 1,
+              other + ": built with --eps 0.01; this run expects 0.003");
+  std::string bytes = readWholeFile(w2);
+  bytes[bytes.size() / 2] ^= 0x40;
+  std::ofstream(w2, std::ios::binary | std::ios::trunc) << bytes;
+  expectError(run + " -o " + out + " --merge " + w0 + " " + w2, 1, w2 + ": ");
+  expectError(run + " -o " + out + " --window 10-20", 2, "--window 10-20 is not within");
+  expectError(run + " -o " + out + " --window 1-3", 2, "holds no key frame");
   fs::remove_all(d);
 }
 

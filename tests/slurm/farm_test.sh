@@ -2,12 +2,14 @@
 # The farm test (ctest label `farm`, issue 17): the bundled scene's 24 frames through
 # pipelines/slurm.mk on a real single-node Slurm cluster (tests/slurm/cluster.sh), SHARDS=4,
 # WAIT=1, against animation.mk's frames on this machine:
-#   1. every frame's pixels (EXR and PNG) are bit-identical to animation.mk's (the files differ
-#      only in their provenance, which records each task's own command line and paths);
+#   1. with rad-global in 3 time windows and a merge (GLOBAL_WINDOWS=3), global.rlh is the single
+#      run's byte for byte, and every frame's pixels (EXR and PNG) are bit-identical to
+#      animation.mk's (the frame files differ only in their provenance, which records each
+#      task's own command line and paths);
 #   2. a movies task killed mid-run makes WAIT fail with one line naming the stage, the task and
 #      its log; the dependent jobs are cancelled; nothing downstream is marked done; the re-run
 #      submits only the killed shard and ends with the same frames;
-#   3. an up-to-date run submits nothing.
+#   3. an up-to-date run submits nothing, and a change of COMPOSE_FLAGS only the frames on.
 # Needs root (it starts slurmctld/slurmd): without it, skipped with one line (exit 77).
 #
 #   tests/slurm/farm_test.sh BIN_DIR WORK_DIR
@@ -58,10 +60,22 @@ same_frames() {
   [ "$n" -eq 48 ] || fail "$a has $n frame files, expected 48"
 }
 
-# 1. A whole run.
-make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 WAIT=1 2>"$work/farm.err" ||
-  fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
+# 1. A whole run, rad-global in 3 time windows and their merge.
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 GLOBAL_WINDOWS=3 WAIT=1 \
+  2>"$work/farm.err" || fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
 same_frames "$work/local" "$work/farm"
+# The merged global.rlh is the one rad-global writes in one piece, byte for byte (provenance
+# included: the merge records the single run's command line, which names this OUT).
+global_cmd=$(make -s -f pipelines/animation.mk "${common[@]}" "OUT=$work/farm" stage-commands |
+  awk -F'\t' '$1 == "global" {print $2}')
+mv "$work/farm/global.rlh" "$work/farm/global-merged.rlh"
+mv "$work/farm/global-report.json" "$work/farm/global-merged-report.json"
+sh -c "$global_cmd" 2>/dev/null || fail "the single rad-global run failed: $global_cmd"
+cmp -s "$work/farm/global.rlh" "$work/farm/global-merged.rlh" ||
+  fail "the merge of 3 windows differs from the single run's global.rlh"
+mv -f "$work/farm/global-merged.rlh" "$work/farm/global.rlh"
+mv -f "$work/farm/global-merged-report.json" "$work/farm/global-report.json"
+echo "farm_test: rad-global in 3 windows merges into the single run's global.rlh, byte for byte"
 for f in movie.mp4 contact-sheet.png movies/.done frames/.done logs/movies_3.log logs/compose_3.log; do
   [ -s "$work/farm/$f" ] || [ -e "$work/farm/$f" ] || fail "$work/farm/$f is missing"
 done
@@ -71,6 +85,13 @@ echo "farm_test: 24 frames through slurm.mk (SHARDS=4) have animation.mk's pixel
 make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 WAIT=1 2>"$work/again.err" ||
   fail "the up-to-date re-run failed"
 if grep -q submitted "$work/again.err"; then fail "an up-to-date run submitted: $(cat "$work/again.err")"; fi
+# A parameter change submits what animation.mk would re-run: COMPOSE_FLAGS, only the frames on.
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 COMPOSE_FLAGS="--exposure 0.5" WAIT=1 \
+  2>"$work/change.err" || fail "the re-run with other COMPOSE_FLAGS failed"
+stages=$(sed -n 's/^slurm.mk: \([a-z0-9-]*\) submitted:.*/\1/p' "$work/change.err" | tr '\n' ' ')
+[ "$stages" = "compose frames-done mp4 contact-sheet " ] ||
+  fail "COMPOSE_FLAGS=--exposure 0.5 submitted: $stages (expected compose frames-done mp4 contact-sheet)"
+echo "farm_test: an up-to-date run submits nothing; COMPOSE_FLAGS submits only: $stages"
 
 # 2. Kill movies task 1 mid-run: submit without waiting, kill its rad-movies once it runs.
 out=$work/kill

@@ -13,6 +13,7 @@
 #include <tbb/task_arena.h>
 
 #include "formats/gltf_scene.h"
+#include "libcommon/core/error.h"
 
 namespace rad {
 namespace {
@@ -363,5 +364,71 @@ TEST(SpaceTimeRadiosity, CoarseCeilingGathersTheWallsAsItSeesThem) {
   EXPECT_LT(std::abs(coarse / fine - 1.0), 0.015);
   EXPECT_GT(std::abs(coarseMean / fine - 1.0), 0.025);
 }
+
+// The render farm (issue 17): key windows solved apart, even overlapping and given out of order,
+// merge into the whole run's solution bit for bit, the union's node order included (a later
+// window lacks the nodes earlier keys made, and makes them in another order), and rows whose
+// activity spans windows rejoin.
+TEST(SpaceTimeRadiosity, KeyWindowsMergeToTheWholeRun) {
+  const Scene scene = cornell();
+  const std::vector<double> keys = {0.0, 3 / 24.0, 6 / 24.0, 9 / 24.0, 12 / 24.0};
+  const SpaceTimeOptions o = fastOptions();
+  const GlobalSolution whole = solveSpaceTime(scene, keys, o);
+  std::vector<KeyWindow> windows;
+  windows.push_back(solveKeyWindow(scene, keys, 3, 4, o));
+  windows.push_back(solveKeyWindow(scene, keys, 0, 1, o));
+  windows.push_back(solveKeyWindow(scene, keys, 1, 3, o));  // overlaps both
+  // The later windows' own node order is not the run's: the merge must replay it.
+  bool otherOrder = false;
+  for (int i = 0; i < windows[0].hierarchy.size() && i < whole.hierarchy.size(); ++i)
+    otherOrder |= windows[0].hierarchy.node(i).id != whole.hierarchy.node(i).id;
+  EXPECT_TRUE(otherOrder);
+  const GlobalSolution merged = mergeKeyWindows(scene, keys, windows, {"w34", "w01", "w123"});
+  expectIdentical(merged, whole);
+  EXPECT_TRUE(merged.topClusterIrradiance == whole.topClusterIrradiance);
+  // Some row spans the windows' seam and came out as one row.
+  size_t spanning = 0;
+  for (const GlobalLink& l : whole.links) spanning += l.firstKey <= 1 && l.lastKey >= 3;
+  EXPECT_GT(spanning, 0u);
+}
+
+// A key in no window names the window before the gap; windows that share a key and disagree
+// there, or come from other key times, are one-line errors naming the window.
+TEST(SpaceTimeRadiosity, KeyWindowsThatDoNotMakeTheRunAreErrors) {
+  const Scene scene = cornell();
+  const std::vector<double> keys = {0.0, 6 / 24.0, 12 / 24.0};
+  SpaceTimeOptions o = fastOptions();
+  o.radiosity.eps = 1e-2;
+  const KeyWindow first = solveKeyWindow(scene, keys, 0, 0, o);
+  const KeyWindow last = solveKeyWindow(scene, keys, 2, 2, o);
+  auto message = [&](std::vector<KeyWindow> windows, std::vector<std::string> names,
+                     const std::vector<double>& times) {
+    try {
+      mergeKeyWindows(scene, times, std::move(windows), names);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ExitCode::kBadInput);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string gap = message({last, first}, {"last.rkw", "first.rkw"}, keys);
+  EXPECT_EQ(gap.rfind("first.rkw: key 1 of the run's 3", 0), 0u) << gap;
+  EXPECT_NE(gap.find("this one ends at key 0"), std::string::npos) << gap;
+  const std::string start = message({last}, {"last.rkw"}, keys);
+  EXPECT_NE(start.find("keys 0-1 of the run's 3"), std::string::npos) << start;
+  EXPECT_NE(start.find("this one starts at key 2"), std::string::npos) << start;
+
+  KeyWindow other = solveKeyWindow(scene, keys, 0, 2, o);
+  other.radiosity[0].x *= 2.0f;  // top 0 at key 0
+  const std::string differ = message({first, other}, {"a.rkw", "b.rkw"}, keys);
+  EXPECT_EQ(differ.rfind("b.rkw: key 0", 0), 0u) << differ;
+  EXPECT_NE(differ.find("differs from a.rkw's"), std::string::npos) << differ;
+
+  const std::string times = message({first, last}, {"a.rkw", "b.rkw"}, {0.0, 0.25, 0.6});
+  EXPECT_EQ(times.rfind("b.rkw: its key times are not this run's", 0), 0u) << times;
+  for (const std::string& m : {gap, start, differ, times})
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
 }  // namespace
 }  // namespace rad

@@ -48,7 +48,7 @@ std::string boundDefault(CLI::Option& opt) {
 nlohmann::json defaultValue(CLI::Option& opt) {
   const std::string text = boundDefault(opt);
   if (opt.get_items_expected_max() == 0) return text == "true" || text == "1";  // a flag
-  if (text.empty()) return nullptr;
+  if (text.empty() || text == "[]") return nullptr;  // no default, or an empty list
   if (isNumberType(opt.get_type_name())) {
     nlohmann::json number = nlohmann::json::parse(text, nullptr, false);
     if (number.is_number()) return number;

@@ -31,8 +31,9 @@ int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** ar
 // Every option's default as one JSON object, for --print-defaults (Radiance's print_rdefaults):
 // keys are the long names without "--" ("eps", "key-step"), values the defaults the options
 // were bound with: numbers as JSON numbers, flags false, other values as strings, an option
-// with no default (empty string, unset std::optional) null. Positionals, --help, --version and
-// --print-defaults are left out. Call it before parsing (it reads the bound variables).
+// with no default (empty string or list, unset std::optional) null. Positionals, --help,
+// --version and --print-defaults are left out. Call it before parsing (it reads the bound
+// variables).
 nlohmann::json optionDefaults(CLI::App& app);
 
 // Runs body, mapping rad::Error and other exceptions to `tool: message` on stderr and the

@@ -1,12 +1,16 @@
 // rad-global: the first pass (paper §3.1, §4.2; DESIGN.md §6 "rad-global"): space-time
 // hierarchical radiosity over the key times of a frame range, written as global.rlh. The
 // options, key times, min-area default and report are libcommon/radiosity/global_stage.h, the
-// algorithm solveSpaceTime; this main parses, calls and reports.
+// algorithm solveSpaceTime; this main parses, calls and reports. For a render farm (issue 17)
+// --window solves a time window's keys into a key window file (solveKeyWindow,
+// formats/key_window.h) and --merge joins such files into the very global.rlh the whole run
+// writes (mergeKeyWindows).
 #include <chrono>
 #include <iostream>
 
 #include "formats/atomic_file.h"
 #include "formats/gltf_scene.h"
+#include "formats/key_window.h"
 #include "formats/link_hierarchy.h"
 #include "formats/provenance.h"
 #include "libcommon/core/stopwatch.h"
@@ -100,6 +104,75 @@ void addOptions(CLI::App& app, Options& o) {
       "--no-coherence", [&g] { g.spaceTime.coherence = false; },
       "recompute every link at every key time (the baseline of the speed-up)");
   app.add_option("--report", o.report, "also write the run report as JSON to this file");
+  // The render farm (issue 17): windows side by side, then one merge.
+  auto* window =
+      app.add_option(
+             "--window", g.window,
+             "render farm: solve only the run's key times within frames FIRST-LAST (the key grid "
+             "of "
+             "--frames and --key-step, so put the whole run's --frames) and write them to -o as a "
+             "key "
+             "window file for --merge; a window starts from scratch, so windows need not overlap")
+          ->type_name("FIRST-LAST");
+  app.add_option("--merge", g.merge,
+                 "render farm: instead of solving, merge these key window files (--window runs "
+                 "of this same command line that together hold every key time) into -o: the "
+                 "same bytes as the run without --merge, provenance included")
+      ->type_name("WINDOW")
+      ->excludes(window);
+}
+
+// The key-time pass alone, on the --window keys, written as a key window file.
+void writeWindow(const Options& o, const rad::Scene& scene, const rad::FrameRange& frames,
+                 const std::vector<double>& keyTimes, const rad::KeyIndexRange& keys,
+                 rad::GlobalReport& report, int argc, char** argv) {
+  const rad::GlobalOptions& g = o.global;
+  rad::KeyWindow window =
+      rad::solveKeyWindow(scene, keyTimes, keys.first, keys.last, g.spaceTime, &report.solve);
+  const nlohmann::json params = g.toJson();
+  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, params);
+  rad::addInput(prov, o.scene);
+  auto tWrite = std::chrono::steady_clock::now();
+  rad::writeKeyWindow(o.output, window, prov,
+                      {{"parameters", params},
+                       {"first_frame", frames.first},
+                       {"last_frame", frames.last},
+                       {"window", g.window},
+                       {"run_key_count", keyTimes.size()},
+                       {"coherence", g.spaceTime.coherence}});
+  report.secondsWrite = rad::secondsSince(tWrite);
+}
+
+// The run's global.rlh, solved or merged from key windows. A merge records the whole run's
+// command line (argv without the --merge words), so its bytes are the whole run's.
+void writeHierarchy(const Options& o, const rad::Scene& scene, const rad::FrameRange& frames,
+                    const std::vector<double>& keyTimes, rad::GlobalReport& report, int argc,
+                    char** argv) {
+  const rad::GlobalOptions& g = o.global;
+  const nlohmann::json params = g.toJson();
+  std::vector<std::string> words(argv, argv + argc);
+  rad::GlobalSolution solution;
+  if (g.merge.empty()) {
+    solution = rad::solveSpaceTime(scene, keyTimes, g.spaceTime, &report.solve);
+  } else {
+    auto tRead = std::chrono::steady_clock::now();
+    std::vector<rad::KeyWindow> windows =
+        rad::readKeyWindows(g.merge, scene, params, rad::hashFile(o.scene));
+    report.secondsRead += rad::secondsSince(tRead);
+    solution = rad::mergeKeyWindows(scene, keyTimes, std::move(windows), g.merge, &report.solve);
+    words = rad::argumentsWithoutMerge(argc, argv, g.merge);
+  }
+  std::vector<const char*> args;
+  for (const std::string& w : words) args.push_back(w.c_str());
+  rad::Provenance prov = rad::makeProvenance(kTool, int(args.size()), args.data(), params);
+  rad::addInput(prov, o.scene);
+  auto tWrite = std::chrono::steady_clock::now();
+  rad::writeLinkHierarchy(o.output, solution, prov,
+                          {{"parameters", params},
+                           {"first_frame", frames.first},
+                           {"last_frame", frames.last},
+                           {"coherence", g.spaceTime.coherence}});
+  report.secondsWrite = rad::secondsSince(tWrite);
 }
 
 int run(Options o, int argc, char** argv) {
@@ -117,21 +190,17 @@ int run(Options o, int argc, char** argv) {
   g.spaceTime.radiosity.minArea =
       rad::resolveMinArea(scene, g.spaceTime.radiosity.minArea, keyTimes.front());
 
-  rad::Progress progress(kTool, long(keyTimes.size()));
+  const rad::KeyIndexRange keys = g.window.empty() ? rad::KeyIndexRange{0, keyTimes.size() - 1}
+                                                   : rad::windowKeys(frames, g.keyStep, g.window);
+
+  rad::Progress progress(kTool, g.merge.empty() ? long(keys.last - keys.first + 1) : 0);
   g.spaceTime.onKeySolved = [&]() { progress.advance(); };
-  rad::GlobalSolution solution = rad::solveSpaceTime(scene, keyTimes, g.spaceTime, &report.solve);
+  if (g.window.empty())
+    writeHierarchy(o, scene, frames, keyTimes, report, argc, argv);
+  else
+    writeWindow(o, scene, frames, keyTimes, keys, report, argc, argv);
   progress.done();
 
-  nlohmann::json params = g.toJson();
-  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, params);
-  rad::addInput(prov, o.scene);
-  auto tWrite = std::chrono::steady_clock::now();
-  rad::writeLinkHierarchy(o.output, solution, prov,
-                          {{"parameters", params},
-                           {"first_frame", frames.first},
-                           {"last_frame", frames.last},
-                           {"coherence", g.spaceTime.coherence}});
-  report.secondsWrite = rad::secondsSince(tWrite);
   report.secondsTotal = rad::secondsSince(tStart);
   report.peakMemoryMb = rad::peakMemoryMb();
   report.coherence = g.spaceTime.coherence;
@@ -147,8 +216,14 @@ int main(int argc, char** argv) {
       "Space-time hierarchical radiosity (first pass): solves the scene at key times of a frame "
       "range with temporal coherence and writes the link hierarchy global.rlh."};
   Options o;
-  rad::setUpApp(app, kTool,
-                "rad-global scene.gltf -o global.rlh --frames 0-95 --fps 24 --key-step 8");
+  rad::setUpApp(
+      app, kTool,
+      "rad-global scene.gltf -o global.rlh --frames 0-95 --fps 24 --key-step 8\n"
+      "Render farm: windows side by side, then the merge (the bytes of the run without --window\n"
+      "or --merge; the windows need the run's --frames):\n"
+      "  rad-global scene.gltf -o w0.rkw --frames 0-95 --window 0-47\n"
+      "  rad-global scene.gltf -o w1.rkw --frames 0-95 --window 48-95\n"
+      "  rad-global scene.gltf -o global.rlh --frames 0-95 --merge w0.rkw w1.rkw");
   addOptions(app, o);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o, argc, argv); });
