@@ -64,8 +64,18 @@ install_packages() {
   done
   ((${#missing[@]})) || return 0
   say "installing ${missing[*]}"
-  apt-get update -qq >&2
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+  # The packaged services must not start (no /etc/slurm/slurm.conf; ours run from $DIR): on a
+  # machine without a policy-rc.d (a container image has one), one that forbids service starts
+  # is put in place for the install and removed after it.
+  local policy=/usr/sbin/policy-rc.d ours_policy=0
+  if [[ ! -e $policy ]]; then
+    printf '#!/bin/sh\nexit 101\n' >"$policy" && chmod 755 "$policy" && ours_policy=1
+  fi
+  local rc=0
+  apt-get update -qq >&2 && apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2 ||
+    rc=$?
+  ((ours_policy == 0)) || rm -f "$policy"
+  ((rc == 0)) || die "apt-get install ${missing[*]} failed (exit $rc)"
 }
 
 write_conf() {
