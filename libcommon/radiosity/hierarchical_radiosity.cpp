@@ -1034,6 +1034,14 @@ void SceneVisibility::setTime(double t) {
 }
 
 bool shaftMeetsBox(const Polygon& a, const Polygon& b, const glm::dvec3& lo, const glm::dvec3& hi) {
+  // Shaft::meets' first test, on the same exact min/max, before building the shaft's hulls:
+  // nearly every link of a coherent key misses the swept boxes here, and building a Shaft for
+  // each was 0.9 s of the 10k-triangle hall's ~10 s per coherent key (a perf profile).
+  glm::dvec3 sLo = a.v[0], sHi = a.v[0];
+  for (int i = 0; i < a.count; ++i) sLo = glm::min(sLo, a.v[i]), sHi = glm::max(sHi, a.v[i]);
+  for (int i = 0; i < b.count; ++i) sLo = glm::min(sLo, b.v[i]), sHi = glm::max(sHi, b.v[i]);
+  for (int k = 0; k < 3; ++k)
+    if (hi[k] < sLo[k] || lo[k] > sHi[k]) return false;
   return Shaft(a, b).meets(lo, hi);
 }
 
