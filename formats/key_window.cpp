@@ -65,22 +65,12 @@ void writeKeyWindow(const std::string& path, const KeyWindow& w, const Provenanc
                  w.radiosity.size() * sizeof(glm::vec3));
   out.addArrayView("node_exposure", w.exposure, {N, K});
   out.addArrayView("node_good_closure", w.goodClosure, {N, K});
-  std::vector<uint32_t> cols(M * 6);
-  std::vector<uint8_t> flags(M);
-  for (size_t i = 0; i < M; ++i) {
-    const GlobalLink& l = w.links[i];
-    const uint32_t row[6] = {l.receiver, l.shooter,      l.firstKey,
-                             l.lastKey,  l.sampleOffset, l.sampleCount};
-    std::copy(row, row + 6, cols.begin() + long(i) * 6);
-    flags[i] = l.flags;
-  }
-  out.addArrayView("links", cols, {M, 6});
-  out.addArrayView("link_flags", flags);
+  const LinkRowArrays rows = encodeLinkRows(w.links);
+  out.addArrayView("links", rows.cols, {M, 6});
+  out.addArrayView("link_flags", rows.flags);
   out.addArrayView("link_values", w.linkValues);
   out.addArrayView("link_visibility", w.linkVisibility);
-  std::vector<uint32_t> pairs;
-  for (const auto& [r, s] : w.badPairs) pairs.insert(pairs.end(), {r, s});
-  out.addArray("bad_pairs", pairs, {w.badPairs.size(), 2});
+  out.addArray("bad_pairs", encodeBadPairs(w.badPairs), {w.badPairs.size(), 2});
   if (!w.clusterIrradiance.empty())
     out.addRawView("top_cluster_irradiance", DType::kF32, {T, K, 3}, w.clusterIrradiance.data(),
                    w.clusterIrradiance.size() * sizeof(glm::vec3));
@@ -107,20 +97,10 @@ KeyWindow readKeyWindow(const ContainerReader& r, const Scene& scene) {
   w.radiosity = unflatten(sizedArray<float>(r, "node_radiosity", N * K * 3));
   w.exposure = sizedArray<float>(r, "node_exposure", N * K);
   w.goodClosure = sizedArray<float>(r, "node_good_closure", N * K);
-  std::vector<uint32_t> cols = r.array<uint32_t>("links");
-  std::vector<uint8_t> flags = r.array<uint8_t>("link_flags");
-  if (cols.size() != flags.size() * 6)
-    throw inputError(where, "links and link_flags differ in size");
-  w.links.resize(flags.size());
-  for (size_t i = 0; i < flags.size(); ++i) {
-    const uint32_t* c = &cols[i * 6];
-    w.links[i] = {c[0], c[1], c[2], c[3], c[4], c[5], flags[i]};
-  }
+  w.links = readLinkRows(r, where);
   w.linkValues = r.array<float>("link_values");
   w.linkVisibility = r.array<float>("link_visibility");
-  std::vector<uint32_t> pairs = r.array<uint32_t>("bad_pairs");
-  if (pairs.size() % 2) throw inputError(where, "bad_pairs has an odd size");
-  for (size_t i = 0; i < pairs.size(); i += 2) w.badPairs.emplace_back(pairs[i], pairs[i + 1]);
+  w.badPairs = readBadPairs(r, where);
   if (r.has("top_cluster_irradiance"))
     w.clusterIrradiance = unflatten(sizedArray<float>(r, "top_cluster_irradiance", T * K * 3));
   const auto reports = r.metadata().find("key_reports");

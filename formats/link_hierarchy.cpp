@@ -76,27 +76,14 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& s,
   w.addRawView("leaf_vertex_good_irradiance", DType::kF32, {L, K, 4, 3},
                s.leafVertexGoodIrradiance.data(),
                s.leafVertexGoodIrradiance.size() * sizeof(glm::vec3));
-  size_t M = s.links.size();
-  std::vector<uint32_t> cols(M * 6);
-  std::vector<uint8_t> flags(M);
-  for (size_t i = 0; i < M; ++i) {
-    const GlobalLink& l = s.links[i];
-    uint32_t row[6] = {l.receiver, l.shooter, l.firstKey, l.lastKey, l.sampleOffset, l.sampleCount};
-    std::copy(row, row + 6, cols.begin() + i * 6);
-    flags[i] = l.flags;
-  }
-  w.addArrayView("links", cols, {M, 6});
-  w.addArrayView("link_flags", flags);
+  const LinkRowArrays rows = encodeLinkRows(s.links);
+  w.addArrayView("links", rows.cols, {s.links.size(), 6});
+  w.addArrayView("link_flags", rows.flags);
   w.addArrayView("link_sample_keys", s.linkSampleKeys);
   w.addArrayView("link_sample_values", s.linkSampleValues);
   if (!s.linkSampleVisibility.empty())
     w.addArrayView("link_sample_visibility", s.linkSampleVisibility);
-  std::vector<uint32_t> pairs;
-  for (auto& p : s.badPairs) {
-    pairs.push_back(p.first);
-    pairs.push_back(p.second);
-  }
-  w.addArray("bad_pairs", pairs, {s.badPairs.size(), 2});
+  w.addArray("bad_pairs", encodeBadPairs(s.badPairs), {s.badPairs.size(), 2});
   if (!s.topClusterIrradiance.empty())  // since 1.3
     w.addRawView("top_cluster_irradiance", DType::kF32, {size_t(s.hierarchy.topCount()), K, 3},
                  s.topClusterIrradiance.data(), s.topClusterIrradiance.size() * sizeof(glm::vec3));
@@ -128,22 +115,12 @@ GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool r
   }
   if (r.has("node_exposure")) s.nodeExposure = r.array<float>("node_exposure");  // since 1.2
   s.leafVertexGoodIrradiance = unflatten(r.array<float>("leaf_vertex_good_irradiance"));
-  std::vector<uint32_t> cols = r.array<uint32_t>("links");
-  std::vector<uint8_t> flags = r.array<uint8_t>("link_flags");
-  if (cols.size() != flags.size() * 6)
-    throw inputError(where, "links and link_flags differ in size");
-  s.links.resize(flags.size());
-  for (size_t i = 0; i < flags.size(); ++i) {
-    const uint32_t* c = &cols[i * 6];
-    s.links[i] = {c[0], c[1], c[2], c[3], c[4], c[5], flags[i]};
-  }
+  s.links = readLinkRows(r, where);
   s.linkSampleKeys = r.array<uint32_t>("link_sample_keys");
   s.linkSampleValues = r.array<float>("link_sample_values");
   if (r.has("link_sample_visibility"))  // since 1.2
     s.linkSampleVisibility = r.array<float>("link_sample_visibility");
-  std::vector<uint32_t> pairs = r.array<uint32_t>("bad_pairs");
-  if (pairs.size() % 2) throw inputError(where, "bad_pairs has an odd size");
-  for (size_t i = 0; i < pairs.size(); i += 2) s.badPairs.emplace_back(pairs[i], pairs[i + 1]);
+  s.badPairs = readBadPairs(r, where);
   if (r.has("top_cluster_irradiance")) {  // since 1.3
     std::vector<float> h = r.array<float>("top_cluster_irradiance");
     if (h.size() != tops * K * 3)
@@ -158,6 +135,50 @@ GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool r
 }
 
 }  // namespace
+
+LinkRowArrays encodeLinkRows(const std::vector<GlobalLink>& links) {
+  LinkRowArrays a;
+  a.cols.resize(links.size() * 6);
+  a.flags.resize(links.size());
+  for (size_t i = 0; i < links.size(); ++i) {
+    const GlobalLink& l = links[i];
+    const uint32_t row[6] = {l.receiver, l.shooter,      l.firstKey,
+                             l.lastKey,  l.sampleOffset, l.sampleCount};
+    std::copy(row, row + 6, a.cols.begin() + long(i) * 6);
+    a.flags[i] = l.flags;
+  }
+  return a;
+}
+
+std::vector<uint32_t> encodeBadPairs(const std::vector<std::pair<uint32_t, uint32_t>>& pairs) {
+  std::vector<uint32_t> out;
+  out.reserve(pairs.size() * 2);
+  for (const auto& [r, s] : pairs) out.insert(out.end(), {r, s});
+  return out;
+}
+
+std::vector<GlobalLink> readLinkRows(const ContainerReader& r, const std::string& where) {
+  const std::vector<uint32_t> cols = r.array<uint32_t>("links");
+  const std::vector<uint8_t> flags = r.array<uint8_t>("link_flags");
+  if (cols.size() != flags.size() * 6)
+    throw inputError(where, "links and link_flags differ in size");
+  std::vector<GlobalLink> links(flags.size());
+  for (size_t i = 0; i < flags.size(); ++i) {
+    const uint32_t* c = &cols[i * 6];
+    links[i] = {c[0], c[1], c[2], c[3], c[4], c[5], flags[i]};
+  }
+  return links;
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> readBadPairs(const ContainerReader& r,
+                                                        const std::string& where) {
+  const std::vector<uint32_t> pairs = r.array<uint32_t>("bad_pairs");
+  if (pairs.size() % 2) throw inputError(where, "bad_pairs has an odd size");
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+  out.reserve(pairs.size() / 2);
+  for (size_t i = 0; i < pairs.size(); i += 2) out.emplace_back(pairs[i], pairs[i + 1]);
+  return out;
+}
 
 GlobalSolution readLinkHierarchy(const ContainerReader& r, const Scene& scene) {
   return readSolution(r, scene, false);

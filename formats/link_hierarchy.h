@@ -2,7 +2,10 @@
 // Arrays and metadata: formats/link_hierarchy.md.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -37,6 +40,19 @@ GlobalSolution readLinkHierarchyRadiosity(const ContainerReader& reader, const S
 // groups of 4 siblings in subdivision order. Errors are rad::inputError(where, ...).
 PatchHierarchy hierarchyFromNodeIds(const std::vector<uint64_t>& ids, const Scene& scene,
                                     int64_t topCount, const std::string& where);
+
+// The `links` [M, 6] / `link_flags` [M] and `bad_pairs` [P, 2] arrays, as linkhier and keywindow
+// files store them (formats/link_hierarchy.md): encoded for a writer (which keeps them alive
+// while its views point at them) and decoded by a reader; errors are rad::inputError(where, ...).
+struct LinkRowArrays {
+  std::vector<uint32_t> cols;
+  std::vector<uint8_t> flags;
+};
+LinkRowArrays encodeLinkRows(const std::vector<GlobalLink>& links);
+std::vector<uint32_t> encodeBadPairs(const std::vector<std::pair<uint32_t, uint32_t>>& pairs);
+std::vector<GlobalLink> readLinkRows(const ContainerReader& reader, const std::string& where);
+std::vector<std::pair<uint32_t, uint32_t>> readBadPairs(const ContainerReader& reader,
+                                                        const std::string& where);
 
 // rad-inspect's content summary of a linkhier container (no scene needed).
 nlohmann::json summarizeLinkHierarchy(const ContainerReader& reader);

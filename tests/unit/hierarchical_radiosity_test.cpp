@@ -790,20 +790,36 @@ TEST(ClusterLinks, ExposedFloorMatchesAllPairsAtTheDefaultSeparation) {
   EXPECT_LT(std::abs(exposedBias(byDefault)), 0.01);
 }
 
+// A 6 x 3 x 5 m room tiled 6 x 6 per wall, a 1 m ceiling light facing down and a tiled box on
+// the floor (the link-bound tests' scene).
+struct LitRoom {
+  std::vector<Polygon> polys;
+  std::vector<SurfaceProperties> surf;
+  int light = 0;
+};
+LitRoom litRoom() {
+  LitRoom r;
+  r.polys = tiledBoxFaces({0, 0, 0}, {6, 3, 5}, true, 6);
+  r.light = int(r.polys.size());
+  r.polys.push_back(boxFaces({2.5, 2.9, 2.0}, {3.5, 3.0, 3.0}, false)[0]);  // faces down
+  for (const Polygon& p : tiledBoxFaces({1, 0, 1}, {2, 1, 2}, false, 2)) r.polys.push_back(p);
+  r.surf.resize(r.polys.size());
+  for (auto& s : r.surf) s.reflectance = glm::dvec3(0.7);
+  r.surf[size_t(r.light)].emission = glm::dvec3(10.0);
+  r.surf[size_t(r.light)].reflectance = glm::dvec3(0.0);
+  return r;
+}
+
 // At the link bound, refinement goes on for the lights' links only: every top that sees the
 // light keeps its own link to it (the second pass's per-texel shadows), and the bound is
 // reported. It had stopped wherever it was and not said so: the 30k-triangle hall lost 92 % of
 // its bad pairs, its lights reaching whole clusters unshadowed.
 TEST(ClusterLinks, LightsKeepTheirLinksAtTheLinkBound) {
-  std::vector<Polygon> polys = tiledBoxFaces({0, 0, 0}, {6, 3, 5}, true, 6);
-  const int light = int(polys.size());
-  polys.push_back(boxFaces({2.5, 2.9, 2.0}, {3.5, 3.0, 3.0}, false)[0]);  // faces down
-  for (const Polygon& p : tiledBoxFaces({1, 0, 1}, {2, 1, 2}, false, 2)) polys.push_back(p);
+  const LitRoom room = litRoom();
+  const std::vector<Polygon>& polys = room.polys;
+  const std::vector<SurfaceProperties>& surf = room.surf;
+  const int light = room.light;
   VisibilityScene vis(visibilityTrianglesOf(polys));
-  std::vector<SurfaceProperties> surf(polys.size());
-  for (auto& s : surf) s.reflectance = glm::dvec3(0.7);
-  surf[size_t(light)].emission = glm::dvec3(10.0);
-  surf[size_t(light)].reflectance = glm::dvec3(0.0);
   auto lit = [&](size_t maxLinks, bool& capped) {
     PatchHierarchy h = hierarchyOf(polys);
     RadiosityOptions o;
@@ -828,15 +844,10 @@ TEST(ClusterLinks, LightsKeepTheirLinksAtTheLinkBound) {
 // reported the bound at every key time with a quarter of it in use. A bound a little above what
 // an unbounded solve holds must now leave that solve as it was.
 TEST(ClusterLinks, LinkBoundCountsOnlyTheLinksInUse) {
-  std::vector<Polygon> polys = tiledBoxFaces({0, 0, 0}, {6, 3, 5}, true, 6);
-  const int light = int(polys.size());
-  polys.push_back(boxFaces({2.5, 2.9, 2.0}, {3.5, 3.0, 3.0}, false)[0]);  // faces down
-  for (const Polygon& p : tiledBoxFaces({1, 0, 1}, {2, 1, 2}, false, 2)) polys.push_back(p);
+  const LitRoom room = litRoom();
+  const std::vector<Polygon>& polys = room.polys;
+  const std::vector<SurfaceProperties>& surf = room.surf;
   VisibilityScene vis(visibilityTrianglesOf(polys));
-  std::vector<SurfaceProperties> surf(polys.size());
-  for (auto& s : surf) s.reflectance = glm::dvec3(0.7);
-  surf[size_t(light)].emission = glm::dvec3(10.0);
-  surf[size_t(light)].reflectance = glm::dvec3(0.0);
   auto solve = [&](size_t maxLinks) {
     PatchHierarchy h = hierarchyOf(polys);
     RadiosityOptions o;

@@ -122,6 +122,14 @@ void addOptions(CLI::App& app, Options& o) {
       ->excludes(window);
 }
 
+// The metadata of both outputs: what ran.
+nlohmann::json runMetadata(const rad::GlobalOptions& g, const rad::FrameRange& frames) {
+  return {{"parameters", g.toJson()},
+          {"first_frame", frames.first},
+          {"last_frame", frames.last},
+          {"coherence", g.spaceTime.coherence}};
+}
+
 // The key-time pass alone, on the --window keys, written as a key window file.
 void writeWindow(const Options& o, const rad::Scene& scene, const rad::FrameRange& frames,
                  const std::vector<double>& keyTimes, const rad::KeyIndexRange& keys,
@@ -129,17 +137,13 @@ void writeWindow(const Options& o, const rad::Scene& scene, const rad::FrameRang
   const rad::GlobalOptions& g = o.global;
   rad::KeyWindow window =
       rad::solveKeyWindow(scene, keyTimes, keys.first, keys.last, g.spaceTime, &report.solve);
-  const nlohmann::json params = g.toJson();
-  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, params);
+  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, g.toJson());
   rad::addInput(prov, o.scene);
+  nlohmann::json metadata = runMetadata(g, frames);
+  metadata["window"] = g.window;
+  metadata["run_key_count"] = keyTimes.size();
   auto tWrite = std::chrono::steady_clock::now();
-  rad::writeKeyWindow(o.output, window, prov,
-                      {{"parameters", params},
-                       {"first_frame", frames.first},
-                       {"last_frame", frames.last},
-                       {"window", g.window},
-                       {"run_key_count", keyTimes.size()},
-                       {"coherence", g.spaceTime.coherence}});
+  rad::writeKeyWindow(o.output, window, prov, metadata);
   report.secondsWrite = rad::secondsSince(tWrite);
 }
 
@@ -167,11 +171,7 @@ void writeHierarchy(const Options& o, const rad::Scene& scene, const rad::FrameR
   rad::Provenance prov = rad::makeProvenance(kTool, int(args.size()), args.data(), params);
   rad::addInput(prov, o.scene);
   auto tWrite = std::chrono::steady_clock::now();
-  rad::writeLinkHierarchy(o.output, solution, prov,
-                          {{"parameters", params},
-                           {"first_frame", frames.first},
-                           {"last_frame", frames.last},
-                           {"coherence", g.spaceTime.coherence}});
+  rad::writeLinkHierarchy(o.output, solution, prov, runMetadata(g, frames));
   report.secondsWrite = rad::secondsSince(tWrite);
 }
 
