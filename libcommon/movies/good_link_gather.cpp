@@ -234,7 +234,7 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
       }
       // A receiver partly covered by a touching solid: V counts the covered sample points as
       // occluded towards shooters outside the solid; the texel is exposed.
-      const glm::dvec3 b = solution_.radiosityAtKey(int(l.shooter), k);
+      const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(l.shooter), k);
       carried[j] = std::max(carried[j], (b.x + b.y + b.z) * fv);
       if (visibility_ && storedVisibility && v > 0.0 && v < 1.0)
         risk[j] = std::max(risk[j], (b.x + b.y + b.z) * fv * (1.0 - v));
@@ -516,7 +516,7 @@ void GoodLinkGather::planVisibility(Link& l, const std::vector<char>& needed) co
   const int K = solution_.keyCount(), k = visibilityRays_;
   for (int key = 0; key < K; ++key)
     if (needed[size_t(key)] && solution_.linkFvAtKey(g, key) > 0.0)
-      l.weight[size_t(key)] = solution_.radiosityAtKey(int(l.shooter), key);
+      l.weight[size_t(key)] = solution_.exposedRadiosityAtKey(int(l.shooter), key);
   l.seed = linkSeed(h.node(int(g.receiver)).id, h.node(int(l.shooter)).id);
   const double t0 = keyTimes_.front();
   const Polygon shooter = nodeWorld(l.shooter, t0);

@@ -108,6 +108,13 @@ void GlobalSolution::keyWeights(double t, int& k0, int& k1, double& w) const {
   w = (t - keyTimes[k0]) / (keyTimes[k1] - keyTimes[k0]);
 }
 
+glm::dvec3 GlobalSolution::exposedRadiosityAtKey(int node, int key) const {
+  int n = node;
+  while (!(exposureAtKey(n, key) > 0.0) && hierarchy.node(n).parent >= 0)
+    n = hierarchy.node(n).parent;
+  return radiosityAtKey(exposureAtKey(n, key) > 0.0 ? n : node, key);
+}
+
 glm::dvec3 GlobalSolution::radiosity(int node, double t) const {
   int k0, k1;
   double w;

@@ -86,6 +86,12 @@ class GlobalSolution {
   glm::dvec3 radiosityAtKey(int node, int key) const {
     return nodeRadiosity[size_t(node) * keyCount() + key];
   }
+  // B of node i at key k as a texel beside it sees it: a node wholly covered by a touching
+  // solid (exposure 0 at its ray start points) has no B of a surface anyone sees (its gather is
+  // skipped), yet a texel's point form factor can still take the sliver of it outside the
+  // solid's footprint; it then takes the B of its nearest ancestor with an exposed part (the
+  // exposed-area mean of that ancestor's children).
+  glm::dvec3 exposedRadiosityAtKey(int node, int key) const;
   // H_good at the point of top-level patch `top` with top-level (u,v) `uv`, at key k:
   // Gouraud-interpolated over the union leaf that contains the point.
   glm::dvec3 goodIrradianceAtKey(int top, glm::dvec2 uv, int key) const;

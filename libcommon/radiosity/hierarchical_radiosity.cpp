@@ -512,15 +512,17 @@ class KeyTimeSolver {
   // amplified by 1 / (1 - rho), made 7 % too bright at rho = 0.9 and 52 % at 0.99. The shooters
   // b_k of a leaf's links tile the top-level patches it is linked with, so for a top-level
   // patch q that every one of those links sees unoccluded (V = 1), the links to q carry exactly
-  // $F(r \to q)$ at the leaf's own resolution; the leaf's gathered irradiance is scaled by
-  //   $c_r = \sum_q G_q / \sum_k F(a_k \to b_k) V_k$,
-  // $G_q = F(r \to q)$ for such a q and $\sum_{k \in q} F(a_k \to b_k) V_k$ (unchanged) for a q
-  // any of whose links is occluded: row sums exact in a closed empty room at any refinement,
-  // and the averaging error of unoccluded pairs (a wall meeting the floor) removed in any
-  // scene, while the occluded pairs keep hierarchical radiosity's estimate (scaling them by an
-  // unoccluded ratio would brighten what an occluder darkens). The good-link share (shooters
-  // that do not emit: the default bad-link rule's good links) gets its own factor, which
-  // rad-global's merge applies to the good-link irradiance the second pass interpolates.
+  // $F(r \to q)$ at the leaf's own resolution; the leaf's links to such a q are scaled by
+  //   $c_{rq} = G_q / \sum_{k \in q} F(a_k \to b_k) V_k$,  $G_q = F(r \to q)$
+  // (topExcess_ holds c_rq - 1 per link), the links to a q any of whose links is occluded are
+  // kept: row sums exact in a closed empty room at any refinement, and the averaging error of
+  // unoccluded pairs (a wall meeting the floor) removed in any scene, while the occluded pairs
+  // keep hierarchical radiosity's estimate (scaling them by an unoccluded ratio would brighten
+  // what an occluder darkens). Per top, not one ratio for the row: a floor leaf beside a dim
+  // wall had its light scaled by the wall's ratio (1.85 in the bundled scene). The good-link
+  // share (shooters that do not emit: the default bad-link rule's good links) also gets one
+  // factor, goodClosure, which rad-global's merge applies to the good-link irradiance the
+  // Gouraud layer interpolates.
   void computeClosure() {
     buildGatherLists();
     const size_t N = size_t(h_.size());
@@ -529,6 +531,7 @@ class KeyTimeSolver {
     goodFactor_.assign(N, 1.0);
     closed_.resize(N, -1);  // kept from the rounds before: a node's rays do not change
     leafTopFormFactor_.resize(N);
+    topExcess_.assign(N, {});
     std::vector<int> leaves;
     for (size_t i = 0; i < N; ++i)
       if (s_.inTree(int(i), h_) && !s_.split[i]) leaves.push_back(int(i));
@@ -647,6 +650,10 @@ class KeyTimeSolver {
     // of rad-global's time on the table scene at eps 1e-4).
     for (size_t i = 0; i < known.size(); ++i) slot[known[i].first] = int(i);
     glm::dvec2 own(0.0), averaged(0.0);  // (all, good)
+    // Per top whose share is replaced, G_q / sum_k F V - 1 (0: kept), indexed like `slot`.
+    thread_local std::vector<double> excess;
+    excess.resize(size_t(h_.topCount()), 0.0);
+    bool anyExcess = false;
     for (const TopShare& t : shares) {
       double g = t.fv;
       if (t.unoccluded && t.fromAncestor && !moves(t.top) && !moves(h_.node(r).id.top)) {
@@ -656,16 +663,49 @@ class KeyTimeSolver {
           known.push_back({t.top, leafToTop(r, t.top)});
         }
         g = known[size_t(at)].second;
+        if (t.fv > 0.0 && g != t.fv) {
+          excess[t.top] = g / t.fv - 1.0;
+          anyExcess = true;
+        }
       }
       const double good = surfaces_[t.top].isEmitter() ? 0.0 : 1.0;
       own += glm::dvec2(g, good * g);
       averaged += glm::dvec2(t.fv, good * t.fv);
     }
     for (const std::pair<uint32_t, double>& k : known) slot[k.first] = -1;
-    if (averaged.x > 0.0) s_.closure[size_t(r)] = own.x / averaged.x;
+    // Each replaced top's links are scaled by their own top's ratio, the others kept: a leaf
+    // beside a wall sees much more of that dim wall than its ancestor's links say, and one
+    // ratio for the whole row had scaled the light by the wall's share too (the bundled
+    // scene's floor strip in front of the tall box came out 1.8x too bright, the box's foot on
+    // the frames with it).
+    std::vector<std::pair<size_t, double>>& extra = topExcess_[size_t(r)];
+    extra.clear();
+    if (anyExcess)
+      for (int a = r; a >= 0; a = h_.node(a).parent) {
+        const double e = exposure_[size_t(a)];
+        if (!(e > 0.0)) continue;
+        for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k) {
+          const double x = excess[h_.node(s_.links[adj_[k]].shooter).id.top];
+          if (x != 0.0) extra.emplace_back(adj_[k], x / e);
+        }
+      }
+    for (const TopShare& t : shares) excess[t.top] = 0.0;
+    // The good-link irradiance rad-movies interpolates (Gouraud layer) takes the good share's
+    // ratio as one factor.
     if (averaged.y > 0.0) s_.goodClosure[size_t(r)] = own.y / averaged.y;
-    goodFactor_[size_t(r)] = s_.closure[size_t(r)];
     if (opt_.closedRooms) closeRoomRow(r);
+  }
+
+  // A leaf's replaced tops' excess irradiance (topExcess_), (emitting shooters, the others).
+  std::pair<glm::dvec3, glm::dvec3> excessIrradiance(int r) const {
+    std::pair<glm::dvec3, glm::dvec3> H{glm::dvec3(0.0), glm::dvec3(0.0)};
+    if (size_t(r) >= topExcess_.size()) return H;
+    for (const auto& [k, c] : topExcess_[size_t(r)]) {
+      const SolverLink& l = s_.links[k];
+      (shooterEmits_[k] ? H.first : H.second) +=
+          c * double(l.fv()) * l.shooterShape * B_[size_t(l.shooter)];
+    }
+    return H;
   }
 
   // A leaf inside a closed room sees the scene's surfaces and nothing else, so the row sum of
@@ -681,13 +721,15 @@ class KeyTimeSolver {
   // row is scaled.
   void closeRoomRow(int r) {
     if (!(exposure_[size_t(r)] > 0.0)) return;
-    glm::dvec2 coef(0.0);  // (emitting shooters, the others)
+    glm::dvec2 coef(0.0);  // (emitting shooters, the others), the replaced tops' excess included
     for (int a = r; a >= 0; a = h_.node(a).parent) {
       const double e = exposure_[size_t(a)];
       if (!(e > 0.0)) continue;
       for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k)
         (shooterEmits_[adj_[k]] ? coef.x : coef.y) += s_.links[adj_[k]].fv() / e;
     }
+    for (const auto& [k, c] : topExcess_[size_t(r)])
+      (shooterEmits_[k] ? coef.x : coef.y) += c * s_.links[k].fv();
     if (!(coef.x + coef.y > 0.0) || !closedAt(r)) return;
     // The cluster links' share (gathered at the top, over its exposure) is taken as it is.
     const uint32_t top = h_.node(r).id.top;
@@ -793,6 +835,11 @@ class KeyTimeSolver {
         (shooterEmits_[adj_[k]] ? H.light : H.good) += term;
       }
     if (!s_.split[size_t(i)]) {
+      if (e > 0.0) {
+        const auto [light, good] = excessIrradiance(i);
+        H.light += light;
+        H.good += good;
+      }
       const glm::dvec3 irradiance =
           H.cluster + (s_.closure.empty()
                            ? H.light + H.good
@@ -899,6 +946,9 @@ class KeyTimeSolver {
   // Per dense node: the closure factor of a leaf's links to shooters that do not emit (its
   // closure factor, or the closed-room one).
   std::vector<double> goodFactor_;
+  // Per leaf: its chain's links whose top's share the closure replaces (link index, the top's
+  // G_q / sum F V - 1 over the exposure of the node that gathers it).
+  std::vector<std::vector<std::pair<size_t, double>>> topExcess_;
   std::vector<int8_t> closed_;         // per dense node: closedAt once cast (0 or 1), else -1
   std::vector<uint8_t> shooterEmits_;  // per link: its shooter's top-level patch emits
   std::vector<double> shooterRange_;   // per dense node: measureShooterRanges
