@@ -14,14 +14,15 @@
 
 namespace rad {
 
-// Reads the named channels of the first part (any pixel type, converted to float). Throws
-// rad::inputError(path, ...) if the file is unreadable or lacks a channel (the message lists
-// the channels it has).
+// Reads the named channels of the first part (any pixel type, converted to float). Every
+// channel is read, and checked against the part's rad.pixelChecksum when it has one (required
+// for rad frames 2.x; formats/pixel_checksum.h). Throws rad::inputError(path, ...) if the file
+// is unreadable, corrupted or lacks a channel (the message lists the channels it has).
 FloatImage readExrImage(const std::string& path,
                         const std::vector<std::string>& channels = {"R", "G", "B"});
 
 // Writes image atomically (AtomicFile) as FLOAT channels with the given string attributes
-// (e.g. "rad.provenance"). Throws rad::outputError(path, ...) on failure.
+// (e.g. "rad.provenance") and rad.pixelChecksum. Throws rad::outputError(path, ...) on failure.
 void writeExrImage(const std::string& path, const FloatImage& image,
                    const std::map<std::string, std::string>& stringAttributes = {});
 
@@ -43,6 +44,11 @@ class ExrFileStream : public Imf::OStream {
   void seekp(uint64_t pos) override { pos_ = pos; }
   // Writes what is buffered and closes the file (call it after OpenEXR's file object is gone).
   void close();
+  // The file's bytes [offset, offset + n) as written so far (fewer at its end), and an
+  // overwrite of bytes already written: for attributes a writer fills in after the pixels
+  // (TextureMovieWriter's rad.pixelChecksum). Both write what is buffered first.
+  std::vector<char> readBack(uint64_t offset, size_t n);
+  void overwrite(uint64_t offset, const std::string& bytes);
 
  private:
   void flush();

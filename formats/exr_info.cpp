@@ -14,6 +14,7 @@
 #include <OpenEXR/ImfStringVectorAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
 
+#include "formats/provenance.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -22,12 +23,17 @@ namespace {
 
 nlohmann::json attributeValue(const Imf::Attribute& a) {
   using namespace Imf;
-  if (auto* s = dynamic_cast<const StringAttribute*>(&a)) return s->value();
+  // Attribute strings are bytes; JSON needs UTF-8 (shown with U+FFFD where they are not).
+  if (auto* s = dynamic_cast<const StringAttribute*>(&a)) return rad::toValidUtf8(s->value());
   if (auto* i = dynamic_cast<const IntAttribute*>(&a)) return i->value();
   if (auto* f = dynamic_cast<const FloatAttribute*>(&a)) return f->value();
   if (auto* d = dynamic_cast<const DoubleAttribute*>(&a)) return d->value();
   if (auto* v = dynamic_cast<const FloatVectorAttribute*>(&a)) return v->value();
-  if (auto* v = dynamic_cast<const StringVectorAttribute*>(&a)) return v->value();
+  if (auto* v = dynamic_cast<const StringVectorAttribute*>(&a)) {
+    nlohmann::json strings = nlohmann::json::array();
+    for (const std::string& s : v->value()) strings.push_back(rad::toValidUtf8(s));
+    return strings;
+  }
   if (auto* b = dynamic_cast<const Box2iAttribute*>(&a)) {
     const auto& r = b->value();
     return {r.min.x, r.min.y, r.max.x, r.max.y};
@@ -40,7 +46,8 @@ nlohmann::json attributeValue(const Imf::Attribute& a) {
   if (auto* c = dynamic_cast<const CompressionAttribute*>(&a)) return int(c->value());
   if (auto* c = dynamic_cast<const ChannelListAttribute*>(&a)) {
     nlohmann::json names = nlohmann::json::array();
-    for (auto it = c->value().begin(); it != c->value().end(); ++it) names.push_back(it.name());
+    for (auto it = c->value().begin(); it != c->value().end(); ++it)
+      names.push_back(rad::toValidUtf8(it.name()));
     return names;
   }
   return std::string("<") + a.typeName() + ">";
@@ -68,23 +75,30 @@ nlohmann::json readExrInfo(const std::string& path) {
     for (int p = 0; p < file.parts(); ++p) {
       const Imf::Header& h = file.header(p);
       nlohmann::json part;
-      part["name"] = h.hasName() ? h.name() : "";
-      part["type"] = h.hasType() ? h.type() : "scanlineimage";
+      part["name"] = h.hasName() ? rad::toValidUtf8(h.name()) : "";
+      part["type"] = h.hasType() ? rad::toValidUtf8(h.type()) : "scanlineimage";
       const auto& dw = h.dataWindow();
       part["width"] = dw.max.x - dw.min.x + 1;
       part["height"] = dw.max.y - dw.min.y + 1;
       nlohmann::json channels = nlohmann::json::array();
       for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
-        channels.push_back({{"name", it.name()}, {"type", pixelTypeName(it.channel().type)}});
+        channels.push_back(
+            {{"name", rad::toValidUtf8(it.name())}, {"type", pixelTypeName(it.channel().type)}});
       }
       part["channels"] = channels;
       nlohmann::json attrs = nlohmann::json::object();
       for (auto it = h.begin(); it != h.end(); ++it)
-        attrs[it.name()] = attributeValue(it.attribute());
+        attrs[rad::toValidUtf8(it.name())] = attributeValue(it.attribute());
+      // A damaged provenance is an error naming the file, not a JSON exception.
+      if (const auto* pv = h.findTypedAttribute<Imf::StringAttribute>("rad.provenance"))
+        rad::parseProvenanceJson(pv->value(),
+                                 path + ": part " + std::to_string(p) + ": rad.provenance");
       part["attributes"] = attrs;
       parts.push_back(part);
     }
     return {{"parts", parts}};
+  } catch (const Error&) {
+    throw;
   } catch (const std::exception& e) {
     throw inputError(path, std::string("not a readable OpenEXR file: ") + e.what());
   }

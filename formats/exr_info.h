@@ -8,7 +8,9 @@
 namespace rad {
 
 // {"parts": [{"name", "type", "dataWindow", "channels": [...], "attributes": {name: value}}]}
-// Throws rad::inputError(path, ...) if the file is not a readable OpenEXR file.
+// Strings that are not UTF-8 are shown with U+FFFD. Throws rad::inputError(path, ...) if the
+// file is not a readable OpenEXR file or a part's rad.provenance is not a provenance JSON
+// (parseProvenanceJson). Headers only: verifyExrPixels (formats/pixel_checksum.h) reads pixels.
 nlohmann::json readExrInfo(const std::string& path);
 
 }  // namespace rad

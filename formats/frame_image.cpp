@@ -20,6 +20,8 @@
 #include <png.h>
 
 #include "formats/atomic_file.h"
+#include "formats/checksum.h"
+#include "formats/pixel_checksum.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -64,14 +66,22 @@ void writeFrameExr(const std::string& path, const ComposedFrame& frame, const Fr
   std::vector<Imath::half> halves;
   const char* base = reinterpret_cast<const char*>(frame.rgb.data());
   size_t elem = sizeof(float);
+  uint64_t checksum = 0;
   if (half) {
     // Half overflows at 65504: clamp rather than write inf (DESIGN.md §5).
     halves.resize(frame.rgb.size());
-    for (size_t i = 0; i < frame.rgb.size(); ++i)
+    std::vector<float> stored(frame.rgb.size());  // what a reader decodes
+    for (size_t i = 0; i < frame.rgb.size(); ++i) {
       halves[i] = Imath::half(std::min(frame.rgb[i], 65504.0f));
+      stored[i] = float(halves[i]);
+    }
     base = reinterpret_cast<const char*>(halves.data());
     elem = sizeof(Imath::half);
+    checksum = rgbPixelChecksum(stored.data(), w, h);
+  } else {
+    checksum = rgbPixelChecksum(frame.rgb.data(), w, h);
   }
+  header.insert(kPixelChecksumAttribute, Imf::StringAttribute(formatFnv1a64(checksum)));
   // Through ExrFileStream: an uncompressed file is one chunk per scanline, and OpenEXR writes
   // each with its own system call (240 per frame at 352x240).
   AtomicFile file(path, info.durability);

@@ -4,9 +4,10 @@
 // HALF with --half; values above 65504 are clamped there), row 0 = top; uncompressed unless
 // --compression says otherwise (ZIP saved 7 % of the bytes of noise-free float radiance and
 // doubled rad-compose's time on the table scene).
-// String/int/double attributes: rad.format "frame 1.0", rad.frame, rad.time, rad.units,
-// rad.exposureEV (what the PNG used), rad.coveredPixels, rad.moviePixels, rad.fallbackPixels and
-// rad.provenance (Provenance::toJson().dump()). Readable with exrheader / oiiotool / rad-inspect.
+// String/int/double attributes: rad.format "frame 2.0", rad.pixelChecksum
+// (formats/pixel_checksum.h), rad.frame, rad.time, rad.units, rad.exposureEV (what the PNG used),
+// rad.coveredPixels, rad.moviePixels, rad.fallbackPixels and rad.provenance
+// (Provenance::toJson().dump()). Readable with exrheader / oiiotool / rad-inspect.
 //
 // PNG: 8-bit sRGB of the radiance scaled by 2^exposureEV (frame_composer.h toSrgb8), written
 // with libpng; the provenance goes into its "Description" text chunk (zTXt).
@@ -24,7 +25,7 @@
 
 namespace rad {
 
-constexpr int kFrameImageMajor = 1;
+constexpr int kFrameImageMajor = 2;
 constexpr int kFrameImageMinor = 0;
 
 struct FrameImageInfo {

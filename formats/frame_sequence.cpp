@@ -18,6 +18,40 @@
 namespace rad {
 namespace {
 
+// Throws rad::inputError(path, ...) unless the movie is the one the intervals describe.
+void requireMovieMatches(const TextureMovie& movie, const MovieExtent& iv,
+                         const std::string& path) {
+  auto differs = [&](const std::string& what, const std::string& got, const std::string& expected) {
+    throw inputError(path, what + " " + got + " differs from the intervals' " + expected +
+                               " (movie " + std::to_string(iv.movie) + ")");
+  };
+  if (movie.patch != iv.patch) differs("patch", movie.patch.toString(), iv.patch.toString());
+  if (movie.firstFrame != iv.firstFrame || movie.lastFrame != iv.lastFrame)
+    differs("frames", std::to_string(movie.firstFrame) + "-" + std::to_string(movie.lastFrame),
+            std::to_string(iv.firstFrame) + "-" + std::to_string(iv.lastFrame));
+  if (movie.width != iv.width || movie.height != iv.height)
+    differs("texture size", std::to_string(movie.width) + "x" + std::to_string(movie.height),
+            std::to_string(iv.width) + "x" + std::to_string(iv.height));
+}
+
+// True if one of the sorted `frames` lies in the movie's interval.
+bool usedByFrames(const MovieExtent& iv, const std::vector<int>& frames) {
+  const auto f = std::lower_bound(frames.begin(), frames.end(), iv.firstFrame);
+  return f != frames.end() && *f <= iv.lastFrame;
+}
+
+// Every movie the frames use: its headers read and checked (rad.format, parts, checksums
+// present, patch, frames, size) before the first frame is written, so that a bad or missing
+// movie leaves no frame behind. The pixels are verified as each key is loaded.
+void checkMovieHeaders(const TextureIntervals& intervals, const std::string& dir,
+                       const std::vector<int>& frames) {
+  for (const MovieExtent& iv : intervals.movies) {
+    if (!usedByFrames(iv, frames)) continue;
+    const std::string path = textureMoviePath(dir, iv.movie);
+    requireMovieMatches(readTextureMovieHeaders(path), iv, path);
+  }
+}
+
 // The movies in memory: read on first use, dropped once the frames have passed their last.
 class MovieCache {
  public:
@@ -31,19 +65,7 @@ class MovieCache {
     const MovieExtent& iv = intervals_.movies[index];
     std::string path = textureMoviePath(dir_, iv.movie);
     auto stream = std::make_unique<TextureMovieStream>(path);
-    const TextureMovie* movie = &stream->movie();
-    auto differs = [&](const std::string& what, const std::string& got,
-                       const std::string& expected) {
-      throw inputError(path, what + " " + got + " differs from the intervals' " + expected +
-                                 " (movie " + std::to_string(iv.movie) + ")");
-    };
-    if (movie->patch != iv.patch) differs("patch", movie->patch.toString(), iv.patch.toString());
-    if (movie->firstFrame != iv.firstFrame || movie->lastFrame != iv.lastFrame)
-      differs("frames", std::to_string(movie->firstFrame) + "-" + std::to_string(movie->lastFrame),
-              std::to_string(iv.firstFrame) + "-" + std::to_string(iv.lastFrame));
-    if (movie->width != iv.width || movie->height != iv.height)
-      differs("texture size", std::to_string(movie->width) + "x" + std::to_string(movie->height),
-              std::to_string(iv.width) + "x" + std::to_string(iv.height));
+    requireMovieMatches(stream->movie(), iv, path);
     ++read_;
     TextureMovieStream& ref = *stream;
     loaded_.emplace(index, std::move(stream));
@@ -115,6 +137,7 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
                       std::to_string(intervals.lastFrame));
   if (!(options.fps > 0.0)) throw Error(ExitCode::kUsage, "--fps", "must be positive");
 
+  checkMovieHeaders(intervals, options.moviesDir, frames);
   std::error_code ec;
   std::filesystem::create_directories(options.framesDir, ec);
   if (ec || !std::filesystem::is_directory(options.framesDir))
@@ -134,47 +157,58 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
   MovieCache cache(intervals, options.moviesDir);
   ComposedFrame frame;
   std::vector<MovieTexture> active;
-  for (int f : frames) {
-    const auto frameStart = Clock::now();
-    cache.evictBefore(f);
-    const double t = f / options.fps;
-    active.clear();
-    for (size_t i = 0; i < intervals.movies.size(); ++i) {
-      const MovieExtent& iv = intervals.movies[i];
-      if (iv.firstFrame > f || iv.lastFrame < f) continue;
-      TextureMovieStream& stream = cache.get(i);
-      const TextureMovie& movie = stream.movie();
-      MovieTexture mt;
-      mt.patch = movie.patch;
-      mt.width = movie.width;
-      mt.height = movie.height;
-      // The two key textures around t, blended per sampled texel by the composer (no copy of
-      // the texture: those copies, one per active movie, grew to 41 MB on the 32-cube scene).
-      if (movie.constant())
-        mt.irradiance = stream.key(0).data();
-      else
-        stream.keysAt(t, mt.irradiance, mt.nextIrradiance, mt.weight);
-      active.push_back(mt);
-    }
-    composer.compose(t, active, frame);
-    info.frame = f;
-    writeFrameExr(framePath(options.framesDir, f, ".exr"), frame, info, options.half,
-                  options.compression);
-    if (options.png) writeFramePng(framePath(options.framesDir, f, ".png"), frame, info);
-    if (frame.fallbackPixels > 0 && warn)
-      warn("frame " + std::to_string(f) + ": " + std::to_string(frame.fallbackPixels) +
-           " pixels fell back to the global solution");
+  try {
+    for (int f : frames) {
+      const auto frameStart = Clock::now();
+      cache.evictBefore(f);
+      const double t = f / options.fps;
+      active.clear();
+      for (size_t i = 0; i < intervals.movies.size(); ++i) {
+        const MovieExtent& iv = intervals.movies[i];
+        if (iv.firstFrame > f || iv.lastFrame < f) continue;
+        TextureMovieStream& stream = cache.get(i);
+        const TextureMovie& movie = stream.movie();
+        MovieTexture mt;
+        mt.patch = movie.patch;
+        mt.width = movie.width;
+        mt.height = movie.height;
+        // The two key textures around t, blended per sampled texel by the composer (no copy of
+        // the texture: those copies, one per active movie, grew to 41 MB on the 32-cube scene).
+        if (movie.constant())
+          mt.irradiance = stream.key(0).data();
+        else
+          stream.keysAt(t, mt.irradiance, mt.nextIrradiance, mt.weight);
+        active.push_back(mt);
+      }
+      composer.compose(t, active, frame);
+      info.frame = f;
+      writeFrameExr(framePath(options.framesDir, f, ".exr"), frame, info, options.half,
+                    options.compression);
+      if (options.png) writeFramePng(framePath(options.framesDir, f, ".png"), frame, info);
+      if (frame.fallbackPixels > 0 && warn)
+        warn("frame " + std::to_string(f) + ": " + std::to_string(frame.fallbackPixels) +
+             " pixels fell back to the global solution");
 
-    ComposeFrameStats s;
-    s.frame = f;
-    s.time = t;
-    s.movies = int(active.size());
-    s.coveredPixels = frame.coveredPixels;
-    s.moviePixels = frame.moviePixels;
-    s.fallbackPixels = frame.fallbackPixels;
-    s.seconds = std::chrono::duration<double>(Clock::now() - frameStart).count();
-    report.frames.push_back(s);
-    if (progress) progress();
+      ComposeFrameStats s;
+      s.frame = f;
+      s.time = t;
+      s.movies = int(active.size());
+      s.coveredPixels = frame.coveredPixels;
+      s.moviePixels = frame.moviePixels;
+      s.fallbackPixels = frame.fallbackPixels;
+      s.seconds = std::chrono::duration<double>(Clock::now() - frameStart).count();
+      report.frames.push_back(s);
+      if (progress) progress();
+    }
+  } catch (const Error& e) {
+    // A key whose pixels fail their checksum is found only when it is loaded: say which frames
+    // this run had written (Make takes none as done: frames/.done follows the exit status).
+    if (report.frames.empty()) throw;
+    throw Error(e.code(), "",
+                std::string(e.what()) + " (after writing " + std::to_string(report.frames.size()) +
+                    " of " + std::to_string(frames.size()) + " frames, " +
+                    std::to_string(report.frames.front().frame) + "-" +
+                    std::to_string(report.frames.back().frame) + ": the sequence is incomplete)");
   }
   syncFileSystemOf(options.framesDir);
   report.moviesRead = cache.read();

@@ -63,19 +63,106 @@ void appendText(const Provenance& p, std::set<std::string>& printed, std::ostrin
   for (const auto& in : p.inputs) out << "    input " << in.path << " " << in.hash << "\n";
 }
 
+// Length of the well-formed UTF-8 sequence at text[i], or 0 if it is ill-formed (RFC 3629).
+size_t utf8SequenceAt(const std::string& text, size_t i) {
+  const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char b0 = byte(i);
+  if (b0 < 0x80) return 1;
+  size_t n;
+  unsigned char lo = 0x80, hi = 0xbf;  // allowed range of the second byte
+  if (b0 >= 0xc2 && b0 <= 0xdf) {
+    n = 2;
+  } else if (b0 >= 0xe0 && b0 <= 0xef) {
+    n = 3;
+    if (b0 == 0xe0) lo = 0xa0;  // overlong
+    if (b0 == 0xed) hi = 0x9f;  // surrogates
+  } else if (b0 >= 0xf0 && b0 <= 0xf4) {
+    n = 4;
+    if (b0 == 0xf0) lo = 0x90;  // overlong
+    if (b0 == 0xf4) hi = 0x8f;  // above U+10FFFF
+  } else {
+    return 0;
+  }
+  if (i + n > text.size() || byte(i + 1) < lo || byte(i + 1) > hi) return 0;
+  for (size_t k = 2; k < n; ++k)
+    if (byte(i + k) < 0x80 || byte(i + k) > 0xbf) return 0;
+  return n;
+}
+
+// `j` with every string (keys included) made valid UTF-8.
+nlohmann::json validUtf8Json(const nlohmann::json& j) {
+  if (j.is_string()) return toValidUtf8(j.get<std::string>());
+  if (j.is_array()) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& v : j) out.push_back(validUtf8Json(v));
+    return out;
+  }
+  if (j.is_object()) {
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& [k, v] : j.items()) out[toValidUtf8(k)] = validUtf8Json(v);
+    return out;
+  }
+  return j;
+}
+
 }  // namespace
 
+size_t firstInvalidUtf8(const std::string& text) {
+  for (size_t i = 0; i < text.size();) {
+    const size_t n = utf8SequenceAt(text, i);
+    if (n == 0) return i;
+    i += n;
+  }
+  return std::string::npos;
+}
+
+std::string toValidUtf8(const std::string& text) {
+  if (firstInvalidUtf8(text) == std::string::npos) return text;
+  std::string out;
+  for (size_t i = 0; i < text.size();) {
+    const size_t n = utf8SequenceAt(text, i);
+    if (n == 0) {
+      out += "\xEF\xBF\xBD";  // U+FFFD REPLACEMENT CHARACTER
+      ++i;
+    } else {
+      out.append(text, i, n);
+      i += n;
+    }
+  }
+  return out;
+}
+
+nlohmann::json parseProvenanceJson(const std::string& text, const std::string& where) {
+  const size_t bad = firstInvalidUtf8(text);
+  if (bad != std::string::npos)
+    throw inputError(where, "provenance is not valid UTF-8 (byte " + std::to_string(bad) +
+                                "): the file is damaged");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw inputError(where, "provenance is not valid JSON (byte " + std::to_string(e.byte) +
+                                "): the file is damaged");
+  }
+  Provenance::fromJson(j, where);
+  return j;
+}
+
 nlohmann::json Provenance::toJson() const {
+  // Everything here may come from argv or from paths, which are bytes, not necessarily UTF-8.
   nlohmann::json inputsJson = nlohmann::json::array();
   for (const auto& in : inputs) {
-    inputsJson.push_back({{"path", in.path}, {"hash", in.hash}, {"history", in.history}});
+    inputsJson.push_back({{"path", toValidUtf8(in.path)},
+                          {"hash", toValidUtf8(in.hash)},
+                          {"history", validUtf8Json(in.history)}});
   }
-  return {{"tool", tool},
-          {"version", version},
-          {"git_revision", gitRevision},
-          {"command_line", commandLine},
-          {"parameters", parameters.is_null() ? nlohmann::json::object() : parameters},
-          {"inputs", inputsJson}};
+  return {
+      {"tool", toValidUtf8(tool)},
+      {"version", toValidUtf8(version)},
+      {"git_revision", toValidUtf8(gitRevision)},
+      {"command_line", toValidUtf8(commandLine)},
+      {"parameters", parameters.is_null() ? nlohmann::json::object() : validUtf8Json(parameters)},
+      {"inputs", inputsJson}};
 }
 
 Provenance Provenance::fromJson(const nlohmann::json& j, const std::string& where) {

@@ -46,6 +46,19 @@ struct Provenance {
 Provenance makeProvenance(const std::string& tool, int argc, const char* const* argv,
                           const nlohmann::json& parameters);
 
+// Provenance JSON read from a file (an OpenEXR rad.provenance attribute): parsed and checked as a
+// Provenance. Throws rad::inputError(where, ...) on one line (no bytes of the text in it) if it
+// is not valid UTF-8, not JSON or not a provenance object.
+nlohmann::json parseProvenanceJson(const std::string& text, const std::string& where);
+
+// Byte offset of the first ill-formed UTF-8 sequence in `text` (overlong forms, surrogates and
+// code points above U+10FFFF included), or std::string::npos if there is none.
+size_t firstInvalidUtf8(const std::string& text);
+// `text` with each ill-formed sequence replaced by U+FFFD. JSON strings must be UTF-8, and
+// nlohmann::json throws (type_error 316) when it dumps one that is not: command lines, paths and
+// other attributes' bytes go through this before they are put in JSON.
+std::string toValidUtf8(const std::string& text);
+
 // POSIX-shell quoting: words made only of safe characters are left bare, others are put in
 // single quotes ('it'\''s').
 std::string shellQuote(const std::string& word);

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <regex>
 
 #include <OpenEXR/ImfChannelList.h>
@@ -27,7 +28,9 @@
 #include <OpenEXR/openexr.h>
 
 #include "formats/atomic_file.h"
+#include "formats/checksum.h"
 #include "formats/exr_image.h"
+#include "formats/pixel_checksum.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -124,6 +127,9 @@ std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<i
     h.insert("rad.units", Imf::StringAttribute("irradiance W/m^2"));
     if (k == 0 && !m.provenanceJson.empty())
       h.insert("rad.provenance", Imf::StringAttribute(m.provenanceJson));
+    // The pixels are not known yet when the headers are written (keys stream in): a
+    // placeholder of the checksum's length, filled in by commit() (fillInChecksums).
+    h.insert(kPixelChecksumAttribute, Imf::StringAttribute(kPixelChecksumPlaceholder));
     headers.push_back(h);
   }
   return headers;
@@ -174,6 +180,8 @@ void TextureMovieWriter::open(size_t parts) {
   try {
     file_->exr = std::make_unique<Imf::MultiPartOutputFile>(*file_->stream, headers.data(),
                                                             int(headers.size()));
+    headersEnd_ = file_->stream->tellp();
+    checksums_.assign(parts, 0);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
@@ -186,6 +194,7 @@ void TextureMovieWriter::writePart(size_t k, const std::vector<float>& rgb) {
     Imf::OutputPart part(*file_->exr, int(k));
     part.setFrameBuffer(rgbFrameBuffer(const_cast<float*>(rgb.data()), meta_.width));
     part.writePixels(meta_.height);
+    checksums_[k] = rgbPixelChecksum(rgb.data(), meta_.width, meta_.height);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
@@ -239,10 +248,28 @@ size_t TextureMovieWriter::commit() {
   } catch (const std::exception& e) {
     throw outputError(path_, e.what());
   }
+  fillInChecksums();
   file_->stream->close();
   file_->atomic.commit();
   committed_ = true;
   return parts;
+}
+
+void TextureMovieWriter::fillInChecksums() {
+  // The placeholders are found by walking the headers written (the layout of OpenEXR headers
+  // is fixed by the file format), not by searching for their text.
+  const std::vector<char> headers = file_->stream->readBack(0, size_t(headersEnd_));
+  const std::vector<uint64_t> at =
+      exrStringAttributeOffsets(headers, int(checksums_.size()), kPixelChecksumAttribute);
+  if (at.size() != checksums_.size())
+    throw Error(ExitCode::kInternal, path_, "texture movie part without a checksum placeholder");
+  for (size_t k = 0; k < at.size(); ++k) {
+    const std::string value = formatFnv1a64(checksums_[k]);
+    if (at[k] + value.size() > headers.size() ||
+        std::string(headers.data() + at[k], value.size()) != kPixelChecksumPlaceholder)
+      throw Error(ExitCode::kInternal, path_, "texture movie checksum placeholder not found");
+    file_->stream->overwrite(at[k], value);
+  }
 }
 
 void writeTextureMovie(const std::string& path, const TextureMovie& m) {
@@ -258,6 +285,12 @@ void writeTextureMovie(const std::string& path, const TextureMovie& m) {
 }
 
 namespace {
+
+size_t channelCount(const Imf::ChannelList& list) {
+  size_t n = 0;
+  for (auto it = list.begin(); it != list.end(); ++it) ++n;
+  return n;
+}
 
 template <class A>
 const A& attr(const Imf::Header& h, const char* name, const std::string& path) {
@@ -280,9 +313,18 @@ TextureMovie readHeaders(Imf::MultiPartInputFile& in, const std::string& path) {
     const std::string fmt = attr<Imf::StringAttribute>(h, "rad.format", path).value();
     if (fmt.rfind("texture-movie ", 0) != 0) throw inputError(path, "not a texture movie");
     int major = std::atoi(fmt.c_str() + 14);
+    if (major < kTextureMovieMajor)
+      throw inputError(path, "texture-movie version " + fmt.substr(14) +
+                                 " is no longer read (its pixels carry no checksum): re-run "
+                                 "rad-movies");
     if (major != kTextureMovieMajor)
       throw inputError(path, "texture-movie version " + fmt.substr(14) + ", expected " +
                                  std::to_string(kTextureMovieMajor) + ".x");
+    const std::optional<uint64_t> checksum =
+        storedPixelChecksum(h, path, "part " + std::to_string(k));
+    if (!checksum)
+      throw inputError(path, "part " + std::to_string(k) + ": no " + kPixelChecksumAttribute);
+    m.keyChecksums.push_back(*checksum);
     const Imath::Box2i dw = h.dataWindow();
     int w = dw.max.x - dw.min.x + 1, hh = dw.max.y - dw.min.y + 1;
     if (dw.min.x != 0 || dw.min.y != 0 || w < 1 || hh < 1 || w > 16384 || hh > 16384)
@@ -294,6 +336,9 @@ TextureMovie readHeaders(Imf::MultiPartInputFile& in, const std::string& path) {
       if (!h.channels().findChannel(c) || h.channels().findChannel(c)->type != Imf::FLOAT)
         throw inputError(path,
                          std::string("part ") + std::to_string(k) + ": no FLOAT channel " + c);
+    // The checksum covers every channel and the readers decode R, G, B only.
+    if (channelCount(h.channels()) != 3)
+      throw inputError(path, "part " + std::to_string(k) + ": channels other than R, G, B");
     if (k == 0) {
       m.width = w;
       m.height = hh;
@@ -323,6 +368,8 @@ std::vector<float> readKey(Imf::MultiPartInputFile& in, int k, const TextureMovi
   Imf::InputPart part(in, k);
   part.setFrameBuffer(rgbFrameBuffer(px.data(), m.width));
   part.readPixels(0, m.height - 1);
+  requirePixelChecksum(m.keyChecksums[size_t(k)], rgbPixelChecksum(px.data(), m.width, m.height),
+                       path, "part " + std::to_string(k));
   for (float v : px)
     if (!std::isfinite(v))
       throw inputError(path, "non-finite irradiance in part " + std::to_string(k));
@@ -349,6 +396,13 @@ TextureMovie readTextureMovie(const std::string& path) {
     TextureMovie m = readHeaders(in, path);
     for (int k = 0; k < in.parts(); ++k) m.keys.push_back(readKey(in, k, m, path));
     return m;
+  });
+}
+
+TextureMovie readTextureMovieHeaders(const std::string& path) {
+  return readingExr(path, [&] {
+    Imf::MultiPartInputFile in(path.c_str());
+    return readHeaders(in, path);
   });
 }
 
@@ -502,6 +556,8 @@ void TextureMovieStream::load(size_t k) {
     checkExr(exr_decoding_run(ctx, part, &decoder), path_, "decoding");
   }
   reader_->dropWindow();
+  requirePixelChecksum(movie_.keyChecksums[k], rgbPixelChecksum(px.data(), w, h), path_,
+                       "part " + std::to_string(k));
   for (float v : px)
     if (!std::isfinite(v))
       throw inputError(path_, "non-finite irradiance in part " + std::to_string(k));

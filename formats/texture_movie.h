@@ -17,7 +17,7 @@
 
 namespace rad {
 
-constexpr int kTextureMovieMajor = 1;
+constexpr int kTextureMovieMajor = 2;
 constexpr int kTextureMovieMinor = 0;
 
 struct TextureMovie {
@@ -32,6 +32,9 @@ struct TextureMovie {
   // texture does not change over its interval has exactly one key ("constant").
   std::vector<std::vector<float>> keys;
   std::string provenanceJson;  // Provenance::toJson().dump() of the tool that baked it
+  // Read from the file: each part's rad.pixelChecksum (formats/pixel_checksum.h), which the
+  // readers verify against the pixels they decode. Writers compute their own.
+  std::vector<uint64_t> keyChecksums;
 
   bool constant() const { return keys.size() == 1; }
   // Irradiance texture at time t: linear between the two key textures around t (held before
@@ -88,18 +91,23 @@ class TextureMovieWriter {
  private:
   void open(size_t parts);
   void writePart(size_t k, const std::vector<float>& rgb);
+  void fillInChecksums();
   std::string path_;
   AtomicFile::Durability durability_;
   TextureMovie meta_;  // keys empty
   bool collapse_ = false, diverged_ = false, committed_ = false;
   size_t next_ = 0, texelFloats_ = 0;
-  std::vector<float> key0_;  // held while the movie may be constant
-  struct File;               // AtomicFile + OpenEXR multi-part output
+  std::vector<uint64_t> checksums_;  // of the parts written, by part
+  uint64_t headersEnd_ = 0;          // bytes of the file before the first chunk table
+  std::vector<float> key0_;          // held while the movie may be constant
+  struct File;                       // AtomicFile + OpenEXR multi-part output
   std::unique_ptr<File> file_;
 };
-// Reads and validates (part count, sizes, attributes, finite values). Throws
+// Reads and validates (part count, sizes, attributes, pixel checksums, finite values). Throws
 // rad::inputError(path, ...), never crashes on a truncated or corrupted file.
 TextureMovie readTextureMovie(const std::string& path);
+// The metadata alone (keys empty), every part's header checked as readTextureMovie checks it.
+TextureMovie readTextureMovieHeaders(const std::string& path);
 
 // A movie read as it plays: every part's header is read and checked at construction, the
 // pixels of a key only when textureAt needs them, and at most the two keys around the current
@@ -107,8 +115,8 @@ TextureMovie readTextureMovie(const std::string& path);
 // patch's movie spans the whole animation). textureAt gives exactly TextureMovie::textureAt.
 class TextureMovieStream {
  public:
-  // Checks every part's header and opens the file for reading (it stays open until
-  // destruction); throws rad::inputError(path, ...).
+  // Checks every part's header (a checksum present in each) and opens the file for reading (it
+  // stays open until destruction); throws rad::inputError(path, ...).
   explicit TextureMovieStream(std::string path);
   ~TextureMovieStream();
   TextureMovieStream(const TextureMovieStream&) = delete;
@@ -121,7 +129,8 @@ class TextureMovieStream {
   // = keyWeight(t, k0, k1). Keys other than k0, k1 are dropped; the pointers stay valid until
   // the next textureAt/keysAt/key call.
   void keysAt(double t, const float*& from, const float*& to, float& weight);
-  // Key k's texture, loaded if it is not (for a constant movie: its only texture).
+  // Key k's texture, loaded if it is not (for a constant movie: its only texture). Every key
+  // loaded is verified against its part's checksum (rad::inputError naming the part if not).
   const std::vector<float>& key(size_t k);
   long long keysRead() const { return keysRead_; }
 

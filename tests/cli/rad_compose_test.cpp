@@ -2,6 +2,7 @@
 // written with the real writers; frames checked for radiance, fallback warnings, PNG encoding,
 // provenance, determinism and atomic failure.
 #include <filesystem>
+#include <fstream>
 #include <regex>
 
 #include <OpenEXR/ImfHeader.h>
@@ -274,8 +275,10 @@ TEST_F(RadCompose, UnwritableOutputIsOneLineExit3) {
   EXPECT_EQ(r.err.rfind("rad-compose: " + out + ": ", 0), 0u) << r.err;
 }
 
-TEST_F(RadCompose, BadMovieMidSequenceLeavesNoPartialFrame) {
-  // Movie 2 claims another patch than the intervals give it: fails when frame 2 loads it.
+// Every movie's headers are checked before the first frame is written (issue 18: a bad movie
+// of a later interval used to leave the earlier frames behind).
+TEST_F(RadCompose, BadMovieHeaderLeavesNoFrame) {
+  // Movie 2 claims another patch than the intervals give it; it is first used at frame 2.
   TextureMovie bad = constantMovie(2, PatchId{kWallTop, 1}.child(1), 2, 3, kWallKey0);
   writeTextureMovie(textureMoviePath((dir / "movies").string(), 2), bad);
   std::string out = (dir / "frames").string();
@@ -283,10 +286,29 @@ TEST_F(RadCompose, BadMovieMidSequenceLeavesNoPartialFrame) {
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_EQ(countLines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("000002.exr: patch 0/1 differs"), std::string::npos) << r.err;
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"0000.exr", "0000.png", "0001.exr", "0001.png"}));
+  EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out));
+}
+
+// A key whose pixels fail their checksum is found when it is loaded (frame 3 loads movie 2's
+// key 1): exit 1, one line naming the movie, the part and the frames already written.
+TEST_F(RadCompose, CorruptedKeyIsOneLineNamingTheFramesWritten) {
+  const std::string movie = textureMoviePath((dir / "movies").string(), 2);
+  // The file ends with the last scan line of its last part (key 1): flip a bit of it.
+  std::string bytes = readWholeFile(movie);
+  bytes.back() = char(bytes.back() ^ 0x01);
+  std::ofstream(movie, std::ios::binary | std::ios::trunc) << bytes;
+  std::string out = (dir / "frames").string();
+  CommandResult r = runCommand(command(out));
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  // Frame 2's fallback warning (the lamp has no movie there), then the error on one line.
+  EXPECT_EQ(countLines(r.err), 2) << r.err;
+  const std::string error = r.err.substr(r.err.find('\n') + 1);
+  EXPECT_EQ(error.rfind("rad-compose: " + movie + ": part 1: pixel checksum mismatch", 0), 0u)
+      << r.err;
+  EXPECT_NE(error.find("(after writing 3 of 4 frames, 0-2: the sequence is incomplete)\n"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(framePath(out, 3, ".exr")));
 }
 
 TEST_F(RadCompose, MissingMovieAndFramesOutsideTheWindow) {

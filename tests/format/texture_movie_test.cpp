@@ -94,7 +94,7 @@ TEST_F(TextureMovieFormat, RoundTripKeepsEverythingBitExact) {
   EXPECT_EQ(in.header(3).name(), "key0003");
   EXPECT_EQ(in.header(1).findTypedAttribute<Imf::StringAttribute>("rad.patch")->value(), "7/2.1");
   EXPECT_EQ(in.header(0).findTypedAttribute<Imf::StringAttribute>("rad.format")->value(),
-            "texture-movie 1.0");
+            "texture-movie 2.0");
 }
 
 TEST_F(TextureMovieFormat, ConstantMovieAndInterpolation) {
@@ -275,12 +275,12 @@ TEST_F(TextureMovieFormat, NotAMovieAndFutureVersionsAreRefusedByName) {
   TextureMovie m = sampleMovie(2);
   std::string path = dir() + "/m.exr";
   writeTextureMovie(path, m);
-  // Rewrite the version string in place ("texture-movie 1.0" -> "texture-movie 9.0").
+  // Rewrite the version string in place ("texture-movie 2.0" -> "texture-movie 9.0").
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), {});
   size_t pos = 0;
   int replaced = 0;
-  while ((pos = bytes.find("texture-movie 1.", pos)) != std::string::npos) {
+  while ((pos = bytes.find("texture-movie 2.", pos)) != std::string::npos) {
     bytes[pos + 14] = '9';
     ++replaced;
   }
@@ -288,7 +288,15 @@ TEST_F(TextureMovieFormat, NotAMovieAndFutureVersionsAreRefusedByName) {
   std::string future = dir() + "/future.exr";
   std::ofstream(future, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
   std::string e = errorOf(future);
-  EXPECT_NE(e.find("texture-movie version 9.0, expected 1.x"), std::string::npos) << e;
+  EXPECT_NE(e.find("texture-movie version 9.0, expected 2.x"), std::string::npos) << e;
+  // The previous version (no pixel checksums) is refused with the stage to re-run.
+  for (size_t at = 0; (at = bytes.find("texture-movie 9.", at)) != std::string::npos;)
+    bytes[at + 14] = '1';
+  std::string old = dir() + "/old.exr";
+  std::ofstream(old, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+  EXPECT_EQ(errorOf(old), old +
+                              ": texture-movie version 1.0 is no longer read (its pixels "
+                              "carry no checksum): re-run rad-movies");
 }
 
 TEST_F(TextureMovieFormat, WriterRefusesInconsistentMovies) {

@@ -11,6 +11,8 @@
 #include "formats/file_kind.h"
 #include "formats/gltf_scene.h"
 #include "formats/inspect_kinds.h"
+#include "formats/pixel_checksum.h"
+#include "formats/provenance.h"
 #include "formats/texture_movie.h"
 #include "libcommon/scene/scene_summary.h"
 #include "tools/common/tool_main.h"
@@ -138,6 +140,20 @@ nlohmann::json inspectContainer(const std::string& path, const Options& o, std::
   return j;
 }
 
+// Every pixel of the file read and checked against its parts' checksums: a truncated or
+// corrupted movie or frame is an error, not a header that looks fine. A texture movie is read
+// as rad-compose reads it (every key, finite values, consistent parts).
+nlohmann::json verifyExr(const std::string& path, const nlohmann::json& info) {
+  const nlohmann::json& attrs = info["parts"][0]["attributes"];
+  const auto format = attrs.find("rad.format");
+  if (format != attrs.end() && format->is_string() &&
+      format->get<std::string>().rfind("texture-movie ", 0) == 0) {
+    const rad::TextureMovie movie = rad::readTextureMovie(path);
+    return {{"parts", movie.keys.size()}, {"checksummed_parts", movie.keys.size()}};
+  }
+  return rad::verifyExrPixels(path);
+}
+
 nlohmann::json inspectOne(const std::string& path, const Options& o, std::string& text) {
   if (std::filesystem::is_directory(path)) {
     nlohmann::json s = rad::summarizeTextureMovieDirectory(path);
@@ -166,10 +182,12 @@ nlohmann::json inspectOne(const std::string& path, const Options& o, std::string
     }
     case rad::FileKind::kOpenExr: {
       nlohmann::json info = rad::readExrInfo(path);
-      info["path"] = path;
+      info["path"] = rad::toValidUtf8(path);
       info["type"] = "openexr";
+      info["pixels"] = verifyExr(path, info);
       std::ostringstream os;
-      os << path << ": OpenEXR, " << info["parts"].size() << " part(s)\n";
+      os << path << ": OpenEXR, " << info["parts"].size() << " part(s), pixels read, "
+         << info["pixels"]["checksummed_parts"] << " verified against rad.pixelChecksum\n";
       for (const auto& p : info["parts"]) {
         os << "  part '" << p["name"].get<std::string>() << "' " << p["width"] << "x" << p["height"]
            << " channels " << p["channels"].dump() << "\n";
@@ -215,6 +233,9 @@ int main(int argc, char** argv) {
     });
     worst = std::max(worst, rc);
   }
-  if (o.json && !o.check) std::cout << (all.size() == 1 ? all[0] : all).dump(1) << "\n";
+  if (o.json && !o.check)
+    std::cout << (all.size() == 1 ? all[0] : all)
+                     .dump(1, ' ', false, nlohmann::json::error_handler_t::replace)
+              << "\n";
   return worst;
 }

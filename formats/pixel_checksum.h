@@ -1,0 +1,65 @@
+// rad.pixelChecksum: a checksum of the pixels of one OpenEXR part, written by every rad EXR writer
+// (texture movies, frames, rad-reference's frames) and verified by every reader, so a flipped
+// byte or a truncated chunk is an error rather than a silently wrong pixel (issue 18). Defined in
+// formats/texture_movie.md and formats/frame_image.md:
+//
+//   FNV-1a 64 (formats/checksum.h) over the part's decoded values, scan line by scan line from
+//   the data window's first, within a line channel by channel in the part's channel-list order
+//   (OpenEXR sorts by name: B, G, R), within a channel left to right; each value as the 4 bytes,
+//   little-endian, of its 32-bit float (a HALF value converted to float exactly). The attribute
+//   is a string "fnv1a64:<16 hex digits>".
+//
+// For FLOAT channels that is the byte order of an uncompressed part's chunk data, so a writer
+// hashes what it writes and a reader what it decodes, with no second pass over the file.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <OpenEXR/ImfForward.h>
+#include <nlohmann/json.hpp>
+
+namespace rad {
+
+constexpr const char* kPixelChecksumAttribute = "rad.pixelChecksum";
+// What a writer puts in the attribute until the pixels are written (the same length as a
+// checksum, and not one: a reader refuses it as malformed).
+constexpr const char* kPixelChecksumPlaceholder = "fnv1a64:????????????????";
+
+// Checksum of `height` rows of `width` interleaved pixels of `channels` floats each.
+// listOrder[i] is the index within a pixel of the i-th channel of the part's channel list.
+uint64_t pixelChecksum(const float* pixels, int width, int height, int channels,
+                       const std::vector<int>& listOrder);
+// Interleaved R, G, B pixels (list order B, G, R).
+uint64_t rgbPixelChecksum(const float* rgb, int width, int height);
+
+// The value of "fnv1a64:<16 lowercase hex>", or nothing if `text` is not one.
+std::optional<uint64_t> parseFnv1a64(const std::string& text);
+
+// The checksum a part's header stores, parsed. Throws rad::inputError(path, "<part>: ...") if
+// the attribute is malformed, or missing where the part's rad.format version requires it
+// (frame >= 2, texture-movie >= 2); an older version of those is refused with the stage to
+// re-run. Nothing for a part that has none and need not (rad-reference's older frames, EXR
+// files from other programs).
+std::optional<uint64_t> storedPixelChecksum(const Imf::Header& header, const std::string& path,
+                                            const std::string& part);
+
+// Throws rad::inputError(path, "<part>: pixel checksum mismatch ...") unless equal.
+void requirePixelChecksum(uint64_t stored, uint64_t computed, const std::string& path,
+                          const std::string& part);
+
+// Reads every pixel of every scan-line part of an OpenEXR file (all channels) and verifies each
+// part's checksum (storedPixelChecksum). Throws rad::inputError(path, ...) for an unreadable,
+// truncated or corrupted file. Returns {"parts": n, "checksummed_parts": m}.
+nlohmann::json verifyExrPixels(const std::string& path);
+
+// Offsets of the value of string attribute `name` in each of the first `parts` headers of an
+// OpenEXR file whose first bytes are `bytes` (magic, version, headers); a part without it gets
+// no entry. Throws rad::Error(kInternal) if the headers are cut short. For writers that fill in
+// an attribute after the pixels (TextureMovieWriter's checksums).
+std::vector<uint64_t> exrStringAttributeOffsets(const std::vector<char>& bytes, int parts,
+                                                const std::string& name);
+
+}  // namespace rad
