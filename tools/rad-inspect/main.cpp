@@ -216,5 +216,5 @@ int main(int argc, char** argv) {
     worst = std::max(worst, rc);
   }
   if (o.json && !o.check) std::cout << (all.size() == 1 ? all[0] : all).dump(1) << "\n";
-  return worst;
+  return rad::finishStdout(kTool, worst);
 }
