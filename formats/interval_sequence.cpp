@@ -48,6 +48,9 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
   for (int f : frames) {
     builder.addFrame(f, [&](const IntervalFrame& fr) {
       run.itemSeconds.push_back(fr.itemBufferSeconds);
+      const std::vector<uint32_t>& ids = fr.itemBuffer->id;
+      if (std::all_of(ids.begin(), ids.end(), [](uint32_t id) { return id == kNoItem; }))
+        run.emptyFrames.push_back(fr.frame);
       if (itemBuffersDir.empty()) return;
       char name[32];
       std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
@@ -77,6 +80,7 @@ nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::st
   const int n = run.frames;
   report["output"] = output;
   report["frames"] = n;
+  report["empty_frames"] = run.emptyFrames.size();
   report["image_size"] = {run.intervals.imageWidth, run.intervals.imageHeight};
   report["top_patches"] = run.topPatches;
   report["patch_nodes"] = run.patchNodes;

@@ -22,6 +22,9 @@ struct IntervalSequence {
                                // frame_step
   // For the report.
   int frames = 0;  // frames added
+  // Frames whose item buffer shows no surface (the camera's clip planes or view miss the whole
+  // scene): their final frames would be black, which the tool warns about.
+  std::vector<int> emptyFrames;
   int topPatches = 0;
   int patchNodes = 0;
   double itemBufferSeconds = 0.0;   // total render + readback
@@ -41,7 +44,8 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
                                          const std::function<void()>& frameDone = {});
 
 // rad-intervals' --report: summarizeTextureIntervals of the file written at `output` (read
-// back, which also checks it) plus the run's counts and times.
+// back, which also checks it) plus the run's counts (empty_frames: how many frames show no
+// surface) and times.
 nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::string& output);
 
 }  // namespace rad

@@ -4,6 +4,7 @@
 // `rad-tool: path: what is wrong` on one line, then exits with the error's code.
 #pragma once
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -30,6 +31,14 @@ class Error : public std::runtime_error {
  private:
   ExitCode code_;
 };
+
+// A number for a message, %g style: 1.79769e+308 and 1e-07, where std::to_string(double)
+// prints 309 digits and 0.000000.
+inline std::string numberText(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
 
 // Shorthands for the common cases.
 inline Error inputError(const std::string& where, const std::string& what) {

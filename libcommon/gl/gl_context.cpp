@@ -4,8 +4,16 @@
 #include "libcommon/gl/gl_context.h"
 
 #include <GL/osmesa.h>
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
 
 #include "libcommon/core/error.h"
 
@@ -62,11 +70,9 @@ GLuint compileShader(const std::string& name, GLenum type, const std::string& so
   return shader;
 }
 
-}  // namespace
-
-GlContext::GlContext() {
-  // Core profile 4.5: FBOs, integer targets, GL_DEPTH_COMPONENT32F and glClipControl.
-  // No depth/stencil/accum in the dummy default framebuffer: all rendering goes to FBOs.
+// Core profile 4.5: FBOs, integer targets, GL_DEPTH_COMPONENT32F and glClipControl.
+// No depth/stencil/accum in the dummy default framebuffer: all rendering goes to FBOs.
+OSMesaContext createCoreContext() {
   const int attribs[] = {OSMESA_FORMAT,
                          OSMESA_RGBA,
                          OSMESA_DEPTH_BITS,
@@ -82,11 +88,61 @@ GlContext::GlContext() {
                          OSMESA_CONTEXT_MINOR_VERSION,
                          5,
                          0};
-  OSMesaContext ctx = OSMesaCreateContextAttribs(attribs, nullptr);
+  return OSMesaCreateContextAttribs(attribs, nullptr);
+}
+
+// What the user set that chooses Mesa's driver, for the messages: " with GALLIUM_DRIVER=x" or "".
+std::string driverChoice() {
+  const char* driver = std::getenv("GALLIUM_DRIVER");
+  return driver ? std::string(" with GALLIUM_DRIVER=") + driver : std::string();
+}
+
+// How creating a context went in a child process: "" when it worked, else why not. Mesa 22.3
+// dereferences a null screen when GALLIUM_DRIVER names a driver it cannot load (nonexistent,
+// or zink without Vulkan): a SIGSEGV inside OSMesaCreateContextAttribs that no check in this
+// process can catch. The child (its stderr silenced: Mesa's own complaints are several lines)
+// takes the fall; the screen is made once per process, so one probe serves every context.
+std::string probeContextInChild() {
+  const pid_t pid = fork();
+  if (pid < 0) return "";  // cannot probe (no memory for a process): try in this one
+  if (pid == 0) {
+    const rlimit noCore{0, 0};  // a crash here is expected, not a core file to leave behind
+    setrlimit(RLIMIT_CORE, &noCore);
+    const int null = open("/dev/null", O_WRONLY);
+    if (null >= 0) {
+      dup2(null, STDOUT_FILENO);
+      dup2(null, STDERR_FILENO);
+    }
+    _exit(createCoreContext() ? 0 : 1);  // no destructors, no atexit: the parent's state
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return "";
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
+  if (WIFSIGNALED(status))
+    return std::string("Mesa crashed (") + strsignal(WTERMSIG(status)) +
+           ") creating an OpenGL context" + driverChoice();
+  return "cannot create an OpenGL 4.5 core context" + driverChoice();
+}
+
+// The probe's verdict, taken once per process before its first context.
+const std::string& contextProbe() {
+  static const std::string verdict = probeContextInChild();
+  return verdict;
+}
+
+}  // namespace
+
+GlContext::GlContext() {
+  const std::string remedy = std::getenv("GALLIUM_DRIVER")
+                                 ? "; unset GALLIUM_DRIVER or set it to llvmpipe"
+                                 : " (OSMesaCreateContextAttribs failed; is libosmesa6 with "
+                                   "llvmpipe installed?)";
+  if (const std::string& failed = contextProbe(); !failed.empty())
+    throw environmentError(failed + remedy);
+  OSMesaContext ctx = createCoreContext();
   if (!ctx)
-    throw environmentError(
-        "cannot create an OpenGL 4.5 core context (OSMesaCreateContextAttribs failed; is "
-        "libosmesa6 with llvmpipe installed?)");
+    throw environmentError("cannot create an OpenGL 4.5 core context" + driverChoice() + remedy);
   context_ = ctx;
   dummy_.assign(4, 0);
   if (!OSMesaMakeCurrent(ctx, dummy_.data(), GL_UNSIGNED_BYTE, 1, 1)) {

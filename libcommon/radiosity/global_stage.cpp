@@ -166,13 +166,19 @@ std::string GlobalReport::table(const std::string& tool) const {
   out << tool << ": " << solve.keys.size() << " key times, " << solve.topPatches
       << " top-level patches\n";
   out << "  key   time(s)    links  recomputed    reused  nodes  sweeps  links(s) solve(s)\n";
-  for (size_t k = 0; k < solve.keys.size(); ++k) {
+  auto row = [&](size_t k) {
     const KeyTimeReport& r = solve.keys[k];
     out << std::setw(5) << k << std::setw(10) << std::fixed << std::setprecision(3) << r.time
         << std::setw(9) << r.links << std::setw(12) << r.recomputed << std::setw(10) << r.reused
         << std::setw(7) << r.nodes << std::setw(8) << r.iterations << std::setw(10)
         << r.secondsLinks << std::setw(9) << r.secondsSolve << "\n";
-  }
+  };
+  const size_t K = solve.keys.size();
+  const size_t head = K > kTableKeys ? kTableKeys / 2 : K;
+  for (size_t k = 0; k < head; ++k) row(k);
+  if (K > kTableKeys)
+    out << "  ... " << K - kTableKeys << " more key times (every one in --report's key_times)\n";
+  for (size_t k = std::max(head, K - kTableKeys / 2); k < K; ++k) row(k);
   const KeyTotals t = totalsOf(solve.keys);
   out << "  total: " << t.links << " links (and " << t.clusterLinks << " cluster links), "
       << t.recomputed << " recomputed (" << t.visibilityOnly << " of them visibility only), "

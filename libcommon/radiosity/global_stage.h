@@ -78,7 +78,10 @@ struct GlobalReport {
   // The --report JSON: key_times[], totals, seconds, peak_memory_mb, coherence
   // (pipelines/bench.py and the CLI tests read these keys).
   nlohmann::json toJson() const;
-  // The stderr table: a header line naming `tool`, one row per key time, two total lines.
+  // The stderr table: a header line naming `tool`, one row per key time, two total lines. Of
+  // more than kTableKeys key times only the first and last kTableKeys / 2 have rows, and one
+  // line says how many are left out (--frames 0-100000 made 12,505 lines; --report has all).
+  static constexpr size_t kTableKeys = 20;
   std::string table(const std::string& tool) const;
   // Key times whose refinement stopped at the link bound (RadiosityOptions::maxLinks).
   size_t keysAtLinkCap() const;

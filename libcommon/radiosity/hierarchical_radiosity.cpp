@@ -891,8 +891,8 @@ class KeyTimeSolver {
       ++s_.iterations;
       if (nonFinite_ || maxB_ > radiosityBound_)
         throw Error(ExitCode::kInternal, "",
-                    "the radiosity solve diverges (B reached " + std::to_string(maxB_) +
-                        " W/m^2, a million times E/(1 - rho) = " + std::to_string(radiosityBound_) +
+                    "the radiosity solve diverges (B reached " + numberText(maxB_) +
+                        " W/m^2, a million times E/(1 - rho) = " + numberText(radiosityBound_) +
                         "): the refined links' form factors sum to more than 1/reflectance "
                         "somewhere; use a lower reflectance or a coarser refinement threshold");
       s_.lastChange = maxB_ > 0 ? maxDelta_ / maxB_ : 0.0;

@@ -825,8 +825,8 @@ std::vector<size_t> keyOwners(const std::vector<KeyWindow>& windows,
     const std::string missing =
         (k == end ? "key " + std::to_string(k)
                   : "keys " + std::to_string(k) + "-" + std::to_string(end)) +
-        " of the run's " + std::to_string(K) + " (t = " + std::to_string(keyTimes[k]) +
-        (k == end ? "" : " .. " + std::to_string(keyTimes[end])) + " s)";
+        " of the run's " + std::to_string(K) + " (t = " + numberText(keyTimes[k]) +
+        (k == end ? "" : " .. " + numberText(keyTimes[end])) + " s)";
     // Named: the window before the gap, or the first one when the gap opens the run.
     const size_t beside = k > 0 ? owner[k - 1] : order.front();
     const KeyWindow& b = windows[beside];
@@ -857,7 +857,7 @@ void checkSharedKeys(const std::vector<KeyWindow>& windows, const std::vector<si
             std::memcmp(&a.exposure[t * a.keyCount() + ka], &b.exposure[t * b.keyCount() + kb],
                         sizeof(float)) != 0)
           throw inputError(names[w], "key " + std::to_string(k) +
-                                         " (t = " + std::to_string(a.keyTimes[ka]) +
+                                         " (t = " + numberText(a.keyTimes[ka]) +
                                          " s) differs from " + names[owner[k]] +
                                          "'s: the windows were not computed alike");
     }

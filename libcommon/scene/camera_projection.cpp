@@ -23,17 +23,16 @@ void validate(const Camera& lens, ImageSize size) {
                 "image size " + std::to_string(size.width) + "x" + std::to_string(size.height) +
                     "; expected positive");
   if (!(lens.znear > 0.0))
-    throw inputError(lensName(lens), "znear " + std::to_string(lens.znear) + "; expected > 0");
+    throw inputError(lensName(lens), "znear " + numberText(lens.znear) + "; expected > 0");
   if (lens.zfar != 0.0 && !(lens.zfar > lens.znear))
-    throw inputError(lensName(lens), "zfar " + std::to_string(lens.zfar) + " not beyond znear " +
-                                         std::to_string(lens.znear));
+    throw inputError(lensName(lens), "zfar " + numberText(lens.zfar) + " not beyond znear " +
+                                         numberText(lens.znear));
   if (lens.perspective) {
     if (!(lens.yfov > 0.0 && lens.yfov < kPi))
-      throw inputError(lensName(lens),
-                       "yfov " + std::to_string(lens.yfov) + "; expected in (0, pi)");
+      throw inputError(lensName(lens), "yfov " + numberText(lens.yfov) + "; expected in (0, pi)");
     if (lens.aspectRatio < 0.0 || !std::isfinite(lens.aspectRatio))
-      throw inputError(lensName(lens), "aspectRatio " + std::to_string(lens.aspectRatio) +
-                                           "; expected > 0 or absent");
+      throw inputError(lensName(lens),
+                       "aspectRatio " + numberText(lens.aspectRatio) + "; expected > 0 or absent");
   } else {
     if (!(lens.xmag > 0.0 && lens.ymag > 0.0))
       throw inputError(lensName(lens), "orthographic xmag/ymag must be > 0");

@@ -4,8 +4,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <new>
 #include <regex>
@@ -13,6 +19,7 @@
 #include <tbb/global_control.h>
 
 #include "formats/build_info.h"
+#include "libcommon/scene/scene.h"
 
 namespace rad {
 
@@ -77,7 +84,7 @@ void setUpApp(CLI::App& app, const std::string& tool, const std::string& example
   // comes from ids): it only bounds the cores used, e.g. for make -j or a shared machine.
   app.add_option("--threads", gThreads, "worker threads; 0: all cores")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeInteger());
   app.add_flag_callback(
       kPrintDefaults, [] { throw CallForDefaults(); },
       "print every option's default as one JSON object on stdout and exit");
@@ -89,13 +96,13 @@ int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** ar
     app.parse(argc, argv);
   } catch (const CallForDefaults&) {
     std::cout << defaults.dump(1) << "\n";
-    return 0;
+    return finishStdout(tool, 0);
   } catch (const CLI::CallForHelp&) {
     std::cout << app.help();
-    return 0;
+    return finishStdout(tool, 0);
   } catch (const CLI::CallForVersion&) {
     std::cout << app.version() << "\n";
-    return 0;
+    return finishStdout(tool, 0);
   } catch (const CLI::ParseError& e) {
     std::cerr << tool << ": " << e.what() << " (try --help)\n";
     return int(ExitCode::kUsage);
@@ -118,30 +125,122 @@ std::string oneLine(std::string s) {
 }  // namespace
 
 int runTool(const std::string& tool, const std::function<int()>& body) {
+  int rc = 0;
   try {
-    return body();
+    rc = body();
   } catch (const Error& e) {
     std::cerr << tool << ": " << oneLine(e.what()) << "\n";
-    return int(e.code());
+    rc = int(e.code());
   } catch (const std::bad_alloc&) {
     std::cerr << tool << ": out of memory\n";
-    return int(ExitCode::kEnvironment);
+    rc = int(ExitCode::kEnvironment);
   } catch (const std::exception& e) {
     std::cerr << tool << ": internal error: " << oneLine(e.what()) << "\n";
-    return int(ExitCode::kInternal);
+    rc = int(ExitCode::kInternal);
   }
+  return finishStdout(tool, rc);
 }
+
+int finishStdout(const std::string& tool, int rc) {
+  static bool reported = false;  // rad-inspect finishes once per file: one line for all
+  // std::cout shares stdout's buffer (sync_with_stdio): a failed write leaves badbit on the one
+  // and the error flag on the other; the flush reports what was still buffered.
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0;
+  const int flushErrno = errno;
+  if (flushed && std::cout && !std::ferror(stdout)) return rc;
+  if (!reported) {
+    std::cerr << tool << ": stdout: write failed";
+    if (!flushed && flushErrno != 0) std::cerr << ": " << std::strerror(flushErrno);
+    std::cerr << "\n";
+    reported = true;
+  }
+  return std::max(rc, int(ExitCode::kOutput));
+}
+
+namespace {
+// A CLI11 check that `accept`s the option's value, a finite number; `want` says what it must be
+// in the error, `tag` in --help's type column (FLOAT:POSITIVE).
+CLI::Validator finiteCheck(const std::string& want, const std::string& tag,
+                           const std::function<bool(double)>& accept) {
+  return CLI::Validator(
+      [want, accept](std::string& input) -> std::string {
+        const char* begin = input.c_str();
+        char* end = nullptr;
+        const double x = std::strtod(begin, &end);
+        if (end == begin || *end != '\0' || !std::isfinite(x) || !accept(x))
+          return input + " is not " + want;
+        return "";
+      },
+      tag);
+}
+}  // namespace
+
+CLI::Validator finiteNumber() {
+  return finiteCheck("a finite number", "FINITE", [](double) { return true; });
+}
+CLI::Validator positiveFinite() {
+  return finiteCheck("a finite number > 0", "POSITIVE", [](double x) { return x > 0.0; });
+}
+CLI::Validator nonNegativeFinite() {
+  return finiteCheck("a finite number >= 0", "NONNEGATIVE", [](double x) { return x >= 0.0; });
+}
+CLI::Validator finiteRange(double lo, double hi) {
+  const std::string range = "[" + numberText(lo) + ", " + numberText(hi) + "]";
+  return finiteCheck("a number in " + range, range,
+                     [lo, hi](double x) { return x >= lo && x <= hi; });
+}
+
+CLI::Validator integerRange(long long lo, long long hi) {
+  const bool open = hi == std::numeric_limits<long long>::max();
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  const std::string want = open ? "an integer >= " + std::to_string(lo) : "an integer in " + range;
+  const std::string tag = !open ? range : lo > 0 ? "POSITIVE" : "NONNEGATIVE";
+  return CLI::Validator(
+      [want, lo, hi](std::string& input) -> std::string {
+        const char* begin = input.c_str();
+        char* end = nullptr;
+        errno = 0;
+        const long long n = std::strtoll(begin, &end, 10);
+        if (end == begin || *end != '\0' || errno == ERANGE || n < lo || n > hi)
+          return input + " is not " + want;
+        return "";
+      },
+      tag);
+}
+CLI::Validator positiveInteger() {
+  return integerRange(1, std::numeric_limits<long long>::max());
+}
+CLI::Validator nonNegativeInteger() {
+  return integerRange(0, std::numeric_limits<long long>::max());
+}
+
+namespace {
+// The number a run of decimal digits names, or -1 when it exceeds `max` (std::stol threw
+// out_of_range, an internal error, on 20 digits).
+long boundedNumber(const std::string& digits, long max) {
+  const size_t first = std::min(digits.find_first_not_of('0'), digits.size());
+  if (digits.size() - first > 18) return -1;  // more than any long holds
+  const long n = first == digits.size() ? 0 : std::stol(digits.substr(first));
+  return n <= max ? n : -1;
+}
+}  // namespace
 
 std::vector<int> parseFrameRange(const std::string& spec, const std::string& flag) {
   static const std::regex re(R"(^\s*(\d+)(?:\s*-\s*(\d+)(?:x(\d+))?)?\s*$)");
+  constexpr long kMaxFrame = 100000000;
   std::smatch m;
   if (!std::regex_match(spec, m, re)) {
     throw Error(ExitCode::kUsage, "", flag + " " + spec + ": expected FIRST-LAST[xSTEP]");
   }
-  long first = std::stol(m[1]);
-  long last = m[2].matched ? std::stol(m[2]) : first;
-  long step = m[3].matched ? std::stol(m[3]) : 1;
-  if (last < first || step < 1 || last > 100000000) {
+  const long first = boundedNumber(m[1], kMaxFrame);
+  const long last = m[2].matched ? boundedNumber(m[2], kMaxFrame) : first;
+  const long step = m[3].matched ? boundedNumber(m[3], kMaxFrame) : 1;
+  if (first < 0 || last < 0 || step < 0)
+    throw Error(ExitCode::kUsage, "",
+                flag + " " + spec + ": frame numbers and step must be at most " +
+                    std::to_string(kMaxFrame));
+  if (last < first || step < 1) {
     throw Error(ExitCode::kUsage, "", flag + " " + spec + ": empty or out-of-range frame range");
   }
   std::vector<int> frames;
@@ -151,15 +250,27 @@ std::vector<int> parseFrameRange(const std::string& spec, const std::string& fla
 
 std::pair<int, int> parseImageSize(const std::string& spec, const std::string& flag) {
   static const std::regex re(R"(^(\d+)x(\d+)$)");
+  constexpr long kMaxSide = 16384;
   std::smatch m;
   if (!std::regex_match(spec, m, re)) {
     throw Error(ExitCode::kUsage, "", flag + " " + spec + ": expected WIDTHxHEIGHT");
   }
-  long w = std::stol(m[1]), h = std::stol(m[2]);
-  if (w < 1 || h < 1 || w > 16384 || h > 16384) {
+  const long w = boundedNumber(m[1], kMaxSide), h = boundedNumber(m[2], kMaxSide);
+  if (w < 1 || h < 1) {
     throw Error(ExitCode::kUsage, "", flag + " " + spec + ": size must be 1..16384 per side");
   }
   return {int(w), int(h)};
+}
+
+std::string emptyFramesWarning(const std::string& tool, size_t empty, int firstEmpty, size_t frames,
+                               const Camera& lens) {
+  if (empty == 0) return "";
+  const std::string camera = lens.name.empty() ? "the camera" : "camera '" + lens.name + "'";
+  const std::string zfar = lens.zfar > 0.0 ? numberText(lens.zfar) : std::string("infinite");
+  return tool + ": warning: " + std::to_string(empty) + " of " + std::to_string(frames) +
+         " frames show no surface (the first: frame " + std::to_string(firstEmpty) +
+         "), so they are black: the scene lies outside " + camera + "'s view or clip planes " +
+         "(znear " + numberText(lens.znear) + ", zfar " + zfar + ")\n";
 }
 
 double peakMemoryMb() {
@@ -173,10 +284,15 @@ bool stderrIsTerminal() {
 }
 
 Progress::Progress(std::string label, long total)
-    : label_(std::move(label)), total_(total), active_(stderrIsTerminal() && total > 0) {}
+    : label_(std::move(label)),
+      total_(total),
+      active_(stderrIsTerminal() && total > 0),
+      logging_(!stderrIsTerminal() && total > 0),
+      lastLog_(std::chrono::steady_clock::now()) {}
 
 void Progress::advance(long n) {
   count_ += n;
+  if (logging_) log();
   if (!active_) return;
   int pct = int(100 * count_ / total_);
   if (pct == lastPercent_) return;
@@ -187,9 +303,19 @@ void Progress::advance(long n) {
   std::fflush(stderr);
 }
 
+void Progress::log() {
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - lastLog_).count() < kLogSeconds || count_ >= total_)
+    return;
+  lastLog_ = now;
+  std::fprintf(stderr, "%s: %ld/%ld (%d %%)\n", label_.c_str(), count_, total_,
+               int(100 * count_ / total_));
+}
+
 void Progress::done() {
   if (active_ && lastPercent_ >= 0) std::fprintf(stderr, "\n");
   active_ = false;
+  logging_ = false;
 }
 
 Progress::~Progress() {

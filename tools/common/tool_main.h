@@ -2,6 +2,7 @@
 // (CONVENTIONS.md "Small tools with thin mains", "Errors").
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include "libcommon/core/error.h"
 
 namespace rad {
+
+struct Camera;
 
 // The exit-code table every --help ends with.
 inline const char* exitCodeHelp() {
@@ -37,8 +40,26 @@ int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** ar
 nlohmann::json optionDefaults(CLI::App& app);
 
 // Runs body, mapping rad::Error and other exceptions to `tool: message` on stderr and the
-// documented exit code.
+// documented exit code; then finishStdout.
 int runTool(const std::string& tool, const std::function<int()>& body);
+
+// Flushes stdout and returns rc, or, when what the tool printed there was lost (a full disk:
+// `rad-inspect --json f > /dev/full`), prints `tool: stdout: write failed: REASON` and returns
+// max(rc, 3). Without it the loss shows only at exit, where nothing checks it (exit 0).
+int finishStdout(const std::string& tool, int rc);
+
+// Checks for floating-point options, for every tool's float option. CLI11's own
+// (PositiveNumber, NonNegativeNumber, Range) let "nan" through, since every comparison with NaN
+// is false, accept "inf", and print their bounds with %f (DBL_MAX as 309 digits). These accept
+// finite numbers only, and say what they want in %g style.
+CLI::Validator finiteNumber();
+CLI::Validator positiveFinite();                   // > 0
+CLI::Validator nonNegativeFinite();                // >= 0
+CLI::Validator finiteRange(double lo, double hi);  // lo <= x <= hi
+// The same for integer options (CLI11's PositiveNumber on --key-step 0 printed 309 digits).
+CLI::Validator integerRange(long long lo, long long hi);  // lo <= n <= hi
+CLI::Validator positiveInteger();                         // >= 1
+CLI::Validator nonNegativeInteger();                      // >= 0
 
 // Parses "a-b", "a-bxs" or "a" (oiiotool style) into the frames it names; throws a usage
 // Error naming `flag` on bad syntax.
@@ -47,12 +68,20 @@ std::vector<int> parseFrameRange(const std::string& spec, const std::string& fla
 // Parses "352x240".
 std::pair<int, int> parseImageSize(const std::string& spec, const std::string& flag = "--size");
 
+// The warning line (with its newline) for `empty` of `frames` frames in which the camera sees no
+// surface, the first of them `firstEmpty`: they come out black, usually because `lens`'s clip
+// planes or view miss the whole scene. "" when empty is 0.
+std::string emptyFramesWarning(const std::string& tool, size_t empty, int firstEmpty, size_t frames,
+                               const Camera& lens);
+
 // Peak resident memory of this process so far, MiB (getrusage ru_maxrss), for --report.
 double peakMemoryMb();
 // True when stderr is a terminal (progress bars only then).
 bool stderrIsTerminal();
 
-// A progress bar on stderr that draws only on a terminal.
+// A progress bar on stderr. On a terminal it redraws one line; elsewhere (a log file, a farm
+// job's output) it prints a plain line `label: done/total (pct %)` at most every kLogSeconds, none
+// in a shorter run: 12,501 key times once made one line each.
 class Progress {
  public:
   Progress(std::string label, long total);
@@ -61,10 +90,15 @@ class Progress {
   ~Progress();
 
  private:
+  static constexpr double kLogSeconds = 10.0;
+  void log();
+
   std::string label_;
   long total_, count_ = 0;
   int lastPercent_ = -1;
   bool active_;
+  bool logging_;  // off a terminal
+  std::chrono::steady_clock::time_point lastLog_;
 };
 
 }  // namespace rad

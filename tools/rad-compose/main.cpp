@@ -85,6 +85,14 @@ void warnAboutDifferences(const rad::ComposeSequenceOptions& c, const std::strin
       std::cerr << kTool << ": warning: " << intervalsPath << ": " << m << "\n";
 }
 
+// Frames in which no pixel shows a surface: black frames.
+std::vector<int> emptyFrames(const rad::ComposeSequenceReport& report) {
+  std::vector<int> empty;
+  for (const rad::ComposeFrameStats& f : report.frames)
+    if (f.coveredPixels == 0) empty.push_back(f.frame);
+  return empty;
+}
+
 int run(const rad::ComposeOptions& given, int argc, char** argv) {
   rad::ComposeOptions o = given;
   rad::Scene scene = rad::readGltfScene(o.scene);
@@ -120,8 +128,13 @@ int run(const rad::ComposeOptions& given, int argc, char** argv) {
   progress.done();
   if (o.autoExposure)
     std::cerr << kTool << ": auto exposure " << report.exposureEV << " EV for all frames\n";
+  const std::vector<int> empty = emptyFrames(report);
+  if (!empty.empty())
+    std::cerr << rad::emptyFramesWarning(kTool, empty.size(), empty.front(), report.frames.size(),
+                                         scene.cameras[scene.nodes[c.cameraNode].camera]);
   if (!o.report.empty()) {
     nlohmann::json j = report.toJson();
+    j["empty_frames"] = empty.size();
     j["provenance"] = provenance.toJson();
     j["peak_memory_mb"] = rad::peakMemoryMb();  // of the process (getrusage), issue 16
     rad::writeTextFile(o.report, j.dump(1) + "\n");
@@ -151,12 +164,14 @@ int main(int argc, char** argv) {
   app.add_option("--frames", o.frames,
                  "frames to compose, FIRST-LAST[xSTEP] (default: all of "
                  "the intervals' window)");
-  app.add_option("--fps", o.fps, "frames per second, frame f at f/fps (default: the intervals')");
+  app.add_option("--fps", o.fps, "frames per second, frame f at f/fps (default: the intervals')")
+      ->check(rad::positiveFinite());
   app.add_option("--size", o.size, "image size WIDTHxHEIGHT (default: the intervals')");
   app.add_option("--camera", o.camera, "camera node or camera name (default: the first camera)");
   auto* exposure = app.add_option("--exposure", o.exposure,
                                   "PNG exposure in EV: PNG = sRGB(L * 2^EV) "
-                                  "(default 0)");
+                                  "(default 0)")
+                       ->check(rad::finiteNumber());
   app.add_flag("--auto-exposure", o.autoExposure,
                "one exposure for the whole sequence: the 99th area percentile of the global "
                "solution's non-emitter radiance maps to white")

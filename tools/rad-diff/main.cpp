@@ -420,10 +420,12 @@ int main(int argc, char** argv) {
   app.add_option("--ref2", o.reference2,
                  "second reference of another seed (same kind and frames as REFERENCE): removes "
                  "the references' noise from rmse/mean");
-  auto* threshold = app.add_option(
-      "--emitter-threshold", o.emitters.threshold,
-      "a pixel whose reference luminance Y exceeds this is an emitter (default: 10 x "
-      "the median Y of the lit reference pixels, per frame)");
+  auto* threshold =
+      app.add_option(
+             "--emitter-threshold", o.emitters.threshold,
+             "a pixel whose reference luminance Y exceeds this is an emitter (default: 10 x "
+             "the median Y of the lit reference pixels, per frame)")
+          ->check(rad::nonNegativeFinite());
   app.add_option("--emitter-mask", o.emitterMask,
                  "EXR (or directory of NNNN.exr, like REFERENCE) whose first channel > 0.5 marks "
                  "the emitter pixels; replaces the luminance rule")
@@ -442,7 +444,7 @@ int main(int argc, char** argv) {
   app.add_option("--static-tolerance", o.staticTolerance,
                  "flicker: a reference pixel is static when no channel changes by more")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(rad::nonNegativeFinite());
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o); });
 }

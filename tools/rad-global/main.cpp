@@ -36,16 +36,16 @@ void addOptions(CLI::App& app, Options& o) {
                  "frame range a-b (time = frame / fps); default: the scene's whole animation");
   app.add_option("--fps", g.fps, "frames per second")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(rad::positiveFinite());
   app.add_option("--key-step", g.keyStep, "frames between key times (the last frame is always one)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(rad::positiveInteger());
   app.add_option(
          "--eps", r.eps,
          "refinement threshold: refine while B_q F_pq V A_p > eps x the largest power emitted or, "
          "once it is larger, carried (sum of A B over the patches)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(rad::nonNegativeFinite());
   app.add_option_function<std::string>(
          "--oracle", [&r](const std::string& s) { r.oracle = rad::parseRefinementOracle(s); },
          "what --eps bounds: power (B_q F_pq V A_p, HSA'91), error (B_q V times the spread of the "
@@ -56,13 +56,13 @@ void addOptions(CLI::App& app, Options& o) {
                  "do not subdivide patches of this area (m^2) or less; 0: 1e-4 of the largest "
                  "top-level patch")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(rad::nonNegativeFinite());
   app.add_option("--rays", r.rays, "shadow-ray pairs per link")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(rad::positiveInteger());
   app.add_option("--tol", r.tol, "solver stop: relative change < tol x (1 - max reflectance)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(rad::positiveFinite());
   app.add_option_function<std::string>(
          "--bad-links",
          [&g](const std::string& s) { g.spaceTime.badLinks = rad::parseBadLinkRule(s); },
@@ -73,12 +73,12 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_option("--partial-threshold", g.spaceTime.partialThreshold,
                  "partial: a link is partly visible when threshold < V < 1")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--max-links", r.maxLinks,
                  "memory bound: a key time stops refining at this many links (~160 bytes each) "
                  "and warns")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(rad::positiveInteger());
   app.add_flag_callback(
       "--no-closure", [&r] { r.closure = false; },
       "gather without the closure factor (each leaf's row sum its own; exact energy balance in "
@@ -91,7 +91,7 @@ void addOptions(CLI::App& app, Options& o) {
                  "keep a cluster link only while its ends' centres are at least this many times "
                  "the sum of their bounding radii apart; larger is more accurate and slower")
       ->capture_default_str()
-      ->check(CLI::Range(1.0, 1e6));
+      ->check(rad::finiteRange(1.0, 1e6));
   app.add_flag_callback(
       "--no-clustering", [&r] { r.clustering = false; },
       "link every pair of top-level patches (the baseline) instead of starting from the root "

@@ -237,5 +237,5 @@ int main(int argc, char** argv) {
     std::cout << (all.size() == 1 ? all[0] : all)
                      .dump(1, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
-  return worst;
+  return rad::finishStdout(kTool, worst);
 }

@@ -66,6 +66,12 @@ int run(const rad::IntervalsOptions& given, int argc, char** argv) {
   report["peak_memory_mb"] = rad::peakMemoryMb();  // of the process (getrusage), issue 16
   if (!o.report.empty()) rad::writeTextFile(o.report, report.dump(1) + "\n");
   printSummary(report, sequence.intervals.movies.size());
+  if (!sequence.emptyFrames.empty())
+    std::fputs(
+        rad::emptyFramesWarning(kTool, sequence.emptyFrames.size(), sequence.emptyFrames.front(),
+                                frames.size(), scene.cameras[scene.nodes[camera].camera])
+            .c_str(),
+        stderr);
   return 0;
 }
 
@@ -84,7 +90,8 @@ int main(int argc, char** argv) {
       "--frames", o.frames,
       "frame range a-b or a-bxstep (default: the whole animation, 0 to ceil(end x fps))");
   app.add_option("--fps", o.build.fps, "frames per second; frame f is at time f/fps")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::positiveFinite());
   app.add_option("--size", o.size, "item buffer size WxH (the final frame size)")
       ->capture_default_str();
   app.add_option("--camera", o.camera, "camera node or camera name (default: the first)");
@@ -95,17 +102,21 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--min-visible-fraction", o.build.minVisibleFraction,
                  "theta: below this visible fraction a patch is represented by its children")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--level-hysteresis", o.build.levelHysteresis,
                  "keep a patch's level while its visible fraction stays within this of theta")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--texel-density", o.build.texelDensity, "texels per covered pixel")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::positiveFinite());
   app.add_option("--min-size", o.build.minSize, "smallest texture side")->capture_default_str();
   app.add_option("--max-size", o.build.maxSize, "largest texture side")->capture_default_str();
   app.add_option("--resize-tolerance", o.build.resizeTolerance,
                  "keep a texture size while the ideal size is within a factor 1+tol of it")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::nonNegativeFinite());
   app.add_option("--max-length", o.build.maxLength, "longest movie in frames (0 = no limit)")
       ->capture_default_str();
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;

@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
   CLI::Option* keyStep =
       app.add_option("--movie-key-step", b.keyStep, "frames between key textures of a movie")
           ->capture_default_str()
-          ->check(CLI::PositiveNumber);
+          ->check(rad::positiveInteger());
   app.add_option_function<int>(
          "--key-step",
          [&b](const int& step) {
@@ -103,14 +103,14 @@ int main(int argc, char** argv) {
            b.keyStep = step;
          },
          "deprecated name of --movie-key-step")
-      ->check(CLI::PositiveNumber)
+      ->check(rad::positiveInteger())
       ->excludes(keyStep)
       ->group("Deprecated");
   app.add_option("--moving-shadow-key-step", b.movingShadowKeyStep,
                  "frames between key textures of a movie whose bad links' shadows move (a "
                  "moving blocker in the shaft, or a moving end); 0: --movie-key-step")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(rad::nonNegativeInteger());
   app.add_option("--min-samples", b.minSamples,
                  "shooter samples per bad link, at least (at most --max-samples)")
       ->capture_default_str();
@@ -118,7 +118,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--samples-per-form-factor", b.samplesPerFormFactor,
                  "samples = this x the largest texel-to-shooter form factor (paper §3.1)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::nonNegativeFinite());
   app.add_option("--merge", o.merge,
                  "static/dynamic occlusion merge: exact (bit masks ORed), or the approximate "
                  "max, sum, independent")
@@ -127,7 +128,8 @@ int main(int argc, char** argv) {
   app.add_option("--ray-cast-budget", b.rayCastBudget,
                  "ray cast a pair's occlusion masks on the CPU while texels x samples is at most "
                  "this, else render them with OSMesa; 0: always OSMesa")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::nonNegativeFinite());
   app.add_option("--good-layer", o.goodLayer,
                  "indirect light of the good links: gather (per texel, exact point form factors "
                  "to each link's shooter) or gouraud (the global solution's vertex values, paper "
@@ -137,7 +139,8 @@ int main(int argc, char** argv) {
   app.add_option("--gather-shooter-ratio", b.gatherShooterRatio,
                  "gather: split a link's shooter into the parts of its sub-tree larger than "
                  "this times their distance to the receiver (0: no split)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::nonNegativeFinite());
   app.add_option("--gather-rays", b.gatherRays,
                  "gather: shadow rays from each texel to a partly occluded link's shooter, "
                  "1..64 (0: the link's one visibility over its receiver)")
@@ -156,7 +159,8 @@ int main(int argc, char** argv) {
                  "of a static pair, its form factors and static-blocker masks (independent of "
                  "the number of keys); a movie that needs more is refused (exit 4). The gather "
                  "keeps its per-texel form factors in half of it, else recomputes them per key")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(rad::positiveFinite());
   app.add_option("--report", o.report, "write timings and counts as JSON to this file");
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o, argc, argv); });

@@ -64,15 +64,15 @@ int main(int argc, char** argv) {
                  "frame range a-b (default: the whole animation, 0 to ceil(end x fps))");
   app.add_option("--fps", o.fps, "frames per second")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(rad::positiveFinite());
   app.add_option("--size", o.size, "image size WxH")->capture_default_str();
   app.add_option("--spp", o.spp, "samples per pixel")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1 << 24));
+      ->check(rad::integerRange(1, 1 << 24));
   app.add_option("--camera", o.camera, "camera node or camera name (default: the first)");
   app.add_option("--max-depth", o.maxDepth, "maximum number of reflections per path")
       ->capture_default_str()
-      ->check(CLI::Range(0, 100000));
+      ->check(rad::integerRange(0, 100000));
   app.add_option("--seed", o.seed, "random seed")->capture_default_str();
   app.add_flag("--pixel-centres", o.pixelCentres,
                "every sample through the pixel centre (no antialiasing), as rad-compose samples");
