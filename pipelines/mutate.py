@@ -17,9 +17,12 @@ Each mutant goes through `rad-inspect --check` and, when that accepts it, `rad-g
 triangle lists are valid glTF read by the spec (tests/format/gltf_scene_test.cpp), but make
 coincident reversed triangles (strip) and fans through the boxes' insides, on which rad-global's
 near-contact form factors take 20x the source's time; those two go through rad-inspect only
-unless --run-known-slow (a random mutant that sets a mode to 5 or 6 is reported like any other). Asserted for every run: no signal, exit code 0 or 1, one
-line on stderr when it fails, a global.rlh without NaN/Inf radiosity when it exits 0, and a time
-within 10x the source scene's (at least 1 s: process start-up noise).
+unless --run-known-slow (a random mutant that sets a mode to 5 or 6 is reported like any other).
+
+Asserted for every run: no signal, exit code 0 or 1, one line on stderr when it fails, a
+global.rlh without NaN/Inf when it exits 0, and a time (of the run, or of its one retry: the
+machine's load spikes) within 10x the source scene's, at least --min-limit (3 s: the source's
+0.1 s is mostly process start-up).
 
 usage: mutate.py [--bin DIR] [--out DIR] [--count N] [--seed S] [--check] [--keep]
                  [--run-known-slow]
@@ -258,6 +261,9 @@ def main():
     ap.add_argument("--seed", type=int, default=18)
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--keep", action="store_true", help="keep every mutant file, not only failures")
+    ap.add_argument("--min-limit", type=float, default=3.0,
+                    help="least time limit per run, s (the source's 0.1 s is mostly start-up, and "
+                    "a shared machine's load varies by more than 10x that)")
     ap.add_argument("--run-known-slow", action="store_true",
                     help="also run rad-global on the modes 5/6 mutants (left open, 20x slower)")
     a = ap.parse_args()
@@ -275,7 +281,7 @@ def main():
             if rc != 0:
                 sys.exit("mutate.py: the source scene fails: " + err.strip())
             base.append(secs)
-    limit = max(10 * min(base), 1.0)
+    limit = max(10 * min(base), a.min_limit)
     print("source: rad-global %.2f s; limit per run %.2f s; %d mutants" %
           (min(base), limit, len(cases)))
     bad, exits, slowest = [], {}, (0.0, "")
@@ -285,6 +291,9 @@ def main():
         open(path, "wb").write(raw)
         load_only = name in KNOWN_SLOW and not a.run_known_slow
         problems, summary, stages = check_one(a.bin, path, limit, load_only)
+        if problems and all(" took " in p for p in problems):
+            # A shared machine's load spikes: a time over the limit counts when it repeats.
+            problems, summary, stages = check_one(a.bin, path, limit, load_only)
         for tool, rc, err, secs in stages:
             exits[(tool, rc)] = exits.get((tool, rc), 0) + 1
             if secs > slowest[0]:
