@@ -12,9 +12,15 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
+#include <limits>
 #include <map>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "libcommon/core/error.h"
 
@@ -24,7 +30,8 @@ namespace {
 
 class Reader {
  public:
-  Reader(const std::string& path, const tinygltf::Model& model) : path_(path), m_(model) {}
+  Reader(const std::string& path, const tinygltf::Model& model, const GltfReadOptions& options)
+      : path_(path), m_(model), options_(options) {}
   Scene read();
 
  private:
@@ -32,25 +39,67 @@ class Reader {
 
   std::vector<double> readAccessor(int index, const std::string& what, int& components,
                                    bool forceNormalized = false) const;
+  void requireFloat(int accessor, const std::string& what) const;
   void readNodes(Scene& scene);
   void readMesh(int meshIndex, Scene& scene);
   int material(int index, Scene& scene);
+  void clampReflectance(Material& mat, const std::string& where, Scene& scene) const;
   int texture(int index, Scene& scene);
   void readCameras(Scene& scene);
   void readAnimations(Scene& scene);
+  void requireConstantScale(const AnimationChannel& ch, const std::string& where) const;
+  void checkWorldBounds(const Scene& scene) const;
+  void requireWorldArea(const Scene& scene, int node, double t) const;
 
   std::string path_;
   const tinygltf::Model& m_;
+  GltfReadOptions options_;
   std::map<int, int> materialMap_;  // glTF material -> Scene::materials
   std::map<int, int> textureMap_;   // glTF texture -> Scene::textures
   size_t droppedTriangles_ = 0;
 };
 
-std::string oneLine(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
+// Quoted input (names, URIs, tinygltf's messages that echo them) is cut at this many bytes:
+// a failed data URI used to be echoed whole, a 12 KB error line.
+constexpr size_t kMaxQuoted = 120;
+
+// `s` cut to `max` bytes (at a UTF-8 character boundary) with "…" appended when cut.
+std::string clipped(const std::string& s, size_t max) {
+  if (s.size() <= max) return s;
+  size_t end = max;
+  while (end > 0 && (static_cast<unsigned char>(s[end]) & 0xC0) == 0x80) --end;
+  return s.substr(0, end) + "…";
+}
+std::string clipInput(const std::string& s) {
+  return clipped(s, kMaxQuoted);
+}
+
+// A library message on one line, every word longer than kMaxQuoted cut (clipInput()), at most
+// 4 x kMaxQuoted bytes in all.
+std::string oneLine(const std::string& text) {
+  std::string out, word;
+  auto flush = [&] {
+    if (word.empty()) return;
+    if (!out.empty()) out += ' ';
+    out += clipInput(word);
+    word.clear();
+  };
+  for (char c : text) {
+    if (c == '\n' || c == '\r' || c == ' ' || c == '\t')
+      flush();
+    else
+      word += c;
+  }
+  flush();
+  return clipped(out, 4 * kMaxQuoted);
+}
+
+// A value in a message: shortest round-trip form ("1e+38", "0.5").
+std::string number(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
 }
 
 bool allFinite(const std::vector<double>& v) {
@@ -141,6 +190,9 @@ int typeComponents(int type) {
   }
 }
 
+// Elements of an accessor without a bufferView (zeros but for sparse substitutions).
+constexpr size_t kMaxZeroElements = size_t(1) << 20;
+
 // Checks that `count` elements of `elementSize` bytes at `offset` with `stride` fit in a view of
 // `viewLength` bytes (no overflow).
 bool fits(size_t offset, size_t count, size_t stride, size_t elementSize, size_t viewLength) {
@@ -169,7 +221,6 @@ std::vector<double> Reader::readAccessor(int index, const std::string& what, int
   // 2^28 elements (> 1 GB of doubles) is far beyond any scene this toolchain handles.
   if (a.count > (size_t(1) << 28))
     fail(where + ": count " + std::to_string(a.count) + " too large");
-  std::vector<double> out(a.count * size_t(components), 0.0);
   auto viewBytes = [&](int viewIndex,
                        const std::string& role) -> std::pair<const unsigned char*, size_t> {
     if (viewIndex < 0 || viewIndex >= int(m_.bufferViews.size()))
@@ -186,10 +237,14 @@ std::vector<double> Reader::readAccessor(int index, const std::string& what, int
            " bytes");
     return {b.data.data() + v.byteOffset, v.byteLength};
   };
+  // Every bound is checked before the output is allocated: a count of 2^25 on a 48-byte view
+  // used to allocate 800 MB before its error.
+  const unsigned char* data = nullptr;
+  size_t stride = elementSize;
   if (a.bufferView >= 0) {
-    auto [data, length] = viewBytes(a.bufferView, "");
+    auto [bytes, length] = viewBytes(a.bufferView, "");
     const tinygltf::BufferView& v = m_.bufferViews[size_t(a.bufferView)];
-    size_t stride = v.byteStride ? v.byteStride : elementSize;
+    stride = v.byteStride ? v.byteStride : elementSize;
     if (stride < elementSize)
       fail(where + ": byteStride " + std::to_string(stride) + " smaller than element size " +
            std::to_string(elementSize));
@@ -197,12 +252,19 @@ std::vector<double> Reader::readAccessor(int index, const std::string& what, int
       fail(where + ": " + std::to_string(a.count) + " elements at offset " +
            std::to_string(a.byteOffset) + " exceed bufferView " + std::to_string(a.bufferView) +
            " (" + std::to_string(length) + " bytes)");
-    for (size_t i = 0; i < a.count; ++i) {
-      const unsigned char* p = data + a.byteOffset + i * stride;
-      for (int c = 0; c < components; ++c)
-        out[i * size_t(components) + size_t(c)] =
-            readComponent(p + size_t(c) * size_t(csize), a.componentType, normalized);
-    }
+    data = bytes + a.byteOffset;
+  } else if (a.count > kMaxZeroElements) {
+    // Without a bufferView the elements are zeros (glTF section 3.6.2.3) taking no bytes of the
+    // file: bounded so that a few bytes of JSON cannot ask for gigabytes.
+    fail(where + ": " + std::to_string(a.count) + " elements without a bufferView (limit " +
+         std::to_string(kMaxZeroElements) + ")");
+  }
+  std::vector<double> out(a.count * size_t(components), 0.0);
+  for (size_t i = 0; data && i < a.count; ++i) {
+    const unsigned char* p = data + i * stride;
+    for (int c = 0; c < components; ++c)
+      out[i * size_t(components) + size_t(c)] =
+          readComponent(p + size_t(c) * size_t(csize), a.componentType, normalized);
   }
   if (a.sparse.isSparse) {  // glTF §3.6.2.3 sparse accessors: substitute the listed elements
     const int n = a.sparse.count;
@@ -234,12 +296,23 @@ std::vector<double> Reader::readAccessor(int index, const std::string& what, int
   return out;
 }
 
+// glTF 2.0 section 3.7.2.1: POSITION and NORMAL are float; integer ones are quantized data of
+// KHR_mesh_quantization (not supported). Read as integers they were garbage geometry: 0..255
+// "metres" from a float buffer's bytes.
+void Reader::requireFloat(int accessor, const std::string& what) const {
+  if (accessor < 0 || accessor >= int(m_.accessors.size())) return;  // readAccessor says so
+  const int ct = m_.accessors[size_t(accessor)].componentType;
+  if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT)
+    fail(what + " has component type " + std::to_string(ct) +
+         ", not float (5126); quantized attributes (KHR_mesh_quantization) are not supported");
+}
+
 Scene Reader::read() {
   Scene scene;
   scene.path = path_;
   for (const std::string& ext : m_.extensionsRequired)
     if (ext != "KHR_materials_emissive_strength")
-      fail("required extension " + ext + " is not supported");
+      fail("required extension " + clipInput(ext) + " is not supported");
   for (size_t i = 0; i < m_.nodes.size(); ++i) {
     if (m_.nodes[i].skin >= 0)
       fail("node " + std::to_string(i) +
@@ -263,6 +336,7 @@ Scene Reader::read() {
                              " zero-area triangles");
   readCameras(scene);
   readAnimations(scene);
+  checkWorldBounds(scene);
   return scene;
 }
 
@@ -367,10 +441,15 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
       fail(where + ": unknown primitive mode " + std::to_string(mode));
     auto pos = prim.attributes.find("POSITION");
     if (pos == prim.attributes.end()) fail(where + ": no POSITION attribute");
+    requireFloat(pos->second, where + ": POSITION");
     int nc = 0;
     std::vector<double> p = readAccessor(pos->second, where + " POSITION", nc);
     if (nc != 3) fail(where + ": POSITION is not VEC3");
     if (!allFinite(p)) fail(where + ": non-finite (NaN or Inf) vertex position");
+    for (double x : p)
+      if (std::abs(x) > kMaxCoordinate)
+        fail(where + ": vertex coordinate " + number(x) + " beyond the limit " +
+             number(kMaxCoordinate));
     const size_t vertexCount = p.size() / 3;
     const int matIndex = material(prim.material, scene);
     const Material* mat = matIndex >= 0 ? &scene.materials[size_t(matIndex)] : nullptr;
@@ -396,6 +475,7 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
     std::vector<double> normals;
     auto na = prim.attributes.find("NORMAL");
     if (na != prim.attributes.end()) {
+      requireFloat(na->second, where + ": NORMAL");
       normals = readAccessor(na->second, where + " NORMAL", nc);
       if (nc != 3) fail(where + ": NORMAL is not VEC3");
       if (normals.size() / 3 != vertexCount)
@@ -475,6 +555,16 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
   }
 }
 
+// rho = 1 reflects all it receives: with any emission the solve diverges (NaN or huge values).
+// Clamped to kMaxReflectance, as the furnace's highest, with one warning.
+void Reader::clampReflectance(Material& mat, const std::string& where, Scene& scene) const {
+  const double before = std::max({mat.reflectance.x, mat.reflectance.y, mat.reflectance.z});
+  if (before <= kMaxReflectance) return;
+  mat.reflectance = glm::min(mat.reflectance, glm::dvec3(kMaxReflectance));
+  scene.warnings.push_back(where + ": reflectance " + number(before) + " clamped to " +
+                           number(kMaxReflectance) + " (the radiosity solve needs rho < 1)");
+}
+
 int Reader::material(int index, Scene& scene) {
   if (index < 0) return -1;  // glTF default material (§3.9.6): white, not emissive
   if (index >= int(m_.materials.size()))
@@ -498,6 +588,7 @@ int Reader::material(int index, Scene& scene) {
     if (mat.baseColorTexture >= 0)
       mat.reflectance *= scene.textures[size_t(mat.baseColorTexture)].mean;
   }
+  clampReflectance(mat, where, scene);
   double strength = 1.0;  // KHR_materials_emissive_strength
   auto ext = g.extensions.find("KHR_materials_emissive_strength");
   if (ext != g.extensions.end() && ext->second.Has("emissiveStrength")) {
@@ -509,8 +600,14 @@ int Reader::material(int index, Scene& scene) {
     fail(where + ": emissiveStrength must be finite and >= 0");
   if (g.emissiveFactor.size() >= 3) {
     if (!allFinite(g.emissiveFactor)) fail(where + ": non-finite emissiveFactor");
-    for (int c = 0; c < 3; ++c)
+    for (int c = 0; c < 3; ++c) {
       mat.emission[c] = std::max(0.0, g.emissiveFactor[size_t(c)]) * strength;
+      // An emissiveStrength of 1e308 gave an infinite power and NaN radiosity with exit 0.
+      if (!(mat.emission[c] <= kMaxEmission))
+        fail(where + ": emission (emissiveFactor x emissiveStrength) " +
+             number(g.emissiveFactor[size_t(c)] * strength) + " beyond the limit " +
+             number(kMaxEmission) + " W m^-2 sr^-1");
+    }
   }
   if (g.emissiveTexture.index >= 0)
     scene.warnings.push_back(where +
@@ -534,7 +631,7 @@ int Reader::texture(int index, Scene& scene) {
   const size_t bytes = bits == 16 ? 2 : 1;
   if (w <= 0 || h <= 0 || comp < 1 || comp > 4 || (bits != 8 && bits != 16) ||
       img.image.size() < size_t(w) * size_t(h) * size_t(comp) * bytes) {
-    scene.warnings.push_back(where + ": image '" + img.name +
+    scene.warnings.push_back(where + ": image '" + clipInput(img.name) +
                              "' not decoded; base colour texture ignored");
     return textureMap_[index] = -1;
   }
@@ -600,7 +697,7 @@ void Reader::readCameras(Scene& scene) {
       if (!(c.znear >= 0.0 && c.zfar > c.znear && std::isfinite(c.zfar)))
         fail(where + ": orthographic camera needs 0 <= znear < zfar");
     } else {
-      fail(where + ": unknown type '" + g.type + "'");
+      fail(where + ": unknown type '" + clipInput(g.type) + "'");
     }
     scene.cameras.push_back(c);
   }
@@ -627,7 +724,7 @@ void Reader::readAnimations(Scene& scene) {
       } else if (gc.target_path == "weights") {
         fail(where + ": animates morph target weights; morph targets are not supported");
       } else {
-        fail(where + ": unknown target path '" + gc.target_path + "'");
+        fail(where + ": unknown target path '" + clipInput(gc.target_path) + "'");
       }
       if (m_.nodes[size_t(ch.node)].matrix.size() == 16)
         fail(where + ": targets node " + std::to_string(ch.node) +
@@ -642,7 +739,7 @@ void Reader::readAnimations(Scene& scene) {
       } else if (gs.interpolation == "CUBICSPLINE") {
         ch.interpolation = Interpolation::kCubicSpline;
       } else {
-        fail(where + ": unknown interpolation '" + gs.interpolation + "'");
+        fail(where + ": unknown interpolation '" + clipInput(gs.interpolation) + "'");
       }
       int nc = 0;
       ch.times = readAccessor(gs.input, where + " input", nc);
@@ -662,40 +759,273 @@ void Reader::readAnimations(Scene& scene) {
         fail(where + ": output has " + std::to_string(ch.values.size() / size_t(want)) +
              " elements, expected " + std::to_string(ch.times.size() * per));
       if (!allFinite(ch.values)) fail(where + ": non-finite output value");
+      if (ch.path == AnimationPath::kScale && !options_.allowScaleAnimation)
+        requireConstantScale(ch, where);
       scene.channels.push_back(std::move(ch));
     }
   }
 }
 
-Scene readGltfScene(const std::string& path) {
+// The scene model is rigid motion (a patch keeps its shape): a scale channel must hold one value
+// (a static scale, within 1e-6 relative) over all its keys, with zero CUBICSPLINE tangents.
+void Reader::requireConstantScale(const AnimationChannel& ch, const std::string& where) const {
+  const size_t keys = ch.times.size();
+  const bool cubic = ch.interpolation == Interpolation::kCubicSpline;
+  auto value = [&](size_t k, size_t c) { return ch.values[((cubic ? 3 * k + 1 : k) * 3) + c]; };
+  for (size_t k = 0; k < keys; ++k)
+    for (size_t c = 0; c < 3; ++c) {
+      const double v = value(k, c), first = value(0, c);
+      const bool tangentsZero =
+          !cubic || (std::abs(ch.values[3 * k * 3 + c]) <= 1e-6 * std::abs(first) &&
+                     std::abs(ch.values[(3 * k + 2) * 3 + c]) <= 1e-6 * std::abs(first));
+      if (std::abs(v - first) > 1e-6 * std::max(std::abs(first), std::abs(v)) || !tangentsZero)
+        fail(where + ": animates the scale of node " + std::to_string(ch.node) + " (key " +
+             std::to_string(k) + ": " + number(v) + ", key 0: " + number(first) +
+             "); only rigid motion is supported: a scale channel must hold one value");
+    }
+}
+
+namespace {
+
+// Largest |translation| and |scale component| a node takes at rest and over its channels' keys,
+// with CUBICSPLINE overshoot (|h10|, |h11| <= 4/27 of the key interval times the tangent).
+struct NodeReach {
+  double translation = 0.0, scale = 0.0;
+};
+
+std::vector<NodeReach> nodeReach(const Scene& scene) {
+  std::vector<NodeReach> reach(scene.nodes.size());
+  for (size_t i = 0; i < scene.nodes.size(); ++i) {
+    const Node& n = scene.nodes[i];
+    reach[i].translation = glm::length(n.translation);
+    reach[i].scale = std::max({std::abs(n.scale.x), std::abs(n.scale.y), std::abs(n.scale.z)});
+  }
+  for (const AnimationChannel& ch : scene.channels) {
+    if (ch.path == AnimationPath::kRotation || ch.node < 0 || ch.node >= int(reach.size()))
+      continue;
+    const bool cubic = ch.interpolation == Interpolation::kCubicSpline;
+    double value = 0.0, tangent = 0.0, interval = 0.0;
+    for (size_t e = 0; e * 3 + 2 < ch.values.size(); ++e) {
+      const glm::dvec3 v(ch.values[3 * e], ch.values[3 * e + 1], ch.values[3 * e + 2]);
+      const double size = ch.path == AnimationPath::kTranslation
+                              ? glm::length(v)
+                              : std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+      if (cubic && e % 3 != 1)
+        tangent = std::max(tangent, size);
+      else
+        value = std::max(value, size);
+    }
+    for (size_t k = 1; k < ch.times.size(); ++k)
+      interval = std::max(interval, ch.times[k] - ch.times[k - 1]);
+    const double bound = cubic ? 2.0 * value + 8.0 / 27.0 * interval * tangent : value;
+    double& r = ch.path == AnimationPath::kTranslation ? reach[size_t(ch.node)].translation
+                                                       : reach[size_t(ch.node)].scale;
+    r = std::max(r, bound);
+  }
+  return reach;
+}
+
+}  // namespace
+
+// Every world coordinate, at every time, stays within kMaxCoordinate: a bound through the
+// hierarchy |T0 + R0 S0 (T1 + R1 S1 (... p))| <= |T0| + s0 (|T1| + s1 (... |p|)). Coordinates of
+// 1e38 made Embree abort (ray.valid()) and areas overflow. Then no mesh node's rest transform
+// may flatten its triangles to zero (or non-finite) area: their normals would be NaN.
+void Reader::checkWorldBounds(const Scene& scene) const {
+  const std::vector<NodeReach> reach = nodeReach(scene);
+  struct Frame {
+    int node;
+    double offset, scale;  // bound on the frame origin's distance, product of scales
+  };
+  std::vector<Frame> stack;
+  for (int r : scene.roots.empty() ? scene.reachableNodes() : scene.roots)
+    if (scene.nodes[size_t(r)].parent < 0) stack.push_back({r, 0.0, 1.0});
+  const double t0 = scene.startTime();
+  std::vector<char> seen(scene.nodes.size(), 0);
+  while (!stack.empty()) {
+    const Frame parent = stack.back();
+    stack.pop_back();
+    const int i = parent.node;
+    if (seen[size_t(i)]) continue;
+    seen[size_t(i)] = 1;
+    const std::string where = "node " + std::to_string(i);
+    const Node& n = scene.nodes[size_t(i)];
+    const Frame f{i, parent.offset + parent.scale * reach[size_t(i)].translation,
+                  parent.scale * reach[size_t(i)].scale};
+    double extent = 0.0;
+    if (n.mesh >= 0)
+      for (const MeshTriangle& t : scene.meshes[size_t(n.mesh)].triangles)
+        for (const glm::dvec3& p : t.p) extent = std::max(extent, glm::length(p));
+    const double reachable = f.offset + f.scale * extent;
+    if (!(reachable <= kMaxCoordinate))
+      fail(where + ": world coordinates reach up to " + number(reachable) + " (from the " +
+           "translations and scales of it and its parents, and its vertices), beyond the limit " +
+           number(kMaxCoordinate));
+    if (n.mesh >= 0) requireWorldArea(scene, i, t0);
+    for (int c : n.children) stack.push_back({c, f.offset, f.scale});
+  }
+}
+
+void Reader::requireWorldArea(const Scene& scene, int node, double t) const {
+  const glm::dmat3 m(scene.worldTransform(node, t));
+  const std::vector<MeshTriangle>& tris =
+      scene.meshes[size_t(scene.nodes[size_t(node)].mesh)].triangles;
+  for (size_t k = 0; k < tris.size(); ++k) {
+    const glm::dvec3 a = m * (tris[k].p[1] - tris[k].p[0]), b = m * (tris[k].p[2] - tris[k].p[0]);
+    const double twiceArea = glm::length(glm::cross(a, b));
+    const double edge = std::max({glm::length(a), glm::length(b), glm::length(b - a)});
+    if (!(twiceArea > 1e-12 * edge * edge) || !std::isfinite(twiceArea))
+      fail("node " + std::to_string(node) + ": its world transform (scale " +
+           number(scene.nodes[size_t(node)].scale.x) + " " +
+           number(scene.nodes[size_t(node)].scale.y) + " " +
+           number(scene.nodes[size_t(node)].scale.z) + " with its parents') flattens triangle " +
+           std::to_string(k) + " of mesh " + std::to_string(scene.nodes[size_t(node)].mesh) +
+           " to zero area");
+  }
+}
+
+namespace {
+
+// Deeper nesting is refused before parsing: tinygltf's JSON parser (nlohmann) recurses once per
+// level and overflows the stack (SIGSEGV) near 100,000 levels. glTF itself nests < 10 levels;
+// extras rarely reach 20.
+constexpr int kMaxJsonDepth = 256;
+
+// The deepest nesting of objects and arrays in the JSON text (strings and their escapes skipped),
+// without recursion; counting stops above `limit`.
+int jsonNestingDepth(const char* text, size_t size, int limit) {
+  int depth = 0, deepest = 0;
+  bool inString = false;
+  for (size_t i = 0; i < size; ++i) {
+    const char c = text[i];
+    if (inString) {
+      if (c == '\\')
+        ++i;  // the escaped character, a quote included, is part of the string
+      else if (c == '"')
+        inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '{' || c == '[') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > limit) break;
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+void checkJsonDepth(const std::string& path, const char* text, size_t size) {
+  if (jsonNestingDepth(text, size, kMaxJsonDepth) > kMaxJsonDepth)
+    throw inputError(
+        path, "invalid gltf: JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+}
+
+// tinygltf reads these with ParseUnsignedProperty, which keeps the default 0 without an error
+// when the value is negative, fractional or not a number: a negative byteOffset silently read
+// from the buffer's start (other meshes' data, hence garbage geometry and slow runs). Checked
+// here on the same JSON text (its depth already bounded).
+void checkUnsignedFields(const std::string& path, const char* text, size_t size) {
+  const nlohmann::json j = nlohmann::json::parse(text, text + size, nullptr, false);
+  if (!j.is_object()) return;  // tinygltf reports the syntax error
+  auto check = [&](const nlohmann::json& o, const char* key, const std::string& where) {
+    if (!o.is_object() || !o.contains(key)) return;
+    if (!o[key].is_number_unsigned())
+      throw inputError(path, where + ": " + key + " " + clipInput(o[key].dump()) +
+                                 " is not a non-negative integer");
+  };
+  auto each = [&](const char* array,
+                  const std::function<void(const nlohmann::json&, const std::string&)>& f) {
+    auto it = j.find(array);
+    if (it == j.end() || !it->is_array()) return;
+    std::string name(array);
+    name.pop_back();  // "bufferViews" -> "bufferView"
+    for (size_t i = 0; i < it->size(); ++i) f((*it)[i], name + " " + std::to_string(i));
+  };
+  each("buffers",
+       [&](const nlohmann::json& o, const std::string& w) { check(o, "byteLength", w); });
+  each("bufferViews", [&](const nlohmann::json& o, const std::string& w) {
+    for (const char* key : {"byteOffset", "byteLength", "byteStride"}) check(o, key, w);
+  });
+  each("accessors", [&](const nlohmann::json& o, const std::string& w) {
+    check(o, "byteOffset", w);
+    check(o, "count", w);
+    if (!o.is_object() || !o.contains("sparse") || !o["sparse"].is_object()) return;
+    const nlohmann::json& sparse = o["sparse"];
+    check(sparse, "count", w + " sparse");
+    for (const char* part : {"indices", "values"})
+      if (sparse.contains(part)) check(sparse[part], "byteOffset", w + " sparse " + part);
+  });
+}
+
+// KHR_lights_punctual lights in the file (not supported; counted to say why a scene is dark).
+int punctualLightCount(const tinygltf::Model& model) {
+  auto ext = model.extensions.find("KHR_lights_punctual");
+  if (ext != model.extensions.end() && ext->second.Has("lights") &&
+      ext->second.Get("lights").IsArray())
+    return int(ext->second.Get("lights").ArrayLen());
+  return int(model.lights.size());
+}
+
+std::string readWholeFile(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw inputError(path, "cannot open file");
-  unsigned char header[12] = {0};
-  file.read(reinterpret_cast<char*>(header), 12);
-  const std::streamsize got = file.gcount();
-  file.clear();
-  file.seekg(0, std::ios::end);
-  const uint64_t fileSize = uint64_t(file.tellg());
-  file.close();
-  const bool binary = got >= 4 && std::memcmp(header, "glTF", 4) == 0;
-  if (binary) {  // GLB header (glTF §4.4.2): magic, version, total length, little-endian u32
-    if (got < 12) throw inputError(path, "truncated glb: " + std::to_string(fileSize) + " bytes");
-    uint32_t version, length;
-    std::memcpy(&version, header + 4, 4);
-    std::memcpy(&length, header + 8, 4);
-    if (version != 2)
-      throw inputError(path, "glb version " + std::to_string(version) + ", expected 2");
-    if (length > fileSize)
-      throw inputError(path, "truncated glb: header declares " + std::to_string(length) +
-                                 " bytes, file has " + std::to_string(fileSize));
-  }
+  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (file.bad()) throw inputError(path, "cannot read file");
+  return bytes;
+}
+
+uint32_t readU32(const std::string& bytes, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, bytes.data() + at, 4);
+  return v;
+}
+
+// GLB (glTF section 4.4): 12-byte header (magic, version 2, total length), then the JSON chunk
+// (length, type "JSON", text). Checked here before tinygltf sees the file; returns the JSON text.
+std::pair<const char*, size_t> glbJsonChunk(const std::string& path, const std::string& bytes) {
+  const uint64_t fileSize = bytes.size();
+  if (fileSize < 12)
+    throw inputError(path, "truncated glb: " + std::to_string(fileSize) + " bytes");
+  const uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8);
+  if (version != 2)
+    throw inputError(path, "glb version " + std::to_string(version) + ", expected 2");
+  if (length > fileSize)
+    throw inputError(path, "truncated glb: header declares " + std::to_string(length) +
+                               " bytes, file has " + std::to_string(fileSize));
+  if (length < 20) throw inputError(path, "truncated glb: no JSON chunk");
+  const uint32_t chunkLength = readU32(bytes, 12), chunkType = readU32(bytes, 16);
+  if (chunkType != 0x4E4F534Au) throw inputError(path, "invalid glb: the first chunk is not JSON");
+  if (chunkLength > length - 20)
+    throw inputError(path, "invalid glb: JSON chunk of " + std::to_string(chunkLength) +
+                               " bytes exceeds the file's " + std::to_string(length));
+  return {bytes.data() + 20, chunkLength};
+}
+
+}  // namespace
+
+Scene readGltfScene(const std::string& path, const GltfReadOptions& options) {
+  const std::string bytes = readWholeFile(path);
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  const auto [json, jsonSize] = binary ? glbJsonChunk(path, bytes)
+                                       : std::pair<const char*, size_t>{bytes.data(), bytes.size()};
+  if (!binary && bytes.size() > std::numeric_limits<unsigned int>::max())
+    throw inputError(path, "invalid gltf: JSON text over 4 GB");
+  checkJsonDepth(path, json, jsonSize);
+  checkUnsignedFields(path, json, jsonSize);
+  const std::string baseDir = std::filesystem::path(path).parent_path().string();
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   std::string err, warn;
   bool ok = false;
   try {
-    ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data,
+                                              static_cast<unsigned int>(bytes.size()), baseDir)
+                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
+                                             static_cast<unsigned int>(bytes.size()), baseDir);
+  } catch (const std::bad_alloc&) {
+    throw inputError(path, "invalid gltf: out of memory while parsing");
   } catch (const std::exception& e) {
     throw inputError(path, std::string("invalid gltf: ") + oneLine(e.what()));
   }
@@ -704,14 +1034,15 @@ Scene readGltfScene(const std::string& path) {
     throw inputError(path, "invalid gltf: " + (what.empty() ? std::string("unknown error") : what));
   }
   try {
-    Reader reader(path, model);
+    Reader reader(path, model, options);
     Scene scene = reader.read();
+    scene.punctualLights = punctualLightCount(model);
     if (!warn.empty()) scene.warnings.push_back("tinygltf: " + oneLine(warn));
     return scene;
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {  // e.g. bad_alloc on absurd sizes: still bad input
-    throw inputError(path, std::string("cannot read: ") + e.what());
+    throw inputError(path, std::string("cannot read: ") + oneLine(e.what()));
   }
 }
 

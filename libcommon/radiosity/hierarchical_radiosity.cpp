@@ -108,7 +108,9 @@ std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
       out[size_t(t)].emission = glm::max(mat.emission, glm::dvec3(0.0)) * M_PI;  // B_e = pi L_e
       out[size_t(t)].doubleSided = mat.doubleSided;
     } else {
-      out[size_t(t)].reflectance = glm::dvec3(1.0);  // glTF default material: white, no emission
+      // glTF default material: white (rho 1, kept below 1 as a file's are: the solve needs
+      // rho < 1), no emission.
+      out[size_t(t)].reflectance = glm::dvec3(kMaxReflectance);
     }
   }
   return out;

@@ -4,6 +4,7 @@
 // Appendix C "Animation Sampler Interpolation Modes" (Khronos, glTF 2.0.1).
 #include "libcommon/scene/scene.h"
 
+#include "libcommon/core/error.h"
 #include "libcommon/scene/patch_hierarchy.h"
 
 #include <algorithm>
@@ -554,6 +555,24 @@ std::vector<int> movingNodesOf(const Scene& scene, const std::vector<InputPolygo
     if (scene.isDynamic(p.node, t0, t1)) moving.push_back(p.node);
   }
   return moving;
+}
+
+std::string missingEmitterMessage(const Scene& scene) {
+  for (int node : scene.meshNodes())
+    for (const MeshTriangle& t : scene.meshes[size_t(scene.nodes[size_t(node)].mesh)].triangles)
+      if (t.material >= 0 && t.material < int(scene.materials.size()) &&
+          scene.materials[size_t(t.material)].isEmitter())
+        return "";
+  std::string what = "no emissive material";
+  if (scene.punctualLights > 0)
+    what += "; " + std::to_string(scene.punctualLights) + " KHR_lights_punctual light" +
+            (scene.punctualLights > 1 ? "s are" : " is") + " not supported";
+  return what + ": give a mesh an emissive material (emissiveFactor) instead";
+}
+
+void requireEmitter(const Scene& scene) {
+  const std::string what = missingEmitterMessage(scene);
+  if (!what.empty()) throw inputError(scene.path, what);
 }
 
 }  // namespace rad

@@ -21,6 +21,17 @@
 
 namespace rad {
 
+// Limits of the scene model, enforced when a scene is read (formats/gltf_scene.md "Limits").
+// World coordinates (vertices, node and camera positions, at every time): Embree asserts on
+// rays whose origin or direction exceeds ~1.8e18, and areas (squares) must stay finite.
+constexpr double kMaxCoordinate = 1e15;
+// Exitant radiance L_e per channel, W m^-2 sr^-1 (the sun's disc is ~2e7): emitted power
+// pi L_e A and the radiosity B_e / (1 - rho) stay finite, also in float32 outputs.
+constexpr double kMaxEmission = 1e12;
+// Diffuse reflectance per channel: the radiosity solve converges like rho^n, so rho = 1 with any
+// emission diverges; 0.999 is the furnace's highest (DESIGN.md section 8).
+constexpr double kMaxReflectance = 0.999;
+
 struct Texture {
   std::string name;
   int width = 0, height = 0;
@@ -30,7 +41,8 @@ struct Texture {
 
 struct Material {
   std::string name;
-  // Diffuse reflectance rho = baseColorFactor.rgb x mean(baseColorTexture), each in [0, 1].
+  // Diffuse reflectance rho = baseColorFactor.rgb x mean(baseColorTexture), each in
+  // [0, kMaxReflectance] when read from a file.
   glm::dvec3 reflectance{1.0};
   // Exitant radiance L_e = emissiveFactor x KHR_materials_emissive_strength, W/(m^2 sr).
   // Emitted radiosity is B_e = pi L_e.
@@ -117,7 +129,6 @@ struct InputPolygon {
 // the interpolation degenerates or faces away from the flat normal's side.
 glm::dvec3 shadingNormalAt(const InputPolygon& p, glm::dvec2 uv);
 
-
 class Scene {
  public:
   std::string path;  // file it was read from (for messages)
@@ -129,6 +140,7 @@ class Scene {
   std::vector<Camera> cameras;
   std::vector<AnimationChannel> channels;
   std::vector<std::string> warnings;  // e.g. "dropped 3 zero-area triangles"
+  int punctualLights = 0;  // KHR_lights_punctual lights in the file: not supported, not emitters
 
   // Local transform of a node at time t with glTF semantics (T * R * S).
   glm::dmat4 localTransform(int node, double t) const;
@@ -170,6 +182,13 @@ class Scene {
   int cameraNode(const std::string& name) const;
   CameraView cameraAt(int node, double t) const;
 };
+
+// Empty when a mesh of the displayed scene has an emitting material; else what is missing, on
+// one line ("no emissive material; 3 KHR_lights_punctual lights are not supported: ...").
+std::string missingEmitterMessage(const Scene& scene);
+// Throws rad::Error (kBadInput) `path: missingEmitterMessage` when there is no emitter: a tool
+// that computes light would render black frames.
+void requireEmitter(const Scene& scene);
 
 // The distinct mesh nodes of `polygons` that move somewhere in [t0, t1] (Scene::isDynamic),
 // in first-appearance order.

@@ -80,7 +80,8 @@ nlohmann::json summarizeScene(const Scene& scene) {
 
   nlohmann::json warnings = scene.warnings;
   if (cameras.empty()) warnings.push_back("no camera: rad-intervals and rad-compose need one");
-  if (emitters.empty()) warnings.push_back("no emitter: rad-global needs one");
+  if (emitters.empty())
+    warnings.push_back(missingEmitterMessage(scene) + " (rad-global and rad-reference refuse it)");
   s["warnings"] = warnings;
   return s;
 }

@@ -236,6 +236,21 @@ TEST(RadGlobal, MergeOfWindowsThatDoNotMakeTheRunIsOneLineError) {
   fs::remove_all(d);
 }
 
+// Issue 18: a scene without emitter ran with exit 0 and rendered black; now one line, exit 1.
+TEST(RadGlobal, SceneWithoutEmitterIsOneLineExit1) {
+  fs::path d = scratchDir();
+  auto r = runCommand(tool("rad-global") + " " + RAD_TEST_DATA +
+                      "/external/khronos_BoxAnimated/BoxAnimated.glb -o " + (d / "g.rlh").string() +
+                      " --frames 0-1");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(test::countLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("BoxAnimated.glb: no emissive material: give a mesh an emissive material"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(d / "g.rlh"));
+  fs::remove_all(d);
+}
+
 TEST(RadGlobal, OutOfRangeParametersAreUsageErrors) {
   for (const char* bad :
        {"--eps -1", "--key-step 0", "--rays 0", "--tol 0", "--oracle fast", "--bad-links some",

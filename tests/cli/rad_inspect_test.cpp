@@ -75,7 +75,9 @@ TEST(RadInspect, SceneWithoutCameraOrEmitterIsAWarning) {
                                "/external/khronos_BoxAnimated/BoxAnimated.glb");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("warning        no camera"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("warning        no emitter"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("warning        no emissive material: give a mesh an emissive material"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST(RadInspect, ContainerTextJsonArrayAndCheck) {

@@ -114,12 +114,21 @@ int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** ar
 }
 
 namespace {
+// An error line is at most this many bytes: a safety net for messages that quote input (each
+// source cuts its quotes at 120 bytes; a failed data URI was once echoed whole, 12.5 KB).
+constexpr size_t kMaxErrorLine = 1000;
+
 // Messages from libraries (OpenEXR, tinygltf) may span lines; ours are one line by contract.
 std::string oneLine(std::string s) {
   for (char& c : s) {
     if (c == '\n' || c == '\r') c = ' ';
   }
   while (!s.empty() && s.back() == ' ') s.pop_back();
+  if (s.size() > kMaxErrorLine) {
+    size_t end = kMaxErrorLine;  // cut at a UTF-8 character boundary
+    while (end > 0 && (static_cast<unsigned char>(s[end]) & 0xC0) == 0x80) --end;
+    s = s.substr(0, end) + "…";
+  }
   return s;
 }
 }  // namespace

@@ -182,6 +182,7 @@ int run(Options o, int argc, char** argv) {
   rad::GlobalReport report;
   auto tRead = std::chrono::steady_clock::now();
   rad::Scene scene = rad::readGltfScene(o.scene);
+  rad::requireEmitter(scene);  // else the solution is zero and every frame black
   report.secondsRead = rad::secondsSince(tRead);
   rad::FrameRange frames = given.empty() ? rad::animationFrames(scene, g.fps)
                                          : rad::FrameRange{given.front(), given.back()};

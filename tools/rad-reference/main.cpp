@@ -22,6 +22,7 @@ constexpr const char* kTool = "rad-reference";
 int run(const rad::ReferenceOptions& given, int argc, char** argv) {
   rad::ReferenceOptions o = given;
   rad::Scene scene = rad::readGltfScene(o.scene);
+  rad::requireEmitter(scene);  // else every frame is black
   const int cameraNode = scene.cameraNode(o.camera);
   if (cameraNode < 0)
     throw rad::inputError(
