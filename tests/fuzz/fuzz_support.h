@@ -30,7 +30,9 @@ void runReader(Read&& read) {
 // A private directory for this process (the path readers take their input by). Under
 // $TMPDIR, or /dev/shm when it exists so each execution's write stays in memory.
 inline const std::string& scratchDir() {
-  static const std::string dir = [] {
+  // Never destroyed: the atexit handler that removes the directory runs after static
+  // destructors registered later would have freed it.
+  static const std::string* dir = [] {
     const char* base = std::getenv("TMPDIR");
     std::string root = base ? base : (access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp");
     std::string pattern = root + "/rad-fuzz-XXXXXX";
@@ -38,9 +40,9 @@ inline const std::string& scratchDir() {
     buf.push_back('\0');
     if (!mkdtemp(buf.data())) std::abort();
     std::atexit([] { std::filesystem::remove_all(scratchDir()); });
-    return std::string(buf.data());
+    return new std::string(buf.data());
   }();
-  return dir;
+  return *dir;
 }
 
 // Writes the fuzzer's bytes to `name` in scratchDir() and returns its path.

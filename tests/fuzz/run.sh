@@ -3,12 +3,12 @@
 # into build-fuzz/ (clang, libFuzzer + ASan + UBSan; only the readers' libraries, not the tools),
 # makes the seeds with build/bin's tools (run pipelines/bootstrap.sh first) and runs the ctest
 # label `fuzz`, then prints each harness's executions and crashes.
-#   FUZZ_SECONDS  time cap per harness (default 120)
+#   FUZZ_SECONDS  time cap per harness (default 60)
 #   FUZZ_RUNS     executions per harness (default 20000; -1: no limit but the time)
 # tests/run.sh runs it after the other tests; make -f pipelines/bench.mk fuzz runs it long.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-seconds=${FUZZ_SECONDS:-120}
+seconds=${FUZZ_SECONDS:-60}
 runs=${FUZZ_RUNS:-20000}
 
 pipelines/apt_install.sh clang-14 libclang-rt-14-dev
