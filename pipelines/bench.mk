@@ -19,6 +19,9 @@
 #   make -f pipelines/bench.mk furnace [FURNACE_RHO=0.5,0.9,0.99,0.999] [FURNACE_FLAGS="global=--eps 1e-4"]
 #       the closed furnace through the whole pipeline at each rho: frame mean against the exact
 #       L_e / (1 - rho), time and peak memory; out/furnace/
+#   make -f pipelines/bench.mk fuzz [FUZZ_SECONDS=600]
+#       every reader's libFuzzer harness for FUZZ_SECONDS each (tests/fuzz/run.sh, clang build in
+#       build-fuzz/): executions and crashes per harness; reproducers in build-fuzz/fuzz-work/
 
 BIN ?= build/bin
 BENCH_FRAMES ?= 400
@@ -44,7 +47,9 @@ FARM_FLAGS ?=
 FURNACE_RHO ?= 0.5,0.9,0.99,0.999
 FURNACE_FLAGS ?=
 
-.PHONY: tables tradeoff furnace contact scale farm-model
+FUZZ_SECONDS ?= 600
+
+.PHONY: tables tradeoff furnace contact scale farm-model fuzz
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -68,3 +73,6 @@ furnace:
 farm-model:
 	python3 pipelines/farm_model.py --bin $(BIN) --scene $(FARM_SCENE) --frames $(FARM_FRAMES) \
 	  --size $(BENCH_SIZE) --nodes $(FARM_NODES) --out out/farm-model $(FARM_FLAGS)
+
+fuzz:
+	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=-1 bash tests/fuzz/run.sh

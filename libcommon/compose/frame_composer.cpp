@@ -410,21 +410,6 @@ PixelSource FrameComposer::Impl::shadePixel(double t, const std::vector<MovieTex
   return source;
 }
 
-double srgbEncode(double x) {
-  x = std::clamp(x, 0.0, 1.0);
-  return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
-}
-
-std::vector<uint8_t> toSrgb8(const std::vector<float>& rgb, double exposureEV) {
-  const double scale = std::exp2(exposureEV);
-  std::vector<uint8_t> out(rgb.size());
-  for (size_t i = 0; i < rgb.size(); ++i) {
-    double v = std::isfinite(rgb[i]) ? double(rgb[i]) * scale : 0.0;
-    out[i] = uint8_t(std::lround(255.0 * srgbEncode(v)));
-  }
-  return out;
-}
-
 double autoExposureEV(const Scene& scene, const GlobalSolution& solution, double percentile) {
   const PatchHierarchy& h = solution.hierarchy;
   std::vector<std::pair<double, double>> lumArea;  // (luminance of B/pi, area)

@@ -12,6 +12,7 @@
 namespace rad {
 
 int PatchId::level() const {
+  if (path == 0) return -1;  // no patch (path 1 is the top); a hostile file's node id can be 0
   int bits = 32 - __builtin_clz(path);
   return (bits - 1) / 2;
 }

@@ -26,7 +26,7 @@ struct PatchId {
   uint32_t top = 0;
   uint32_t path = 1;
 
-  int level() const;
+  int level() const;           // -1 for path 0, which names no patch
   PatchId child(int k) const;  // k in 0..3; level must be < kMaxLevel
   PatchId parent() const;      // level must be > 0
   int childIndex() const;      // which child of its parent (level > 0)
