@@ -410,6 +410,29 @@ class BadInput : public ::testing::Test {
     }
   }
   fs::path dir;
+
+  // The triangle scene with one animation channel of node 0 (`path`: translation or scale) whose
+  // two keys, at t = 0 and 1, hold values[0..2] and values[3..5].
+  std::string animatedTriangleGltf(const char* path, const float (&values)[6]) {
+    std::string bin = triangleBin();
+    const float times[2] = {0, 1};
+    bin.append(reinterpret_cast<const char*>(times), 8);    // 44..51
+    bin.append(reinterpret_cast<const char*>(values), 24);  // 52..75
+    write("tri.bin", bin);
+    std::string gltf =
+        triangleGltf(std::string(R"(, "animations": [{"samplers": [{"input": 2, "output": 3}],
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": ")") +
+                         path + R"("}}]}])",
+                     "", "\"count\": 3", 76);
+    gltf.replace(gltf.find("\"byteLength\": 8}]"), 17,
+                 R"("byteLength": 8}, {"buffer": 0, "byteOffset": 44, "byteLength": 8},
+                    {"buffer": 0, "byteOffset": 52, "byteLength": 24}])");
+    gltf.replace(
+        gltf.find("\"count\": 3}]"), 12,
+        R"("count": 3}, {"bufferView": 2, "componentType": 5126, "type": "SCALAR", "count": 2},
+                    {"bufferView": 3, "componentType": 5126, "type": "VEC3", "count": 2}])");
+    return gltf;
+  }
 };
 
 TEST_F(BadInput, GoodTriangleLoads) {
@@ -651,21 +674,8 @@ TEST_F(BadInput, CoordinatesBeyondTheLimitAreOneLine) {
 
 // An animated translation key of 1e38 (the camera's or a mesh node's) is refused the same way.
 TEST_F(BadInput, AnimatedTranslationBeyondTheLimit) {
-  std::string bin = triangleBin();
-  float times[2] = {0, 1}, values[6] = {0, 0, 0, 1e38f, 0, 0};
-  bin.append(reinterpret_cast<const char*>(times), 8);    // 44..51
-  bin.append(reinterpret_cast<const char*>(values), 24);  // 52..75
-  write("tri.bin", bin);
-  std::string gltf = triangleGltf(R"(, "animations": [{"samplers": [{"input": 2, "output": 3}],
-      "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}]}])",
-                                  "", "\"count\": 3", 76);
-  gltf.replace(gltf.find("\"byteLength\": 8}]"), 17,
-               R"("byteLength": 8}, {"buffer": 0, "byteOffset": 44, "byteLength": 8},
-                  {"buffer": 0, "byteOffset": 52, "byteLength": 24}])");
-  gltf.replace(
-      gltf.find("\"count\": 3}]"), 12,
-      R"("count": 3}, {"bufferView": 2, "componentType": 5126, "type": "SCALAR", "count": 2},
-                  {"bufferView": 3, "componentType": 5126, "type": "VEC3", "count": 2}])");
+  const float values[6] = {0, 0, 0, 1e38f, 0, 0};
+  const std::string gltf = animatedTriangleGltf("translation", values);
   expectBadInput(write("anim.gltf", gltf), "node 0: world coordinates reach up to 1e+38");
 }
 
@@ -791,22 +801,8 @@ TEST_F(BadInput, PunctualLightsAreCountedAndNoEmitterIsNamed) {
 // The scene model is rigid motion: a scale channel must hold one value.
 TEST_F(BadInput, AnimatedScaleIsRefusedConstantScaleLoads) {
   auto scene = [&](float second) {
-    std::string bin = triangleBin();
-    float times[2] = {0, 1}, values[6] = {2, 2, 2, second, 2, 2};
-    bin.append(reinterpret_cast<const char*>(times), 8);
-    bin.append(reinterpret_cast<const char*>(values), 24);
-    write("tri.bin", bin);
-    std::string gltf = triangleGltf(R"(, "animations": [{"samplers": [{"input": 2, "output": 3}],
-        "channels": [{"sampler": 0, "target": {"node": 0, "path": "scale"}}]}])",
-                                    "", "\"count\": 3", 76);
-    gltf.replace(gltf.find("\"byteLength\": 8}]"), 17,
-                 R"("byteLength": 8}, {"buffer": 0, "byteOffset": 44, "byteLength": 8},
-                    {"buffer": 0, "byteOffset": 52, "byteLength": 24}])");
-    gltf.replace(
-        gltf.find("\"count\": 3}]"), 12,
-        R"("count": 3}, {"bufferView": 2, "componentType": 5126, "type": "SCALAR", "count": 2},
-                    {"bufferView": 3, "componentType": 5126, "type": "VEC3", "count": 2}])");
-    return write("s.gltf", gltf);
+    const float values[6] = {2, 2, 2, second, 2, 2};
+    return write("s.gltf", animatedTriangleGltf("scale", values));
   };
   expectBadInput(scene(3.0f),
                  "animation 0 channel 0: animates the scale of node 0 (key 1: 3, key 0: 2)");

@@ -64,6 +64,14 @@ std::vector<Polygon> geometry(const std::string& name) {
   return out;
 }
 
+// The quad a, b, c, d (counter-clockwise about its front normal).
+Polygon quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
+  Polygon p;
+  p.count = 4;
+  p.v = {a, b, c, d};
+  return p;
+}
+
 KeySolveInput identityInput(const PatchHierarchy& h) {
   KeySolveInput in;
   in.topToWorld.assign(size_t(h.topCount()), glm::dmat4(1.0));
@@ -558,12 +566,6 @@ TEST(HierarchicalRadiosity, OccludedFurnaceRowsSumToOneInAClosedRoom) {
 // covered quadrant has exposure ~0, the rest 1, and the floor's B is the average over what is
 // exposed: within the exposed children's range, not a quarter below it.
 TEST(HierarchicalRadiosity, CoveredAreaDoesNotDarkenWhatIsExposed) {
-  auto quad = [](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
-    Polygon p;
-    p.count = 4;
-    p.v = {a, b, c, d};
-    return p;
-  };
   std::vector<Polygon> polys = {
       quad({0, 0, 0}, {0, 0, 2}, {2, 0, 2}, {2, 0, 0}),      // floor, +y
       quad({0, 1, 0}, {2, 1, 0}, {2, 1, 2}, {0, 1, 2}),      // light, -y
@@ -611,12 +613,6 @@ TEST(HierarchicalRadiosity, CoveredAreaDoesNotDarkenWhatIsExposed) {
 // out 1.8x too bright (its closure was 1.85). Here the wall is black, so no floor leaf may gather
 // more than the light's unoccluded point irradiance at its centre.
 TEST(HierarchicalRadiosity, ClosureOfADimWallDoesNotScaleTheLight) {
-  auto quad = [](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
-    Polygon p;
-    p.count = 4;
-    p.v = {a, b, c, d};
-    return p;
-  };
   std::vector<Polygon> polys = {
       quad({0, 0, 0}, {0, 0, 2}, {2, 0, 2}, {2, 0, 0}),     // floor, +y
       quad({0, 1, 0}, {2, 1, 0}, {2, 1, 2}, {0, 1, 2}),     // light, -y
