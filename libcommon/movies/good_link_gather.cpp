@@ -18,14 +18,15 @@ namespace rad {
 
 bool coveredBySolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
                     uint32_t top, const glm::dvec3& p, const glm::dvec3& d, double t) {
-  const uint32_t hit = blockers.firstHit(p, d, top);
-  if (hit == VisibilityScene::kNoSurface || hit >= uint32_t(h.topCount())) return false;
-  const InputPolygon& surface = h.top(int(hit));
-  const int m = surface.material;
-  if (m >= 0 && m < int(scene.materials.size()) && scene.materials[size_t(m)].doubleSided)
-    return false;
-  return glm::dot(surface.local.transformed(scene.worldTransform(surface.node, t)).normal(), d) >
-         0.0;
+  return entersSolid(blockers, p, d, top, [&](uint32_t hit) {
+    if (hit >= uint32_t(h.topCount())) return false;
+    const InputPolygon& surface = h.top(int(hit));
+    const int m = surface.material;
+    if (m >= 0 && m < int(scene.materials.size()) && scene.materials[size_t(m)].doubleSided)
+      return false;
+    return glm::dot(surface.local.transformed(scene.worldTransform(surface.node, t)).normal(), d) >
+           0.0;
+  });
 }
 
 GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {

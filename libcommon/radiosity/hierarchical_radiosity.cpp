@@ -785,9 +785,11 @@ class KeyTimeSolver {
     int exposed = 0;
     for (size_t k = 0; k < points.size(); ++k) {
       const glm::dvec3 d = direction(seed, k) * size;  // firstHit's tnear is relative to |d|
-      uint32_t hit = input_.visibility->firstHit(points[k], d, n.id.top);
-      bool covered = hit != VisibilityScene::kNoSurface && hit < uint32_t(h_.topCount()) &&
-                     !surfaces_[hit].doubleSided && glm::dot(s_.world[hit].normal(), d) > 0.0;
+      const bool covered =
+          entersSolid(*input_.visibility, points[k], d, n.id.top, [&](uint32_t hit) {
+            return hit < uint32_t(h_.topCount()) && !surfaces_[hit].doubleSided &&
+                   glm::dot(s_.world[hit].normal(), d) > 0.0;
+          });
       exposed += covered ? 0 : 1;
     }
     return points.empty() ? 1.0 : double(exposed) / double(points.size());

@@ -431,37 +431,63 @@ double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
 namespace {
 // The surface id of the first triangle of `scene` the ray hits (kNoSurface: none); `child` is the
 // instanced scene for a hit without an instance (the static scene traversed directly).
-std::uint32_t firstHitIn(RTCScene scene, const glm::dvec3& origin, const glm::dvec3& direction,
-                         std::uint32_t ignore, unsigned child,
-                         const std::vector<const std::vector<std::uint32_t>*>& childSurfaces) {
+VisibilityScene::Hit firstHitIn(RTCScene scene, const glm::dvec3& origin,
+                                const glm::dvec3& direction, std::uint32_t ignoreA,
+                                std::uint32_t ignoreB, unsigned child,
+                                const std::vector<const std::vector<std::uint32_t>*>& childSurfaces,
+                                double tnear = VisibilityScene::kSegmentEpsilon,
+                                double tfar = std::numeric_limits<double>::infinity()) {
+  VisibilityScene::Hit none;
   RTCRayHit rh;
-  rh.ray = rayOf(origin, direction, std::numeric_limits<double>::infinity());
+  rh.ray = rayOf(origin, direction, tfar);
+  rh.ray.tnear = float(tnear);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  if (!(rh.ray.dir_x != 0.0f || rh.ray.dir_y != 0.0f || rh.ray.dir_z != 0.0f))
-    return VisibilityScene::kNoSurface;
+  if (!(rh.ray.dir_x != 0.0f || rh.ray.dir_y != 0.0f || rh.ray.dir_z != 0.0f)) return none;
   FilterContext fc;
   rtcInitIntersectContext(&fc.context);
-  fc.ignoreA = ignore;
-  fc.ignoreB = ignore;
+  fc.ignoreA = ignoreA;
+  fc.ignoreB = ignoreB;
   rtcIntersect1(scene, &fc.context, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return VisibilityScene::kNoSurface;
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return none;
   if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) child = rh.hit.instID[0];
-  if (child >= childSurfaces.size() || !childSurfaces[child]) return VisibilityScene::kNoSurface;
+  if (child >= childSurfaces.size() || !childSurfaces[child]) return none;
   const std::vector<std::uint32_t>& ids = *childSurfaces[child];
-  return rh.hit.primID < ids.size() ? ids[rh.hit.primID] : VisibilityScene::kNoSurface;
+  if (rh.hit.primID >= ids.size()) return none;
+  return {ids[rh.hit.primID], double(rh.ray.tfar)};
 }
 }  // namespace
 
 std::uint32_t VisibilityScene::firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
                                         std::uint32_t ignore) const {
-  return firstHitIn(impl_->top, origin, direction, ignore, RTC_INVALID_GEOMETRY_ID,
-                    impl_->childSurfaces);
+  return nearestHit(origin, direction, ignore).surface;
+}
+
+VisibilityScene::Hit VisibilityScene::nearestHit(const glm::dvec3& origin,
+                                                 const glm::dvec3& direction, std::uint32_t ignoreA,
+                                                 std::uint32_t ignoreB, double tnear,
+                                                 double tfar) const {
+  return firstHitIn(impl_->top, origin, direction, ignoreA, ignoreB, RTC_INVALID_GEOMETRY_ID,
+                    impl_->childSurfaces, tnear, tfar);
 }
 
 std::uint32_t VisibilityScene::firstStaticHit(const glm::dvec3& origin, const glm::dvec3& direction,
                                               std::uint32_t ignore) const {
-  return firstHitIn(impl_->children[0], origin, direction, ignore, 0, impl_->childSurfaces);
+  return firstHitIn(impl_->children[0], origin, direction, ignore, ignore, 0, impl_->childSurfaces)
+      .surface;
+}
+
+bool entersSolid(const VisibilityScene& v, const glm::dvec3& origin, const glm::dvec3& direction,
+                 std::uint32_t ignore, const std::function<bool(std::uint32_t)>& isBack) {
+  const VisibilityScene::Hit first = v.nearestHit(origin, direction, ignore);
+  if (first.surface == VisibilityScene::kNoSurface) return false;
+  if (isBack(first.surface)) return true;
+  // Only the coincident surfaces: the second ray is cut to the first hit's distance, so it
+  // costs little more than a box test (most texels' rays meet a front).
+  const double tol = first.t * 1e-5 + 1e-7;
+  const VisibilityScene::Hit second = v.nearestHit(origin, direction, ignore, first.surface,
+                                                   std::max(first.t - tol, 0.0), first.t + tol);
+  return second.surface != VisibilityScene::kNoSurface && isBack(second.surface);
 }
 
 std::vector<double> VisibilityScene::visibilityBatch(const std::vector<VisibilityQuery>& queries,

@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -118,6 +119,16 @@ class VisibilityScene {
   // it hits nothing. Thread-safe after commit().
   std::uint32_t firstHit(const glm::dvec3& origin, const glm::dvec3& direction,
                          std::uint32_t ignore = kNoSurface) const;
+  // firstHit with where it hits (t in units of |direction|), a second surface to ignore, and
+  // the ray's extent t in [tnear, tfar].
+  struct Hit {
+    std::uint32_t surface = kNoSurface;
+    double t = 0.0;
+  };
+  Hit nearestHit(const glm::dvec3& origin, const glm::dvec3& direction,
+                 std::uint32_t ignoreA = kNoSurface, std::uint32_t ignoreB = kNoSurface,
+                 double tnear = kSegmentEpsilon,
+                 double tfar = std::numeric_limits<double>::infinity()) const;
   // firstHit against the static geometry alone, without the dynamic objects: the same at every
   // time (rad-global's closed-room test, which moving objects inside a room cannot open).
   std::uint32_t firstStaticHit(const glm::dvec3& origin, const glm::dvec3& direction,
@@ -133,6 +144,15 @@ class VisibilityScene {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Whether the ray origin + t direction from a point of surface `ignore` enters a solid first:
+// the first surface it meets is the back of a one-sided patch (`isBack(surface)`), or a front
+// with such a back at the same distance (1e-5 relative). A partition's top flush with the
+// ceiling is both at once, and Embree returns either: a floor point under the partition, whose
+// ray up met the ceiling's front, was taken as exposed (the cubic scene's dark floor texels
+// along every partition, issue 15).
+bool entersSolid(const VisibilityScene& v, const glm::dvec3& origin, const glm::dvec3& direction,
+                 std::uint32_t ignore, const std::function<bool(std::uint32_t)>& isBack);
 
 // The visibility of b's points bPoints from the point x (normal n) through the unoccluded ones
 // (openFrom's bits), each weighted by the kernel cos cos / r^2 (0 behind either plane) and by
