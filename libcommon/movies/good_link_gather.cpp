@@ -16,9 +16,10 @@
 
 namespace rad {
 
-bool coveredBySolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
-                    uint32_t top, const glm::dvec3& p, const glm::dvec3& d, double t) {
-  return entersSolid(blockers, p, d, top, [&](uint32_t hit) {
+RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
+                        const PatchHierarchy& h, uint32_t top, const glm::dvec3& p,
+                        const glm::dvec3& d, double t) {
+  return rayStart(blockers, p, d, top, [&](uint32_t hit) {
     if (hit >= uint32_t(h.topCount())) return false;
     const InputPolygon& surface = h.top(int(hit));
     const int m = surface.material;
@@ -480,7 +481,10 @@ std::vector<char> GoodLinkGather::coveredTiles() const {
       for (size_t x : tiles_[ti].cornerTexels(w)) {
         const glm::dvec3 p = frame.point(texels_.localPoint[x]);
         const glm::dvec3 d = frame.normal(texels_.localNormal[x]) * size;
-        if (coveredBySolid(blockers, scene_, h, uint32_t(receiverTop_), p, d, t)) {
+        // Undecided counts as covered here: the tile then gathers its partial links per
+        // texel, which is right either way.
+        if (coveredBySolid(blockers, scene_, h, uint32_t(receiverTop_), p, d, t) !=
+            RayStart::kOutside) {
           covered[ti] = 1;
           return;
         }

@@ -60,8 +60,9 @@ namespace rad {
 // Whether point p of top-level patch `top` lies under a touching solid at time t (a box's foot
 // on the floor): the first surface its outward ray (direction d) meets is the back of a
 // one-sided patch, as rad-global's exposure decides (exposureOf).
-bool coveredBySolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
-                    uint32_t top, const glm::dvec3& p, const glm::dvec3& d, double t);
+RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
+                        const PatchHierarchy& h, uint32_t top, const glm::dvec3& p,
+                        const glm::dvec3& d, double t);
 
 // The good links that gather (not refined, not of a bad pair), grouped by receiver node: built
 // once per solution, shared by every movie.

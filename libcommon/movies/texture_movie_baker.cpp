@@ -385,9 +385,15 @@ class MovieBake {
       const double c = std::cos(88.0 * M_PI / 180.0), sn = std::sin(88.0 * M_PI / 180.0);
       const glm::dvec3 dirs[5] = {n, c * n + sn * u, c * n - sn * u, c * n + sn * v,
                                   c * n - sn * v};
-      for (const glm::dvec3& d : dirs)
-        if (!coveredBySolid(blockers, geo_.scene(), hierarchy, top, p, d * size, at)) return false;
-      return true;
+      // Every ray inside or undecided, one at least inside (a sheet's undecided ray beside
+      // fronts is outside; the flush partition's ray up beside its sides is inside).
+      bool inside = false;
+      for (const glm::dvec3& d : dirs) {
+        const RayStart r = coveredBySolid(blockers, geo_.scene(), hierarchy, top, p, d * size, at);
+        if (r == RayStart::kOutside) return false;
+        inside = inside || r == RayStart::kInside;
+      }
+      return inside;
     };
     // A texel whose centre lies within a quarter texel outside a solid's foot (a partition
     // standing on a texel row: the cubic scene's walls are 5 cm from the floor tiles' edges, a

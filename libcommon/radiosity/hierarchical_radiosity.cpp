@@ -782,16 +782,21 @@ class KeyTimeSolver {
         VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(n.id));
     const uint64_t seed = splitMix64(receiverSeed(n.id));
     const double size = polygonSize(P);
-    int exposed = 0;
+    // Undecided rays (a front and a back at one distance: a partition flush with the ceiling,
+    // a sheet of two back-to-back patches) go with the majority of the decided ones.
+    int exposed = 0, inside = 0, undecided = 0;
     for (size_t k = 0; k < points.size(); ++k) {
       const glm::dvec3 d = direction(seed, k) * size;  // firstHit's tnear is relative to |d|
-      const bool covered =
-          entersSolid(*input_.visibility, points[k], d, n.id.top, [&](uint32_t hit) {
-            return hit < uint32_t(h_.topCount()) && !surfaces_[hit].doubleSided &&
-                   glm::dot(s_.world[hit].normal(), d) > 0.0;
-          });
-      exposed += covered ? 0 : 1;
+      const RayStart r = rayStart(*input_.visibility, points[k], d, n.id.top, [&](uint32_t hit) {
+        return hit < uint32_t(h_.topCount()) && !surfaces_[hit].doubleSided &&
+               glm::dot(s_.world[hit].normal(), d) > 0.0;
+      });
+      (r == RayStart::kOutside ? exposed : r == RayStart::kInside ? inside : undecided) += 1;
     }
+    if (inside > exposed)
+      inside += undecided;
+    else
+      exposed += undecided;
     return points.empty() ? 1.0 : double(exposed) / double(points.size());
   }
 

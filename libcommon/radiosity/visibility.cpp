@@ -477,17 +477,19 @@ std::uint32_t VisibilityScene::firstStaticHit(const glm::dvec3& origin, const gl
       .surface;
 }
 
-bool entersSolid(const VisibilityScene& v, const glm::dvec3& origin, const glm::dvec3& direction,
-                 std::uint32_t ignore, const std::function<bool(std::uint32_t)>& isBack) {
+RayStart rayStart(const VisibilityScene& v, const glm::dvec3& origin, const glm::dvec3& direction,
+                  std::uint32_t ignore, const std::function<bool(std::uint32_t)>& isBack) {
   const VisibilityScene::Hit first = v.nearestHit(origin, direction, ignore);
-  if (first.surface == VisibilityScene::kNoSurface) return false;
-  if (isBack(first.surface)) return true;
-  // Only the coincident surfaces: the second ray is cut to the first hit's distance, so it
-  // costs little more than a box test (most texels' rays meet a front).
+  if (first.surface == VisibilityScene::kNoSurface) return RayStart::kOutside;
+  // The surfaces at the first hit's distance: the second ray is cut to it, so it costs little
+  // more than a box test. Either order of the two gives the same answer.
   const double tol = first.t * 1e-5 + 1e-7;
   const VisibilityScene::Hit second = v.nearestHit(origin, direction, ignore, first.surface,
                                                    std::max(first.t - tol, 0.0), first.t + tol);
-  return second.surface != VisibilityScene::kNoSurface && isBack(second.surface);
+  const bool firstBack = isBack(first.surface);
+  if (second.surface == VisibilityScene::kNoSurface || isBack(second.surface) == firstBack)
+    return firstBack ? RayStart::kInside : RayStart::kOutside;
+  return RayStart::kUndecided;
 }
 
 std::vector<double> VisibilityScene::visibilityBatch(const std::vector<VisibilityQuery>& queries,

@@ -145,14 +145,16 @@ class VisibilityScene {
   std::unique_ptr<Impl> impl_;
 };
 
-// Whether the ray origin + t direction from a point of surface `ignore` enters a solid first:
-// the first surface it meets is the back of a one-sided patch (`isBack(surface)`), or a front
-// with such a back at the same distance (1e-5 relative). A partition's top flush with the
-// ceiling is both at once, and Embree returns either: a floor point under the partition, whose
-// ray up met the ceiling's front, was taken as exposed (the cubic scene's dark floor texels
-// along every partition, issue 15).
-bool entersSolid(const VisibilityScene& v, const glm::dvec3& origin, const glm::dvec3& direction,
-                 std::uint32_t ignore, const std::function<bool(std::uint32_t)>& isBack);
+// Where the ray origin + t direction from a point of surface `ignore` starts: outside (its
+// first surface is a front, or none), inside a solid (the back of a one-sided patch,
+// `isBack(surface)`), or undecided: a front and such a back at the same distance (1e-5
+// relative), where Embree returns either. That is a partition's top flush with the ceiling (a
+// floor point under the partition is inside it; the cubic scene's walls, issue 15), but also a
+// thin sheet made of two back-to-back patches (the table scene's car fins), which a point
+// outside meets: the caller decides from its other rays.
+enum class RayStart { kOutside, kInside, kUndecided };
+RayStart rayStart(const VisibilityScene& v, const glm::dvec3& origin, const glm::dvec3& direction,
+                  std::uint32_t ignore, const std::function<bool(std::uint32_t)>& isBack);
 
 // The visibility of b's points bPoints from the point x (normal n) through the unoccluded ones
 // (openFrom's bits), each weighted by the kernel cos cos / r^2 (0 behind either plane) and by

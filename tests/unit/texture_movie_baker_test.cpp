@@ -834,8 +834,8 @@ TEST(TextureMovieBaker, CoveredTexelsBesideAFootTakeTheirExposedNeighbours) {
 // plane, and a floor point's ray up meets both at once. Embree returned the ceiling's front,
 // the texels under the partition were taken as exposed, not filled, and a pixel beside the
 // partition interpolated their dark value: a dashed dark line along every partition's foot
-// (0.07 against 0.31, the cubic scene's 30 worst pixels). entersSolid takes the back at the
-// same distance.
+// (0.07 against 0.31, the cubic scene's 30 worst pixels). rayStart reports the two at one
+// distance, and the partition's sides decide.
 TEST(TextureMovieBaker, CoveredTexelsUnderAPartitionFlushWithTheCeilingAreFilled) {
   EXPECT_NEAR(coveredRingUnderABox(1.0, true).edgeRatio, 1.0, 0.02);
 }

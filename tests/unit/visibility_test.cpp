@@ -192,12 +192,12 @@ TEST(Visibility, TouchingNeighboursDoNotBlock) {
   EXPECT_TRUE(scene.occluded({0.5, 0.5, 0.5}, {-1, 0.5, 0.5}));
 }
 
-// A partition's top flush with the ceiling (the cubic scene): a floor point under it, whose
-// ray up meets the ceiling's front and the partition top's back at the same distance, is inside
-// a solid, whichever of the two Embree returns first. The first hit alone took the ceiling for
-// one of the two orders in which the surfaces are listed: the floor texels under every
-// partition were taken as exposed (issue 15).
-TEST(Visibility, EntersSolidWhenAFrontAndABackCoincide) {
+// A partition's top flush with the ceiling (the cubic scene): a floor point's ray up meets the
+// ceiling's front and the partition top's back at the same distance. rayStart says so
+// (undecided, for the caller's other rays to decide) whichever of the two Embree returns first.
+// The first hit alone took the ceiling for one of the two orders in which the surfaces are
+// listed: the floor texels under every partition were taken as exposed (issue 15).
+TEST(Visibility, RayStartIsUndecidedWhenAFrontAndABackCoincide) {
   constexpr std::uint32_t kCeiling = 7, kPartitionTop = 8;
   int ceilingFirstHits = 0;           // over both orders: the case the first hit alone got wrong
   const Polygon ceiling = squareB();  // faces -z (down)
@@ -218,10 +218,11 @@ TEST(Visibility, EntersSolidWhenAFrontAndABackCoincide) {
         const glm::dvec3 p(0.26 + 0.48 * i / 15.0, 0.26 + 0.48 * j / 15.0, 0.0);
         const glm::dvec3 up(0, 0, 2);
         firstHitCeiling += scene.firstHit(p, up, kSurfA) == kCeiling;
-        EXPECT_TRUE(entersSolid(scene, p, up, kSurfA, isBack)) << i << " " << j;
+        EXPECT_EQ(rayStart(scene, p, up, kSurfA, isBack), RayStart::kUndecided) << i << " " << j;
         // Beside the partition the ceiling is a front: exposed.
-        EXPECT_FALSE(entersSolid(scene, p + glm::dvec3(0.0, 0.5, 0.0) * (p.y > 0.5 ? 1.0 : -1.0),
-                                 up, kSurfA, isBack));
+        EXPECT_EQ(RayStart::kOutside,
+                  rayStart(scene, p + glm::dvec3(0.0, 0.5, 0.0) * (p.y > 0.5 ? 1.0 : -1.0), up,
+                           kSurfA, isBack));
       }
     std::printf("ceiling listed %s: the first hit is the ceiling for %d of 256 points\n",
                 ceilingFirst ? "first" : "second", firstHitCeiling);
