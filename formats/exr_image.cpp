@@ -19,6 +19,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/checksum.h"
+#include "formats/exr_header_scan.h"
 #include "formats/pixel_checksum.h"
 #include "libcommon/core/error.h"
 
@@ -41,6 +42,7 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
   if (!std::filesystem::is_regular_file(path))
     throw inputError(
         path, std::filesystem::exists(path) ? "is not a regular file" : "cannot open (missing)");
+  scanExrFile(path);  // sizes the header declares, bounded by the file's before OpenEXR reads
   try {
     Imf::InputFile in(path.c_str());
     const Imath::Box2i dw = in.header().dataWindow();

@@ -13,6 +13,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include "formats/atomic_file.h"
+#include "formats/exr_header_scan.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -50,6 +51,7 @@ void writeItemBufferExr(const std::string& path, const ItemBuffer& b, int frame,
 
 ItemBuffer readItemBufferExr(const std::string& path) {
   ItemBuffer b;
+  scanExrFile(path);  // sizes the header declares, bounded by the file's before OpenEXR reads
   try {
     Imf::InputFile in(path.c_str());
     const Imf::Header& h = in.header();

@@ -12,6 +12,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include "formats/checksum.h"
+#include "formats/exr_header_scan.h"
 #include "formats/frame_image.h"
 #include "formats/texture_movie.h"
 #include "libcommon/core/error.h"
@@ -108,6 +109,7 @@ void requirePixelChecksum(uint64_t stored, uint64_t computed, const std::string&
 
 nlohmann::json verifyExrPixels(const std::string& path) {
   int checksummed = 0, parts = 0;
+  scanExrFile(path);  // sizes the headers declare, bounded by the file's before OpenEXR reads
   try {
     Imf::MultiPartInputFile file(path.c_str());
     parts = file.parts();
