@@ -113,7 +113,19 @@ nlohmann::json verifyExrPixels(const std::string& path) {
   try {
     Imf::MultiPartInputFile file(path.c_str());
     parts = file.parts();
-    for (int p = 0; p < parts; ++p) {
+    checksummed = verifyExrPartPixels(file, path, 0);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw inputError(path, std::string("not a readable OpenEXR file: ") + e.what());
+  }
+  return {{"parts", parts}, {"checksummed_parts", checksummed}};
+}
+
+int verifyExrPartPixels(Imf::MultiPartInputFile& file, const std::string& path, int firstPart) {
+  int checksummed = 0;
+  try {
+    for (int p = firstPart; p < file.parts(); ++p) {
       const Imf::Header& h = file.header(p);
       const std::string part = "part " + std::to_string(p);
       const std::optional<uint64_t> stored = storedPixelChecksum(h, path, part);
@@ -157,7 +169,7 @@ nlohmann::json verifyExrPixels(const std::string& path) {
   } catch (const std::exception& e) {
     throw inputError(path, std::string("not a readable OpenEXR file: ") + e.what());
   }
-  return {{"parts", parts}, {"checksummed_parts", checksummed}};
+  return checksummed;
 }
 
 std::vector<uint64_t> exrStringAttributeOffsets(const std::vector<char>& bytes, int parts,

@@ -54,6 +54,9 @@ void requirePixelChecksum(uint64_t stored, uint64_t computed, const std::string&
 // part's checksum (storedPixelChecksum). Throws rad::inputError(path, ...) for an unreadable,
 // truncated or corrupted file. Returns {"parts": n, "checksummed_parts": m}.
 nlohmann::json verifyExrPixels(const std::string& path);
+// The same for parts [firstPart, parts) of a file already open (readExrImage reads part 0 itself
+// and verifies the others with this). Returns the number of parts verified against a checksum.
+int verifyExrPartPixels(Imf::MultiPartInputFile& file, const std::string& path, int firstPart);
 
 // Offsets of the value of string attribute `name` in each of the first `parts` headers of an
 // OpenEXR file whose first bytes are `bytes` (magic, version, headers); a part without it gets
