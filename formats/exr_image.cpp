@@ -51,7 +51,11 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
     const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
     const Imf::ChannelList& list = header.channels();
     std::vector<std::string> all;  // every channel, in list order: the checksum covers them all
-    for (auto it = list.begin(); it != list.end(); ++it) all.push_back(it.name());
+    std::vector<bool> isUint;      // read as UINT (the checksum hashes its bits), then converted
+    for (auto it = list.begin(); it != list.end(); ++it) {
+      all.push_back(it.name());
+      isUint.push_back(it.channel().type == Imf::UINT);
+    }
     for (const std::string& c : channels) {
       if (list.findChannel(c.c_str()) == nullptr) {
         std::string have;
@@ -71,7 +75,8 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
       char* base = reinterpret_cast<char*>(image.pixels.data() + c) -
                    std::ptrdiff_t(dw.min.x) * std::ptrdiff_t(xStride) -
                    std::ptrdiff_t(dw.min.y) * std::ptrdiff_t(yStride);
-      fb.insert(all[c].c_str(), Imf::Slice(Imf::FLOAT, base, xStride, yStride));
+      fb.insert(all[c].c_str(),
+                Imf::Slice(isUint[c] ? Imf::UINT : Imf::FLOAT, base, xStride, yStride));
     }
     Imf::InputPart in(file, 0);
     in.setFrameBuffer(fb);
@@ -81,6 +86,14 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
           *stored,
           pixelChecksum(image.pixels.data(), image.width, image.height, int(nc), listOrderOf(all)),
           path, "part 0");
+    for (std::size_t c = 0; c < nc; ++c) {
+      if (!isUint[c]) continue;
+      for (std::size_t p = c; p < image.pixels.size(); p += nc) {
+        uint32_t u;
+        std::memcpy(&u, &image.pixels[p], sizeof u);
+        image.pixels[p] = float(u);
+      }
+    }
     // The parts after the first are not returned, but their checksums are verified too: a
     // corrupted file is refused whichever part the damage is in.
     verifyExrPartPixels(file, path, 1);

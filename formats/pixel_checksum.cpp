@@ -14,6 +14,7 @@
 #include "formats/checksum.h"
 #include "formats/exr_header_scan.h"
 #include "formats/frame_image.h"
+#include "formats/item_buffer_exr.h"
 #include "formats/texture_movie.h"
 #include "libcommon/core/error.h"
 
@@ -41,6 +42,7 @@ struct ChecksummedFormat {
 const ChecksummedFormat kChecksummedFormats[] = {
     {"texture-movie ", kTextureMovieMajor, "rad-movies"},
     {"frame ", kFrameImageMajor, "rad-compose"},
+    {"item-buffer ", kItemBufferExrMajor, "rad-intervals"},
 };
 
 }  // namespace
@@ -137,10 +139,12 @@ int verifyExrPartPixels(Imf::MultiPartInputFile& file, const std::string& path, 
       const long long w = (long long)dw.max.x - dw.min.x + 1,
                       hh = (long long)dw.max.y - dw.min.y + 1;
       std::vector<std::string> names;
+      std::vector<Imf::PixelType> types;  // UINT read as UINT: its 4 bytes are what is hashed
       for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
         if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
           throw inputError(path, part + ": subsampled channel " + it.name() + " not supported");
         names.push_back(it.name());
+        types.push_back(it.channel().type == Imf::UINT ? Imf::UINT : Imf::FLOAT);
       }
       if (w < 1 || hh < 1 || double(w) * double(hh) * double(names.size()) > 1.0e9)
         throw inputError(path, part + ": invalid data window");
@@ -152,7 +156,7 @@ int verifyExrPartPixels(Imf::MultiPartInputFile& file, const std::string& path, 
         char* base = reinterpret_cast<char*>(px.data() + c) -
                      std::ptrdiff_t(dw.min.x) * std::ptrdiff_t(xs) -
                      std::ptrdiff_t(dw.min.y) * std::ptrdiff_t(ys);
-        fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, xs, ys));
+        fb.insert(names[c], Imf::Slice(types[c], base, xs, ys));
       }
       Imf::InputPart in(file, p);
       in.setFrameBuffer(fb);
