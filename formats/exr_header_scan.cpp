@@ -109,6 +109,39 @@ struct PartHeader {
   std::optional<uint32_t> tileX, tileY;
 };
 
+// The value size of OpenEXR's fixed-size attribute types (0: not one). OpenEXR reads these
+// many bytes whatever the declared size, so a different size would make its walk through the
+// header and this scan's part ways (a fuzzed 126-byte box2i led it to a 1.6 GB string).
+uint32_t fixedSize(const std::string& type) {
+  static const std::pair<const char*, uint32_t> kSizes[] = {{"box2i", 16},
+                                                            {"box2f", 16},
+                                                            {"chromaticities", 32},
+                                                            {"compression", 1},
+                                                            {"deepImageState", 1},
+                                                            {"double", 8},
+                                                            {"envmap", 1},
+                                                            {"float", 4},
+                                                            {"int", 4},
+                                                            {"keycode", 28},
+                                                            {"lineOrder", 1},
+                                                            {"m33d", 72},
+                                                            {"m33f", 36},
+                                                            {"m44d", 128},
+                                                            {"m44f", 64},
+                                                            {"rational", 8},
+                                                            {"tiledesc", 9},
+                                                            {"timecode", 8},
+                                                            {"v2d", 16},
+                                                            {"v2f", 8},
+                                                            {"v2i", 8},
+                                                            {"v3d", 24},
+                                                            {"v3f", 12},
+                                                            {"v3i", 12}};
+  for (const auto& [name, size] : kSizes)
+    if (type == name) return size;
+  return 0;
+}
+
 std::string singlePartType(uint32_t version) {
   if (version & kFlagDeep) return (version & kFlagTiled) ? "deeptile" : "deepscanline";
   return (version & kFlagTiled) ? "tiledimage" : "scanlineimage";
@@ -213,17 +246,20 @@ class Scanner {
   // Parses what the bounds need; checks counts inside values OpenEXR allocates by.
   void readValue(PartHeader& h, const std::string& name, const std::string& type, uint32_t size,
                  int part) {
+    if (const uint32_t fixed = fixedSize(type)) requireSize(shown(name), size, fixed, part);
+    if (type == "floatvector" && size % 4 != 0)
+      failIn(part, "float vector '" + shown(name) + "' of " + std::to_string(size) + " bytes");
     const bool parsed =
-        (name == "channels" && type == "chlist") ||
-        (name == "compression" && type == "compression") ||
+        type == "chlist" || (name == "compression" && type == "compression") ||
         (name == "dataWindow" && type == "box2i") || (name == "type" && type == "string") ||
         (name == "chunkCount" && type == "int") || (name == "tiles" && type == "tiledesc") ||
         type == "preview" || type == "stringvector";
     if (!parsed) return;
     need(size);
     const uint8_t* v = bytes_.at(pos_);
-    if (name == "channels" && type == "chlist") {
-      h.channels = readChannels(v, size, part);
+    if (type == "chlist") {
+      std::vector<Channel> channels = readChannels(v, size, part);
+      if (name == "channels") h.channels = std::move(channels);
     } else if (name == "compression" && type == "compression") {
       requireSize(name, size, 1, part);
       h.compression = v[0];
@@ -244,7 +280,7 @@ class Scanner {
       // uint32 width, height, then width x height RGBA bytes: OpenEXR allocates the declared.
       if (size < 8) failIn(part, "preview '" + shown(name) + "' shorter than 8 bytes");
       const uint64_t pixels = uint64_t(le32(v)) * le32(v + 4);
-      if (pixels > (size - 8) / 4)
+      if (pixels > (size - 8) / 4 || 8 + 4 * pixels != size)
         failIn(part, "preview '" + shown(name) + "' declares " + std::to_string(le32(v)) + "x" +
                          std::to_string(le32(v + 4)) + " pixels in " + std::to_string(size) +
                          " bytes");
@@ -274,7 +310,12 @@ class Scanner {
       const uint32_t length = uint32_t(static_cast<const uint8_t*>(end) - (v + at));
       const std::string channel(reinterpret_cast<const char*>(v + at), length);
       at += length + 1;
-      if (channel.empty()) break;
+      if (length > 255) failIn(part, "channel name longer than 255 bytes");
+      if (channel.empty()) {
+        // OpenEXR reads to the list's end marker: it must be the attribute's last byte.
+        if (at != size) failIn(part, "channel list ends before its attribute does");
+        break;
+      }
       if (size - at < 16) failIn(part, "channel list cut short");
       const int32_t pixelType = lei32(v + at);
       Channel c;

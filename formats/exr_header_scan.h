@@ -8,9 +8,11 @@
 //
 //   - a magic number other than 20000630, a version other than 2, unknown version flags;
 //   - a name or type that is empty or unterminated within 256 bytes, or cut by the end of file;
-//   - an attribute whose declared size is negative or exceeds the bytes left in the file, and
-//     inside known types (chlist, preview, stringvector, box2i, tiledesc, ...) a count or size
-//     that exceeds the attribute's own size;
+//   - an attribute whose declared size is negative or exceeds the bytes left in the file; a
+//     fixed-size type (box2i, int, tiledesc, ...) of another size, a channel list, preview or
+//     string vector whose contents do not end exactly at the attribute's end (OpenEXR reads
+//     what the value says, not the declared size, so the two walks would part ways), and counts
+//     inside values (a preview's pixels, a string's length) that exceed the attribute;
 //   - a part without channels, compression or dataWindow, an empty data window, an unknown
 //     compression;
 //   - a part whose decoded size (data window pixels x bytes per pixel of its channels, with

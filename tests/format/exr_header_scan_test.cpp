@@ -256,6 +256,25 @@ TEST_F(ExrHeaderScanTest, HostileCountsInsideValues) {
   EXPECT_NE(scanError(strings.b).find("string vector 'names' declares a string of 1073741824"),
             std::string::npos)
       << scanError(strings.b);
+  // A fixed-size type of another size: OpenEXR reads 16 bytes of a box2i whatever its size
+  // says and parses the rest as the next attributes (the fuzzers' box2i-wrong-size.exr: a
+  // 126-byte displayWindow, then a 1.6 GB string OpenEXR tried to read).
+  ExrBytes box;
+  box.part({"R"}, 2, 0, 0, 0);
+  box.attribute("displayWindow", "box2i", 20, std::vector<uint8_t>(20, 0));
+  box.end();
+  box.zeros(64);
+  EXPECT_NE(scanError(box.b).find("part 0: attribute 'displayWindow' has 20 bytes, expected 16"),
+            std::string::npos)
+      << scanError(box.b);
+  ExrBytes list;  // a channel list whose end marker comes before the attribute's end
+  list.part({"R"}, 2, 0, 0, 0);
+  list.attribute("extra", "chlist", 4, {0, 'x', 'y', 0});
+  list.end();
+  list.zeros(64);
+  EXPECT_NE(scanError(list.b).find("channel list ends before its attribute does"),
+            std::string::npos)
+      << scanError(list.b);
   ExrBytes sampling;
   sampling.part({"R"}, 2, 0, 0, 0);
   sampling.b[8 + 9 + 7 + 4 + 2 + 8] = 0;  // R's xSampling: 0
