@@ -17,7 +17,7 @@
 //     compression;
 //   - a part whose decoded size (data window pixels x bytes per pixel of its channels, with
 //     their sampling), or whose decode buffer for one chunk (lines per chunk, or one tile),
-//     exceeds kExrMaxRatio(compression) x file size + 1 MiB (exrDecodedLimit);
+//     exceeds exrMaxRatio(compression) x file size + 1 MiB (exrDecodedLimit);
 //   - chunk offset tables (8 bytes per chunk: the chunks the data window needs, or the part's
 //     chunkCount if larger) that do not fit between the end of the headers and the end of file.
 //
