@@ -11,7 +11,8 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfInputPart.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
 
@@ -19,6 +20,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/checksum.h"
+#include "formats/exr_header_scan.h"
 #include "formats/pixel_checksum.h"
 #include "libcommon/core/error.h"
 
@@ -41,13 +43,19 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
   if (!std::filesystem::is_regular_file(path))
     throw inputError(
         path, std::filesystem::exists(path) ? "is not a regular file" : "cannot open (missing)");
+  scanExrFile(path);  // sizes the header declares, bounded by the file's before OpenEXR reads
   try {
-    Imf::InputFile in(path.c_str());
-    const Imath::Box2i dw = in.header().dataWindow();
+    Imf::MultiPartInputFile file(path.c_str());
+    const Imf::Header& header = file.header(0);
+    const Imath::Box2i dw = header.dataWindow();
     const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
-    const Imf::ChannelList& list = in.header().channels();
+    const Imf::ChannelList& list = header.channels();
     std::vector<std::string> all;  // every channel, in list order: the checksum covers them all
-    for (auto it = list.begin(); it != list.end(); ++it) all.push_back(it.name());
+    std::vector<bool> isUint;      // read as UINT (the checksum hashes its bits), then converted
+    for (auto it = list.begin(); it != list.end(); ++it) {
+      all.push_back(it.name());
+      isUint.push_back(it.channel().type == Imf::UINT);
+    }
     for (const std::string& c : channels) {
       if (list.findChannel(c.c_str()) == nullptr) {
         std::string have;
@@ -55,7 +63,7 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
         throw inputError(path, "no channel '" + c + "' (channels: " + have + ")");
       }
     }
-    const std::optional<uint64_t> stored = storedPixelChecksum(in.header(), path, "part 0");
+    const std::optional<uint64_t> stored = storedPixelChecksum(header, path, "part 0");
     if (w < 1 || h < 1 || double(w) * double(h) * double(all.size()) > 1.0e9)
       throw inputError(path, "invalid data window");
     FloatImage image(int(w), int(h), all);
@@ -67,8 +75,10 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
       char* base = reinterpret_cast<char*>(image.pixels.data() + c) -
                    std::ptrdiff_t(dw.min.x) * std::ptrdiff_t(xStride) -
                    std::ptrdiff_t(dw.min.y) * std::ptrdiff_t(yStride);
-      fb.insert(all[c].c_str(), Imf::Slice(Imf::FLOAT, base, xStride, yStride));
+      fb.insert(all[c].c_str(),
+                Imf::Slice(isUint[c] ? Imf::UINT : Imf::FLOAT, base, xStride, yStride));
     }
+    Imf::InputPart in(file, 0);
     in.setFrameBuffer(fb);
     in.readPixels(dw.min.y, dw.max.y);
     if (stored)
@@ -76,6 +86,17 @@ FloatImage readExrImage(const std::string& path, const std::vector<std::string>&
           *stored,
           pixelChecksum(image.pixels.data(), image.width, image.height, int(nc), listOrderOf(all)),
           path, "part 0");
+    for (std::size_t c = 0; c < nc; ++c) {
+      if (!isUint[c]) continue;
+      for (std::size_t p = c; p < image.pixels.size(); p += nc) {
+        uint32_t u;
+        std::memcpy(&u, &image.pixels[p], sizeof u);
+        image.pixels[p] = float(u);
+      }
+    }
+    // The parts after the first are not returned, but their checksums are verified too: a
+    // corrupted file is refused whichever part the damage is in.
+    verifyExrPartPixels(file, path, 1);
     if (channels == all) return image;
     FloatImage selected(image.width, image.height, channels);
     for (size_t c = 0; c < channels.size(); ++c) {

@@ -16,8 +16,10 @@ namespace rad {
 
 // Reads the named channels of the first part (any pixel type, converted to float). Every
 // channel is read, and checked against the part's rad.pixelChecksum when it has one (required
-// for rad frames 2.x; formats/pixel_checksum.h). Throws rad::inputError(path, ...) if the file
-// is unreadable, corrupted or lacks a channel (the message lists the channels it has).
+// for rad frames 2.x; formats/pixel_checksum.h); every other part of a multi-part file is read
+// and checked against its own (verifyExrPartPixels). The headers are bounded by the file's size
+// first (scanExrFile). Throws rad::inputError(path, ...) if the file is unreadable, corrupted
+// or lacks a channel (the message lists the channels it has).
 FloatImage readExrImage(const std::string& path,
                         const std::vector<std::string>& channels = {"R", "G", "B"});
 

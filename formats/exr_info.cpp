@@ -14,6 +14,7 @@
 #include <OpenEXR/ImfStringVectorAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
 
+#include "formats/exr_header_scan.h"
 #include "formats/provenance.h"
 #include "libcommon/core/error.h"
 
@@ -69,6 +70,7 @@ const char* pixelTypeName(Imf::PixelType t) {
 }  // namespace
 
 nlohmann::json readExrInfo(const std::string& path) {
+  scanExrFile(path);  // sizes the headers declare, bounded by the file's before OpenEXR reads
   try {
     Imf::MultiPartInputFile file(path.c_str());
     nlohmann::json parts = nlohmann::json::array();

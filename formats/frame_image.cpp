@@ -21,6 +21,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/checksum.h"
+#include "formats/exr_header_scan.h"
 #include "formats/pixel_checksum.h"
 #include "libcommon/core/error.h"
 
@@ -167,6 +168,7 @@ void writeFramePng(const std::string& path, const ComposedFrame& frame,
 
 FrameExr readFrameExr(const std::string& path) {
   FrameExr f;
+  scanExrFile(path);  // sizes the header declares, bounded by the file's before OpenEXR reads
   try {
     Imf::InputFile in(path.c_str());
     const Imf::Header& h = in.header();

@@ -2,6 +2,7 @@
 #include "formats/item_buffer_exr.h"
 
 #include <cstdlib>
+#include <cstring>
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfDoubleAttribute.h>
@@ -13,9 +14,23 @@
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include "formats/atomic_file.h"
+#include "formats/checksum.h"
+#include "formats/exr_header_scan.h"
+#include "formats/pixel_checksum.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
+
+uint64_t itemBufferChecksum(const ItemBuffer& b) {
+  // Channel-list order Z, id; pixelChecksum hashes each value's 4 bytes, so an id's bits are
+  // carried in a float slot unchanged (memcpy, no conversion).
+  std::vector<float> words(b.depth.size() * 2);
+  for (size_t p = 0; p < b.depth.size(); ++p) {
+    words[2 * p] = b.depth[p];
+    std::memcpy(&words[2 * p + 1], &b.id[p], sizeof(uint32_t));
+  }
+  return pixelChecksum(words.data(), b.width, b.height, 2, {0, 1});
+}
 
 void writeItemBufferExr(const std::string& path, const ItemBuffer& b, int frame, double time,
                         const std::string& provenanceJson) {
@@ -32,6 +47,7 @@ void writeItemBufferExr(const std::string& path, const ItemBuffer& b, int frame,
   h.insert("rad.frame", Imf::IntAttribute(frame));
   h.insert("rad.time", Imf::DoubleAttribute(time));
   if (!provenanceJson.empty()) h.insert("rad.provenance", Imf::StringAttribute(provenanceJson));
+  h.insert(kPixelChecksumAttribute, Imf::StringAttribute(formatFnv1a64(itemBufferChecksum(b))));
   AtomicFile file(path);
   try {
     Imf::OutputFile out(file.tempPath().c_str(), h);
@@ -50,12 +66,15 @@ void writeItemBufferExr(const std::string& path, const ItemBuffer& b, int frame,
 
 ItemBuffer readItemBufferExr(const std::string& path) {
   ItemBuffer b;
+  scanExrFile(path);  // sizes the header declares, bounded by the file's before OpenEXR reads
   try {
     Imf::InputFile in(path.c_str());
     const Imf::Header& h = in.header();
     const auto* fmt = h.findTypedAttribute<Imf::StringAttribute>("rad.format");
     if (!fmt || fmt->value().rfind("item-buffer ", 0) != 0)
       throw inputError(path, "not an item buffer (no rad.format \"item-buffer\")");
+    // Refuses 1.x (no checksum: re-run rad-intervals) and a malformed or missing checksum.
+    const std::optional<uint64_t> stored = storedPixelChecksum(h, path, "part 0");
     int major = std::atoi(fmt->value().c_str() + 12);
     if (major != kItemBufferExrMajor)
       throw inputError(path, "item-buffer version " + fmt->value().substr(12) + ", expected " +
@@ -79,6 +98,8 @@ ItemBuffer readItemBufferExr(const std::string& path) {
         "Z", Imf::Slice(Imf::FLOAT, (char*)b.depth.data(), sizeof(float), sizeof(float) * b.width));
     in.setFrameBuffer(fb);
     in.readPixels(dw.min.y, dw.max.y);
+    if (!stored) throw inputError(path, std::string("part 0: no ") + kPixelChecksumAttribute);
+    requirePixelChecksum(*stored, itemBufferChecksum(b), path, "part 0");
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {

@@ -12,7 +12,9 @@
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include "formats/checksum.h"
+#include "formats/exr_header_scan.h"
 #include "formats/frame_image.h"
+#include "formats/item_buffer_exr.h"
 #include "formats/texture_movie.h"
 #include "libcommon/core/error.h"
 
@@ -40,6 +42,7 @@ struct ChecksummedFormat {
 const ChecksummedFormat kChecksummedFormats[] = {
     {"texture-movie ", kTextureMovieMajor, "rad-movies"},
     {"frame ", kFrameImageMajor, "rad-compose"},
+    {"item-buffer ", kItemBufferExrMajor, "rad-intervals"},
 };
 
 }  // namespace
@@ -108,10 +111,23 @@ void requirePixelChecksum(uint64_t stored, uint64_t computed, const std::string&
 
 nlohmann::json verifyExrPixels(const std::string& path) {
   int checksummed = 0, parts = 0;
+  scanExrFile(path);  // sizes the headers declare, bounded by the file's before OpenEXR reads
   try {
     Imf::MultiPartInputFile file(path.c_str());
     parts = file.parts();
-    for (int p = 0; p < parts; ++p) {
+    checksummed = verifyExrPartPixels(file, path, 0);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw inputError(path, std::string("not a readable OpenEXR file: ") + e.what());
+  }
+  return {{"parts", parts}, {"checksummed_parts", checksummed}};
+}
+
+int verifyExrPartPixels(Imf::MultiPartInputFile& file, const std::string& path, int firstPart) {
+  int checksummed = 0;
+  try {
+    for (int p = firstPart; p < file.parts(); ++p) {
       const Imf::Header& h = file.header(p);
       const std::string part = "part " + std::to_string(p);
       const std::optional<uint64_t> stored = storedPixelChecksum(h, path, part);
@@ -123,10 +139,12 @@ nlohmann::json verifyExrPixels(const std::string& path) {
       const long long w = (long long)dw.max.x - dw.min.x + 1,
                       hh = (long long)dw.max.y - dw.min.y + 1;
       std::vector<std::string> names;
+      std::vector<Imf::PixelType> types;  // UINT read as UINT: its 4 bytes are what is hashed
       for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
         if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
           throw inputError(path, part + ": subsampled channel " + it.name() + " not supported");
         names.push_back(it.name());
+        types.push_back(it.channel().type == Imf::UINT ? Imf::UINT : Imf::FLOAT);
       }
       if (w < 1 || hh < 1 || double(w) * double(hh) * double(names.size()) > 1.0e9)
         throw inputError(path, part + ": invalid data window");
@@ -138,7 +156,7 @@ nlohmann::json verifyExrPixels(const std::string& path) {
         char* base = reinterpret_cast<char*>(px.data() + c) -
                      std::ptrdiff_t(dw.min.x) * std::ptrdiff_t(xs) -
                      std::ptrdiff_t(dw.min.y) * std::ptrdiff_t(ys);
-        fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, xs, ys));
+        fb.insert(names[c], Imf::Slice(types[c], base, xs, ys));
       }
       Imf::InputPart in(file, p);
       in.setFrameBuffer(fb);
@@ -155,7 +173,7 @@ nlohmann::json verifyExrPixels(const std::string& path) {
   } catch (const std::exception& e) {
     throw inputError(path, std::string("not a readable OpenEXR file: ") + e.what());
   }
-  return {{"parts", parts}, {"checksummed_parts", checksummed}};
+  return checksummed;
 }
 
 std::vector<uint64_t> exrStringAttributeOffsets(const std::vector<char>& bytes, int parts,

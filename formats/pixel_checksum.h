@@ -6,8 +6,8 @@
 //   FNV-1a 64 (formats/checksum.h) over the part's decoded values, scan line by scan line from
 //   the data window's first, within a line channel by channel in the part's channel-list order
 //   (OpenEXR sorts by name: B, G, R), within a channel left to right; each value as the 4 bytes,
-//   little-endian, of its 32-bit float (a HALF value converted to float exactly). The attribute
-//   is a string "fnv1a64:<16 hex digits>".
+//   little-endian, of its 32-bit float (a HALF value converted to float exactly; a UINT value,
+//   item buffers' ids, as its own uint32). The attribute is a string "fnv1a64:<16 hex digits>".
 //
 // For FLOAT channels that is the byte order of an uncompressed part's chunk data, so a writer
 // hashes what it writes and a reader what it decodes, with no second pass over the file.
@@ -54,6 +54,9 @@ void requirePixelChecksum(uint64_t stored, uint64_t computed, const std::string&
 // part's checksum (storedPixelChecksum). Throws rad::inputError(path, ...) for an unreadable,
 // truncated or corrupted file. Returns {"parts": n, "checksummed_parts": m}.
 nlohmann::json verifyExrPixels(const std::string& path);
+// The same for parts [firstPart, parts) of a file already open (readExrImage reads part 0 itself
+// and verifies the others with this). Returns the number of parts verified against a checksum.
+int verifyExrPartPixels(Imf::MultiPartInputFile& file, const std::string& path, int firstPart);
 
 // Offsets of the value of string attribute `name` in each of the first `parts` headers of an
 // OpenEXR file whose first bytes are `bytes` (magic, version, headers); a part without it gets

@@ -29,6 +29,7 @@
 
 #include "formats/atomic_file.h"
 #include "formats/checksum.h"
+#include "formats/exr_header_scan.h"
 #include "formats/exr_image.h"
 #include "formats/pixel_checksum.h"
 #include "libcommon/core/error.h"
@@ -392,6 +393,7 @@ auto readingExr(const std::string& path, F&& f) {
 
 TextureMovie readTextureMovie(const std::string& path) {
   return readingExr(path, [&] {
+    scanExrFile(path);  // sizes the headers declare, bounded by the file's (texture_movie.md)
     Imf::MultiPartInputFile in(path.c_str());
     TextureMovie m = readHeaders(in, path);
     for (int k = 0; k < in.parts(); ++k) m.keys.push_back(readKey(in, k, m, path));
@@ -401,6 +403,7 @@ TextureMovie readTextureMovie(const std::string& path) {
 
 TextureMovie readTextureMovieHeaders(const std::string& path) {
   return readingExr(path, [&] {
+    scanExrFile(path);
     Imf::MultiPartInputFile in(path.c_str());
     return readHeaders(in, path);
   });
@@ -491,6 +494,7 @@ void checkExr(exr_result_t rv, const std::string& path, const char* what) {
 
 TextureMovieStream::TextureMovieStream(std::string path) : path_(std::move(path)) {
   movie_ = readingExr(path_, [&] {
+    scanExrFile(path_);
     Imf::MultiPartInputFile in(path_.c_str());
     return readHeaders(in, path_);
   });

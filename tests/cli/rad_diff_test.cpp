@@ -1,6 +1,7 @@
 // rad-diff as a user runs it: two EXR files or two frame directories, text and --json output,
-// and the one-line error on a size mismatch.
+// the one-line error on a size mismatch, and every part's pixel checksum verified.
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -8,7 +9,9 @@
 #include "formats/exr_image.h"
 #include "formats/gltf_scene.h"
 #include "formats/item_buffer_exr.h"
+#include "formats/texture_movie.h"
 #include "tests/cli/cli_util.h"
+#include "tests/format/exr_layout.h"
 
 namespace rad::test {
 namespace {
@@ -270,6 +273,40 @@ TEST(RadDiff, DirectoriesWithSecondReference) {
 // --surfaces: the figures per glTF node and material seen in rad-intervals' item buffer. A
 // test frame 50 % too bright on the red wall alone and exact elsewhere reads bias +0.5 there
 // and 0 on every other surface, and the groups' pixels add up to the covered pixels.
+// rad-diff compares the first part of a file; a multi-part file's other parts are read and
+// checked against their rad.pixelChecksum too (before: part 0's only, so a corrupted byte in
+// part 1 passed).
+TEST(RadDiff, VerifiesTheChecksumOfEveryPart) {
+  fs::path d = freshDir("parts");
+  TextureMovie m;
+  m.movie = 1;
+  m.patch = PatchId{0, 1};
+  m.firstFrame = 0;
+  m.lastFrame = 1;
+  m.width = 4;
+  m.height = 3;
+  for (int k = 0; k < 2; ++k) {
+    m.keyFrames.push_back(k);
+    m.keyTimes.push_back(k / 24.0);
+    m.keys.emplace_back(size_t(m.width) * m.height * 3, 0.5f + float(k));
+  }
+  const std::string file = (d / "movie.exr").string();
+  writeTextureMovie(file, m);
+  CommandResult r = runCommand(tool("rad-diff") + " " + file + " " + file + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Layout layout = layoutOf(file);
+  ASSERT_EQ(layout.pixelData.size(), 6u);  // 3 scan lines a part, one chunk each
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(std::streamoff(layout.pixelData[4].first + 1));  // part 1, line 1
+    f.put(char(0x7f));
+  }
+  r = runCommand(tool("rad-diff") + " " + file + " " + file + " --json");
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("rad-diff: " + file + ": part 1: pixel checksum mismatch", 0), 0u) << r.err;
+}
+
 TEST(RadDiff, PerSurfaceBiasNamesTheWrongSurface) {
   const std::string scene = RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
   fs::path d = freshDir("surfaces");

@@ -15,6 +15,7 @@
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -26,6 +27,7 @@
 #include "formats/checksum.h"
 #include "formats/exr_image.h"
 #include "formats/frame_image.h"
+#include "formats/item_buffer_exr.h"
 #include "formats/texture_movie.h"
 #include "libcommon/core/error.h"
 #include "tests/format/exr_layout.h"
@@ -331,6 +333,73 @@ TEST_F(PixelChecksum, OlderFramesAreRefusedForeignFilesRead) {
               old +
                   ": frame 1.0 is no longer read (its pixels carry no checksum): re-run "
                   "rad-compose");
+  }
+}
+
+// Item buffers (rad-intervals --item-buffers, read by rad-diff --surfaces) carry the checksum
+// since item-buffer 2.0: over Z then id, an id hashed as its uint32's bytes. readItemBufferExr,
+// rad-inspect's verifyExrPixels and readExrImage (ids converted to float) all verify it.
+TEST_F(PixelChecksum, ItemBuffersCarryAndVerifyIt) {
+  ItemBuffer b;
+  b.width = 5;
+  b.height = 3;
+  for (int p = 0; p < 15; ++p) {
+    b.id.push_back(p % 4 == 0 ? kNoItem : uint32_t(p * 1000003));
+    b.depth.push_back(p % 4 == 0 ? INFINITY : 0.5f + float(p));
+  }
+  const std::string file = path("0003.exr");
+  writeItemBufferExr(file, b, 3, 0.125, "{}");
+  const ItemBuffer r = readItemBufferExr(file);
+  EXPECT_EQ(r.id, b.id);
+  EXPECT_EQ(verifyExrPixels(file)["checksummed_parts"], 1);
+  const FloatImage image = readExrImage(file, {"id"});
+  EXPECT_EQ(image.pixels[1], float(1000003));
+  // The spec's definition, recomputed here: FNV-1a over Z's then id's 4 bytes, line by line.
+  uint64_t h = kFnv1a64Offset;
+  auto hash = [&](const void* word) {
+    for (int i = 0; i < 4; ++i) h = (h ^ static_cast<const uint8_t*>(word)[i]) * kFnv1a64Prime;
+  };
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) hash(&b.depth[size_t(y * 5 + x)]);
+    for (int x = 0; x < 5; ++x) hash(&b.id[size_t(y * 5 + x)]);
+  }
+  EXPECT_EQ(itemBufferChecksum(b), h);
+
+  // A stored checksum that does not match the pixels (one hex digit changed).
+  std::vector<char> bytes = bytesOf(file);
+  std::string text(bytes.begin(), bytes.end());
+  const size_t at = text.find("fnv1a64:");
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + 8] = bytes[at + 8] == '0' ? '1' : '0';
+  const std::string wrong = path("wrong.exr");
+  writeBytes(wrong, bytes, bytes.size());
+  for (const auto& read : std::vector<std::function<void()>>{[&] { readItemBufferExr(wrong); },
+                                                             [&] { verifyExrPixels(wrong); },
+                                                             [&] { readExrImage(wrong, {"Z"}); }}) {
+    try {
+      read();
+      ADD_FAILURE() << "a wrong checksum was accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(wrong + ": part 0: pixel checksum mismatch", 0), 0u)
+          << e.what();
+    }
+  }
+  // An item-buffer 1.0 (no checksum) is refused with the stage to re-run.
+  bytes = bytesOf(file);
+  text.assign(bytes.begin(), bytes.end());
+  const size_t version = text.find("item-buffer 2.0");
+  ASSERT_NE(version, std::string::npos);
+  bytes[version + 12] = '1';
+  const std::string old = path("old.exr");
+  writeBytes(old, bytes, bytes.size());
+  try {
+    readItemBufferExr(old);
+    ADD_FAILURE() << "an item-buffer 1.0 was read";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              old +
+                  ": item-buffer 1.0 is no longer read (its pixels carry no checksum): re-run "
+                  "rad-intervals");
   }
 }
 
