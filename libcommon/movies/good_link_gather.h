@@ -57,9 +57,10 @@
 
 namespace rad {
 
-// Whether point p of top-level patch `top` lies under a touching solid at time t (a box's foot
-// on the floor): the first surface its outward ray (direction d) meets is the back of a
-// one-sided patch, as rad-global's exposure decides (exposureOf).
+// Where the ray from point p of top-level patch `top` (direction d) starts at time t: inside a
+// touching solid (a box's foot on the floor: the first surface it meets is the back of a
+// one-sided patch), outside, or undecided (a front and such a back at one distance; rayStart),
+// as rad-global's exposure decides (exposureOf).
 RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
                         const PatchHierarchy& h, uint32_t top, const glm::dvec3& p,
                         const glm::dvec3& d, double t);
