@@ -560,6 +560,23 @@ TEST(HierarchicalRadiosity, OccludedFurnaceRowsSumToOneInAClosedRoom) {
   EXPECT_GT(worstLeaf(false), 0.05) << "what failed";
 }
 
+// One key time of `polys` with visibility between them, at the default options.
+KeySolution solveWithVisibility(PatchHierarchy& h, const std::vector<Polygon>& polys,
+                                const std::vector<SurfaceProperties>& surf) {
+  VisibilityScene vis(visibilityTrianglesOf(polys));
+  KeySolveInput in = identityInput(h);
+  in.visibility = &vis;
+  return solveKeyTime(h, surf, in, RadiosityOptions());
+}
+
+// Every patch white (reflectance 0.5), patch 1 a light of emission 1.
+std::vector<SurfaceProperties> whiteUnderALight(size_t patches) {
+  std::vector<SurfaceProperties> surf(patches);
+  for (auto& sp : surf) sp.reflectance = glm::dvec3(0.5);
+  surf[1].emission = glm::dvec3(1.0);
+  return surf;
+}
+
 // Exposure (the darkening at contacts): a box standing on a floor covers a quadrant of it. The
 // floor's links from under the box are blocked, so without exposure the floor's radiosity (the
 // area average) is pulled down by the dark covered part, which nothing sees. With it, the
@@ -575,13 +592,7 @@ TEST(HierarchicalRadiosity, CoveredAreaDoesNotDarkenWhatIsExposed) {
       quad({0, 0, 1}, {1, 0, 1}, {1, .5, 1}, {0, .5, 1}),    // +z
       quad({0, 0, 0}, {0, .5, 0}, {1, .5, 0}, {1, 0, 0})};   // -z
   PatchHierarchy h = hierarchyOf(polys);
-  std::vector<SurfaceProperties> surf(polys.size());
-  for (auto& sp : surf) sp.reflectance = glm::dvec3(0.5);
-  surf[1].emission = glm::dvec3(1.0);
-  VisibilityScene vis(visibilityTrianglesOf(polys));
-  KeySolveInput in = identityInput(h);
-  in.visibility = &vis;
-  KeySolution s = solveKeyTime(h, surf, in, RadiosityOptions());
+  KeySolution s = solveWithVisibility(h, polys, whiteUnderALight(polys.size()));
   ASSERT_TRUE(s.split[0]) << "the floor is subdivided";
   const int first = h.node(0).firstChild;
   double lo = 1e300, hi = 0;
@@ -617,13 +628,7 @@ TEST(HierarchicalRadiosity, ASheetOfTwoBackToBackPatchesCoversNothing) {
       quad({1, 0, 0}, {1, .5, 0}, {1, .5, 2}, {1, 0, 2}),   // sheet, +x
       quad({1, 0, 0}, {1, 0, 2}, {1, .5, 2}, {1, .5, 0})};  // its back, -x
   PatchHierarchy h = hierarchyOf(polys);
-  std::vector<SurfaceProperties> surf(polys.size());
-  for (auto& sp : surf) sp.reflectance = glm::dvec3(0.5);
-  surf[1].emission = glm::dvec3(1.0);
-  VisibilityScene vis(visibilityTrianglesOf(polys));
-  KeySolveInput in = identityInput(h);
-  in.visibility = &vis;
-  KeySolution s = solveKeyTime(h, surf, in, RadiosityOptions());
+  KeySolution s = solveWithVisibility(h, polys, whiteUnderALight(polys.size()));
   int floorNodes = 0;
   for (int i = 0; i < h.size(); ++i)
     if (h.node(i).id.top == 0 && s.inTree(i, h)) {
@@ -648,10 +653,7 @@ TEST(HierarchicalRadiosity, ClosureOfADimWallDoesNotScaleTheLight) {
   std::vector<SurfaceProperties> surf(polys.size());
   surf[0].reflectance = glm::dvec3(0.5);
   surf[1].emission = glm::dvec3(1.0);
-  VisibilityScene vis(visibilityTrianglesOf(polys));
-  KeySolveInput in = identityInput(h);
-  in.visibility = &vis;
-  KeySolution s = solveKeyTime(h, surf, in, RadiosityOptions());
+  KeySolution s = solveWithVisibility(h, polys, surf);
   int checked = 0;
   double worst = 0.0;
   for (int i = 0; i < h.size(); ++i) {
