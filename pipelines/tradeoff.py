@@ -43,6 +43,7 @@ KNOBS = [
     ("movie-key-step", "movies", "--movie-key-step", ["24", "12", "3", "1"]),
     ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32"]),
     ("gather-rays", "movies", "--gather-rays", ["0", "4", "32"]),
+    ("near-shooter-levels", "movies", "--near-shooter-levels", ["1", "2"]),
 ]
 TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
          "compose": "rad-compose"}

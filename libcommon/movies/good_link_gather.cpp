@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -30,6 +31,46 @@ RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
   });
 }
 
+namespace {
+
+int cellLevel(uint32_t cell) {
+  return (31 - __builtin_clz(cell)) / 2;
+}
+
+// The 4^levels cells of polygon p in path order (subdividePolygon's children at each level).
+std::vector<Polygon> cellsOf(const Polygon& p, int levels) {
+  std::vector<Polygon> c{p};
+  for (int d = 0; d < levels; ++d) {
+    std::vector<Polygon> next;
+    next.reserve(c.size() * 4);
+    for (const Polygon& q : c)
+      for (const Polygon& child : subdividePolygon(q)) next.push_back(child);
+    c = std::move(next);
+  }
+  return c;
+}
+
+// Point p of top-level patch `top` (normal n) lies inside a touching solid at time t: the four
+// rays 88 degrees from the normal all start inside or undecided, one at least inside (as
+// rad-movies' fill of covered texels decides).
+bool insideSolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
+                 uint32_t top, const glm::dvec3& p, const glm::dvec3& n, double size, double t) {
+  glm::dvec3 u = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+  u = glm::normalize(glm::cross(u, n));
+  const glm::dvec3 v = glm::cross(n, u);
+  const double c = std::cos(88.0 * M_PI / 180.0), sn = std::sin(88.0 * M_PI / 180.0);
+  const glm::dvec3 dirs[4] = {c * n + sn * u, c * n - sn * u, c * n + sn * v, c * n - sn * v};
+  bool inside = false;
+  for (const glm::dvec3& d : dirs) {
+    const RayStart r = coveredBySolid(blockers, scene, h, top, p, d * size, t);
+    if (r == RayStart::kOutside) return false;
+    inside = inside || r == RayStart::kInside;
+  }
+  return inside;
+}
+
+}  // namespace
+
 GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
   const size_t N = size_t(s.hierarchy.size());
   auto gathers = [N](const GlobalLink& l) {
@@ -46,6 +87,22 @@ GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
     if (gathers(l)) rows[next[l.receiver]++] = r;
   }
   smoothClusterIrradiance(s);
+}
+
+void GoodLinksByReceiver::indexAllLinks(const GlobalSolution& s) {
+  if (!allStart.empty()) return;
+  const size_t N = size_t(s.hierarchy.size());
+  auto gathers = [N](const GlobalLink& l) {
+    return !(l.flags & kLinkRefined) && l.receiver < N && l.shooter < N;
+  };
+  allStart.assign(N + 1, 0);
+  for (const GlobalLink& l : s.links)
+    if (gathers(l)) ++allStart[l.receiver + 1];
+  for (size_t i = 0; i < N; ++i) allStart[i + 1] += allStart[i];
+  allRows.resize(allStart[N]);
+  std::vector<uint32_t> next(allStart.begin(), allStart.end() - 1);
+  for (uint32_t r = 0; r < uint32_t(s.links.size()); ++r)
+    if (gathers(s.links[r])) allRows[next[s.links[r].receiver]++] = r;
 }
 
 void GoodLinksByReceiver::smoothClusterIrradiance(const GlobalSolution& s) {
@@ -82,10 +139,11 @@ void GoodLinksByReceiver::smoothClusterIrradiance(const GlobalSolution& s) {
 }
 
 GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
-                               const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
+                               GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                                const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
                                double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
-                               SceneVisibility* visibility, int visibilityRays)
+                               SceneVisibility* visibility, int visibilityRays,
+                               int nearShooterLevels)
     : scene_(scene),
       solution_(solution),
       clusterCorners_(byReceiver.clusterCorners),
@@ -94,7 +152,10 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
       keyTimes_(movieKeyTimes),
       receiverTop_(int(request.patch.top)),
       visibility_(visibility),
-      visibilityRays_(visibilityRays) {
+      visibilityRays_(visibilityRays),
+      byReceiver_(byReceiver),
+      nearShooterLevels_(visibility && visibilityRays > 0 && shooterRatio > 0.0 ? nearShooterLevels
+                                                                                : 0) {
   // The nodes in the moving part of the visibility scene, those that move anywhere in the
   // solution's time range (SceneVisibility's split), with their bounds swept over the movie:
   // one that rests during the movie still blocks. Only the nodes moving during the movie had
@@ -115,6 +176,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
     solution.keyWeights(t, k0, k1, w);
     needed[size_t(k0)] = needed[size_t(k1)] = 1;
   }
+  planNearShooters(needed, stats);
   planWeights(needed);
   planTexels(cacheBytes);
   stats.links += long(links_.size());
@@ -156,7 +218,7 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
   std::sort(receivers.begin(), receivers.end());
   const double t0 = keyTimes_.front(), t1 = keyTimes_.back();
   const bool receiverMoves = scene_.isDynamic(h.top(receiverTop_).node, t0, t1);
-  std::vector<uint32_t> shooters;
+  std::vector<uint32_t> shooters, cells{1u};
   for (int r : receivers) {
     const Polygon receiver = nodeWorld(uint32_t(r), t0);
     for (uint32_t k = byReceiver.start[size_t(r)]; k < byReceiver.start[size_t(r) + 1]; ++k) {
@@ -165,11 +227,22 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
       const bool moves = receiverMoves || scene_.isDynamic(h.topOf(int(shooter)).node, t0, t1);
       shooterParts(receiver, shooter, t0, shooters);
       for (uint32_t q : shooters) {
-        Link l;
-        l.row = row;
-        l.shooter = q;
-        l.moves = moves;
-        links_.push_back(std::move(l));
+        const int m = h.topOf(int(q)).material;
+        const bool emitter =
+            m >= 0 && m < int(scene_.materials.size()) && scene_.materials[size_t(m)].isEmitter();
+        if (nearShooterLevels_ > 0 && h.isLeaf(int(q)) && !emitter)
+          nearCells(receiver, q, t0, cells);
+        else
+          cells.assign(1, 1u);
+        for (uint32_t cell : cells) {
+          Link l;
+          l.row = row;
+          l.shooter = q;
+          l.cell = cell;
+          l.rays = std::max(1, visibilityRays_ >> (2 * cellLevel(cell)));
+          l.moves = moves;
+          links_.push_back(std::move(l));
+        }
       }
     }
   }
@@ -204,6 +277,203 @@ void GoodLinkGather::shooterParts(const Polygon& receiver, uint32_t shooter, dou
   }
 }
 
+Polygon GoodLinkGather::linkWorld(const Link& l, double t) const {
+  Polygon p = nodeWorld(l.shooter, t);
+  for (int i = cellLevel(l.cell) - 1; i >= 0; --i)
+    p = subdividePolygon(p)[size_t((l.cell >> (2 * i)) & 3u)];
+  return p;
+}
+
+// The cells of a near leaf shooter a texel gathers from: its virtual quadtree descended, as
+// shooterParts descends the union tree, while a cell is larger than shooterRatio times its
+// distance to the receiver, down to nearShooterLevels_.
+void GoodLinkGather::nearCells(const Polygon& receiver, uint32_t leaf, double t,
+                               std::vector<uint32_t>& out) const {
+  out.clear();
+  std::vector<std::pair<uint32_t, Polygon>> stack{{1u, nodeWorld(leaf, t)}};
+  while (!stack.empty()) {
+    const auto [cell, poly] = stack.back();
+    stack.pop_back();
+    bool split = cellLevel(cell) < nearShooterLevels_;
+    if (split) {
+      double d = distanceToPolygon(receiver.centroid(), poly);
+      for (int i = 0; i < receiver.count; ++i)
+        d = std::min(d, distanceToPolygon(receiver.v[i], poly));
+      split = polygonSize(poly) > shooterRatio_ * d;
+    }
+    if (!split) {
+      out.push_back(cell);
+      continue;
+    }
+    const std::array<Polygon, 4> c = subdividePolygon(poly);
+    for (int k = 3; k >= 0; --k) stack.push_back({(cell << 2) | uint32_t(k), c[size_t(k)]});
+  }
+}
+
+// The re-gathered radiosity of the near leaf shooters' cells at the needed keys, made for the
+// leaves not yet in byReceiver_'s store (the moving nodes placed at each key's time first).
+void GoodLinkGather::planNearShooters(const std::vector<char>& needed, GoodLinkGatherStats& stats) {
+  if (nearShooterLevels_ == 0) return;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<uint32_t> leaves;
+  for (const Link& l : links_)
+    if (l.cell != 1) leaves.push_back(l.shooter);
+  if (leaves.empty()) return;
+  std::sort(leaves.begin(), leaves.end());
+  leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
+  byReceiver_.indexAllLinks(solution_);
+  const uint64_t K = uint64_t(solution_.keyCount());
+  for (int k = 0; k < int(K); ++k) {
+    if (!needed[size_t(k)]) continue;
+    std::vector<uint32_t> missing;
+    for (uint32_t q : leaves)
+      if (!byReceiver_.nearShooterCells.count(q * K + uint64_t(k))) missing.push_back(q);
+    if (missing.empty()) continue;
+    const double t = solution_.keyTimes[size_t(k)];
+    if (visibility_->dynamicNodeCount() > 0) visibility_->setTime(t);
+    std::vector<std::vector<float>> made(missing.size());
+    std::vector<GoodLinksByReceiver::FixedTerms> fresh(missing.size());
+    std::vector<const GoodLinksByReceiver::FixedTerms*> fixed(missing.size(), nullptr);
+    for (size_t i = 0; i < missing.size(); ++i) {
+      auto it = byReceiver_.nearShooterFixed.find(missing[i]);
+      if (it != byReceiver_.nearShooterFixed.end()) fixed[i] = &it->second;
+    }
+    tbb::parallel_for(size_t(0), missing.size(), [&](size_t i) {
+      made[i] = regatherCells(missing[i], k, t, fixed[i], fixed[i] ? nullptr : &fresh[i]);
+    });
+    for (size_t i = 0; i < missing.size(); ++i) {
+      byReceiver_.nearShooterCells[missing[i] * K + uint64_t(k)] = std::move(made[i]);
+      if (!fixed[i] && !fresh[i].rows.empty())
+        byReceiver_.nearShooterFixed[missing[i]] = std::move(fresh[i]);
+    }
+    stats.nearShooterLeaves += long(missing.size());
+  }
+  stats.nearShooterSeconds +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// B at each cell centre of leaf q at key k (formula in good_link_gather.h), as a ratio to the
+// leaf's B (channel sums): the colour stays the leaf's.
+std::vector<float> GoodLinkGather::regatherCells(uint32_t q, int k, double t,
+                                                 const GoodLinksByReceiver::FixedTerms* fixed,
+                                                 GoodLinksByReceiver::FixedTerms* fresh) const {
+  const PatchHierarchy& h = solution_.hierarchy;
+  const int levels = nearShooterLevels_;
+  const std::vector<Polygon> cells = cellsOf(nodeWorld(q, t), levels);
+  std::vector<float> ratio(cells.size(), 1.0f);
+  const glm::dvec3 bq = solution_.exposedRadiosityAtKey(int(q), k);
+  const double bqSum = bq.x + bq.y + bq.z;
+  if (!(bqSum > 0.0)) return ratio;
+  const uint32_t top = h.node(int(q)).id.top;
+  const int m = h.top(int(top)).material;
+  if (m < 0 || m >= int(scene_.materials.size())) return ratio;
+  const Material& mat = scene_.materials[size_t(m)];
+  const bool storedVisibility = !solution_.linkSampleVisibility.empty();
+  const glm::dvec3 cluster = solution_.clusterIrradianceAtKey(int(top), k);
+  const double size = polygonSize(cells[0]);
+  std::vector<glm::dvec3> y(cells.size()), n(cells.size()), H(cells.size(), cluster);
+  std::vector<char> open(cells.size(), 0);
+  for (size_t i = 0; i < cells.size(); ++i) {
+    y[i] = cells[i].centroid();
+    n[i] = cells[i].normal();
+    open[i] = !(insideSolid(visibility_->staticPart(), scene_, h, top, y[i], n[i], size, t) ||
+                (visibility_->dynamicNodeCount() > 0 &&
+                 insideSolid(visibility_->movingPart(), scene_, h, top, y[i], n[i], size, t)));
+  }
+  // The terms of one link at every cell: F(y_i -> s) times, where the link is partly occluded,
+  // V from rays (against the moving nodes too unless `fixedOnly`).
+  auto terms = [&](uint32_t row, bool fixedOnly, auto&& add) {
+    const GlobalLink& g = solution_.links[row];
+    const Polygon s = nodeWorld(g.shooter, t);
+    // A kept link's one sample, whatever the key (one outside its activity reads 0).
+    const double v = !storedVisibility ? 1.0
+                     : fixedOnly       ? double(solution_.linkSampleVisibility[g.sampleOffset])
+                                       : solution_.linkVisibilityAtKey(g, k);
+    const bool partial = v < 1.0;
+    const bool moving = !fixedOnly && visibility_->dynamicNodeCount() > 0;
+    std::vector<glm::dvec3> points;
+    const uint32_t sTop = h.node(int(g.shooter)).id.top;
+    for (size_t i = 0; i < cells.size(); ++i) {
+      if (!open[i] && !fixedOnly) continue;
+      double f = pointToPolygonFormFactor(y[i], n[i], s);
+      if (!(f > 0.0)) continue;
+      if (partial) {
+        if (points.empty())
+          points = VisibilityScene::samplePoints(s, visibilityRays_, splitMix64(row));
+        uint64_t bits = visibility_->staticPart().openFrom(y[i], points, top, sTop);
+        if (bits != 0 && moving)
+          bits = visibility_->movingPart().openFrom(y[i], points, top, sTop, bits);
+        f *= pointVisibility(y[i], n[i], points, s.normal(), bits, nullptr);
+      }
+      add(i, f);
+    }
+  };
+  // A static leaf's links that do not change (both ends static, one F·V sample: no moving node
+  // crossed their shaft) take the same terms at every key: made once (against the static
+  // blockers), kept, and summed first, so that a key's sum does not depend on which key came
+  // first (movies in any order, any shard split: bit-identical).
+  const double t0 = solution_.keyTimes.front(), t1 = solution_.keyTimes.back();
+  const bool leafStatic = !scene_.isDynamic(int(h.top(int(top)).node), t0, t1);
+  auto isFixed = [&](const GlobalLink& g) {
+    return leafStatic && g.sampleCount == 1 &&
+           !scene_.isDynamic(int(h.topOf(int(g.shooter)).node), t0, t1);
+  };
+  if (leafStatic && !fixed && fresh) {
+    for (int a = int(q); a >= 0; a = h.node(a).parent)
+      for (uint32_t e = byReceiver_.allStart[size_t(a)]; e < byReceiver_.allStart[size_t(a) + 1];
+           ++e) {
+        const uint32_t row = byReceiver_.allRows[e];
+        if (!isFixed(solution_.links[row])) continue;
+        fresh->rows.push_back(row);
+        fresh->factor.resize(fresh->rows.size() * cells.size(), 0.0f);
+        float* f = &fresh->factor[(fresh->rows.size() - 1) * cells.size()];
+        terms(row, true, [&](size_t i, double v) { f[i] = float(v); });
+      }
+    fixed = fresh;
+  }
+  if (fixed)
+    for (size_t r = 0; r < fixed->rows.size(); ++r) {
+      const GlobalLink& g = solution_.links[fixed->rows[r]];
+      if (!(solution_.linkFvAtKey(g, k) > 0.0)) continue;
+      const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(g.shooter), k);
+      for (size_t i = 0; i < cells.size(); ++i)
+        H[i] += double(fixed->factor[r * cells.size() + i]) * b;
+    }
+  // The other links, link by link (its shooter's polygon and ray ends made once).
+  for (int a = int(q); a >= 0; a = h.node(a).parent)
+    for (uint32_t e = byReceiver_.allStart[size_t(a)]; e < byReceiver_.allStart[size_t(a) + 1];
+         ++e) {
+      const uint32_t row = byReceiver_.allRows[e];
+      const GlobalLink& g = solution_.links[row];
+      if (isFixed(g) || !(solution_.linkFvAtKey(g, k) > 0.0)) continue;
+      const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(g.shooter), k);
+      if (!(b.x + b.y + b.z > 0.0)) continue;
+      terms(row, false, [&](size_t i, double f) { H[i] += f * b; });
+    }
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const glm::dvec3 bi = mat.emission + mat.reflectance * H[i];
+    ratio[i] = open[i] ? float((bi.x + bi.y + bi.z) / bqSum) : 0.0f;
+  }
+  return ratio;
+}
+
+// A cell's ratio: the area-weighted mean of its leaf's finest cells under it.
+double GoodLinkGather::cellRatio(const Link& l, int key) const {
+  if (l.cell == 1) return 1.0;
+  const uint64_t K = uint64_t(solution_.keyCount());
+  const std::vector<float>& r = byReceiver_.nearShooterCells.at(l.shooter * K + uint64_t(key));
+  const int level = cellLevel(l.cell), span = 1 << (2 * (nearShooterLevels_ - level));
+  const uint32_t first = (l.cell & ((1u << (2 * level)) - 1u)) * uint32_t(span);
+  const std::vector<Polygon> cells =
+      cellsOf(solution_.hierarchy.node(int(l.shooter)).local, nearShooterLevels_);
+  double sum = 0.0, area = 0.0;
+  for (uint32_t i = first; i < first + uint32_t(span); ++i) {
+    sum += cells[i].area() * double(r[i]);
+    area += cells[i].area();
+  }
+  return area > 0.0 ? sum / area : 1.0;
+}
+
 // Per link and needed global key: B_q(k) \bar V(k), with \bar V = V / e clamped to [0, 1] (a
 // file before linkhier 1.2 has no V: F·V / (\bar F e), \bar F once for a link that does not
 // move).
@@ -236,7 +506,7 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
       }
       // A receiver partly covered by a touching solid: V counts the covered sample points as
       // occluded towards shooters outside the solid; the texel is exposed.
-      const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(l.shooter), k);
+      const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(l.shooter), k) * cellRatio(l, k);
       carried[j] = std::max(carried[j], (b.x + b.y + b.z) * fv);
       if (visibility_ && storedVisibility && v > 0.0 && v < 1.0)
         risk[j] = std::max(risk[j], (b.x + b.y + b.z) * fv * (1.0 - v));
@@ -318,7 +588,7 @@ void GoodLinkGather::planTexels(double cacheBytes) {
   std::vector<glm::dvec3> shooterCentre(links_.size());
   std::vector<double> shooterRadius(links_.size(), 0.0);
   for (size_t j = 0; j < links_.size(); ++j) {
-    shooter[j] = nodeWorld(links_[j].shooter, t0);
+    shooter[j] = linkWorld(links_[j], t0);
     shooterCentre[j] = shooter[j].centroid();
     for (int k = 0; k < shooter[j].count; ++k)
       shooterRadius[j] =
@@ -518,13 +788,14 @@ GoodLinkGather::TexelFrame GoodLinkGather::texelFrame(double t) const {
 void GoodLinkGather::planVisibility(Link& l, const std::vector<char>& needed) const {
   const PatchHierarchy& h = solution_.hierarchy;
   const GlobalLink& g = solution_.links[l.row];
-  const int K = solution_.keyCount(), k = visibilityRays_;
+  const int K = solution_.keyCount(), k = l.rays;
   for (int key = 0; key < K; ++key)
     if (needed[size_t(key)] && solution_.linkFvAtKey(g, key) > 0.0)
-      l.weight[size_t(key)] = solution_.exposedRadiosityAtKey(int(l.shooter), key);
+      l.weight[size_t(key)] =
+          solution_.exposedRadiosityAtKey(int(l.shooter), key) * cellRatio(l, key);
   l.seed = linkSeed(h.node(int(g.receiver)).id, h.node(int(l.shooter)).id);
   const double t0 = keyTimes_.front();
-  const Polygon shooter = nodeWorld(l.shooter, t0);
+  const Polygon shooter = linkWorld(l, t0);
   const std::vector<glm::dvec3> points = VisibilityScene::samplePoints(shooter, k, l.seed);
   const bool triangle = h.topOf(int(l.shooter)).local.count == 3;
   const int top = int(h.node(int(l.shooter)).id.top);
@@ -581,12 +852,12 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   for (size_t j = 0; j < links_.size(); ++j) {
     const Link& l = links_[j];
     weight[j] = (1.0 - w) * l.weight[size_t(k0)] + w * l.weight[size_t(k1)];
-    if (l.moves || !cached_ || l.partial) shooter[j] = nodeWorld(l.shooter, t);
+    if (l.moves || !cached_ || l.partial) shooter[j] = linkWorld(l, t);
     if (!l.partial) continue;
-    for (int i = 0; i < rays; ++i)
-      pointWeight[j * rays + i] = (1.0 - w) * l.pointWeight[size_t(k0) * rays + i] +
-                                  w * l.pointWeight[size_t(k1) * rays + i];
-    if (l.moves) points[j] = VisibilityScene::samplePoints(shooter[j], rays, l.seed);
+    for (int i = 0; i < l.rays; ++i)
+      pointWeight[j * rays + i] = (1.0 - w) * l.pointWeight[size_t(k0) * l.rays + i] +
+                                  w * l.pointWeight[size_t(k1) * l.rays + i];
+    if (l.moves) points[j] = VisibilityScene::samplePoints(shooter[j], l.rays, l.seed);
     castNow = castNow || l.movingBlockers;
   }
   // Rays cast now see the moving nodes where they are at t (not thread-safe: before the loop).

@@ -37,6 +37,23 @@
 // (kTileFarRatio times its size) is evaluated at the tile's corners and interpolated
 // bilinearly, so only near links cost a form factor per texel.
 //
+// Near shooters (--near-shooter-levels L > 0, issue 15): a shooter part that is a leaf and still
+// larger than shooterRatio times its distance to the receiver is split further into the cells
+// of its virtual quadtree down to L levels, each carrying its own radiosity
+//
+//   B(y) = E + \rho (H_c + \sum_{l = (p <- s), p \in chain(q)} B_s F(y -> s) V(y, s))
+//
+// re-gathered at the cell centre y from every link of the leaf's chain (good and bad: the
+// lights' links too), with V(y, s) from --gather-rays rays where the link is partly occluded
+// (0 in a cell covered by a touching solid). A leaf's B is its chain's gather, and an
+// ancestor's link carries the visibility averaged over the ancestor: the floor strip in front of
+// the Cornell box's short box, in the box's shadow, took its ceiling light through 0/3.2 (V 0.17
+// to 0.63 over a node 0.2 m across) and came out at B 0.023 where the movie's own gather (and
+// the reference) has 0.015-0.017; the box front's foot, which sees that strip over half its
+// hemisphere, was 31-60 % too bright. The estimate depends only on the leaf and the key, so it
+// is made once per rad-movies run (GoodLinksByReceiver::nearShooterCells). Costly (the final
+// setting only): the Cornell box's rad-movies 5 -> 59 s at L = 2.
+//
 // Between key times the gather is linear in t, as the Gouraud layer is. Coherence (§5): for a
 // link whose two ends do not move during the movie, F(x -> q) is computed once per movie and
 // kept (up to a memory budget); only B and \bar V change per key. A link with a moving end
@@ -46,6 +63,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -71,6 +89,20 @@ struct GoodLinksByReceiver {
   explicit GoodLinksByReceiver(const GlobalSolution& solution);
   std::vector<uint32_t> start;  // per node: its links are rows[start[i] .. start[i + 1])
   std::vector<uint32_t> rows;   // indices into solution.links
+  // Near shooters: every link that gathers, good or bad, by receiver node (indexAllLinks), and
+  // the re-gathered radiosity of each near leaf shooter's cells already made, keyed by
+  // leaf * keyCount + key: per cell, its B's channel sum over the leaf's (0: covered).
+  std::vector<uint32_t> allStart, allRows;
+  std::unordered_map<uint64_t, std::vector<float>> nearShooterCells;
+  // Per static near leaf: F(y_i -> s) V(y_i, s) of its chain's links that do not change (both
+  // ends static, one F·V sample over the keys: no moving node crossed their shaft), per cell,
+  // made at its first key and kept for the others, which then only sum B_s times them.
+  struct FixedTerms {
+    std::vector<uint32_t> rows;  // link rows, in the chain's order
+    std::vector<float> factor;   // [row index * cells + cell]
+  };
+  std::unordered_map<uint32_t, FixedTerms> nearShooterFixed;
+  void indexAllLinks(const GlobalSolution& solution);
   // The cluster irradiance at each top's corners, [(top * K + k) * 4 + c] (empty without
   // cluster links): the mean of topClusterIrradiance over the tops of the same mesh node that
   // share the corner's position and face the same way (normals within 8 degrees). The gather
@@ -98,6 +130,8 @@ struct GoodLinkGatherStats {
   long tileEntries = 0;                 // (tile, far link) terms, each 4 corner form factors
   long partialLinks = 0;                // links with V per texel (partly occluded)
   long partialLinksMovingBlockers = 0;  // of which rays also meet moving blockers per key
+  long nearShooterLeaves = 0;           // (leaf, key) re-gathered (--near-shooter-levels)
+  double nearShooterSeconds = 0.0;      // their time, part of the good layer's
 };
 
 class GoodLinkGather {
@@ -107,10 +141,11 @@ class GoodLinkGather {
   // visibility at the global keys it needs and, within `cacheBytes`, the per-texel form factors
   // of the links whose ends do not move.
   GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
-                 const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
+                 GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                  const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
                  double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
-                 SceneVisibility* visibility = nullptr, int visibilityRays = 16);
+                 SceneVisibility* visibility = nullptr, int visibilityRays = 16,
+                 int nearShooterLevels = 0);
 
   // acc[x] = G(x, t), the cluster irradiance of the receiver's top included (every texel).
   void gather(double t, std::vector<glm::dvec3>& acc) const;
@@ -119,7 +154,13 @@ class GoodLinkGather {
   struct Link {  // one link row's share from one part of its shooter
     uint32_t row = 0;
     uint32_t shooter = 0;  // dense node: the link's shooter or a node of its sub-tree
-    bool moves = false;    // an end moves during the movie: F per key
+    // A cell of a near leaf shooter: its path in the leaf's virtual quadtree (a leading 1 bit,
+    // two bits per level, as PatchId::path); 1: the whole node.
+    uint32_t cell = 1;
+    // Its shooter points for V per texel: visibilityRays_ over a whole node, that share of them
+    // over a cell (one per finest cell), so that a leaf split into cells casts as many rays.
+    int rays = 0;
+    bool moves = false;  // an end moves during the movie: F per key
     // Partly occluded at a needed key (0 < V < 1): V per texel from rays to its shooter part
     // instead of the link's one V (pointVisibility); its weight is then B_q alone.
     bool partial = false;
@@ -142,6 +183,8 @@ class GoodLinkGather {
   int receiverTop_ = 0;
   SceneVisibility* visibility_ = nullptr;
   int visibilityRays_ = 16;
+  GoodLinksByReceiver& byReceiver_;
+  int nearShooterLevels_ = 0;
   std::vector<Link> links_;
   // Texels are planned in tiles of kTile x kTile; a link whose shooter part is farther than
   // kTileFarRatio times a tile's size is evaluated at the tile's corners and interpolated.
@@ -178,6 +221,15 @@ class GoodLinkGather {
   std::vector<int> movingNodes_;                  // those nodes
 
   Polygon nodeWorld(uint32_t node, double t) const;
+  Polygon linkWorld(const Link& l, double t) const;  // its shooter part (or cell) at t
+  void nearCells(const Polygon& receiver, uint32_t leaf, double t,
+                 std::vector<uint32_t>& out) const;
+  void planNearShooters(const std::vector<char>& neededKeys, GoodLinkGatherStats& stats);
+  // fixed: the leaf's kept terms, or null; fresh: where to keep them when null (static leaf).
+  std::vector<float> regatherCells(uint32_t leaf, int key, double t,
+                                   const GoodLinksByReceiver::FixedTerms* fixed,
+                                   GoodLinksByReceiver::FixedTerms* fresh) const;
+  double cellRatio(const Link& l, int key) const;  // the cell's B over its leaf's (1: no cell)
   void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request);
   void shooterParts(const Polygon& receiver, uint32_t shooter, double t,
                     std::vector<uint32_t>& out) const;

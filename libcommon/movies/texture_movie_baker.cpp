@@ -791,6 +791,7 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"good-layer", goodLayerName(goodLayer)},
           {"gather-shooter-ratio", gatherShooterRatio},
           {"gather-rays", gatherRays},
+          {"near-shooter-levels", nearShooterLevels},
           {"no-fill-covered", !fillCovered},
           {"moving-shadow-key-step", movingShadowKeyStep},
           {"no-coherence", !coherence},
@@ -818,7 +819,9 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
             {"cached_entries", gather.cachedEntries},
             {"tile_entries", gather.tileEntries},
             {"partial_links", gather.partialLinks},
-            {"partial_links_moving_blockers", gather.partialLinksMovingBlockers}}},
+            {"partial_links_moving_blockers", gather.partialLinksMovingBlockers},
+            {"near_shooter_leaves", gather.nearShooterLeaves},
+            {"near_shooter_seconds", gather.nearShooterSeconds}}},
           {"covered_texels_filled", coveredTexelsFilled},
           {"seconds",
            {{"good_layer", secondsGood},
@@ -859,6 +862,8 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
     throw Error(ExitCode::kUsage, "--gather-shooter-ratio", "must be a finite number >= 0");
   if (options_.gatherRays < 0 || options_.gatherRays > VisibilityScene::kMaxRecordedPairs)
     throw Error(ExitCode::kUsage, "--gather-rays", "must be in 0..64");
+  if (options_.nearShooterLevels < 0 || options_.nearShooterLevels > 3)
+    throw Error(ExitCode::kUsage, "--near-shooter-levels", "must be in 0..3");
   if (options_.minSamples < 1) throw Error(ExitCode::kUsage, "--min-samples", "must be >= 1");
   if (!(options_.samplesPerFormFactor >= 0.0))
     throw Error(ExitCode::kUsage, "--samples-per-form-factor", "must be >= 0");
@@ -1008,7 +1013,8 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     gather = std::make_unique<GoodLinkGather>(
         scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
         options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather,
-        options_.gatherRays > 0 ? sceneVisibility() : nullptr, options_.gatherRays);
+        options_.gatherRays > 0 ? sceneVisibility() : nullptr, options_.gatherRays,
+        options_.nearShooterLevels);
     stats_.secondsGood += secondsSince(clock);
   }
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);

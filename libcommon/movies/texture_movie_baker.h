@@ -90,6 +90,10 @@ struct TextureMovieBakerOptions {
   // (good_link_gather.h); 0: the link's one V over its receiver node, whose steps showed where
   // two receiver nodes met (the bundled scene's back wall, 4.3 %).
   int gatherRays = 16;
+  // --near-shooter-levels: a near leaf shooter is split into up to 4^L cells, each with its
+  // radiosity re-gathered at its centre from the leaf's links (good_link_gather.h); 0: the
+  // leaf's one B (the default: the final setting's cost, rad-movies ~10x).
+  int nearShooterLevels = 0;
   // --no-fill-covered: false leaves the texels under a touching solid as they come out (~0),
   // which darkens the pixels beside the solid's foot (fillCoveredTexels).
   bool fillCovered = true;

@@ -145,6 +145,11 @@ int main(int argc, char** argv) {
                  "gather: shadow rays from each texel to a partly occluded link's shooter, "
                  "1..64 (0: the link's one visibility over its receiver)")
       ->capture_default_str();
+  app.add_option("--near-shooter-levels", b.nearShooterLevels,
+                 "gather: split a near leaf shooter into up to 4^L cells, each with its radiosity "
+                 "re-gathered at its centre from the leaf's links, 0..3 (0: the leaf's one "
+                 "radiosity; the final setting uses 2)")
+      ->capture_default_str();
   app.add_flag_callback(
       "--no-fill-covered", [&b] { b.fillCovered = false; },
       "leave the texels under a touching solid as they come out (~0) instead of giving them "
