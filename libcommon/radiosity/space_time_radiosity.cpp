@@ -217,14 +217,11 @@ const char* badLinkRuleName(BadLinkRule r) {
   return "?";
 }
 
-LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy& h) {
+LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy&) {
   // The closure integrates only pairs of patches that never move (KeySolveInput::movingTops),
-  // so every value it kept stays valid at the next key time.
-  LeafFormFactorCache cache;
-  for (size_t i = 0; i < prev.leafTopFormFactor.size(); ++i)
-    for (const auto& [q, f] : prev.leafTopFormFactor[i])
-      cache.emplace(std::make_pair(h.node(int(i)).id.packed(), uint64_t(q)), f);
-  return cache;
+  // so every value it kept stays valid at the next key time; the union hierarchy's dense node
+  // numbering is the same at every key.
+  return prev.leafTopFormFactor;
 }
 
 LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const Scene& scene,

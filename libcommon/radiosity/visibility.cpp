@@ -395,6 +395,42 @@ double VisibilityScene::weightedVisibilityFrom(
   return kernelTotal > 0.0 ? kernelOpen / kernelTotal : static_cast<double>(unoccluded) / k;
 }
 
+void VisibilityScene::pairsFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
+                                const Polygon& b, std::uint64_t seed,
+                                std::vector<glm::dvec3>& bPoints, std::vector<double>& kernel) {
+  const int k = int(aPoints.size());
+  bPoints = k > 0 ? pairedPoints(b, k, seed) : std::vector<glm::dvec3>();
+  const glm::dvec3 bNormal = b.normal();
+  kernel.resize(size_t(k));
+  for (int i = 0; i < k; ++i)
+    kernel[size_t(i)] = pairKernel(aPoints[size_t(i)], aNormal, bPoints[size_t(i)], bNormal);
+}
+
+double VisibilityScene::weightedVisibilityOfPairs(int k, const double* kernel, std::uint64_t known,
+                                                  const double* weightAtB, std::uint64_t* openPairs,
+                                                  double* kernelMeanWeight) {
+  if (k == 0) return 1.0;
+  double weighted = 0.0, weight = 0.0;         // kernel x weightAtB
+  double kernelOpen = 0.0, kernelTotal = 0.0;  // kernel alone
+  int unoccluded = 0;
+  std::uint64_t open = 0;
+  for (int i = 0; i < k; ++i) {
+    const bool isOpen = ((known >> i) & 1u) != 0;
+    unoccluded += isOpen ? 1 : 0;
+    if (isOpen) open |= std::uint64_t(1) << i;
+    double w = kernel[i];
+    kernelTotal += w;
+    kernelOpen += isOpen ? w : 0.0;
+    w *= std::max(0.0, weightAtB[i]);
+    weight += w;
+    weighted += isOpen ? w : 0.0;
+  }
+  if (openPairs) *openPairs = open;
+  if (kernelMeanWeight) *kernelMeanWeight = kernelTotal > 0.0 ? weight / kernelTotal : -1.0;
+  if (weight > 0.0) return weighted / weight;
+  return kernelTotal > 0.0 ? kernelOpen / kernelTotal : static_cast<double>(unoccluded) / k;
+}
+
 std::uint64_t VisibilityScene::openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,
                                         std::uint32_t ignoreA, std::uint32_t ignoreB,
                                         std::uint64_t candidates) const {
