@@ -154,6 +154,7 @@ class VisibilityScene {
   int instanceCount() const;
 
  private:
+  bool segmentMayHit(const glm::dvec3& a, const glm::dvec3& b) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
