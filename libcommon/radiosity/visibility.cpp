@@ -181,8 +181,11 @@ struct VisibilityScene::Impl {
   std::mutex errorMutex;
   std::string lastError;
   // The top scene's bounds at the last commit, widened by far more than single precision's
-  // rounding of a ray (segmentMayHit); empty (lo > hi) for a scene without triangles.
+  // rounding of a ray (segmentMayHit); empty (lo > hi) for a scene without triangles. Tested
+  // only in a scene of instances alone (SceneVisibility's moving part): a scene with static
+  // triangles spans the room its rays are cast in, and the test would only cost.
   glm::dvec3 lo{1.0}, hi{-1.0};
+  bool boundsTest = false;
 
   ~Impl() {
     for (RTCGeometry g : instances) rtcReleaseGeometry(g);
@@ -289,6 +292,7 @@ VisibilityScene::VisibilityScene(const std::vector<VisibilityTriangle>& staticTr
   impl_->check("rtcNewScene");
   rtcSetSceneFlags(impl_->top, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(impl_->top, RTC_BUILD_QUALITY_LOW);
+  impl_->boundsTest = staticTriangles.empty();
   RTCScene statics = impl_->buildMesh(staticTriangles);
   RTCGeometry g = impl_->instance(statics, glm::dmat4(1.0));
   rtcReleaseGeometry(g);  // never moves; the top scene keeps it alive
@@ -363,7 +367,7 @@ int VisibilityScene::instanceCount() const {
 
 bool VisibilityScene::occluded(const glm::dvec3& from, const glm::dvec3& to, std::uint32_t ignoreA,
                                std::uint32_t ignoreB) const {
-  if (!segmentMayHit(from, to)) return false;
+  if (impl_->boundsTest && !segmentMayHit(from, to)) return false;
   RTCRay ray = rayOf(from, to - from, 1.0 - kSegmentEpsilon);
   if (!(ray.dir_x != 0.0f || ray.dir_y != 0.0f || ray.dir_z != 0.0f)) return false;
   FilterContext fc;
