@@ -336,6 +336,7 @@ class KeyTimeSolver {
         // The values, never a decision: F starts as the estimate as in a fresh evaluation,
         // and the accurate pass takes the known accurate F instead of integrating again.
         const CachedLink& c = it->second;
+        if (input_.reuseRayPairs) l.knownRayPairs = c.rayPairs;
         l.estimate = c.estimate;
         l.spreadArea = c.spreadArea;
         l.formFactor = l.estimate;
@@ -388,34 +389,42 @@ class KeyTimeSolver {
       return;
     }
     // The links weighted for the first time in this key solve get their pairs (kernel, the
-    // shooter's (u,v) at each pair's end); every round after takes them over, as this key's
-    // geometry and rays do not change between rounds. Regenerating the points, kernels and
-    // (u,v) of every link at every round had been 38 % of rad-global's time on the table
-    // scene (perf: samplePoints, pairedPoints, polygonUvAt, descendToChild).
+    // shooter's (u,v) at each pair's end): the previous key's for a link coherence took over
+    // (both ends static, so the same values), else made here; every round after takes them
+    // over, as this key's geometry and rays do not change between rounds. Regenerating the
+    // points, kernels and (u,v) of every link at every round had been 38 % of rad-global's
+    // time on the table scene (perf: samplePoints, pairedPoints, polygonUvAt, descendToChild).
     const size_t L = s_.links.size();
-    pairStart_.resize(L, kNoPairs);
+    pairStart_.resize(L, kNoRayPairs);
     std::vector<size_t> fresh;
     for (size_t li = 0; li < L; ++li)
-      if (pairStart_[li] == kNoPairs && weighted(s_.links[li])) {
+      if (pairStart_[li] == kNoRayPairs && weighted(s_.links[li])) {
         pairStart_[li] = pairs_.size() + fresh.size() * size_t(k);
         fresh.push_back(li);
       }
     pairs_.resize(pairs_.size() + fresh.size() * size_t(k));
+    pairState_.resize(pairs_.size());
     tbb::parallel_for(size_t(0), fresh.size(), [&](size_t f) {
       const SolverLink& l = s_.links[fresh[f]];
-      const PatchNode& r = h_.node(l.receiver);
-      const PatchNode& q = h_.node(l.shooter);
-      const Polygon& P = s_.world[size_t(l.receiver)];
-      const Polygon& Q = s_.world[size_t(l.shooter)];
-      const bool triangle = Q.count == 3;
-      std::vector<glm::dvec3> bPoints;
-      std::vector<double> kernel;
-      VisibilityScene::pairsFrom(VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)),
-                                 P.normal(), Q, linkSeed(r.id, q.id), bPoints, kernel);
-      ShooterPair* pair = &pairs_[pairStart_[fresh[f]]];
-      for (int i = 0; i < k; ++i)
-        pair[i] = {clampToParameterDomain(polygonUvAt(Q, bPoints[size_t(i)]), triangle),
-                   kernel[size_t(i)], l.shooter};
+      LinkRayPair* pair = &pairs_[pairStart_[fresh[f]]];
+      PairState* state = &pairState_[pairStart_[fresh[f]]];
+      if (l.knownRayPairs != kNoRayPairs && input_.reuseRayPairs) {
+        std::copy_n(input_.reuseRayPairs->begin() + std::ptrdiff_t(l.knownRayPairs), k, pair);
+      } else {
+        const PatchNode& r = h_.node(l.receiver);
+        const PatchNode& q = h_.node(l.shooter);
+        const Polygon& P = s_.world[size_t(l.receiver)];
+        const Polygon& Q = s_.world[size_t(l.shooter)];
+        const bool triangle = Q.count == 3;
+        std::vector<glm::dvec3> bPoints;
+        std::vector<double> kernel;
+        VisibilityScene::pairsFrom(VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)),
+                                   P.normal(), Q, linkSeed(r.id, q.id), bPoints, kernel);
+        for (int i = 0; i < k; ++i)
+          pair[i] = {clampToParameterDomain(polygonUvAt(Q, bPoints[size_t(i)]), triangle),
+                     kernel[size_t(i)]};
+      }
+      for (int i = 0; i < k; ++i) state[i] = {pair[i].uv, l.shooter};
     });
     tbb::parallel_for(size_t(0), L, [&](size_t li) {
       SolverLink& l = s_.links[li];
@@ -423,16 +432,17 @@ class KeyTimeSolver {
       l.shooterShape = 1.0;
       if (!weighted(l)) return;
       const bool triangle = s_.world[size_t(l.shooter)].count == 3;
-      ShooterPair* pair = &pairs_[pairStart_[li]];
+      const LinkRayPair* pair = &pairs_[pairStart_[li]];
+      PairState* state = &pairState_[pairStart_[li]];
       double kernel[VisibilityScene::kMaxRecordedPairs], weight[VisibilityScene::kMaxRecordedPairs];
       for (int i = 0; i < k; ++i) {
         // The leaf under the pair's end: descended on from where the last round left it (the
         // shooter's tree only grows within a key solve).
-        ShooterPair& p = pair[i];
+        PairState& p = state[i];
         while (s_.split[size_t(p.node)])
           p.node = h_.node(p.node).firstChild + descendToChild(p.uv, triangle);
         const glm::dvec3 b = B_[size_t(p.node)];
-        kernel[i] = p.kernel;
+        kernel[i] = pair[i].kernel;
         weight[i] = b.x + b.y + b.z;
       }
       double seen = -1.0;
@@ -997,6 +1007,9 @@ class KeyTimeSolver {
       s_.clusterBounds = clusters_->clusterBounds();
     }
     s_.radiosity = std::move(B_);
+    pairStart_.resize(s_.links.size(), kNoRayPairs);
+    s_.rayPairStart = std::move(pairStart_);
+    s_.rayPairs = std::move(pairs_);
     s_.leafTopFormFactor = std::move(leafTopFormFactor_);
     for (size_t i = 0; i < closed_.size(); ++i)
       if (closed_[i] >= 0 && !moves(h_.node(int(i)).id.top))
@@ -1035,16 +1048,15 @@ class KeyTimeSolver {
   // Per dense node: F(node -> top-level patch) computed for the closure in this key's solve.
   std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor_;
   // weightVisibilityByShooterRadiosity's ray pairs, opt_.rays per link from pairStart_[link]
-  // (kNoPairs: not weighted yet in this key solve): the kernel and, at the pair's end on the
-  // shooter, the node last descended to and the (u,v) in it.
-  struct ShooterPair {
+  // (kNoRayPairs: not weighted yet in this key solve), and per pair the shooter node last
+  // descended to and the (u,v) in it.
+  struct PairState {
     glm::dvec2 uv;
-    double kernel = 0;
     int node = 0;
   };
-  static constexpr size_t kNoPairs = ~size_t(0);
   std::vector<size_t> pairStart_;
-  std::vector<ShooterPair> pairs_;
+  std::vector<LinkRayPair> pairs_;
+  std::vector<PairState> pairState_;
   double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
   bool nonFinite_ = false;          // a sweep produced NaN or Inf
   double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges

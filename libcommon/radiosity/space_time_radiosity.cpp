@@ -234,7 +234,8 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     if (scene.isDynamic(node, t0, t1)) swept.push_back(scene.sweptBounds(node, t0, t1));
   LinkCache cache;
   cache.reserve(prev.links.size());
-  for (const SolverLink& l : prev.links) {
+  for (size_t li = 0; li < prev.links.size(); ++li) {
+    const SolverLink& l = prev.links[li];
     const PatchNode& r = h.node(l.receiver);
     const PatchNode& s = h.node(l.shooter);
     // A moving end changes the geometry: nothing of the link is known.
@@ -254,6 +255,7 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     c.visibility = l.rayVisibility;
     c.openPairs = l.openPairs;
     c.visibilityValid = !hit;  // a moving object in the shaft: the shadow rays again
+    if (li < prev.rayPairStart.size()) c.rayPairs = prev.rayPairStart[li];
     cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
   }
   return cache;
@@ -377,6 +379,7 @@ class KeyTimePass {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
       in.reuse = &cache;
+      in.reuseRayPairs = &prev.rayPairs;
       leafCache = reusableLeafFormFactors(prev, h_);
       in.reuseLeafFormFactors = &leafCache;
       if (!clusters_.empty()) {
