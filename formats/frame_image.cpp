@@ -151,6 +151,10 @@ void writeFramePng(const std::string& path, const ComposedFrame& frame,
   png_set_IHDR(png, pinfo, png_uint_32(w), png_uint_32(h), 8, PNG_COLOR_TYPE_RGB,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_sRGB_gAMA_and_cHRM(png, pinfo, PNG_sRGB_INTENT_PERCEPTUAL);
+  // zlib's fastest level: the same pixels, deflated at about a third of the default level's
+  // cost (perf: writing the PNGs was 40 % of rad-compose on the table scene, deflate 26 %), for
+  // PNGs about a quarter larger (the table scene's 400: 19 -> 24 MB, beside 390 MB of EXRs).
+  png_set_compression_level(png, 1);
   png_text text[2] = {};
   text[0].compression = PNG_TEXT_COMPRESSION_zTXt;  // the provenance JSON compresses well
   text[0].key = const_cast<char*>("Description");

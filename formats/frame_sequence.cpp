@@ -42,21 +42,32 @@ bool usedByFrames(const MovieExtent& iv, const std::vector<int>& frames) {
 
 // Every movie the frames use: its headers read and checked (rad.format, parts, checksums
 // present, patch, frames, size) before the first frame is written, so that a bad or missing
-// movie leaves no frame behind. The pixels are verified as each key is loaded.
-void checkMovieHeaders(const TextureIntervals& intervals, const std::string& dir,
-                       const std::vector<int>& frames) {
-  for (const MovieExtent& iv : intervals.movies) {
+// movie leaves no frame behind. The pixels are verified as each key is loaded. Returns the
+// headers by interval index, for the streams to open with (MovieCache::get).
+std::map<size_t, TextureMovie> checkMovieHeaders(const TextureIntervals& intervals,
+                                                 const std::string& dir,
+                                                 const std::vector<int>& frames) {
+  std::map<size_t, TextureMovie> headers;
+  for (size_t i = 0; i < intervals.movies.size(); ++i) {
+    const MovieExtent& iv = intervals.movies[i];
     if (!usedByFrames(iv, frames)) continue;
     const std::string path = textureMoviePath(dir, iv.movie);
-    requireMovieMatches(readTextureMovieHeaders(path), iv, path);
+    TextureMovie m = readTextureMovieHeaders(path);
+    requireMovieMatches(m, iv, path);
+    // Kept until the movie is opened: without the baking tool's provenance, which the frames
+    // do not use (a from-scratch run's 74,000 one-frame movies held 150 MB of it).
+    std::string().swap(m.provenanceJson);
+    headers.emplace(i, std::move(m));
   }
+  return headers;
 }
 
 // The movies in memory: read on first use, dropped once the frames have passed their last.
 class MovieCache {
  public:
-  MovieCache(const TextureIntervals& intervals, std::string dir)
-      : intervals_(intervals), dir_(std::move(dir)) {}
+  MovieCache(const TextureIntervals& intervals, std::string dir,
+             std::map<size_t, TextureMovie> headers)
+      : intervals_(intervals), dir_(std::move(dir)), headers_(std::move(headers)) {}
 
   // Opens (once) and returns the movie of interval `index`.
   TextureMovieStream& get(size_t index) {
@@ -64,7 +75,17 @@ class MovieCache {
     if (it != loaded_.end()) return *it->second;
     const MovieExtent& iv = intervals_.movies[index];
     std::string path = textureMoviePath(dir_, iv.movie);
-    auto stream = std::make_unique<TextureMovieStream>(path);
+    // The headers checkMovieHeaders read: parsing every part's header again with OpenEXR's
+    // C++ reader had been 7 % of rad-compose (perf, table scene). A file changed since is
+    // still caught: the stream checks its part count, each chunk's size and each key's checksum.
+    auto known = headers_.find(index);
+    std::unique_ptr<TextureMovieStream> stream;
+    if (known != headers_.end()) {
+      stream = std::make_unique<TextureMovieStream>(path, std::move(known->second));
+      headers_.erase(known);
+    } else {
+      stream = std::make_unique<TextureMovieStream>(path);
+    }
     requireMovieMatches(stream->movie(), iv, path);
     ++read_;
     TextureMovieStream& ref = *stream;
@@ -89,6 +110,7 @@ class MovieCache {
  private:
   const TextureIntervals& intervals_;
   std::string dir_;
+  std::map<size_t, TextureMovie> headers_;  // checked, not opened yet
   std::map<size_t, std::unique_ptr<TextureMovieStream>> loaded_;
   long long read_ = 0;
   int peak_ = 0;
@@ -137,7 +159,7 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
                       std::to_string(intervals.lastFrame));
   if (!(options.fps > 0.0)) throw Error(ExitCode::kUsage, "--fps", "must be positive");
 
-  checkMovieHeaders(intervals, options.moviesDir, frames);
+  std::map<size_t, TextureMovie> headers = checkMovieHeaders(intervals, options.moviesDir, frames);
   std::error_code ec;
   std::filesystem::create_directories(options.framesDir, ec);
   if (ec || !std::filesystem::is_directory(options.framesDir))
@@ -154,7 +176,7 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
   info.durability = AtomicFile::Durability::kDeferred;
 
   FrameComposer composer(scene, solution, options.size, options.cameraNode);
-  MovieCache cache(intervals, options.moviesDir);
+  MovieCache cache(intervals, options.moviesDir, std::move(headers));
   ComposedFrame frame;
   std::vector<MovieTexture> active;
   try {

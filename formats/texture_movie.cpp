@@ -498,7 +498,21 @@ TextureMovieStream::TextureMovieStream(std::string path) : path_(std::move(path)
     Imf::MultiPartInputFile in(path_.c_str());
     return readHeaders(in, path_);
   });
-  movie_.keys.resize(movie_.keyTimes.size());
+  open();
+}
+
+TextureMovieStream::TextureMovieStream(std::string path, TextureMovie headers)
+    : path_(std::move(path)), movie_(std::move(headers)) {
+  open();
+  int parts = 0;
+  checkExr(exr_get_count(reader_->ctx, &parts), path_, "part count");
+  if (size_t(parts) != movie_.keyTimes.size())
+    throw inputError(path_, "changed since its headers were read: " + std::to_string(parts) +
+                                " parts, not " + std::to_string(movie_.keyTimes.size()));
+}
+
+void TextureMovieStream::open() {
+  movie_.keys.assign(movie_.keyTimes.size(), {});
   reader_ = std::make_unique<Reader>();
   reader_->fd = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
   struct stat st;

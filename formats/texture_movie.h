@@ -118,6 +118,9 @@ class TextureMovieStream {
   // Checks every part's header (a checksum present in each) and opens the file for reading (it
   // stays open until destruction); throws rad::inputError(path, ...).
   explicit TextureMovieStream(std::string path);
+  // The same with the headers already read and checked (readTextureMovieHeaders of `path`):
+  // only the part count is checked against the file opened.
+  TextureMovieStream(std::string path, TextureMovie headers);
   ~TextureMovieStream();
   TextureMovieStream(const TextureMovieStream&) = delete;
   TextureMovieStream& operator=(const TextureMovieStream&) = delete;
@@ -136,6 +139,7 @@ class TextureMovieStream {
 
  private:
   void load(size_t k);
+  void open();
   void loadAround(double t, size_t& k0, size_t& k1);
   std::string path_;
   struct Reader;  // OpenEXR core context, open for the stream's lifetime

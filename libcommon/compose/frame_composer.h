@@ -94,6 +94,8 @@ double srgbEncode(double linear);
 // 8-bit sRGB of linear radiance scaled by 2^exposureEV: round(255 * srgbEncode(L * 2^EV)).
 // rgb: 3 floats per pixel; returns 3 bytes per pixel in the same order.
 std::vector<uint8_t> toSrgb8(const std::vector<float>& rgb, double exposureEV);
+// toSrgb8 of one value at exposure 0: round(255 * srgbEncode(linear)), 0 when not finite.
+uint8_t srgb8AtExposureZero(float linear);
 
 // One exposure for a whole sequence (so it cannot flicker), from the global solution alone:
 // the area-weighted `percentile` (0..1] of the luminance of B/pi over the union leaves of all

@@ -653,55 +653,51 @@ void GoodLinkGather::planTexels(double cacheBytes) {
     });
   });
   for (const Tile& tile : tiles_) tileLinkCount_ += tile.links.size();
-  // The far links' form factors at the tiles' corners, once per corner texel and link: a corner
-  // is shared by up to four tiles, which mostly interpolate the same links.
-  std::unordered_map<size_t, std::vector<uint32_t>> cornerLinks;
+  // The far links at the tiles' corners, once per corner texel and link: a corner is shared by
+  // up to four tiles, which mostly interpolate the same links. Their form factors (links that
+  // do not move) and open rays past the static blockers are made here, the rest per key
+  // (gather), each once per corner and link: per tile it had been up to four times, 85 M of
+  // rad-movies' 155 M visibilityAt calls on the table scene.
+  std::map<size_t, std::vector<uint32_t>> cornerLinks;  // corner texel -> its links, sorted
   for (const Tile& tile : tiles_)
     for (size_t corner : tile.cornerTexels(w)) {
       std::vector<uint32_t>& ids = cornerLinks[corner];
-      for (uint32_t j : tile.links)
-        if (!links_[j].moves) ids.push_back(j);
+      ids.insert(ids.end(), tile.links.begin(), tile.links.end());
     }
-  std::vector<std::pair<size_t, std::vector<uint32_t>*>> corners;
+  corners_.clear();
+  cornerLink_.clear();
   for (auto& [corner, ids] : cornerLinks) {
     std::sort(ids.begin(), ids.end());
     ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    corners.emplace_back(corner, &ids);
+    corners_.push_back({corner, uint32_t(cornerLink_.size())});
+    cornerLink_.insert(cornerLink_.end(), ids.begin(), ids.end());
   }
-  std::unordered_map<size_t, std::vector<double>> cornerF;
-  std::unordered_map<size_t, std::vector<uint64_t>> cornerOpen;
-  for (const auto& c : corners) {
-    cornerF[c.first].resize(c.second->size());
-    cornerOpen[c.first].resize(c.second->size());
-  }
-  tbb::parallel_for(size_t(0), corners.size(), [&](size_t i) {
-    const size_t x = corners[i].first;
-    const std::vector<uint32_t>& ids = *corners[i].second;
-    std::vector<double>& f = cornerF.at(x);
-    std::vector<uint64_t>& open = cornerOpen.at(x);
+  corners_.push_back({0, uint32_t(cornerLink_.size())});  // the end of the last corner's links
+  cornerFormFactor_.assign(cornerLink_.size(), 0.0);
+  cornerOpen_.assign(cornerLink_.size(), 0);
+  tbb::parallel_for(size_t(0), corners_.size() - 1, [&](size_t i) {
+    const size_t x = corners_[i].texel;
     const glm::dvec3 p = world(x), nx = normal(x);
-    for (size_t k = 0; k < ids.size(); ++k) {
-      f[k] = pointToPolygonFormFactor(p, nx, shooter[ids[k]]);
-      const Link& l = links_[ids[k]];
-      if (l.partial) open[k] = openRays(visibility_->staticPart(), p, l, l.points);
+    for (uint32_t e = corners_[i].first; e < corners_[i + 1].first; ++e) {
+      const Link& l = links_[cornerLink_[e]];
+      if (l.moves) continue;
+      cornerFormFactor_[e] = pointToPolygonFormFactor(p, nx, shooter[cornerLink_[e]]);
+      if (l.partial) cornerOpen_[e] = openRays(visibility_->staticPart(), p, l, l.points);
     }
   });
+  std::unordered_map<size_t, size_t> cornerIndex;  // corner texel -> its corners_ index
+  for (size_t i = 0; i + 1 < corners_.size(); ++i) cornerIndex[corners_[i].texel] = i;
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     Tile& tile = tiles_[ti];
     const std::array<size_t, 4> c4 = tile.cornerTexels(w);
-    tile.formFactor.assign(tile.links.size() * 4, 0.0);
-    tile.open.assign(tile.links.size() * 4, 0);
+    tile.cornerEntry.assign(tile.links.size() * 4, 0);
     for (int c = 0; c < 4; ++c) {
-      const std::vector<uint32_t>& ids = cornerLinks.at(c4[size_t(c)]);
-      const std::vector<double>& f = cornerF.at(c4[size_t(c)]);
-      const std::vector<uint64_t>& open = cornerOpen.at(c4[size_t(c)]);
-      for (size_t k = 0; k < tile.links.size(); ++k) {
-        const uint32_t j = tile.links[k];
-        if (links_[j].moves) continue;
-        const size_t at = size_t(std::lower_bound(ids.begin(), ids.end(), j) - ids.begin());
-        tile.formFactor[k * 4 + size_t(c)] = f[at];
-        tile.open[k * 4 + size_t(c)] = open[at];
-      }
+      const size_t i = cornerIndex.at(c4[size_t(c)]);
+      const auto first = cornerLink_.begin() + corners_[i].first;
+      const auto last = cornerLink_.begin() + corners_[i + 1].first;
+      for (size_t k = 0; k < tile.links.size(); ++k)
+        tile.cornerEntry[k * 4 + size_t(c)] =
+            uint32_t(std::lower_bound(first, last, tile.links[k]) - cornerLink_.begin());
     }
   });
   // Per texel, in texel order: its chain below its tile's common node, then the tile's near links.
@@ -844,6 +840,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   solution_.keyWeights(t, k0, k1, w);
   std::vector<glm::dvec3> weight(links_.size());
   std::vector<Polygon> shooter(links_.size());
+  std::vector<glm::dvec3> shooterNormal(links_.size());  // partial links: once per key
   // Partial links: the shooter points (moving ones where they are at t) and their weights at t.
   const int rays = visibilityRays_;
   std::vector<std::vector<glm::dvec3>> points(links_.size());
@@ -854,6 +851,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
     weight[j] = (1.0 - w) * l.weight[size_t(k0)] + w * l.weight[size_t(k1)];
     if (l.moves || !cached_ || l.partial) shooter[j] = linkWorld(l, t);
     if (!l.partial) continue;
+    shooterNormal[j] = shooter[j].normal();
     for (int i = 0; i < l.rays; ++i)
       pointWeight[j * rays + i] = (1.0 - w) * l.pointWeight[size_t(k0) * l.rays + i] +
                                   w * l.pointWeight[size_t(k1) * l.rays + i];
@@ -909,25 +907,33 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   const int width = texels_.width, height = texels_.height;
   auto world = [&](size_t x) { return frame.point(texels_.localPoint[x]); };
   auto normal = [&](size_t x) { return frame.normal(texels_.localNormal[x]); };
+  // The far links' F V at the corner texels, once per corner and link (the tiles sharing a
+  // corner read it).
+  std::vector<double> cornerValue(cornerLink_.size(), 0.0);
+  tbb::parallel_for(size_t(0), corners_.empty() ? 0 : corners_.size() - 1, [&](size_t i) {
+    const size_t x = corners_[i].texel;
+    const glm::dvec3 p = world(x), nx = normal(x);
+    for (uint32_t e = corners_[i].first; e < corners_[i + 1].first; ++e) {
+      const uint32_t j = cornerLink_[e];
+      const Link& l = links_[j];
+      if (weight[j] == glm::dvec3(0.0)) continue;
+      double f = l.moves ? pointToPolygonFormFactor(p, nx, shooter[j]) : cornerFormFactor_[e];
+      if (l.partial && f > 0.0)
+        f *= visibilityAt(p, nx, l, pointsOf(j), shooterNormal[j],
+                          l.moves ? nullptr : &cornerOpen_[e], &pointWeight[j * rays],
+                          movingNow[j] != 0);
+      cornerValue[e] = f;
+    }
+  });
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     const Tile& tile = tiles_[ti];
     // The tile's far links at its corners (corner c: (i0,j0), (i1,j0), (i1,j1), (i0,j1)).
     glm::dvec3 corner[4] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
-    const std::array<size_t, 4> cornerTexel = tile.cornerTexels(width);
     for (size_t k = 0; k < tile.links.size(); ++k) {
       const uint32_t j = tile.links[k];
-      const Link& l = links_[j];
       if (weight[j] == glm::dvec3(0.0)) continue;
-      for (int c = 0; c < 4; ++c) {
-        const size_t x = cornerTexel[size_t(c)];
-        double f = l.moves ? pointToPolygonFormFactor(world(x), normal(x), shooter[j])
-                           : tile.formFactor[k * 4 + size_t(c)];
-        if (l.partial && f > 0.0)
-          f *= visibilityAt(world(x), normal(x), l, pointsOf(j), shooter[j].normal(),
-                            l.moves ? nullptr : &tile.open[k * 4 + size_t(c)],
-                            &pointWeight[j * rays], movingNow[j] != 0);
-        corner[c] += f * weight[j];
-      }
+      for (int c = 0; c < 4; ++c)
+        corner[c] += cornerValue[tile.cornerEntry[k * 4 + size_t(c)]] * weight[j];
     }
     for (int j = tile.j0; j < std::min(tile.j0 + kTile, height); ++j)
       for (int i = tile.i0; i < std::min(tile.i0 + kTile, width); ++i) {
@@ -944,7 +950,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
           double f = cached_ && !link.moves ? double(texelFormFactor_[e])
                                             : pointToPolygonFormFactor(p, nx, shooter[l]);
           if (link.partial && f > 0.0)
-            f *= visibilityAt(p, nx, link, pointsOf(l), shooter[l].normal(),
+            f *= visibilityAt(p, nx, link, pointsOf(l), shooterNormal[l],
                               cached_ && !link.moves ? &texelOpen_[e] : nullptr,
                               &pointWeight[l * rays], movingNow[l] != 0);
           H += f * weight[l];

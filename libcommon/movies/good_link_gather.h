@@ -202,11 +202,22 @@ class GoodLinkGather {
       return {size_t(j0) * width + i0, size_t(j0) * width + i1, size_t(j1) * width + i1,
               size_t(j1) * width + i0};
     }
-    int common = -1;                 // deepest node holding every texel of the tile
-    std::vector<uint32_t> links;     // links_ indices interpolated over the tile
-    std::vector<double> formFactor;  // per tile link, its 4 corners (links that do not move)
-    std::vector<uint64_t> open;      // per tile link, its 4 corners' rays open past static blockers
+    int common = -1;                    // deepest node holding every texel of the tile
+    std::vector<uint32_t> links;        // links_ indices interpolated over the tile
+    std::vector<uint32_t> cornerEntry;  // per tile link, its 4 corners' cornerLink_ entries
   };
+  // The corner texels of the tiles, each with its far links (sorted links_ indices)
+  // cornerLink_[corners_[i].first .. corners_[i + 1].first) (a last entry ends the list), and
+  // per entry the form factor (links that do not move) and the rays open past the static
+  // blockers (partial links that do not move).
+  struct Corner {
+    size_t texel = 0;
+    uint32_t first = 0;
+  };
+  std::vector<Corner> corners_;
+  std::vector<uint32_t> cornerLink_;
+  std::vector<double> cornerFormFactor_;
+  std::vector<uint64_t> cornerOpen_;
   int tilesX_ = 0;
   std::vector<Tile> tiles_;
   size_t tileLinkCount_ = 0;  // over all tiles (the stats)

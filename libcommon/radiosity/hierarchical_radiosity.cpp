@@ -336,6 +336,7 @@ class KeyTimeSolver {
         // The values, never a decision: F starts as the estimate as in a fresh evaluation,
         // and the accurate pass takes the known accurate F instead of integrating again.
         const CachedLink& c = it->second;
+        if (input_.reuseRayPairs) l.knownRayPairs = c.rayPairs;
         l.estimate = c.estimate;
         l.spreadArea = c.spreadArea;
         l.formFactor = l.estimate;
@@ -381,33 +382,113 @@ class KeyTimeSolver {
   // 5.23 %, table 2.04 -> 2.02 %, cubic 3.36 -> 3.53 % (--no-shooter-shape for the former).
   void weightVisibilityByShooterRadiosity() {
     if (!input_.visibility) return;
-    tbb::parallel_for(size_t(0), s_.links.size(), [&](size_t li) {
+    const int k = std::max(opt_.rays, 1);
+    if (k > VisibilityScene::kMaxRecordedPairs) {  // open pairs not recorded: rays again
+      tbb::parallel_for(size_t(0), s_.links.size(),
+                        [&](size_t li) { weightLinkVisibility(s_.links[li]); });
+      return;
+    }
+    // The links weighted for the first time in this key solve get their pairs (kernel, the
+    // shooter's (u,v) at each pair's end): the previous key's for a link coherence took over
+    // (both ends static, so the same values), else made here; every round after takes them
+    // over, as this key's geometry and rays do not change between rounds. Regenerating the
+    // points, kernels and (u,v) of every link at every round had been 38 % of rad-global's
+    // time on the table scene (perf: samplePoints, pairedPoints, polygonUvAt, descendToChild).
+    const size_t L = s_.links.size();
+    pairStart_.resize(L, kNoRayPairs);
+    std::vector<size_t> fresh;
+    for (size_t li = 0; li < L; ++li)
+      if (pairStart_[li] == kNoRayPairs && weighted(s_.links[li])) {
+        pairStart_[li] = pairs_.size() + fresh.size() * size_t(k);
+        fresh.push_back(li);
+      }
+    pairs_.resize(pairs_.size() + fresh.size() * size_t(k));
+    pairState_.resize(pairs_.size());
+    tbb::parallel_for(size_t(0), fresh.size(), [&](size_t f) {
+      const SolverLink& l = s_.links[fresh[f]];
+      LinkRayPair* pair = &pairs_[pairStart_[fresh[f]]];
+      PairState* state = &pairState_[pairStart_[fresh[f]]];
+      if (l.knownRayPairs != kNoRayPairs && input_.reuseRayPairs) {
+        std::copy_n(input_.reuseRayPairs->begin() + std::ptrdiff_t(l.knownRayPairs), k, pair);
+      } else {
+        const PatchNode& r = h_.node(l.receiver);
+        const PatchNode& q = h_.node(l.shooter);
+        const Polygon& P = s_.world[size_t(l.receiver)];
+        const Polygon& Q = s_.world[size_t(l.shooter)];
+        const bool triangle = Q.count == 3;
+        std::vector<glm::dvec3> bPoints;
+        std::vector<double> kernel;
+        VisibilityScene::pairsFrom(VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)),
+                                   P.normal(), Q, linkSeed(r.id, q.id), bPoints, kernel);
+        for (int i = 0; i < k; ++i)
+          pair[i] = {clampToParameterDomain(polygonUvAt(Q, bPoints[size_t(i)]), triangle),
+                     kernel[size_t(i)]};
+      }
+      for (int i = 0; i < k; ++i) state[i] = {pair[i].uv, l.shooter};
+    });
+    tbb::parallel_for(size_t(0), L, [&](size_t li) {
       SolverLink& l = s_.links[li];
       l.visibility = l.rayVisibility;
       l.shooterShape = 1.0;
-      if (l.refined || !(l.rayVisibility > 0.0)) return;
-      if (!s_.split[size_t(l.shooter)]) return;
-      const PatchNode& r = h_.node(l.receiver);
-      const PatchNode& q = h_.node(l.shooter);
-      const Polygon& P = s_.world[size_t(l.receiver)];
-      const Polygon& Q = s_.world[size_t(l.shooter)];
-      const bool triangle = Q.count == 3;
-      auto radiosityAt = [&](const glm::dvec3& y) {
-        int n = l.shooter;
-        glm::dvec2 uv = clampToParameterDomain(polygonUvAt(Q, y), triangle);
-        while (s_.split[size_t(n)]) n = h_.node(n).firstChild + descendToChild(uv, triangle);
-        const glm::dvec3 b = B_[size_t(n)];
-        return b.x + b.y + b.z;
-      };
+      if (!weighted(l)) return;
+      const bool triangle = s_.world[size_t(l.shooter)].count == 3;
+      const LinkRayPair* pair = &pairs_[pairStart_[li]];
+      PairState* state = &pairState_[pairStart_[li]];
+      double kernel[VisibilityScene::kMaxRecordedPairs], weight[VisibilityScene::kMaxRecordedPairs];
+      for (int i = 0; i < k; ++i) {
+        // The leaf under the pair's end: descended on from where the last round left it (the
+        // shooter's tree only grows within a key solve).
+        PairState& p = state[i];
+        while (s_.split[size_t(p.node)])
+          p.node = h_.node(p.node).firstChild + descendToChild(p.uv, triangle);
+        const glm::dvec3 b = B_[size_t(p.node)];
+        kernel[i] = pair[i].kernel;
+        weight[i] = b.x + b.y + b.z;
+      }
       double seen = -1.0;
-      const double v = input_.visibility->weightedVisibilityFrom(
-          VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)), P.normal(), Q,
-          linkSeed(r.id, q.id), r.id.top, q.id.top, &l.openPairs, radiosityAt, nullptr, &seen);
-      if (l.rayVisibility < 1.0) l.visibility = v;
-      const glm::dvec3 mean = B_[size_t(l.shooter)];
-      if (opt_.shooterShape && seen >= 0.0 && mean.x + mean.y + mean.z > 0.0)
-        l.shooterShape = seen / (mean.x + mean.y + mean.z);
+      const double v = VisibilityScene::weightedVisibilityOfPairs(k, kernel, l.openPairs, weight,
+                                                                  nullptr, &seen);
+      setWeightedVisibility(l, v, seen);
     });
+  }
+
+  // A link whose shooter is split in this key's tree and whose rays are not all blocked.
+  bool weighted(const SolverLink& l) const {
+    return !l.refined && l.rayVisibility > 0.0 && s_.split[size_t(l.shooter)];
+  }
+
+  // The radiosity-weighted V, and the shooter's B as the receiver sees it (`seen`) over its
+  // mean, into l.
+  void setWeightedVisibility(SolverLink& l, double v, double seen) const {
+    if (l.rayVisibility < 1.0) l.visibility = v;
+    const glm::dvec3 mean = B_[size_t(l.shooter)];
+    if (opt_.shooterShape && seen >= 0.0 && mean.x + mean.y + mean.z > 0.0)
+      l.shooterShape = seen / (mean.x + mean.y + mean.z);
+  }
+
+  // weightVisibilityByShooterRadiosity for one link, its pairs made again (more rays than
+  // the open pairs record: cast again).
+  void weightLinkVisibility(SolverLink& l) const {
+    l.visibility = l.rayVisibility;
+    l.shooterShape = 1.0;
+    if (!weighted(l)) return;
+    const PatchNode& r = h_.node(l.receiver);
+    const PatchNode& q = h_.node(l.shooter);
+    const Polygon& P = s_.world[size_t(l.receiver)];
+    const Polygon& Q = s_.world[size_t(l.shooter)];
+    const bool triangle = Q.count == 3;
+    auto radiosityAt = [&](const glm::dvec3& y) {
+      int n = l.shooter;
+      glm::dvec2 uv = clampToParameterDomain(polygonUvAt(Q, y), triangle);
+      while (s_.split[size_t(n)]) n = h_.node(n).firstChild + descendToChild(uv, triangle);
+      const glm::dvec3 b = B_[size_t(n)];
+      return b.x + b.y + b.z;
+    };
+    double seen = -1.0;
+    const double v = input_.visibility->weightedVisibilityFrom(
+        VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)), P.normal(), Q,
+        linkSeed(r.id, q.id), r.id.top, q.id.top, &l.openPairs, radiosityAt, nullptr, &seen);
+    setWeightedVisibility(l, v, seen);
   }
 
   // The refinement oracle (header): power max_c B_q F~ V A_p, error max_c B_q V spreadArea,
@@ -532,6 +613,10 @@ class KeyTimeSolver {
     s_.goodClosure.assign(N, 1.0);
     goodFactor_.assign(N, 1.0);
     closed_.resize(N, -1);  // kept from the rounds before: a node's rays do not change
+    // The previous key's values (coherence) start each node's list: closeLeaf finds them as
+    // its own, and they are kept for the next key (all of them static pairs, valid at every key).
+    if (leafTopFormFactor_.empty() && input_.reuseLeafFormFactors)
+      leafTopFormFactor_ = *input_.reuseLeafFormFactors;
     leafTopFormFactor_.resize(N);
     topExcess_.assign(N, {});
     std::vector<int> leaves;
@@ -600,13 +685,9 @@ class KeyTimeSolver {
     return true;
   }
 
-  // F(leaf r -> top q): taken over from the previous key when both are static (coherence;
-  // the same value recomputing gives), else integrated.
+  // F(leaf r -> top q), integrated (closeLeaf looks in leafTopFormFactor_ first, which holds
+  // the previous key's values under coherence: the same value recomputing gives).
   double leafToTop(int r, uint32_t q) const {
-    if (input_.reuseLeafFormFactors) {
-      auto it = input_.reuseLeafFormFactors->find({h_.node(r).id.packed(), uint64_t(q)});
-      if (it != input_.reuseLeafFormFactors->end()) return it->second;
-    }
     if (opt_.quadratureOrder != kAutoOrder)
       return polygonToPolygonFormFactor(s_.world[size_t(r)], s_.world[q], opt_.quadratureOrder);
     return areaAverageFormFactor(s_.world[size_t(r)], s_.world[q],
@@ -926,6 +1007,9 @@ class KeyTimeSolver {
       s_.clusterBounds = clusters_->clusterBounds();
     }
     s_.radiosity = std::move(B_);
+    pairStart_.resize(s_.links.size(), kNoRayPairs);
+    s_.rayPairStart = std::move(pairStart_);
+    s_.rayPairs = std::move(pairs_);
     s_.leafTopFormFactor = std::move(leafTopFormFactor_);
     for (size_t i = 0; i < closed_.size(); ++i)
       if (closed_[i] >= 0 && !moves(h_.node(int(i)).id.top))
@@ -963,6 +1047,16 @@ class KeyTimeSolver {
   std::vector<double> shooterRange_;   // per dense node: measureShooterRanges
   // Per dense node: F(node -> top-level patch) computed for the closure in this key's solve.
   std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor_;
+  // weightVisibilityByShooterRadiosity's ray pairs, opt_.rays per link from pairStart_[link]
+  // (kNoRayPairs: not weighted yet in this key solve), and per pair the shooter node last
+  // descended to and the (u,v) in it.
+  struct PairState {
+    glm::dvec2 uv;
+    int node = 0;
+  };
+  std::vector<size_t> pairStart_;
+  std::vector<LinkRayPair> pairs_;
+  std::vector<PairState> pairState_;
   double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
   bool nonFinite_ = false;          // a sweep produced NaN or Inf
   double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges

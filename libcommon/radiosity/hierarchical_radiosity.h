@@ -147,8 +147,19 @@ struct SolverLink {
   bool reused = false;          // F and V taken from the previous key time (coherence)
   bool visibilityOnly = false;  // F taken over, V recomputed (the shaft met a moving object)
   double knownFormFactor = -1;  // the accurate F when the previous key computed it, else < 0
+  // The previous key's ray pairs of this link (KeySolveInput::reuseRayPairs), else kNoRayPairs.
+  size_t knownRayPairs = ~size_t(0);
   double fv() const { return formFactor * visibility; }
 };
+
+// One ray pair of a link's radiosity-weighted visibility (weightVisibilityByShooterRadiosity):
+// its kernel and the (u,v) of its end in the shooter. Geometry only: valid while both ends are
+// static, like CachedLink's estimate.
+struct LinkRayPair {
+  glm::dvec2 uv{0.0};
+  double kernel = 0;
+};
+constexpr size_t kNoRayPairs = ~size_t(0);
 
 // Link values that a key-time solve may take over instead of recomputing (paper §4.2): keyed
 // by (receiver id, shooter id). Only values are taken over, never decisions: the solve refines
@@ -160,6 +171,7 @@ struct CachedLink {
   double visibility = 0;                // the shadow rays' V (SolverLink::rayVisibility)
   uint64_t openPairs = 0;               // and their unoccluded pairs
   bool visibilityValid = false;         // false: a moving object's swept bound met the link's shaft
+  size_t rayPairs = kNoRayPairs;        // its first LinkRayPair in the previous KeySolution
 };
 struct LinkKeyHash {
   size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {
@@ -168,8 +180,11 @@ struct LinkKeyHash {
 };
 using LinkCache = std::unordered_map<std::pair<uint64_t, uint64_t>, CachedLink, LinkKeyHash>;
 // The closure's leaf-to-top form factors F(leaf -> top-level patch) a key-time solve may take
-// over (both static): keyed by (leaf id, top index).
-using LeafFormFactorCache = std::unordered_map<std::pair<uint64_t, uint64_t>, double, LinkKeyHash>;
+// over (both static): per dense node of the union hierarchy (whose numbering every key shares),
+// its (top index, F) pairs. A previous key's KeySolution::leafTopFormFactor as it is: a hash
+// map keyed by (node id, top) rebuilt at every key had been 6-7 % of rad-global's time on the
+// table scene (perf), for values a dense index finds directly.
+using LeafFormFactorCache = std::vector<std::vector<std::pair<uint32_t, double>>>;
 // Whether a node of a static top-level patch is inside a closed room (its escape rays all meet
 // the static geometry), keyed by node id: the same at every key time.
 using ClosedNodeCache = std::unordered_map<uint64_t, bool>;
@@ -178,6 +193,8 @@ struct KeySolveInput {
   std::vector<glm::dmat4> topToWorld;           // per top-level patch: its node's world transform
   const VisibilityScene* visibility = nullptr;  // null: every link fully visible
   const LinkCache* reuse = nullptr;             // coherence: values to take over
+  // coherence: the previous key's KeySolution::rayPairs (CachedLink::rayPairs indexes them)
+  const std::vector<LinkRayPair>* reuseRayPairs = nullptr;
   const LeafFormFactorCache* reuseLeafFormFactors = nullptr;  // coherence: the closure's
   const ClosedNodeCache* reuseClosed = nullptr;               // coherence: closed-room tests
   // Per top-level patch: it moves at some time of the animation. The closure corrects only
@@ -216,6 +233,10 @@ struct KeySolution {
   std::vector<ClusterBounds> clusterBounds;
   std::vector<Polygon> world;  // per dense node: world polygon at this key
   std::vector<double> area;    // per dense node: world area
+  // The ray pairs of the links the radiosity weighting saw, RadiosityOptions::rays of them per
+  // link from rayPairStart[link] (kNoRayPairs: none), for the next key's coherence.
+  std::vector<LinkRayPair> rayPairs;
+  std::vector<size_t> rayPairStart;
   int iterations = 0;          // Gauss-Seidel sweeps, all rounds
   int refineRounds = 0;
   bool linkCapReached = false;     // refinement stopped at RadiosityOptions::maxLinks

@@ -217,14 +217,11 @@ const char* badLinkRuleName(BadLinkRule r) {
   return "?";
 }
 
-LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy& h) {
+LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy&) {
   // The closure integrates only pairs of patches that never move (KeySolveInput::movingTops),
-  // so every value it kept stays valid at the next key time.
-  LeafFormFactorCache cache;
-  for (size_t i = 0; i < prev.leafTopFormFactor.size(); ++i)
-    for (const auto& [q, f] : prev.leafTopFormFactor[i])
-      cache.emplace(std::make_pair(h.node(int(i)).id.packed(), uint64_t(q)), f);
-  return cache;
+  // so every value it kept stays valid at the next key time; the union hierarchy's dense node
+  // numbering is the same at every key.
+  return prev.leafTopFormFactor;
 }
 
 LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const Scene& scene,
@@ -237,7 +234,8 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     if (scene.isDynamic(node, t0, t1)) swept.push_back(scene.sweptBounds(node, t0, t1));
   LinkCache cache;
   cache.reserve(prev.links.size());
-  for (const SolverLink& l : prev.links) {
+  for (size_t li = 0; li < prev.links.size(); ++li) {
+    const SolverLink& l = prev.links[li];
     const PatchNode& r = h.node(l.receiver);
     const PatchNode& s = h.node(l.shooter);
     // A moving end changes the geometry: nothing of the link is known.
@@ -257,6 +255,7 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     c.visibility = l.rayVisibility;
     c.openPairs = l.openPairs;
     c.visibilityValid = !hit;  // a moving object in the shaft: the shadow rays again
+    if (li < prev.rayPairStart.size()) c.rayPairs = prev.rayPairStart[li];
     cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
   }
   return cache;
@@ -380,6 +379,7 @@ class KeyTimePass {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
       in.reuse = &cache;
+      in.reuseRayPairs = &prev.rayPairs;
       leafCache = reusableLeafFormFactors(prev, h_);
       in.reuseLeafFormFactors = &leafCache;
       if (!clusters_.empty()) {

@@ -107,6 +107,19 @@ class VisibilityScene {
                                 std::uint64_t* openPairs = nullptr,
                                 double* kernelMeanWeight = nullptr) const;
   static constexpr int kMaxRecordedPairs = 64;
+  // The pairs weightedVisibilityFrom makes from the same arguments: b's points (bPoints[i]
+  // paired with aPoints[i]) and each pair's kernel K_i. For a caller that weights the same
+  // pairs again with other weights (rad-global at each refinement round, whose geometry, rays
+  // and pairs stay while the shooter's B changes).
+  static void pairsFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
+                        const Polygon& b, std::uint64_t seed, std::vector<glm::dvec3>& bPoints,
+                        std::vector<double>& kernel);
+  // weightedVisibilityFrom's value from its pairs' kernels, their open bits `known` (k <=
+  // kMaxRecordedPairs) and weights w(y_i): the same arithmetic in the same order, so the same
+  // bits.
+  static double weightedVisibilityOfPairs(int k, const double* kernel, std::uint64_t known,
+                                          const double* weightAtB, std::uint64_t* openPairs,
+                                          double* kernelMeanWeight);
   // Which of the segments from x to bPoints[i] (i < kMaxRecordedPairs) are unoccluded: bit i,
   // tested only where `candidates` has it (the others stay 0). Thread-safe after commit().
   std::uint64_t openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,
@@ -141,6 +154,7 @@ class VisibilityScene {
   int instanceCount() const;
 
  private:
+  bool segmentMayHit(const glm::dvec3& a, const glm::dvec3& b) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

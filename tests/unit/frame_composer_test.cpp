@@ -372,6 +372,29 @@ TEST(Srgb, EncodeAndExposure) {
   EXPECT_EQ(b, want);
 }
 
+// toSrgb8 at exposure 0 reads thresholds instead of calling pow: the same codes. Every 61st
+// float of [0, 1.125] here (the whole range, 1.07e9 floats, was checked once: no difference),
+// the floats next to 1, and values that are not finite or negative.
+TEST(Srgb, ExposureZeroTableEqualsPowOnFloats) {
+  auto pow8 = [](float f) {
+    return std::isfinite(f) ? uint8_t(std::lround(255.0 * srgbEncode(double(f)))) : uint8_t(0);
+  };
+  long checked = 0;
+  for (uint32_t u = 0; u <= 0x3F900000u; u += (u > 0x3F7FFF00u && u < 0x3F800100u) ? 1u : 61u) {
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    ASSERT_EQ(int(srgb8AtExposureZero(f)), int(pow8(f))) << f;
+    ++checked;
+  }
+  EXPECT_GT(checked, 17000000);
+  for (float f : {-1.0f, -0.0f, 1e30f, INFINITY, -INFINITY, NAN, 0.0031308f, 1e-40f})
+    EXPECT_EQ(int(srgb8AtExposureZero(f)), int(pow8(f))) << f;
+  const std::vector<float> rgb = {0.25f, 0.5f, 2.0f, -1.0f, 0.0f, 0.125f, NAN};
+  std::vector<uint8_t> want;
+  for (float f : rgb) want.push_back(pow8(f));
+  EXPECT_EQ(toSrgb8(rgb, 0.0), want);
+}
+
 TEST_F(FrameComposerTest, AutoExposureIgnoresEmittersAndDependsOnlyOnTheSolution) {
   // Wall leaves B/pi luminance 0.25; lamp (emitter) much brighter, ignored.
   auto B = [](int node, int) {
