@@ -31,7 +31,50 @@ RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
   });
 }
 
+bool insideSolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
+                 uint32_t top, const glm::dvec3& p, const glm::dvec3& n, double size, double t) {
+  glm::dvec3 u = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+  u = glm::normalize(glm::cross(u, n));
+  const glm::dvec3 v = glm::cross(n, u);
+  const double c = std::cos(88.0 * M_PI / 180.0), sn = std::sin(88.0 * M_PI / 180.0);
+  const glm::dvec3 dirs[4] = {c * n + sn * u, c * n - sn * u, c * n + sn * v, c * n - sn * v};
+  // Every ray inside or undecided (rayStart), one at least inside: a ray into a sheet of two
+  // back-to-back patches is undecided, and the sheet's other side is outside.
+  bool inside = false;
+  for (const glm::dvec3& d : dirs) {
+    const RayStart r = coveredBySolid(blockers, scene, h, top, p, d * size, t);
+    if (r == RayStart::kOutside) return false;
+    inside = inside || r == RayStart::kInside;
+  }
+  return inside;
+}
+
 namespace {
+
+// The nearest of the receiver's centroid and corners to polygon p (the split rule's distance).
+double distanceFromReceiver(const Polygon& receiver, const Polygon& p) {
+  double d = distanceToPolygon(receiver.centroid(), p);
+  for (int i = 0; i < receiver.count; ++i) d = std::min(d, distanceToPolygon(receiver.v[i], p));
+  return d;
+}
+
+// Per receiver node, the rows of solution.links that `gathers` keeps: rows[start[i] ..
+// start[i + 1]).
+template <class Keep>
+void indexByReceiver(const GlobalSolution& s, Keep&& gathers, std::vector<uint32_t>& start,
+                     std::vector<uint32_t>& rows) {
+  const size_t N = size_t(s.hierarchy.size());
+  start.assign(N + 1, 0);
+  for (const GlobalLink& l : s.links)
+    if (l.receiver < N && gathers(l)) ++start[l.receiver + 1];
+  for (size_t i = 0; i < N; ++i) start[i + 1] += start[i];
+  rows.resize(start[N]);
+  std::vector<uint32_t> next(start.begin(), start.end() - 1);
+  for (uint32_t r = 0; r < uint32_t(s.links.size()); ++r) {
+    const GlobalLink& l = s.links[r];
+    if (l.receiver < N && gathers(l)) rows[next[l.receiver]++] = r;
+  }
+}
 
 int cellLevel(uint32_t cell) {
   return (31 - __builtin_clz(cell)) / 2;
@@ -50,59 +93,20 @@ std::vector<Polygon> cellsOf(const Polygon& p, int levels) {
   return c;
 }
 
-// Point p of top-level patch `top` (normal n) lies inside a touching solid at time t: the four
-// rays 88 degrees from the normal all start inside or undecided, one at least inside (as
-// rad-movies' fill of covered texels decides).
-bool insideSolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
-                 uint32_t top, const glm::dvec3& p, const glm::dvec3& n, double size, double t) {
-  glm::dvec3 u = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-  u = glm::normalize(glm::cross(u, n));
-  const glm::dvec3 v = glm::cross(n, u);
-  const double c = std::cos(88.0 * M_PI / 180.0), sn = std::sin(88.0 * M_PI / 180.0);
-  const glm::dvec3 dirs[4] = {c * n + sn * u, c * n - sn * u, c * n + sn * v, c * n - sn * v};
-  bool inside = false;
-  for (const glm::dvec3& d : dirs) {
-    const RayStart r = coveredBySolid(blockers, scene, h, top, p, d * size, t);
-    if (r == RayStart::kOutside) return false;
-    inside = inside || r == RayStart::kInside;
-  }
-  return inside;
-}
-
 }  // namespace
 
 GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
-  const size_t N = size_t(s.hierarchy.size());
-  auto gathers = [N](const GlobalLink& l) {
-    return !(l.flags & (kLinkBad | kLinkRefined)) && l.receiver < N;
-  };
-  start.assign(N + 1, 0);
-  for (const GlobalLink& l : s.links)
-    if (gathers(l)) ++start[l.receiver + 1];
-  for (size_t i = 0; i < N; ++i) start[i + 1] += start[i];
-  rows.resize(start[N]);
-  std::vector<uint32_t> next(start.begin(), start.end() - 1);
-  for (uint32_t r = 0; r < uint32_t(s.links.size()); ++r) {
-    const GlobalLink& l = s.links[r];
-    if (gathers(l)) rows[next[l.receiver]++] = r;
-  }
+  indexByReceiver(
+      s, [](const GlobalLink& l) { return !(l.flags & (kLinkBad | kLinkRefined)); }, start, rows);
   smoothClusterIrradiance(s);
 }
 
 void GoodLinksByReceiver::indexAllLinks(const GlobalSolution& s) {
   if (!allStart.empty()) return;
   const size_t N = size_t(s.hierarchy.size());
-  auto gathers = [N](const GlobalLink& l) {
-    return !(l.flags & kLinkRefined) && l.receiver < N && l.shooter < N;
-  };
-  allStart.assign(N + 1, 0);
-  for (const GlobalLink& l : s.links)
-    if (gathers(l)) ++allStart[l.receiver + 1];
-  for (size_t i = 0; i < N; ++i) allStart[i + 1] += allStart[i];
-  allRows.resize(allStart[N]);
-  std::vector<uint32_t> next(allStart.begin(), allStart.end() - 1);
-  for (uint32_t r = 0; r < uint32_t(s.links.size()); ++r)
-    if (gathers(s.links[r])) allRows[next[s.links[r].receiver]++] = r;
+  indexByReceiver(
+      s, [N](const GlobalLink& l) { return !(l.flags & kLinkRefined) && l.shooter < N; }, allStart,
+      allRows);
 }
 
 void GoodLinksByReceiver::smoothClusterIrradiance(const GlobalSolution& s) {
@@ -264,10 +268,7 @@ void GoodLinkGather::shooterParts(const Polygon& receiver, uint32_t shooter, dou
     bool split = !h.isLeaf(int(q)) && shooterRatio_ > 0.0;
     if (split) {
       const Polygon world = nodeWorld(q, t);
-      double d = distanceToPolygon(receiver.centroid(), world);
-      for (int i = 0; i < receiver.count; ++i)
-        d = std::min(d, distanceToPolygon(receiver.v[i], world));
-      split = polygonSize(world) > shooterRatio_ * d;
+      split = polygonSize(world) > shooterRatio_ * distanceFromReceiver(receiver, world);
     }
     if (!split) {
       out.push_back(q);
@@ -295,12 +296,7 @@ void GoodLinkGather::nearCells(const Polygon& receiver, uint32_t leaf, double t,
     const auto [cell, poly] = stack.back();
     stack.pop_back();
     bool split = cellLevel(cell) < nearShooterLevels_;
-    if (split) {
-      double d = distanceToPolygon(receiver.centroid(), poly);
-      for (int i = 0; i < receiver.count; ++i)
-        d = std::min(d, distanceToPolygon(receiver.v[i], poly));
-      split = polygonSize(poly) > shooterRatio_ * d;
-    }
+    if (split) split = polygonSize(poly) > shooterRatio_ * distanceFromReceiver(receiver, poly);
     if (!split) {
       out.push_back(cell);
       continue;
@@ -322,6 +318,11 @@ void GoodLinkGather::planNearShooters(const std::vector<char>& needed, GoodLinkG
   std::sort(leaves.begin(), leaves.end());
   leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
   byReceiver_.indexAllLinks(solution_);
+  for (uint32_t q : leaves) {
+    std::vector<double>& area = cellAreas_[q];
+    for (const Polygon& c : cellsOf(solution_.hierarchy.node(int(q)).local, nearShooterLevels_))
+      area.push_back(c.area());
+  }
   const uint64_t K = uint64_t(solution_.keyCount());
   for (int k = 0; k < int(K); ++k) {
     if (!needed[size_t(k)]) continue;
@@ -462,14 +463,13 @@ double GoodLinkGather::cellRatio(const Link& l, int key) const {
   if (l.cell == 1) return 1.0;
   const uint64_t K = uint64_t(solution_.keyCount());
   const std::vector<float>& r = byReceiver_.nearShooterCells.at(l.shooter * K + uint64_t(key));
+  const std::vector<double>& cellArea = cellAreas_.at(l.shooter);
   const int level = cellLevel(l.cell), span = 1 << (2 * (nearShooterLevels_ - level));
   const uint32_t first = (l.cell & ((1u << (2 * level)) - 1u)) * uint32_t(span);
-  const std::vector<Polygon> cells =
-      cellsOf(solution_.hierarchy.node(int(l.shooter)).local, nearShooterLevels_);
   double sum = 0.0, area = 0.0;
   for (uint32_t i = first; i < first + uint32_t(span); ++i) {
-    sum += cells[i].area() * double(r[i]);
-    area += cells[i].area();
+    sum += cellArea[i] * double(r[i]);
+    area += cellArea[i];
   }
   return area > 0.0 ? sum / area : 1.0;
 }

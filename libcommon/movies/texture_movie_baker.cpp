@@ -383,20 +383,7 @@ class MovieBake {
     // covered the same way, and shows its neighbours' light).
     auto solidAt = [&](const VisibilityScene& blockers, double at, const glm::dvec3& p,
                        const glm::dvec3& n) {
-      glm::dvec3 u = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-      u = glm::normalize(glm::cross(u, n));
-      const glm::dvec3 v = glm::cross(n, u);
-      const double c = std::cos(88.0 * M_PI / 180.0), sn = std::sin(88.0 * M_PI / 180.0);
-      const glm::dvec3 dirs[4] = {c * n + sn * u, c * n - sn * u, c * n + sn * v, c * n - sn * v};
-      // Every ray inside or undecided (rayStart), one at least inside: a ray into a sheet of
-      // two back-to-back patches is undecided, and the sheet's other side is outside.
-      bool inside = false;
-      for (const glm::dvec3& d : dirs) {
-        const RayStart r = coveredBySolid(blockers, geo_.scene(), hierarchy, top, p, d * size, at);
-        if (r == RayStart::kOutside) return false;
-        inside = inside || r == RayStart::kInside;
-      }
-      return inside;
+      return insideSolid(blockers, geo_.scene(), hierarchy, top, p, n, size, at);
     };
     // A texel whose centre lies within a quarter texel outside a solid's foot (a partition
     // standing on a texel row: the cubic scene's walls are 5 cm from the floor tiles' edges, a

@@ -396,6 +396,32 @@ std::vector<glm::dvec3> VisibilityScene::samplePoints(const Polygon& p, int k, s
   return out;
 }
 
+namespace {
+
+// The sums of weightedVisibilityFrom's estimator over its pairs, in pair order.
+struct PairTally {
+  double weighted = 0.0, weight = 0.0;         // kernel x weightAtB
+  double kernelOpen = 0.0, kernelTotal = 0.0;  // kernel alone
+  int unoccluded = 0;
+  void add(bool isOpen, double kernel, double weightAtB) {
+    unoccluded += isOpen ? 1 : 0;
+    kernelTotal += kernel;
+    kernelOpen += isOpen ? kernel : 0.0;
+    const double w = kernel * weightAtB;
+    weight += w;
+    weighted += isOpen ? w : 0.0;
+  }
+  // No weight at any pair that exchanges energy (a shooter still dark, before the first solve):
+  // the kernel's fraction; no pair that exchanges energy: the area-uniform fraction.
+  double visibility(int k, double* kernelMeanWeight) const {
+    if (kernelMeanWeight) *kernelMeanWeight = kernelTotal > 0.0 ? weight / kernelTotal : -1.0;
+    if (weight > 0.0) return weighted / weight;
+    return kernelTotal > 0.0 ? kernelOpen / kernelTotal : static_cast<double>(unoccluded) / k;
+  }
+};
+
+}  // namespace
+
 double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints,
                                        const glm::dvec3& aNormal, const Polygon& b,
                                        std::uint64_t seed, std::uint32_t ignoreA,
@@ -414,29 +440,18 @@ double VisibilityScene::weightedVisibilityFrom(
   const std::vector<glm::dvec3> bPoints = pairedPoints(b, k, seed);
   const glm::dvec3 bNormal = b.normal();
   const bool known = knownOpenPairs && k <= kMaxRecordedPairs;
-  double weighted = 0.0, weight = 0.0;         // kernel x weightAtB
-  double kernelOpen = 0.0, kernelTotal = 0.0;  // kernel alone
-  int unoccluded = 0;
+  PairTally tally;
   std::uint64_t open = 0;
   for (int i = 0; i < k; ++i) {
     const glm::dvec3 pa = aPoints[size_t(i)], pb = bPoints[size_t(i)];
     const bool isOpen =
         known ? ((*knownOpenPairs >> i) & 1u) != 0 : !occluded(pa, pb, ignoreA, ignoreB);
-    unoccluded += isOpen ? 1 : 0;
     if (isOpen && i < kMaxRecordedPairs) open |= std::uint64_t(1) << i;
-    double w = pairKernel(pa, aNormal, pb, bNormal);
-    kernelTotal += w;
-    kernelOpen += isOpen ? w : 0.0;
-    if (weightAtB) w *= std::max(0.0, weightAtB(pb));
-    weight += w;
-    weighted += isOpen ? w : 0.0;
+    tally.add(isOpen, pairKernel(pa, aNormal, pb, bNormal),
+              weightAtB ? std::max(0.0, weightAtB(pb)) : 1.0);
   }
   if (openPairs) *openPairs = open;
-  if (kernelMeanWeight) *kernelMeanWeight = kernelTotal > 0.0 ? weight / kernelTotal : -1.0;
-  // No weight at any pair that exchanges energy (a shooter still dark, before the first solve):
-  // the kernel's fraction; no pair that exchanges energy: the area-uniform fraction.
-  if (weight > 0.0) return weighted / weight;
-  return kernelTotal > 0.0 ? kernelOpen / kernelTotal : static_cast<double>(unoccluded) / k;
+  return tally.visibility(k, kernelMeanWeight);
 }
 
 void VisibilityScene::pairsFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
@@ -454,25 +469,15 @@ double VisibilityScene::weightedVisibilityOfPairs(int k, const double* kernel, s
                                                   const double* weightAtB, std::uint64_t* openPairs,
                                                   double* kernelMeanWeight) {
   if (k == 0) return 1.0;
-  double weighted = 0.0, weight = 0.0;         // kernel x weightAtB
-  double kernelOpen = 0.0, kernelTotal = 0.0;  // kernel alone
-  int unoccluded = 0;
+  PairTally tally;
   std::uint64_t open = 0;
   for (int i = 0; i < k; ++i) {
     const bool isOpen = ((known >> i) & 1u) != 0;
-    unoccluded += isOpen ? 1 : 0;
     if (isOpen) open |= std::uint64_t(1) << i;
-    double w = kernel[i];
-    kernelTotal += w;
-    kernelOpen += isOpen ? w : 0.0;
-    w *= std::max(0.0, weightAtB[i]);
-    weight += w;
-    weighted += isOpen ? w : 0.0;
+    tally.add(isOpen, kernel[i], std::max(0.0, weightAtB[i]));
   }
   if (openPairs) *openPairs = open;
-  if (kernelMeanWeight) *kernelMeanWeight = kernelTotal > 0.0 ? weight / kernelTotal : -1.0;
-  if (weight > 0.0) return weighted / weight;
-  return kernelTotal > 0.0 ? kernelOpen / kernelTotal : static_cast<double>(unoccluded) / k;
+  return tally.visibility(k, kernelMeanWeight);
 }
 
 std::uint64_t VisibilityScene::openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,

@@ -636,6 +636,23 @@ FloorUnderCeiling floorUnderCeiling() {
   return f;
 }
 
+// Whether the segment a -> b meets the box [lo, hi] (slab test).
+bool segmentMeetsBox(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& lo,
+                     const glm::dvec3& hi) {
+  double t0 = 0.0, t1 = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = b[k] - a[k];
+    if (std::abs(d) < 1e-15) {
+      if (a[k] < lo[k] || a[k] > hi[k]) return false;
+      continue;
+    }
+    double u = (lo[k] - a[k]) / d, v = (hi[k] - a[k]) / d;
+    if (u > v) std::swap(u, v);
+    t0 = std::max(t0, u), t1 = std::min(t1, v);
+  }
+  return t0 < t1;
+}
+
 // A black box [lo, hi] (z from lo.z, 0 for one standing on the floor): its top (unless `open`)
 // and four sides, faces outward, no bottom.
 void addBoxOnFloor(Scene& s, const glm::dvec3& lo, const glm::dvec3& hi, bool open = false) {
@@ -727,19 +744,8 @@ TEST(TextureMovieBaker, GatheredVisibilityBesideAFootIsNotInterpolatedFromUnderI
   const glm::dvec3 lo(0.75, 0.25, 0.0), hi(1.25, 0.75, 0.3);
   addBoxOnFloor(s, lo, hi);
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
-  auto blocked = [&](const glm::dvec3& a, const glm::dvec3& b) {  // segment meets the box
-    double t0 = 0.0, t1 = 1.0;
-    for (int k = 0; k < 3; ++k) {
-      const double d = b[k] - a[k];
-      if (std::abs(d) < 1e-15) {
-        if (a[k] < lo[k] || a[k] > hi[k]) return false;
-        continue;
-      }
-      double u = (lo[k] - a[k]) / d, v = (hi[k] - a[k]) / d;
-      if (u > v) std::swap(u, v);
-      t0 = std::max(t0, u), t1 = std::min(t1, v);
-    }
-    return t0 < t1;
+  auto blocked = [&](const glm::dvec3& a, const glm::dvec3& b) {
+    return segmentMeetsBox(a, b, lo, hi);
   };
   const int w = 64, h = 32;
   const double texel = 2.0 / w;
@@ -1212,20 +1218,6 @@ TEST(TextureMovieBaker, NearShooterCellsFollowTheFloorsShadowAtAFoot) {
   const int front =
       addQuadNode(s, {lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, lo.y, hi.z}, {lo.x, lo.y, hi.z}, 3);
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
-  auto blocked = [&](const glm::dvec3& a, const glm::dvec3& b) {  // segment meets the box
-    double t0 = 0.0, t1 = 1.0;
-    for (int k = 0; k < 3; ++k) {
-      const double d = b[k] - a[k];
-      if (std::abs(d) < 1e-15) {
-        if (a[k] < lo[k] || a[k] > hi[k]) return false;
-        continue;
-      }
-      double u = (lo[k] - a[k]) / d, v = (hi[k] - a[k]) / d;
-      if (u > v) std::swap(u, v);
-      t0 = std::max(t0, u), t1 = std::min(t1, v);
-    }
-    return t0 < t1;
-  };
   Polygon light;
   light.count = 4;
   light.v = {glm::dvec3(l0.x, l0.y, lampZ), glm::dvec3(l0.x, l1.y, lampZ),
@@ -1242,8 +1234,10 @@ TEST(TextureMovieBaker, NearShooterCellsFollowTheFloorsShadowAtAFoot) {
       int open = 0;
       for (int b = 0; b < 8; ++b)
         for (int a = 0; a < 8; ++a)
-          open += blocked(c, glm::dvec3(l0.x + (a + 0.5) / 8 * (l1.x - l0.x),
-                                        l0.y + (b + 0.5) / 8 * (l1.y - l0.y), lampZ))
+          open += segmentMeetsBox(c,
+                                  glm::dvec3(l0.x + (a + 0.5) / 8 * (l1.x - l0.x),
+                                             l0.y + (b + 0.5) / 8 * (l1.y - l0.y), lampZ),
+                                  lo, hi)
                       ? 0
                       : 1;
       Polygon cell;
