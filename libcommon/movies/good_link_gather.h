@@ -240,8 +240,10 @@ class GoodLinkGather {
 
   Polygon nodeWorld(uint32_t node, double t) const;
   Polygon linkWorld(const Link& l, double t) const;  // its shooter part (or cell) at t
-  void nearCells(const Polygon& receiver, uint32_t leaf, double t,
-                 std::vector<uint32_t>& out) const;
+  // receiverAt[k]: the receiver at times[k] (one time when neither the receiver nor the shooter
+  // moves during the movie, the movie's keys otherwise).
+  void nearCells(const std::vector<Polygon>& receiverAt, const std::vector<double>& times,
+                 uint32_t leaf, std::vector<uint32_t>& out) const;
   void planNearShooters(const std::vector<char>& neededKeys, GoodLinkGatherStats& stats);
   // fixed: the leaf's kept terms, or null; fresh: where to keep them when null (static leaf).
   std::vector<float> regatherCells(uint32_t leaf, int key, double t,
@@ -251,8 +253,8 @@ class GoodLinkGather {
   // Per near leaf shooter, the areas of its 4^nearShooterLevels_ cells (cellRatio's weights).
   std::unordered_map<uint32_t, std::vector<double>> cellAreas_;
   void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request);
-  void shooterParts(const Polygon& receiver, uint32_t shooter, double t,
-                    std::vector<uint32_t>& out) const;
+  void shooterParts(const std::vector<Polygon>& receiverAt, const std::vector<double>& times,
+                    uint32_t shooter, std::vector<uint32_t>& out) const;
   void planWeights(const std::vector<char>& neededKeys);
   void planTexels(double cacheBytes);
   struct TexelFrame {  // the receiver's local-to-world map and its normal map at one time

@@ -227,8 +227,14 @@ double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& nIn, cons
   glm::dvec3 n = nIn / nl;
   glm::dvec3 m = polygonNormal(v, count);
   if (m == glm::dvec3(0.0)) return 0.0;
-  // One-sided: only an element strictly in front of the polygon's plane sees its front.
-  if (!(glm::dot(m, p - v[0]) > 0.0)) return 0.0;
+  // One-sided: only an element strictly in front of the polygon's plane sees its front. A point
+  // on the plane to rounding (a vertex on a shared edge, computed by a cut: contact_cuts.h) is
+  // not in front; otherwise its form factor is singular at whichever side rounding puts it
+  // (the error oracle then refined a ceiling at 1e-3 scale and not at 1).
+  // Rounding is relative to the coordinates as well as to the polygon's size.
+  double scale = std::max(glm::length(p), glm::length(v[0]));
+  for (std::size_t k = 1; k < count; ++k) scale = std::max(scale, glm::length(v[k] - v[0]));
+  if (!(glm::dot(m, p - v[0]) > 1e-13 * scale)) return 0.0;
 
   // Horizon clipping to n . (x - p) >= 0 (Sutherland-Hodgman against one plane).
   bool anyIn = false, anyOut = false;

@@ -5,6 +5,7 @@
 #include "libcommon/scene/scene.h"
 
 #include "libcommon/core/error.h"
+#include "libcommon/scene/contact_cuts.h"
 #include "libcommon/scene/patch_hierarchy.h"
 
 #include <algorithm>
@@ -498,7 +499,7 @@ std::vector<InputPolygon> Scene::inputPolygons() const {
         out.push_back(reversed(poly));
     }
   }
-  return out;
+  return cutAtContacts(*this, std::move(out));
 }
 
 std::vector<int> Scene::cameraNodes() const {

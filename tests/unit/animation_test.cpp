@@ -376,6 +376,79 @@ TEST(InputPolygons, OrderByNodeAndUnreachableSkipped) {
   EXPECT_EQ(polys[1].node, 2);
 }
 
+// A lamp (0.5 m square, facing +z like the ceiling it hangs in front of) `gap` in front of a
+// 4 m ceiling square (node 0), at x, y in [1.5, 2].
+Scene lampUnderCeiling(double gap) {
+  Scene s;
+  s.nodes.resize(2);
+  s.roots = {0, 1};
+  s.nodes[0].mesh = 0;
+  s.nodes[0].scale = {4, 4, 1};
+  s.nodes[1].mesh = 0;
+  s.nodes[1].scale = {0.5, 0.5, 1};
+  s.nodes[1].translation = {1.5, 1.5, gap};
+  s.meshes = {unitSquare()};
+  return s;
+}
+
+// contact_cuts.h: the ceiling is cut along the lamp's outline and along rims 4 gaps wide
+// outside and inside it, each by a pinwheel of convex quads; nothing else changes.
+TEST(InputPolygons, CutAlongTheOutlineOfAPolygonFlatAgainstThem) {
+  const std::vector<InputPolygon> polys = lampUnderCeiling(0.001).inputPolygons();
+  std::vector<InputPolygon> ceiling;
+  for (const InputPolygon& p : polys)
+    if (p.node == 0) ceiling.push_back(p);
+  ASSERT_EQ(polys.size() - ceiling.size(), 1u);  // the lamp is not cut
+  ASSERT_EQ(ceiling.size(), 13u);                // 4 + 4 outer rim + 4 inner rim + 1
+  // Local frame (the node scales by 4): the lamp's outline is [0.375, 0.5]^2, the rims 1 mm.
+  double area = 0.0;
+  int underLamp = 0, rims = 0;
+  for (const InputPolygon& p : ceiling) {
+    EXPECT_EQ(p.local.count, 4);
+    area += p.local.area();
+    expectNear(p.local.normal(), {0, 0, 1});
+    glm::dvec3 lo(1e9), hi(-1e9);
+    for (int k = 0; k < 4; ++k) {
+      lo = glm::min(lo, p.local.v[k]);
+      hi = glm::max(hi, p.local.v[k]);
+      // The uv map is the ceiling's own (uv = local x, y for the unit square).
+      EXPECT_NEAR(p.uv[k].x, p.local.v[k].x, 1e-12);
+      EXPECT_NEAR(p.uv[k].y, p.local.v[k].y, 1e-12);
+    }
+    // No piece straddles the outline or a rim's edge: each lies inside or outside each square.
+    for (double r : {0.0, 0.001, -0.001}) {
+      const double q0 = 0.375 - r, q1 = 0.5 + r;
+      const double overlap = std::max(0.0, std::min(hi.x, q1) - std::max(lo.x, q0)) *
+                             std::max(0.0, std::min(hi.y, q1) - std::max(lo.y, q0));
+      const bool inside =
+          lo.x >= q0 - 1e-12 && hi.x <= q1 + 1e-12 && lo.y >= q0 - 1e-12 && hi.y <= q1 + 1e-12;
+      EXPECT_TRUE(overlap < 1e-12 || inside) << p.local.toString() << " square " << r;
+    }
+    const double width = std::min(hi.x - lo.x, hi.y - lo.y);
+    if (std::abs(width - 0.001) < 1e-12)
+      ++rims;
+    else  // no sliver along the lines: the other pieces are at least the core's width across
+      EXPECT_GE(width, 0.123 - 1e-12) << p.local.toString();
+    if (glm::length(lo - glm::dvec3(0.376, 0.376, 0)) < 1e-12 &&
+        glm::length(hi - glm::dvec3(0.499, 0.499, 0)) < 1e-12)
+      ++underLamp;
+  }
+  EXPECT_NEAR(area, 1.0, 1e-12);
+  EXPECT_EQ(underLamp, 1);
+  EXPECT_EQ(rims, 8);
+
+  // Farther than kContactGap times the lamp's size, behind the ceiling, or moving: not cut.
+  EXPECT_EQ(lampUnderCeiling(0.03).inputPolygons().size(), 2u);
+  EXPECT_EQ(lampUnderCeiling(-0.001).inputPolygons().size(), 2u);
+  Scene moving = lampUnderCeiling(0.001);
+  AnimationChannel ch;
+  ch.node = 1;
+  ch.times = {0.0, 1.0};
+  ch.values = {1.5, 1.5, 0.001, 1.6, 1.5, 0.001};
+  moving.channels.push_back(ch);
+  EXPECT_EQ(moving.inputPolygons().size(), 2u);
+}
+
 TEST(Camera, WorldFromCameraIsRigid) {
   Scene s;
   s.nodes.resize(2);

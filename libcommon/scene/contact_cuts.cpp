@@ -1,0 +1,267 @@
+// Discontinuity meshing at near contacts (contact_cuts.h).
+#include "libcommon/scene/contact_cuts.h"
+
+#include "libcommon/scene/box_tree.h"
+#include "libcommon/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rad {
+
+namespace {
+
+using Outline = std::vector<glm::dvec3>;  // a convex polygon, CCW about its plane's normal
+
+double outlineArea(const Outline& p, const glm::dvec3& n) {
+  glm::dvec3 s(0.0);
+  for (size_t i = 0; i < p.size(); ++i) s += glm::cross(p[i], p[(i + 1) % p.size()]);
+  return 0.5 * glm::dot(s, n);
+}
+
+// The part of convex p on the side of the line through a along e (in the plane of normal n)
+// where sign * dot(cross(e, x - a), n) >= 0 (Sutherland-Hodgman against one half-plane).
+Outline clipHalfPlane(const Outline& p, const glm::dvec3& a, const glm::dvec3& e,
+                      const glm::dvec3& n, double sign) {
+  Outline out;
+  const size_t m = p.size();
+  for (size_t i = 0; i < m; ++i) {
+    const glm::dvec3& x = p[i];
+    const glm::dvec3& y = p[(i + 1) % m];
+    const double sx = sign * glm::dot(glm::cross(e, x - a), n);
+    const double sy = sign * glm::dot(glm::cross(e, y - a), n);
+    if (sx >= 0.0) out.push_back(x);
+    if ((sx >= 0.0) != (sy >= 0.0)) out.push_back(x + (y - x) * (sx / (sx - sy)));
+  }
+  return out;
+}
+
+// Drops vertices within tol of their predecessor (a cut through a vertex repeats it) and
+// vertices on the straight line of their neighbours (a quad must have four corners).
+Outline dedupe(const Outline& p, double tol, const glm::dvec3& n) {
+  Outline out;
+  for (const glm::dvec3& x : p)
+    if (out.empty() || glm::length(x - out.back()) > tol) out.push_back(x);
+  while (out.size() > 1 && glm::length(out.front() - out.back()) <= tol) out.pop_back();
+  for (bool again = true; again && out.size() > 3;) {
+    again = false;
+    for (size_t i = 0; i < out.size(); ++i) {
+      const glm::dvec3& a = out[(i + out.size() - 1) % out.size()];
+      const glm::dvec3& c = out[(i + 1) % out.size()];
+      if (std::abs(glm::dot(glm::cross(out[i] - a, c - out[i]), n)) <= tol * glm::length(c - a)) {
+        out.erase(out.begin() + long(i));
+        again = true;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+// The outline with every edge moved outwards by r (inwards for r < 0), in the plane of normal n;
+// empty when an edge would turn over (the outline is narrower than 2 |r|).
+Outline offsetOutline(const Outline& a, double r, const glm::dvec3& n) {
+  const size_t m = a.size();
+  std::vector<glm::dvec3> origin(m), dir(m);
+  for (size_t k = 0; k < m; ++k) {
+    dir[k] = a[(k + 1) % m] - a[k];
+    origin[k] = a[k] + r * glm::normalize(glm::cross(dir[k], n));  // right of a CCW edge: out
+  }
+  Outline out(m);
+  for (size_t k = 0; k < m; ++k) {  // vertex k: edges k - 1 and k meet
+    const size_t j = (k + m - 1) % m;
+    const double den = glm::dot(glm::cross(dir[j], dir[k]), n);
+    if (!(std::abs(den) > 0.0)) return {};
+    out[k] = origin[j] + dir[j] * (glm::dot(glm::cross(origin[k] - origin[j], dir[k]), n) / den);
+  }
+  for (size_t k = 0; k < m; ++k)
+    if (glm::dot(out[(k + 1) % m] - out[k], dir[k]) <= 0.0) return {};
+  return out;
+}
+
+// Cuts every piece that the outline a (convex, CCW about n) partly covers into the piece under
+// a and, per edge k of a, the piece outside edge k and inside edge k + 1: a pinwheel of convex
+// pieces that each reach the old piece's boundary (no sliver along a's edge lines). Pieces a does
+// not partly cover stay. Returns whether any piece was cut.
+bool pinwheel(std::vector<Outline>& pieces, const Outline& a, const glm::dvec3& n, double tol,
+              double minArea) {
+  bool cut = false;
+  std::vector<Outline> next;
+  for (const Outline& piece : pieces) {
+    Outline inside = piece;
+    for (size_t k = 0; k < a.size() && inside.size() >= 3; ++k)
+      inside = clipHalfPlane(inside, a[k], a[(k + 1) % a.size()] - a[k], n, 1.0);
+    inside = dedupe(inside, tol, n);
+    const double pieceArea = outlineArea(piece, n);
+    const double insideArea = inside.size() >= 3 ? outlineArea(inside, n) : 0.0;
+    if (insideArea <= minArea || insideArea >= pieceArea - minArea) {
+      next.push_back(piece);
+      continue;
+    }
+    next.push_back(inside);
+    for (size_t k = 0; k < a.size(); ++k) {
+      const size_t k1 = (k + 1) % a.size(), k2 = (k + 2) % a.size();
+      Outline w = clipHalfPlane(piece, a[k], a[k1] - a[k], n, -1.0);
+      if (w.size() >= 3) w = clipHalfPlane(w, a[k1], a[k2] - a[k1], n, 1.0);
+      w = dedupe(w, tol, n);
+      if (w.size() >= 3 && outlineArea(w, n) > minArea) next.push_back(w);
+    }
+    cut = true;
+  }
+  pieces.swap(next);
+  return cut;
+}
+
+// uv and shading normal of `source` at point x of its plane: barycentric in the triangle
+// (v0, v1, v2) or, for a quad, (v0, v2, v3) on its side of the diagonal. A quad's uv map is one
+// affine map (Scene's merge rule), so either triangle gives it exactly.
+void attributesAt(const InputPolygon& source, const glm::dvec3& x, glm::dvec2& uv,
+                  glm::dvec3& normal) {
+  const Polygon& p = source.local;
+  std::array<size_t, 3> t{0, 1, 2};
+  if (p.count == 4) {
+    const glm::dvec3 n = p.normal();
+    if (glm::dot(glm::cross(p.v[2] - p.v[0], x - p.v[0]), n) > 0.0) t = {0, 2, 3};
+  }
+  const glm::dvec3 e1 = p.v[t[1]] - p.v[t[0]], e2 = p.v[t[2]] - p.v[t[0]], d = x - p.v[t[0]];
+  const double a = glm::dot(e1, e1), b = glm::dot(e1, e2), c = glm::dot(e2, e2);
+  const double det = a * c - b * b;
+  double l1 = 0.0, l2 = 0.0;
+  if (det > 0.0) {
+    l1 = (glm::dot(d, e1) * c - glm::dot(d, e2) * b) / det;
+    l2 = (glm::dot(d, e2) * a - glm::dot(d, e1) * b) / det;
+  }
+  const double l0 = 1.0 - l1 - l2;
+  uv = l0 * source.uv[t[0]] + l1 * source.uv[t[1]] + l2 * source.uv[t[2]];
+  normal = l0 * source.normal[t[0]] + l1 * source.normal[t[1]] + l2 * source.normal[t[2]];
+  if (source.normal[0] == glm::dvec3(0.0)) normal = glm::dvec3(0.0);  // flat stays flat
+}
+
+// A convex piece of `source` as quads and at most one triangle: (0,1,2,3), (0,3,4,5), ...
+void emitPiece(const InputPolygon& source, const Outline& piece, std::vector<InputPolygon>& out) {
+  for (size_t first = 1; first + 1 < piece.size();) {
+    const size_t count = std::min<size_t>(3, piece.size() - first);  // vertices after v0
+    InputPolygon q = source;
+    q.local.count = int(count) + 1;
+    q.local.v = {};
+    q.uv = {};
+    q.normal = {};
+    for (size_t k = 0; k <= count; ++k) {
+      const glm::dvec3 x = k == 0 ? piece[0] : piece[first + k - 1];
+      q.local.v[k] = x;
+      attributesAt(source, x, q.uv[k], q.normal[k]);
+    }
+    out.push_back(q);
+    first += count - 1;
+    if (count < 3) break;
+  }
+}
+
+struct Placed {
+  bool still = false;  // its node does not move over the scene's time
+  Polygon world;
+  glm::dvec3 normal{0.0};
+  double size = 0.0;  // longest edge
+};
+
+}  // namespace
+
+std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPolygon> polygons) {
+  const double t0 = scene.startTime(), t1 = scene.endTime();
+  std::vector<Placed> placed(polygons.size());
+  std::vector<AxisBox> reach(polygons.size(), AxisBox{glm::dvec3(1.0), glm::dvec3(-1.0)});
+  for (size_t i = 0; i < polygons.size(); ++i) {
+    const int node = polygons[i].node;
+    Placed& p = placed[i];
+    p.still = !scene.isDynamic(node, t0, t1);
+    if (!p.still) continue;
+    p.world = polygons[i].local.transformed(scene.worldTransform(node, t0));
+    p.normal = p.world.normal();
+    if (p.normal == glm::dvec3(0.0)) {
+      p.still = false;  // degenerate: cuts nothing, is cut by nothing
+      continue;
+    }
+    for (int k = 0; k < p.world.count; ++k)
+      p.size = std::max(
+          p.size, glm::length(p.world.v[size_t((k + 1) % p.world.count)] - p.world.v[size_t(k)]));
+    // A's reach: its bounds grown by the gap it may have to a polygon it cuts and its rim.
+    AxisBox b{p.world.v[0], p.world.v[0]};
+    for (int k = 1; k < p.world.count; ++k) {
+      b[0] = glm::min(b[0], p.world.v[size_t(k)]);
+      b[1] = glm::max(b[1], p.world.v[size_t(k)]);
+    }
+    const glm::dvec3 grow(4.0 * kContactGap * p.size);
+    reach[i] = {b[0] - grow, b[1] + grow};
+  }
+  const BoxTree tree(reach);
+
+  std::vector<InputPolygon> out;
+  out.reserve(polygons.size());
+  std::vector<int> near;
+  for (size_t bi = 0; bi < polygons.size(); ++bi) {
+    const Placed& B = placed[bi];
+    if (!B.still) {
+      out.push_back(polygons[bi]);
+      continue;
+    }
+    AxisBox box{B.world.v[0], B.world.v[0]};
+    for (int k = 1; k < B.world.count; ++k) {
+      box[0] = glm::min(box[0], B.world.v[size_t(k)]);
+      box[1] = glm::max(box[1], B.world.v[size_t(k)]);
+    }
+    near.clear();
+    tree.query(box[0], box[1], near);
+    const double tol = 1e-9 * B.size;
+    const double minArea = 1e-9 * B.world.area();
+    std::vector<Outline> pieces{Outline(B.world.v.begin(), B.world.v.begin() + B.world.count)};
+    bool cut = false;
+    for (int ai : near) {
+      const Placed& A = placed[size_t(ai)];
+      if (size_t(ai) == bi || !A.still) continue;
+      const double facing = glm::dot(A.normal, B.normal);
+      if (std::abs(facing) < std::cos(1e-3)) continue;  // not parallel (1 mrad)
+      // A's height above B's plane, every vertex in front and within the gap.
+      double lo = INFINITY, hi = -INFINITY;
+      for (int k = 0; k < A.world.count; ++k) {
+        const double h = glm::dot(A.world.v[size_t(k)] - B.world.v[0], B.normal);
+        lo = std::min(lo, h);
+        hi = std::max(hi, h);
+      }
+      if (lo < -tol || hi > kContactGap * A.size) continue;
+      // Coincident and facing away: B's own back copy (a double-sided material) or a shell.
+      if (hi <= tol && facing < 0.0 && std::abs(A.world.area() - B.world.area()) <= minArea)
+        continue;
+      // A's outline on B's plane, CCW about B's normal.
+      Outline a;
+      for (int k = 0; k < A.world.count; ++k) {
+        const glm::dvec3 x = A.world.v[size_t(k)];
+        a.push_back(x - glm::dot(x - B.world.v[0], B.normal) * B.normal);
+      }
+      if (facing < 0.0) std::reverse(a.begin(), a.end());
+      // A gap makes B's radiosity fall towards the outline over a few gaps on either side (a
+      // point d from the edge loses the part of its hemisphere below atan(gap / d)): rims 4 gaps
+      // wide outside and inside the outline are pieces of their own, whose movies resolve it.
+      const double rim = 4.0 * std::max(hi, 0.0);
+      std::vector<Outline> outlines{a};
+      if (rim > tol) {
+        outlines.insert(outlines.begin(), offsetOutline(a, rim, B.normal));
+        Outline inner = offsetOutline(a, -rim, B.normal);
+        if (!inner.empty()) outlines.push_back(inner);
+      }
+      for (const Outline& o : outlines) cut = pinwheel(pieces, o, B.normal, tol, minArea) || cut;
+    }
+    if (!cut) {
+      out.push_back(polygons[bi]);
+      continue;
+    }
+    // Back to B's local frame, where its attributes are defined.
+    const glm::dmat4 toLocal = glm::inverse(scene.worldTransform(polygons[bi].node, t0));
+    for (Outline& piece : pieces) {
+      for (glm::dvec3& x : piece) x = glm::dvec3(toLocal * glm::dvec4(x, 1.0));
+      emitPiece(polygons[bi], piece, out);
+    }
+  }
+  return out;
+}
+
+}  // namespace rad
