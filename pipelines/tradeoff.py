@@ -15,7 +15,10 @@ bench.ReferenceNoise). Each setting runs --repeat times and the least CPU time o
 processes on the machine disturb least (wall time of the same run is in the CSV).
 
 usage: tradeoff.py [--scene GLTF] [--frames 0-47] [--size 176x120] [--spp 128] [--repeat 3]
-                   [--out DIR]
+                   [--out DIR] [--eval-frame N] [--references DIR0,DIR1] [--knobs K1,K2]
+
+With --eval-frame the error is that one frame's (references of it alone, or --references'); the
+presets (PRESETS: the README's draft and final settings) are rows of their own.
 """
 import argparse
 import csv
@@ -45,6 +48,14 @@ KNOBS = [
     ("gather-rays", "movies", "--gather-rays", ["0", "4", "32"]),
     ("near-shooter-levels", "movies", "--near-shooter-levels", ["1", "2"]),
 ]
+# Combined settings, each one more row of the sweep (knob "preset"): what the README recommends
+# for drafts and for final frames, so that the front shows where they stand among the knobs.
+PRESETS = [
+    ("draft", {"global": ["--eps", "0.02"]}),
+    ("final", {"global": ["--eps", "1e-5", "--key-step", "4", "--rays", "64"],
+               "movies": ["--min-samples", "64", "--movie-key-step", "2",
+                          "--near-shooter-levels", "2"]}),
+]
 TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
          "compose": "rad-compose"}
 
@@ -53,17 +64,23 @@ def knob_defaults(bin_dir):
     """knob -> the default value its tool reports (`TOOL --print-defaults`, one JSON object keyed
     by long option name), as the label of the default on each knob's curve; "default" for a tool
     that cannot be asked (e.g. --replot without binaries)."""
+    asked = tool_defaults(bin_dir)
+    label = lambda v: "%g" % v if isinstance(v, float) else str(v)
+    return {k: label(asked[s][f.lstrip("-")]) if f.lstrip("-") in asked[s] else "default"
+            for k, s, f, _ in KNOBS}
+
+
+def tool_defaults(bin_dir):
+    """stage -> its tool's `--print-defaults` object ({} when the tool cannot be asked)."""
     asked = {}
-    for stage in {s for _, s, _, _ in KNOBS}:
+    for stage in TOOLS:
         try:
             p = subprocess.run([os.path.join(bin_dir, TOOLS[stage]), "--print-defaults"],
                                capture_output=True, text=True, check=True)
             asked[stage] = json.loads(p.stdout)
         except (OSError, subprocess.CalledProcessError, ValueError):
             asked[stage] = {}
-    label = lambda v: "%g" % v if isinstance(v, float) else str(v)
-    return {k: label(asked[s][f.lstrip("-")]) if f.lstrip("-") in asked[s] else "default"
-            for k, s, f, _ in KNOBS}
+    return asked
 
 
 # What counts as a real difference. Timing: the least CPU time of three runs still varies by
@@ -115,6 +132,14 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "tradeoff"))
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--repeat", type=int, default=3, help="timed runs per setting (fastest kept)")
+    ap.add_argument("--eval-frame", type=int, default=None,
+                    help="compare only this frame (references of it alone), e.g. one midway "
+                         "between key textures, as the README's accuracy table does")
+    ap.add_argument("--references", default=None,
+                    help="DIR0,DIR1: two existing rad-reference --pixel-centres renders of "
+                         "different seeds (same scene, size and frames) instead of rendering them")
+    ap.add_argument("--knobs", default=None,
+                    help="comma-separated knobs (and presets) to sweep; default: all")
     ap.add_argument("--self-test", action="store_true",
                     help="check the Pareto front's dominance rule and exit (ctest runs this)")
     ap.add_argument("--check-knobs", action="store_true",
@@ -142,19 +167,25 @@ def main():
     # renders its own references instead of taking another scene's.
     with open(a.scene, "rb") as f:
         scene_hash = hashlib.sha256(f.read()).hexdigest()[:12]
-    refs = []
-    for seed in (0, 1):
+    ref_frames = a.frames if a.eval_frame is None else "%d-%d" % (a.eval_frame, a.eval_frame)
+    ref_last = last if a.eval_frame is None else a.eval_frame
+    refs = a.references.split(",") if a.references else []
+    if a.references and (len(refs) != 2 or not all(
+            os.path.exists(os.path.join(r, "%04d.exr" % ref_last)) for r in refs)):
+        sys.exit("tradeoff: --references: two directories with %04d.exr expected" % ref_last)
+    for seed in (0, 1) if not refs else ():
         ref = os.path.join(a.out, "reference-%s-%s-%s-centres-%dspp-seed%d" % (
-            scene_hash, a.frames, a.size, a.spp, seed))
-        if not os.path.exists(os.path.join(ref, "%04d.exr" % last)):
+            scene_hash, ref_frames, a.size, a.spp, seed))
+        if not os.path.exists(os.path.join(ref, "%04d.exr" % ref_last)):
             print("tradeoff: reference, %d spp, seed %d" % (a.spp, seed), file=sys.stderr,
                   flush=True)
             t, _, _ = bench.run([os.path.join(a.bin, "rad-reference"), a.scene, "-o", ref,
-                              "--frames", a.frames, "--fps", "24", "--size", a.size, "--spp",
+                              "--frames", ref_frames, "--fps", "24", "--size", a.size, "--spp",
                               str(a.spp), "--seed", str(seed), "--pixel-centres"], log)
-            print("tradeoff: reference took %.1f s (%.2f s/frame)" % (t, t / nframes),
-                  file=sys.stderr)
+            print("tradeoff: reference took %.1f s" % t, file=sys.stderr)
         refs.append(ref)
+    if a.eval_frame is not None:
+        refs = [os.path.join(r, "%04d.exr" % a.eval_frame) for r in refs]
     noise = bench.ReferenceNoise(a.bin, refs)
     print("tradeoff: reference noise %.2f %% of the mean, removed from the errors"
           % (100 * noise.noise_over_mean()), file=sys.stderr)
@@ -162,15 +193,19 @@ def main():
     # The default is timed first and again last (its least CPU time over both is kept): the
     # machine's speed drifts over a 10-minute sweep (another job ending on the other core made
     # later settings 7 % faster than the same computation timed first).
-    runs = ([("default", None, None, "-")] + [(k, s, f, v) for k, s, f, vs in KNOBS for v in vs]
-            + [("default", None, None, "-")])
+    chosen = set(a.knobs.split(",")) if a.knobs else None
+    runs = ([("default", "-", {})]
+            + [(k, v, {s: [f, v]}) for k, s, f, vs in KNOBS for v in vs
+               if chosen is None or k in chosen]
+            + [("preset", name, flags) for name, flags in PRESETS
+               if chosen is None or "preset" in chosen or name in chosen]
+            + [("default", "-", {})])
     # One untimed run first: the first run pays for cold caches (binaries, scene, references).
     bench.pipeline(a.bin, a.scene, os.path.join(a.out, "runs", "warm-up"), a.frames, a.size, {},
                    log)
     settings = {}  # (knob, value) -> row; insertion order, so the default comes first
-    for knob, stage, flag, value in runs:
+    for knob, value, flags in runs:
         out = os.path.join(a.out, "runs", "%s-%s" % (knob, value))
-        flags = {stage: [flag, value]} if stage else {}
         print("tradeoff: %s = %s" % (knob, value), file=sys.stderr, flush=True)
         try:
             times, walls = [], []
@@ -180,7 +215,10 @@ def main():
                 walls.append(r["total"])
             row = settings.get((knob, value))
             if row is None:  # the frames are compared once: a second timing gives the same frames
-                err = noise.error_of(os.path.join(out, "frames"))
+                frames = os.path.join(out, "frames")
+                if a.eval_frame is not None:
+                    frames = os.path.join(frames, "%04d.exr" % a.eval_frame)
+                err = noise.error_of(frames)
                 row = settings[(knob, value)] = {
                     "knob": knob, "value": value, **err,
                     "peak_mib": r["peak_mib"], "times": [], "walls": []}
@@ -204,6 +242,10 @@ def check_knobs(bin_dir):
     """Fails when a swept flag is not an option of its tool (a renamed flag would otherwise make
     every run of that knob fail and drop out of the sweep)."""
     unknown = [k for k, d in knob_defaults(bin_dir).items() if d == "default"]
+    asked = tool_defaults(bin_dir)
+    unknown += ["preset %s: %s" % (name, f) for name, flags in PRESETS
+                for stage, args in flags.items() for f in args
+                if f.startswith("--") and f[2:] not in asked[stage]]
     if unknown:
         sys.exit("tradeoff.py: %s: not an option of the tool that --print-defaults reports"
                  % ", ".join(unknown))
@@ -264,6 +306,13 @@ def write_plot(out, rows, front, defaults):
             for t, e, v in sorted(pts):
                 f.write("%g %g \"%s\"\n" % (t, e, v))
             f.write("\n\n")
+        presets = [r for r in rows if r["knob"] == "preset"]
+        if presets:  # combined settings: labelled points, not a curve
+            f.write("# presets\n")
+            for r in presets:
+                f.write("%g %g \"%s\"\n" % (r["seconds_per_frame"], r["rmse_over_mean"],
+                                            r["value"]))
+            f.write("\n\n")
         f.write("# pareto\n")
         for i in front:
             f.write("%g %g\n" % (rows[i]["seconds_per_frame"], rows[i]["rmse_over_mean"]))
@@ -274,10 +323,15 @@ def write_plot(out, rows, front, defaults):
     plots = ["'%s' index %d using 1:2 with linespoints title '%s', '' index %d using 1:2:3 "
              "with labels offset 0.8,0.6 font ',8' notitle" % (dat, i, k, i)
              for i, k in enumerate(knobs)]
+    i = len(knobs)
+    if presets:
+        plots.append("'%s' index %d using 1:2 with points pt 5 ps 1.5 title 'presets', '' index %d "
+                     "using 1:2:3 with labels offset 0.8,-0.6 font ',9' notitle" % (dat, i, i))
+        i += 1
     plots.append("'%s' index %d using 1:2 with lines lw 3 lc rgb '#80000000' title 'Pareto front'"
-                 % (dat, len(knobs)))
+                 % (dat, i))
     plots.append("'%s' index %d using 1:2 with points pt 7 ps 2 lc rgb 'black' title 'default'"
-                 % (dat, len(knobs) + 1))
+                 % (dat, i + 1))
     with open(gp, "w") as f:
         f.write("set terminal pngcairo size 900,600\n" if has_cairo() else
                 "set terminal png size 900,600\n")
