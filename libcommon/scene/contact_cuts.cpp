@@ -227,10 +227,11 @@ std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPol
         lo = std::min(lo, h);
         hi = std::max(hi, h);
       }
-      if (lo < -tol || hi > kContactGap * A.size) continue;
-      // Coincident and facing away: B's own back copy (a double-sided material) or a shell.
-      if (hi <= tol && facing < 0.0 && std::abs(A.world.area() - B.world.area()) <= minArea)
-        continue;
+      // A gap there must be: a polygon lying on B (a box's bottom on a floor, a partition's top
+      // against a ceiling) hides what it covers, which rad-global's exposure and rad-movies'
+      // covered texels already leave out; cutting B there too only added patches (the cubic
+      // scene: 189 -> 557, and its default frames 1.65 -> 1.98 %).
+      if (lo < -tol || hi <= tol || hi > kContactGap * A.size) continue;
       // A's outline on B's plane, CCW about B's normal.
       Outline a;
       for (int k = 0; k < A.world.count; ++k) {

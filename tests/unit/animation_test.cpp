@@ -437,8 +437,10 @@ TEST(InputPolygons, CutAlongTheOutlineOfAPolygonFlatAgainstThem) {
   EXPECT_EQ(underLamp, 1);
   EXPECT_EQ(rims, 8);
 
-  // Farther than kContactGap times the lamp's size, behind the ceiling, or moving: not cut.
+  // Farther than kContactGap times the lamp's size, lying on it (no gap), behind the ceiling,
+  // or moving: not cut.
   EXPECT_EQ(lampUnderCeiling(0.03).inputPolygons().size(), 2u);
+  EXPECT_EQ(lampUnderCeiling(0.0).inputPolygons().size(), 2u);
   EXPECT_EQ(lampUnderCeiling(-0.001).inputPolygons().size(), 2u);
   Scene moving = lampUnderCeiling(0.001);
   AnimationChannel ch;
