@@ -6,9 +6,11 @@
 #       one run), total and per-frame time, speed-up, peak memory, links updated per key;
 #       coherent and scratch against two rad-reference renders at one frame (0: skip);
 #       out/bench/tables.csv
-#   make -f pipelines/bench.mk tradeoff [TRADEOFF_FRAMES=0-47] [TRADEOFF_SIZE=176x120] [TRADEOFF_SPP=128] [TRADEOFF_REPEAT=3]
-#       each accuracy knob swept against a converged rad-reference render: time per frame vs
-#       RMSE, Pareto front; out/tradeoff/tradeoff.csv and tradeoff.png (gnuplot)
+#   make -f pipelines/bench.mk tradeoff [TRADEOFF_SCENE=...] [TRADEOFF_FRAMES=0-47] [TRADEOFF_SIZE=176x120] [TRADEOFF_SPP=128] [TRADEOFF_REPEAT=3]
+#                                       [TRADEOFF_EVAL_FRAME=20] [TRADEOFF_REFERENCES=DIR0,DIR1] [TRADEOFF_OUT=out/tradeoff]
+#       each accuracy knob swept, and the draft and final presets, against a converged
+#       rad-reference render: time per frame vs RMSE, Pareto front; TRADEOFF_OUT/tradeoff.csv
+#       and tradeoff.png (gnuplot)
 #   make -f pipelines/bench.mk scale [SCALE_TRIANGLES=1000,3000,10000,30000,100000] [SCALE_FRAMES=0-95] [SCALE_MAX_SECONDS=1800] [SCALE_MOVING_LIGHT=1]
 #       the lecture hall of make_hall.py at each triangle count through the four stages: each
 #       stage's time and peak memory, rad-global's links, the log-log slopes of links and
@@ -33,6 +35,7 @@ TRADEOFF_FRAMES ?= 0-47
 TRADEOFF_SIZE ?= 176x120
 TRADEOFF_SPP ?= 128
 TRADEOFF_REPEAT ?= 3
+TRADEOFF_OUT ?= out/tradeoff
 
 SCALE_TRIANGLES ?= 1000,3000,10000,30000,100000
 SCALE_FRAMES ?= 0-95
@@ -56,7 +59,9 @@ tables:
 
 tradeoff:
 	python3 pipelines/tradeoff.py --bin $(BIN) --scene $(TRADEOFF_SCENE) --frames $(TRADEOFF_FRAMES) \
-	  --size $(TRADEOFF_SIZE) --spp $(TRADEOFF_SPP) --repeat $(TRADEOFF_REPEAT) --out out/tradeoff
+	  --size $(TRADEOFF_SIZE) --spp $(TRADEOFF_SPP) --repeat $(TRADEOFF_REPEAT) \
+	  $(if $(TRADEOFF_EVAL_FRAME),--eval-frame $(TRADEOFF_EVAL_FRAME)) \
+	  $(if $(TRADEOFF_REFERENCES),--references $(TRADEOFF_REFERENCES)) --out $(TRADEOFF_OUT)
 
 contact:
 	python3 pipelines/contact.py --bin $(BIN) --out out/contact
