@@ -239,10 +239,13 @@ std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPol
         a.push_back(x - glm::dot(x - B.world.v[0], B.normal) * B.normal);
       }
       if (facing < 0.0) std::reverse(a.begin(), a.end());
-      // A gap makes B's radiosity fall towards the outline over a few gaps on either side (a
-      // point d from the edge loses the part of its hemisphere below atan(gap / d)): rims 4 gaps
-      // wide outside and inside the outline are pieces of their own, whose movies resolve it.
-      const double rim = 4.0 * std::max(hi, 0.0);
+      // A gap makes B's radiosity fall towards the outline over a few gaps on either side: a
+      // point d from a long edge loses (1 - a / sqrt(1 + a^2)) / 2 of its cosine hemisphere to
+      // A, a = d / gap (50 % at the edge, 15 % at 1 gap, 5 % at 2, 1.5 % at 4). Rims 2 gaps wide
+      // outside and inside the outline are pieces of their own, whose movies resolve that fall
+      // (the bundled scene, final setting: rims of 1, 2, 4, 8 gaps gave 0.94, 0.96, 1.05,
+      // 1.13 %; none, 1.18 %).
+      const double rim = kRimGaps * hi;
       std::vector<Outline> outlines{a};
       if (rim > tol) {
         outlines.insert(outlines.begin(), offsetOutline(a, rim, B.normal));

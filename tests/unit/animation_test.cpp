@@ -391,7 +391,7 @@ Scene lampUnderCeiling(double gap) {
   return s;
 }
 
-// contact_cuts.h: the ceiling is cut along the lamp's outline and along rims 4 gaps wide
+// contact_cuts.h: the ceiling is cut along the lamp's outline and along rims 2 gaps wide
 // outside and inside it, each by a pinwheel of convex quads; nothing else changes.
 TEST(InputPolygons, CutAlongTheOutlineOfAPolygonFlatAgainstThem) {
   const std::vector<InputPolygon> polys = lampUnderCeiling(0.001).inputPolygons();
@@ -400,7 +400,7 @@ TEST(InputPolygons, CutAlongTheOutlineOfAPolygonFlatAgainstThem) {
     if (p.node == 0) ceiling.push_back(p);
   ASSERT_EQ(polys.size() - ceiling.size(), 1u);  // the lamp is not cut
   ASSERT_EQ(ceiling.size(), 13u);                // 4 + 4 outer rim + 4 inner rim + 1
-  // Local frame (the node scales by 4): the lamp's outline is [0.375, 0.5]^2, the rims 1 mm.
+  // Local frame (the node scales by 4): the lamp's outline is [0.375, 0.5]^2, the rims 0.5 mm.
   double area = 0.0;
   int underLamp = 0, rims = 0;
   for (const InputPolygon& p : ceiling) {
@@ -416,7 +416,7 @@ TEST(InputPolygons, CutAlongTheOutlineOfAPolygonFlatAgainstThem) {
       EXPECT_NEAR(p.uv[k].y, p.local.v[k].y, 1e-12);
     }
     // No piece straddles the outline or a rim's edge: each lies inside or outside each square.
-    for (double r : {0.0, 0.001, -0.001}) {
+    for (double r : {0.0, 0.0005, -0.0005}) {
       const double q0 = 0.375 - r, q1 = 0.5 + r;
       const double overlap = std::max(0.0, std::min(hi.x, q1) - std::max(lo.x, q0)) *
                              std::max(0.0, std::min(hi.y, q1) - std::max(lo.y, q0));
@@ -425,12 +425,12 @@ TEST(InputPolygons, CutAlongTheOutlineOfAPolygonFlatAgainstThem) {
       EXPECT_TRUE(overlap < 1e-12 || inside) << p.local.toString() << " square " << r;
     }
     const double width = std::min(hi.x - lo.x, hi.y - lo.y);
-    if (std::abs(width - 0.001) < 1e-12)
+    if (std::abs(width - 0.0005) < 1e-12)
       ++rims;
     else  // no sliver along the lines: the other pieces are at least the core's width across
-      EXPECT_GE(width, 0.123 - 1e-12) << p.local.toString();
-    if (glm::length(lo - glm::dvec3(0.376, 0.376, 0)) < 1e-12 &&
-        glm::length(hi - glm::dvec3(0.499, 0.499, 0)) < 1e-12)
+      EXPECT_GE(width, 0.124 - 1e-12) << p.local.toString();
+    if (glm::length(lo - glm::dvec3(0.3755, 0.3755, 0)) < 1e-12 &&
+        glm::length(hi - glm::dvec3(0.4995, 0.4995, 0)) < 1e-12)
       ++underLamp;
   }
   EXPECT_NEAR(area, 1.0, 1e-12);
