@@ -231,10 +231,16 @@ double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& nIn, cons
   // on the plane to rounding (a vertex on a shared edge, computed by a cut: contact_cuts.h) is
   // not in front; otherwise its form factor is singular at whichever side rounding puts it
   // (the error oracle then refined a ceiling at 1e-3 scale and not at 1).
-  // Rounding is relative to the coordinates as well as to the polygon's size.
-  double scale = std::max(glm::length(p), glm::length(v[0]));
-  for (std::size_t k = 1; k < count; ++k) scale = std::max(scale, glm::length(v[k] - v[0]));
-  if (!(glm::dot(m, p - v[0]) > 1e-13 * scale)) return 0.0;
+  // Rounding is relative to the coordinates as well as to the polygon's size (largest
+  // component: no square root on this path, which every texel's every link takes).
+  const double height = glm::dot(m, p - v[0]);
+  if (!(height > 0.0)) return 0.0;
+  auto largest = [](const glm::dvec3& x) {
+    return std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)});
+  };
+  double scale = std::max(largest(p), largest(v[0]));
+  for (std::size_t k = 1; k < count; ++k) scale = std::max(scale, largest(v[k] - v[0]));
+  if (!(height > 1e-13 * scale)) return 0.0;
 
   // Horizon clipping to n . (x - p) >= 0 (Sutherland-Hodgman against one plane).
   bool anyIn = false, anyOut = false;

@@ -2,6 +2,7 @@
 #include "libcommon/scene/contact_cuts.h"
 
 #include "libcommon/scene/box_tree.h"
+#include "libcommon/scene/patch_hierarchy.h"
 #include "libcommon/scene/scene.h"
 
 #include <algorithm>
@@ -112,29 +113,17 @@ bool pinwheel(std::vector<Outline>& pieces, const Outline& a, const glm::dvec3& 
   return cut;
 }
 
-// uv and shading normal of `source` at point x of its plane: barycentric in the triangle
-// (v0, v1, v2) or, for a quad, (v0, v2, v3) on its side of the diagonal. A quad's uv map is one
-// affine map (Scene's merge rule), so either triangle gives it exactly.
+// uv and shading normal of `source` at point x of its plane, as the rest of the toolchain
+// interpolates them: at x's (u,v) in the polygon's own map (polygonUvAt), the texture coordinates
+// like points (polygonPointAt) and the normals by shadingNormalAt; a flat source stays flat.
 void attributesAt(const InputPolygon& source, const glm::dvec3& x, glm::dvec2& uv,
                   glm::dvec3& normal) {
-  const Polygon& p = source.local;
-  std::array<size_t, 3> t{0, 1, 2};
-  if (p.count == 4) {
-    const glm::dvec3 n = p.normal();
-    if (glm::dot(glm::cross(p.v[2] - p.v[0], x - p.v[0]), n) > 0.0) t = {0, 2, 3};
-  }
-  const glm::dvec3 e1 = p.v[t[1]] - p.v[t[0]], e2 = p.v[t[2]] - p.v[t[0]], d = x - p.v[t[0]];
-  const double a = glm::dot(e1, e1), b = glm::dot(e1, e2), c = glm::dot(e2, e2);
-  const double det = a * c - b * b;
-  double l1 = 0.0, l2 = 0.0;
-  if (det > 0.0) {
-    l1 = (glm::dot(d, e1) * c - glm::dot(d, e2) * b) / det;
-    l2 = (glm::dot(d, e2) * a - glm::dot(d, e1) * b) / det;
-  }
-  const double l0 = 1.0 - l1 - l2;
-  uv = l0 * source.uv[t[0]] + l1 * source.uv[t[1]] + l2 * source.uv[t[2]];
-  normal = l0 * source.normal[t[0]] + l1 * source.normal[t[1]] + l2 * source.normal[t[2]];
-  if (source.normal[0] == glm::dvec3(0.0)) normal = glm::dvec3(0.0);  // flat stays flat
+  const glm::dvec2 at = polygonUvAt(source.local, x);
+  Polygon uvs;
+  uvs.count = source.local.count;
+  for (int k = 0; k < uvs.count; ++k) uvs.v[size_t(k)] = glm::dvec3(source.uv[size_t(k)], 0.0);
+  uv = glm::dvec2(polygonPointAt(uvs, at));
+  normal = source.normal[0] == glm::dvec3(0.0) ? glm::dvec3(0.0) : shadingNormalAt(source, at);
 }
 
 // A convex piece of `source` as quads and at most one triangle: (0,1,2,3), (0,3,4,5), ...
@@ -162,36 +151,42 @@ struct Placed {
   Polygon world;
   glm::dvec3 normal{0.0};
   double size = 0.0;  // longest edge
+  AxisBox bounds{glm::dvec3(1.0), glm::dvec3(-1.0)};
 };
 
 }  // namespace
 
 std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPolygon> polygons) {
   const double t0 = scene.startTime(), t1 = scene.endTime();
+  // Per mesh node, once: whether it stays still, and where.
+  std::vector<int> still(scene.nodes.size(), -1);
+  std::vector<glm::dmat4> toWorld(scene.nodes.size());
   std::vector<Placed> placed(polygons.size());
   std::vector<AxisBox> reach(polygons.size(), AxisBox{glm::dvec3(1.0), glm::dvec3(-1.0)});
   for (size_t i = 0; i < polygons.size(); ++i) {
-    const int node = polygons[i].node;
+    const size_t node = size_t(polygons[i].node);
+    if (still[node] < 0) {
+      still[node] = !scene.isDynamic(int(node), t0, t1);
+      if (still[node]) toWorld[node] = scene.worldTransform(int(node), t0);
+    }
     Placed& p = placed[i];
-    p.still = !scene.isDynamic(node, t0, t1);
+    p.still = still[node];
     if (!p.still) continue;
-    p.world = polygons[i].local.transformed(scene.worldTransform(node, t0));
+    p.world = polygons[i].local.transformed(toWorld[node]);
     p.normal = p.world.normal();
     if (p.normal == glm::dvec3(0.0)) {
       p.still = false;  // degenerate: cuts nothing, is cut by nothing
       continue;
     }
-    for (int k = 0; k < p.world.count; ++k)
-      p.size = std::max(
-          p.size, glm::length(p.world.v[size_t((k + 1) % p.world.count)] - p.world.v[size_t(k)]));
-    // A's reach: its bounds grown by the gap it may have to a polygon it cuts and its rim.
-    AxisBox b{p.world.v[0], p.world.v[0]};
-    for (int k = 1; k < p.world.count; ++k) {
-      b[0] = glm::min(b[0], p.world.v[size_t(k)]);
-      b[1] = glm::max(b[1], p.world.v[size_t(k)]);
+    p.bounds = {p.world.v[0], p.world.v[0]};
+    for (int k = 0; k < p.world.count; ++k) {
+      const glm::dvec3& v = p.world.v[size_t(k)];
+      p.size = std::max(p.size, glm::length(p.world.v[size_t((k + 1) % p.world.count)] - v));
+      p.bounds = {glm::min(p.bounds[0], v), glm::max(p.bounds[1], v)};
     }
-    const glm::dvec3 grow(4.0 * kContactGap * p.size);
-    reach[i] = {b[0] - grow, b[1] + grow};
+    // A's reach: its bounds grown by the gap it may have to a polygon it cuts, or by its rim.
+    const glm::dvec3 grow(std::max(1.0, kRimGaps) * kContactGap * p.size);
+    reach[i] = {p.bounds[0] - grow, p.bounds[1] + grow};
   }
   const BoxTree tree(reach);
 
@@ -204,13 +199,8 @@ std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPol
       out.push_back(polygons[bi]);
       continue;
     }
-    AxisBox box{B.world.v[0], B.world.v[0]};
-    for (int k = 1; k < B.world.count; ++k) {
-      box[0] = glm::min(box[0], B.world.v[size_t(k)]);
-      box[1] = glm::max(box[1], B.world.v[size_t(k)]);
-    }
     near.clear();
-    tree.query(box[0], box[1], near);
+    tree.query(B.bounds[0], B.bounds[1], near);
     const double tol = 1e-9 * B.size;
     const double minArea = 1e-9 * B.world.area();
     std::vector<Outline> pieces{Outline(B.world.v.begin(), B.world.v.begin() + B.world.count)};
@@ -259,7 +249,7 @@ std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPol
       continue;
     }
     // Back to B's local frame, where its attributes are defined.
-    const glm::dmat4 toLocal = glm::inverse(scene.worldTransform(polygons[bi].node, t0));
+    const glm::dmat4 toLocal = glm::inverse(toWorld[size_t(polygons[bi].node)]);
     for (Outline& piece : pieces) {
       for (glm::dvec3& x : piece) x = glm::dvec3(toLocal * glm::dvec4(x, 1.0));
       emitPiece(polygons[bi], piece, out);
