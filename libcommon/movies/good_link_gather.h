@@ -21,8 +21,10 @@
 // a concave corner, the bright band next to a lit wall. For an unoccluded link the texel's sum is
 // the exact form factor, so a closed room sums to 1 at every texel, not only per element.
 //
-// A link whose stored V is partial (0 < V < 1 at a key the movie needs) takes its visibility
-// per texel instead, V(x, q): --gather-rays shadow rays from x to points on the shooter part q
+// A link whose stored V is partial (0 < V < 1 at a key the movie needs), or 0 while the link is
+// active (none of its ray pairs got through, yet it may be partly visible), takes its
+// visibility per texel instead when its risk B_q F (1 - V) is at least kPartialShare of what
+// the texel gathers, V(x, q): --gather-rays shadow rays from x to points on the shooter part q
 // (the same points for every texel), each weighted by the kernel and by the global solution's B
 // at its end (pointVisibility), so that
 //
@@ -168,8 +170,9 @@ class GoodLinkGather {
     // over a cell (one per finest cell), so that a leaf split into cells casts as many rays.
     int rays = 0;
     bool moves = false;  // an end moves during the movie: F per key
-    // Partly occluded at a needed key (0 < V < 1): V per texel from rays to its shooter part
-    // instead of the link's one V (pointVisibility); its weight is then B_q alone.
+    // Partly occluded at a needed key (0 < V < 1, or V = 0 while active) and risky enough: V per
+    // texel from rays to its shooter part instead of the link's one V (pointVisibility); its
+    // weight is then B_q alone at every key where the link is active.
     bool partial = false;
     // Coherence (§5), as the bad layer's static and dynamic blockers: the rays of a partial link
     // whose ends do not move are cast against the static blockers once per movie; against the
