@@ -47,6 +47,7 @@ KNOBS = [
     ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32"]),
     ("gather-rays", "movies", "--gather-rays", ["0", "4", "32"]),
     ("near-shooter-levels", "movies", "--near-shooter-levels", ["1", "2"]),
+    ("gather-partial-share", "movies", "--gather-partial-share", ["0.001", "0.004"]),
 ]
 # Combined settings, each one more row of the sweep (knob "preset"): what the README recommends
 # for drafts and for final frames, so that the front shows where they stand among the knobs.
@@ -54,7 +55,7 @@ PRESETS = [
     ("draft", {"global": ["--eps", "0.02"]}),
     ("final", {"global": ["--eps", "1e-5", "--key-step", "4", "--rays", "64"],
                "movies": ["--min-samples", "64", "--movie-key-step", "2",
-                          "--near-shooter-levels", "2"]}),
+                          "--near-shooter-levels", "2", "--gather-partial-share", "0.001"]}),
 ]
 TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
          "compose": "rad-compose"}

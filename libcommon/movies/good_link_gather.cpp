@@ -155,7 +155,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
                                const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
                                double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
                                SceneVisibility* visibility, int visibilityRays,
-                               int nearShooterLevels)
+                               int nearShooterLevels, double partialShare)
     : scene_(scene),
       solution_(solution),
       clusterCorners_(byReceiver.clusterCorners),
@@ -167,7 +167,8 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
       visibilityRays_(visibilityRays),
       byReceiver_(byReceiver),
       nearShooterLevels_(visibility && visibilityRays > 0 && shooterRatio > 0.0 ? nearShooterLevels
-                                                                                : 0) {
+                                                                                : 0),
+      partialShare_(partialShare) {
   // The nodes in the moving part of the visibility scene, those that move anywhere in the
   // solution's time range (SceneVisibility's split), with their bounds swept over the movie:
   // one that rests during the movie still blocks. Only the nodes moving during the movie had
@@ -565,8 +566,8 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
   });
   if (!visibility_) return;
   // Per texel visibility where it matters: a partial link whose risk is at least
-  // kPartialShare of what its receiver node and the node's ancestors carry (a texel gathers at
-  // least that); the others keep the link's V, an error below that share each.
+  // --gather-partial-share of what its receiver node and the node's ancestors carry (a texel
+  // gathers at least that); the others keep the link's V, an error below that share each.
   const PatchHierarchy& h = solution_.hierarchy;
   std::map<int, double> chain;  // receiver node -> what it and its ancestors carry
   for (size_t j = 0; j < links_.size(); ++j)
@@ -583,7 +584,7 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
     Link& l = links_[j];
     const int r = int(solution_.links[l.row].receiver);
-    l.partial = risk[j] >= 0.0 && risk[j] >= kPartialShare * total.at(r);
+    l.partial = risk[j] >= 0.0 && risk[j] >= partialShare_ * total.at(r);
     if (l.partial) planVisibility(l, needed);
   });
 }

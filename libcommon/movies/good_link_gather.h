@@ -23,8 +23,8 @@
 //
 // A link whose stored V is partial (0 < V < 1 at a key the movie needs), or 0 while the link is
 // active (none of its ray pairs got through, yet it may be partly visible), takes its
-// visibility per texel instead when its risk B_q F (1 - V) is at least kPartialShare of what
-// the texel gathers, V(x, q): --gather-rays shadow rays from x to points on the shooter part q
+// visibility per texel instead when its risk B_q F (1 - V) is at least --gather-partial-share of
+// what the texel gathers, V(x, q): --gather-rays shadow rays from x to points on the shooter part q
 // (the same points for every texel), each weighted by the kernel and by the global solution's B
 // at its end (pointVisibility), so that
 //
@@ -154,7 +154,7 @@ class GoodLinkGather {
                  const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
                  double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
                  SceneVisibility* visibility = nullptr, int visibilityRays = 16,
-                 int nearShooterLevels = 0);
+                 int nearShooterLevels = 0, double partialShare = 0.002);
 
   // acc[x] = G(x, t), the cluster irradiance of the receiver's top included (every texel).
   void gather(double t, std::vector<glm::dvec3>& acc) const;
@@ -199,11 +199,9 @@ class GoodLinkGather {
   // Texels are planned in tiles of kTile x kTile; a link whose shooter part is farther than
   // kTileFarRatio times a tile's size is evaluated at the tile's corners and interpolated.
   static constexpr int kTile = 8;
-  // A partly occluded link gets V per texel when B F V (1 - V) is at least this share of what
-  // its receiver chain carries. On table-static-static (25 frames): every partial link 1.82 %
-  // RMSE / mean, rad-movies 10.5 s; 0.001: 2.01 %, 5.6 s; 0.003: 2.43 %, 5.4 s; 0.01: 3.84 %;
-  // one V per node (--gather-rays 0) 4.32 %, 4.9 s. The bundled scene: 6.02, 6.00, 6.19, 7.15 %.
-  static constexpr double kPartialShare = 0.001;
+  // --gather-partial-share: a partly occluded link gets V per texel when its risk B F (1 - V)
+  // is at least this share of what its receiver chain carries (TextureMovieBakerOptions).
+  double partialShare_ = 0.002;
   static constexpr double kTileFarRatio = 2.0;
   struct Tile {
     int i0 = 0, j0 = 0, i1 = 0, j1 = 0;  // first texel and the corner texels (last column, row)

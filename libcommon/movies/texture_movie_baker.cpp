@@ -778,6 +778,7 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"good-layer", goodLayerName(goodLayer)},
           {"gather-shooter-ratio", gatherShooterRatio},
           {"gather-rays", gatherRays},
+          {"gather-partial-share", gatherPartialShare},
           {"near-shooter-levels", nearShooterLevels},
           {"no-fill-covered", !fillCovered},
           {"moving-shadow-key-step", movingShadowKeyStep},
@@ -1001,7 +1002,7 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
         scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
         options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather,
         options_.gatherRays > 0 ? sceneVisibility() : nullptr, options_.gatherRays,
-        options_.nearShooterLevels);
+        options_.nearShooterLevels, options_.gatherPartialShare);
     stats_.secondsGood += secondsSince(clock);
   }
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);

@@ -145,6 +145,12 @@ int main(int argc, char** argv) {
                  "gather: shadow rays from each texel to a partly occluded link's shooter, "
                  "1..64 (0: the link's one visibility over its receiver)")
       ->capture_default_str();
+  app.add_option("--gather-partial-share", b.gatherPartialShare,
+                 "gather: a partly occluded link takes its visibility per texel when B F (1 - V) "
+                 "is at least this share of what the texel gathers (smaller: more links per "
+                 "texel, slower; the final setting uses 0.001)")
+      ->capture_default_str()
+      ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--near-shooter-levels", b.nearShooterLevels,
                  "gather: split a near leaf shooter into up to 4^L cells, each with its radiosity "
                  "re-gathered at its centre from the leaf's links, 0..3 (0: the leaf's one "
