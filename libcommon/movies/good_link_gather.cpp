@@ -523,20 +523,20 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
     for (int k = 0; k < K; ++k) {
       if (!needed[size_t(k)]) continue;
       const double fv = solution_.linkFvAtKey(g, k);
+      const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(l.shooter), k) * cellRatio(l, k);
       if (!(fv > 0.0)) {
         // Active, but no ray pair got through (V = 0): the link may still be partly visible (a
         // wall 20 % visible through a doorway has all 16 pairs blocked 3 % of the time). Kept at
         // 0 it is lost from every texel, while the links whose V came out above 0 are corrected
         // per texel: the sum of F V over the cubic scene's walls' texels 0.98-0.99 in a closed
         // furnace, 0.99-1.00 with these. Its risk is what it would carry unoccluded, B_q F.
-        if (visibility_ && storedVisibility && k >= int(g.firstKey) && k <= int(g.lastKey)) {
+        if (visibility_ && storedVisibility && GlobalSolution::linkActiveAtKey(g, k)) {
           double f = hiddenF;
           if (f < 0.0) {
             const double t = solution_.keyTimes[size_t(k)];
             f = areaAverageFormFactor(nodeWorld(g.receiver, t), linkWorld(l, t), 1e-3);
             if (!l.moves) hiddenF = f;
           }
-          const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(l.shooter), k) * cellRatio(l, k);
           if (f > 0.0) risk[j] = std::max(risk[j], (b.x + b.y + b.z) * f);
         }
         continue;
@@ -553,12 +553,11 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
         }
         v = f > 0.0 ? fv / f : 0.0;
       }
-      // A receiver partly covered by a touching solid: V counts the covered sample points as
-      // occluded towards shooters outside the solid; the texel is exposed.
-      const glm::dvec3 b = solution_.exposedRadiosityAtKey(int(l.shooter), k) * cellRatio(l, k);
       carried[j] = std::max(carried[j], (b.x + b.y + b.z) * fv);
       if (visibility_ && storedVisibility && v > 0.0 && v < 1.0)
         risk[j] = std::max(risk[j], (b.x + b.y + b.z) * fv / v * (1.0 - v));
+      // A receiver partly covered by a touching solid: V counts the covered sample points as
+      // occluded towards shooters outside the solid; the texel is exposed.
       const double e = solution_.exposureAtKey(int(g.receiver), k);
       v = e > 0.0 ? std::clamp(v / e, 0.0, 1.0) : 0.0;
       l.weight[size_t(k)] = b * v;
@@ -835,7 +834,7 @@ void GoodLinkGather::planVisibility(Link& l, const std::vector<char>& needed) co
   const GlobalLink& g = solution_.links[l.row];
   const int K = solution_.keyCount(), k = l.rays;
   for (int key = 0; key < K; ++key)
-    if (needed[size_t(key)] && key >= int(g.firstKey) && key <= int(g.lastKey))
+    if (needed[size_t(key)] && GlobalSolution::linkActiveAtKey(g, key))
       l.weight[size_t(key)] =
           solution_.exposedRadiosityAtKey(int(l.shooter), key) * cellRatio(l, key);
   l.seed = linkSeed(h.node(int(g.receiver)).id, h.node(int(l.shooter)).id);

@@ -153,8 +153,8 @@ class GoodLinkGather {
                  GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                  const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
                  double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
-                 SceneVisibility* visibility = nullptr, int visibilityRays = 16,
-                 int nearShooterLevels = 0, double partialShare = 0.002);
+                 SceneVisibility* visibility, int visibilityRays, int nearShooterLevels,
+                 double partialShare);
 
   // acc[x] = G(x, t), the cluster irradiance of the receiver's top included (every texel).
   void gather(double t, std::vector<glm::dvec3>& acc) const;
@@ -201,7 +201,7 @@ class GoodLinkGather {
   static constexpr int kTile = 8;
   // --gather-partial-share: a partly occluded link gets V per texel when its risk B F (1 - V)
   // is at least this share of what its receiver chain carries (TextureMovieBakerOptions).
-  double partialShare_ = 0.002;
+  double partialShare_;
   static constexpr double kTileFarRatio = 2.0;
   struct Tile {
     int i0 = 0, j0 = 0, i1 = 0, j1 = 0;  // first texel and the corner texels (last column, row)

@@ -167,14 +167,14 @@ double sampleAtKey(const uint32_t* keys, const float* values, uint32_t n, int ke
 }  // namespace
 
 double GlobalSolution::linkFvAtKey(const GlobalLink& l, int key) const {
-  if (key < int(l.firstKey) || key > int(l.lastKey)) return 0.0;
+  if (!linkActiveAtKey(l, key)) return 0.0;
   return sampleAtKey(&linkSampleKeys[l.sampleOffset], &linkSampleValues[l.sampleOffset],
                      l.sampleCount, key);
 }
 
 double GlobalSolution::linkVisibilityAtKey(const GlobalLink& l, int key) const {
   if (linkSampleVisibility.empty()) return 1.0;
-  if (key < int(l.firstKey) || key > int(l.lastKey)) return 0.0;
+  if (!linkActiveAtKey(l, key)) return 0.0;
   return sampleAtKey(&linkSampleKeys[l.sampleOffset], &linkSampleVisibility[l.sampleOffset],
                      l.sampleCount, key);
 }

@@ -110,6 +110,10 @@ class GlobalSolution {
   // F·V of link row l at key k: piecewise linear through its samples, held outside them; 0 when
   // k is outside the row's activity interval.
   double linkFvAtKey(const GlobalLink& l, int key) const;
+  // Whether link row l is active at key k (within [firstKey, lastKey]).
+  static bool linkActiveAtKey(const GlobalLink& l, int key) {
+    return key >= int(l.firstKey) && key <= int(l.lastKey);
+  }
   // V of link row l at key k, the same way (1 when the file has no visibility samples).
   double linkVisibilityAtKey(const GlobalLink& l, int key) const;
   // Shooter tops of the bad pairs whose receiver is `receiverTop`, ascending.
