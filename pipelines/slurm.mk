@@ -50,8 +50,17 @@ split-frames = $(shell awk -v a=$(word 1,$(subst -, ,$(FRAMES))) -v b=$(word 2,$
   for (i = 0; i < n; ++i) printf "%d-%d ", a + int(c * i / n), a + int(c * (i + 1) / n) - 1 }')
 CHUNKS := $(call split-frames,$(SHARDS))
 CHUNK_COUNT := $(words $(CHUNKS))
-# rad-global's time windows, and the window files the merge joins.
-WINDOWS := $(call split-frames,$(GLOBAL_WINDOWS))
+# rad-global's time windows, and the window files the merge joins. rad-global deals out the key
+# times (`--print-windows`, the key grid of --frames and --key-step), so no window is without one
+# however GLOBAL_WINDOWS and the key step meet; a plain split of the frames is not.
+ifeq ($(GLOBAL_WINDOWS),1)
+WINDOWS := $(FRAMES)
+else
+WINDOWS := $(shell $(BIN)/rad-global $(SCENE) -o $(OUT)/global.rlh $(GLOBAL_ARGS) --print-windows $(GLOBAL_WINDOWS))
+ifeq ($(strip $(WINDOWS)),)
+$(error slurm.mk: GLOBAL_WINDOWS=$(GLOBAL_WINDOWS): $(BIN)/rad-global --print-windows gave no windows (build it first))
+endif
+endif
 WINDOW_COUNT := $(words $(WINDOWS))
 WINDOW_FILES := $(foreach i,$(shell seq 0 $$(($(WINDOW_COUNT) - 1))),$(OUT)/global-windows/w$(i).rkw)
 

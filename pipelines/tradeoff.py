@@ -39,7 +39,7 @@ import bench  # noqa: E402
 # (`--print-defaults`), not from a copy here.
 KNOBS = [
     ("eps", "global", "--eps", ["0.5", "0.1", "0.02", "0.005", "0.001", "0.0001"]),
-    ("key-step", "global", "--key-step", ["16", "12", "4", "2"]),
+    ("key-step", "global", "--key-step", ["32", "24", "8", "4"]),
     ("bad-links", "global", "--bad-links", ["none", "partial", "all"]),
     ("rays", "global", "--rays", ["4", "64"]),
     ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "2"]),

@@ -58,6 +58,18 @@ KeyIndexRange windowKeys(const FrameRange& frames, int keyStep, const std::strin
   return r;
 }
 
+std::vector<FrameRange> keyWindows(const FrameRange& frames, int keyStep, int count) {
+  const std::vector<int> keys = keyFrames(frames.first, frames.last, keyStep);
+  const size_t K = keys.size(), n = std::min(K, size_t(std::max(count, 1)));
+  std::vector<FrameRange> out;
+  for (size_t i = 0; i < n; ++i) {
+    const size_t firstKey = K * i / n, nextKey = K * (i + 1) / n;
+    out.push_back(
+        {i == 0 ? frames.first : keys[firstKey], i + 1 == n ? frames.last : keys[nextKey] - 1});
+  }
+  return out;
+}
+
 std::vector<std::string> argumentsWithoutMerge(int argc, const char* const* argv,
                                                const std::vector<std::string>& merged) {
   std::vector<std::string> out;

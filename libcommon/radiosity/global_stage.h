@@ -21,12 +21,14 @@ struct GlobalOptions {
   // (animationFrames). The key times span the first to the last frame named.
   std::string frames;
   double fps = 24.0;  // frame f is at time f / fps
-  // Frames between key times (>= 1; the last frame is always one). 8, not 4: on four scenes
-  // (the bundled one, 8 cubes, the table with moving lights, static and following camera; 48
-  // frames, tradeoff.py) 8 gave the same error against the path-traced reference to 0.03 % and
-  // 17-28 % less CPU time; the good links' indirect light between keys is smooth, and the
-  // lights' (bad) links are re-evaluated per movie key anyway.
-  int keyStep = 8;
+  // Frames between key times (>= 1; the last frame is always one). 16: on the bundled scene and
+  // 8 cubes (frames 0-24, tradeoff.py at f74227a) 16 gave the error of 8 to 0.003 points at 17 %
+  // less CPU time, so 8 was off the speed/accuracy front. With a moving light over 400 frames
+  // (table-dynamic-static, frames 8, 24, ..., 392, midway between keys 16 apart) the frames
+  // differ from --key-step 2 by 0.28-0.34 % RMSE / mean (8: 0.17-0.23 %), against a default
+  // error of 1.6-2.5 %; rad-global took 13.6 s instead of 22.7 s. The good links' indirect
+  // light between keys is smooth, and the lights' (bad) links are re-evaluated per movie key.
+  int keyStep = 16;
   // radiosity.minArea 0 (the default): resolveMinArea's 1e-4 of the largest top-level patch.
   SpaceTimeOptions spaceTime;
   // The render farm (issue 17): `window` FIRST-LAST solves only the run's key times within
@@ -52,6 +54,13 @@ struct KeyIndexRange {
   size_t first = 0, last = 0;
 };
 KeyIndexRange windowKeys(const FrameRange& frames, int keyStep, const std::string& window);
+
+// The run's frames split into at most `count` contiguous windows for --window, each holding
+// whole key times: the key times are dealt out as evenly as they go, and each window runs from
+// its first key frame to the frame before the next window's (the first from frames.first, the
+// last to frames.last). A split of the frames alone leaves windows with no key frame once they
+// are shorter than --key-step (the render farm's GLOBAL_WINDOWS, `rad-global --print-windows`).
+std::vector<FrameRange> keyWindows(const FrameRange& frames, int keyStep, int count);
 
 // The command line the whole run has that a --merge run stands for: argv without "--merge" and
 // the values it took (`merged`, in order), nor "--merge=VALUE". The merged file's provenance

@@ -32,6 +32,32 @@ TEST(GlobalStage, WindowKeysAreTheRunsKeysWithinTheFrames) {
   }
 }
 
+// The farm's windows (--print-windows) tile the frames and each holds at least one key frame,
+// whatever the window count and the key step: a plain split of frames 0-23 in three at key step
+// 16 (keys 0, 16, 23) left 8-15 without one, and that window's rad-global refused to run.
+TEST(GlobalStage, KeyWindowsTileTheFramesAndEachHoldsAKey) {
+  for (const FrameRange frames : {FrameRange{0, 23}, FrameRange{5, 100}, FrameRange{7, 7}})
+    for (int step : {1, 4, 8, 16, 48})
+      for (int count : {1, 2, 3, 5, 64}) {
+        const std::vector<FrameRange> w = keyWindows(frames, step, count);
+        const std::vector<int> keys = keyFrames(frames.first, frames.last, step);
+        ASSERT_FALSE(w.empty());
+        EXPECT_EQ(w.size(), std::min(size_t(count), keys.size()));
+        EXPECT_EQ(w.front().first, frames.first);
+        EXPECT_EQ(w.back().last, frames.last);
+        size_t held = 0;
+        for (size_t i = 0; i < w.size(); ++i) {
+          if (i > 0) {
+            EXPECT_EQ(w[i].first, w[i - 1].last + 1);
+          }
+          const KeyIndexRange r = windowKeys(frames, step, w[i].toString());  // throws if none
+          held += r.last - r.first + 1;
+        }
+        EXPECT_EQ(held, keys.size());
+      }
+  EXPECT_EQ(keyWindows({0, 23}, 16, 3).at(1).toString(), "16-22");
+}
+
 TEST(GlobalStage, MergeRunRecordsTheWholeRunsCommandLine) {
   auto without = [](std::vector<const char*> argv, std::vector<std::string> merged) {
     return argumentsWithoutMerge(int(argv.size()), argv.data(), merged);

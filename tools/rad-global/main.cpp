@@ -23,6 +23,7 @@ constexpr const char* kTool = "rad-global";
 
 struct Options {
   std::string scene, output, report;
+  int printWindows = 0;  // > 0: print that many --window ranges and exit (no solve)
   rad::GlobalOptions global;
 };
 
@@ -120,6 +121,13 @@ void addOptions(CLI::App& app, Options& o) {
                  "same bytes as the run without --merge, provenance included")
       ->type_name("WINDOW")
       ->excludes(window);
+  app.add_option("--print-windows", o.printWindows,
+                 "render farm: print at most N --window ranges of the run's frames, each holding "
+                 "whole key times, on one line, and exit without solving (pipelines/slurm.mk's "
+                 "GLOBAL_WINDOWS)")
+      ->type_name("N")
+      ->check(rad::positiveInteger())
+      ->excludes(window);
 }
 
 // The metadata of both outputs: what ran.
@@ -175,10 +183,21 @@ void writeHierarchy(const Options& o, const rad::Scene& scene, const rad::FrameR
   report.secondsWrite = rad::secondsSince(tWrite);
 }
 
+// --print-windows: the --window ranges of a farm run, on one line.
+int printWindows(const rad::FrameRange& frames, int keyStep, int count) {
+  const char* sep = "";
+  for (const rad::FrameRange& w : rad::keyWindows(frames, keyStep, count))
+    std::cout << sep << w.toString(), sep = " ";
+  std::cout << "\n";
+  return 0;
+}
+
 int run(Options o, int argc, char** argv) {
   auto tStart = std::chrono::steady_clock::now();
   rad::GlobalOptions& g = o.global;
   std::vector<int> given = g.frames.empty() ? std::vector<int>{} : rad::parseFrameRange(g.frames);
+  if (o.printWindows > 0 && !given.empty())  // the key grid alone: no scene read, no solve
+    return printWindows({given.front(), given.back()}, g.keyStep, o.printWindows);
   rad::GlobalReport report;
   auto tRead = std::chrono::steady_clock::now();
   rad::Scene scene = rad::readGltfScene(o.scene);
@@ -187,6 +206,7 @@ int run(Options o, int argc, char** argv) {
   rad::FrameRange frames = given.empty() ? rad::animationFrames(scene, g.fps)
                                          : rad::FrameRange{given.front(), given.back()};
   if (given.empty()) g.frames = frames.toString();  // the provenance says what ran
+  if (o.printWindows > 0) return printWindows(frames, g.keyStep, o.printWindows);
   std::vector<double> keyTimes = rad::keyTimesOf(frames, g.keyStep, g.fps);
   g.spaceTime.radiosity.minArea =
       rad::resolveMinArea(scene, g.spaceTime.radiosity.minArea, keyTimes.front());
@@ -219,7 +239,7 @@ int main(int argc, char** argv) {
   Options o;
   rad::setUpApp(
       app, kTool,
-      "rad-global scene.gltf -o global.rlh --frames 0-95 --fps 24 --key-step 8\n"
+      "rad-global scene.gltf -o global.rlh --frames 0-95 --fps 24 --key-step 16\n"
       "Render farm: windows side by side, then the merge (the bytes of the run without --window\n"
       "or --merge; the windows need the run's --frames):\n"
       "  rad-global scene.gltf -o w0.rkw --frames 0-95 --window 0-47\n"
