@@ -70,15 +70,10 @@ std::pair<const uint32_t*, const uint32_t*> ClusterLinks::membersOf(ClusterRef r
   return {base + n.first, base + n.first + n.count};
 }
 
-size_t ClusterLinks::activeCount() const {
-  size_t n = 0;
-  for (const ClusterLink& l : links_) n += l.refined ? 0 : 1;
-  return n;
-}
 
-// A link between r and s, unless they cannot exchange energy: a top-level patch end sees
-// nothing of a cluster whose bounding box lies wholly on or behind its plane.
-void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<size_t>& next) {
+// A link between r and s into `next`, unless they cannot exchange energy: a top-level patch end
+// sees nothing of a cluster whose bounding box lies wholly on or behind its plane.
+void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next) {
   auto behind = [&](ClusterRef patch, ClusterRef other) {
     if (isCluster(patch) || !isCluster(other)) return false;
     // The normal and centroid kept per top (the same values): recomputing them here for each
@@ -96,8 +91,7 @@ void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<size_t>& next) {
   ClusterLink l;
   l.receiver = r;
   l.shooter = s;
-  next.push_back(links_.size());
-  links_.push_back(l);
+  next.push_back(l);
 }
 
 bool ClusterLinks::wantsRefinement(const ClusterLink& l, double epsAbs) const {
@@ -117,36 +111,47 @@ bool ClusterLinks::wantsRefinement(const ClusterLink& l, double epsAbs) const {
 
 size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
                             std::vector<std::pair<int, int>>& patchPairs, bool& overBudget) {
-  std::vector<size_t> work;
-  for (size_t i = 0; i < links_.size(); ++i)
-    if (!links_[i].refined) work.push_back(i);
-  const size_t start = links_.size();
-  size_t count = 0;
+  // Level by level: `work` holds one level's links, `next` their children, `kept` the links
+  // that stay. A refined link is dropped at once, so memory holds the links in use and one
+  // level's children, not every link refinement went through: on the 10k-triangle hall the
+  // vector that kept them all until the end had reached 470 MB for 1.2 M live links (heaptrack).
+  // The links keep the order they had that way (each level's survivors after the last's).
+  std::vector<ClusterLink> work, kept;
+  work.swap(links_);
+  kept.reserve(work.size());
+  size_t made = 0, count = 0;
   listsValid_ = false;
-  auto pairOrLink = [&](ClusterRef r, ClusterRef s, std::vector<size_t>& next) {
+  auto pairOrLink = [&](ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next) {
     if (!isCluster(r) && !isCluster(s)) {
       if (r != s) patchPairs.emplace_back(r, s);
     } else {
+      const size_t before = next.size();
       link(r, s, next);
+      made += next.size() - before;
     }
   };
   while (!work.empty()) {
-    std::vector<size_t> next;
-    for (size_t li : work) {
+    std::vector<ClusterLink> next;
+    for (const ClusterLink& l : work) {
       // Past the link bound only the lights' links go on: a light left inside a cluster link
       // would reach its receivers without shadows (the 30k-triangle hall lost 92 % of its
       // bad pairs so). They are bounded by the top-level patches times the lights. A refined
       // link is replaced by its children, so it no longer counts (`count` of them this call).
-      if (links_.size() - start + patchPairs.size() > budget + count) overBudget = true;
-      const ClusterLink l = links_[li];  // a copy: link() may move links_
-      if (l.refined || (overBudget && !emits(l.shooter))) continue;
+      if (made + patchPairs.size() > budget + count) overBudget = true;
+      if (overBudget && !emits(l.shooter)) {
+        kept.push_back(l);
+        continue;
+      }
       if (l.receiver == l.shooter) {  // a cluster's self-link: its children's pairs
         const std::vector<ClusterRef>& ch = tree_.node(clusterIndex(l.receiver)).children;
         for (ClusterRef a : ch)
           for (ClusterRef b : ch)
             if (a != b || isCluster(a)) pairOrLink(a, b, next);
       } else {
-        if (!refineAll && !wantsRefinement(l, epsAbs)) continue;
+        if (!refineAll && !wantsRefinement(l, epsAbs)) {
+          kept.push_back(l);
+          continue;
+        }
         // Split the larger cluster (a top-level patch end is split by the patch hierarchy).
         const bool splitReceiver =
             isCluster(l.receiver) &&
@@ -155,26 +160,17 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
         for (ClusterRef c : tree_.node(clusterIndex(split)).children)
           splitReceiver ? pairOrLink(c, l.shooter, next) : pairOrLink(l.receiver, c, next);
       }
-      links_[li].refined = true;
       ++count;
     }
     work.swap(next);
   }
-  compact();
+  links_.swap(kept);
   return count;
-}
-
-// The refined links are not needed any more (their children replace them): dropped, so that
-// memory holds the links in use, not every link refinement went through.
-void ClusterLinks::compact() {
-  links_.erase(
-      std::remove_if(links_.begin(), links_.end(), [](const ClusterLink& l) { return l.refined; }),
-      links_.end());
 }
 
 void ClusterLinks::evaluate() {
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t i) {
-    if (!links_[i].refined && !links_[i].evaluated) evaluateLink(links_[i]);
+    if (!links_[i].evaluated) evaluateLink(links_[i]);
   });
   listsValid_ = false;
 }
@@ -268,7 +264,7 @@ void ClusterLinks::buildReceiverLists() {
   std::vector<std::vector<uint32_t>> atTop(emits_.size()), atCluster(size_t(tree_.size()));
   for (uint32_t i = 0; i < uint32_t(links_.size()); ++i) {
     const ClusterLink& l = links_[i];
-    if (l.refined || !l.evaluated) continue;
+    if (!l.evaluated) continue;
     (isCluster(l.receiver) ? atCluster[size_t(clusterIndex(l.receiver))]
                            : atTop[size_t(l.receiver)])
         .push_back(i);
@@ -341,7 +337,7 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, std::vector<glm::
   linkB_.assign(links_.size(), glm::dvec3(0.0));
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t i) {
     const ClusterLink& l = links_[i];
-    if (l.refined || !l.evaluated) return;
+    if (!l.evaluated) return;
     if (!isCluster(l.shooter)) {
       linkB_[i] = topB[size_t(l.shooter)];
       return;
@@ -369,7 +365,7 @@ std::vector<double> ClusterLinks::rowSums() const {
   const size_t T = emits_.size();
   std::vector<double> out(T, 0.0);
   for (const ClusterLink& l : links_) {
-    if (l.refined || !l.evaluated) continue;
+    if (!l.evaluated) continue;
     auto add = [&](uint32_t t) { out[t] += formFactor(l, t); };
     if (isCluster(l.receiver)) {
       auto [b, e] = membersOf(l.receiver);

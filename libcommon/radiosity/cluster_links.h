@@ -45,7 +45,6 @@ struct ClusterLink {
   double transfer = 0;        // V P_S / pi: H_i = transfer max(0, n_i . omega_i) B_S / r_i^2
   double visibility = 1;      // V_RS (1 until evaluated)
   bool evaluated = false;
-  bool refined = false;  // replaced by its children's links (then dropped: compact())
 };
 
 // A cluster link's values that the next key time may take over (coherence, paper §4.2), keyed
@@ -92,11 +91,10 @@ class ClusterLinks {
   size_t size() const { return links_.size(); }
   size_t reusedCount() const { return reused_; }
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
-  size_t activeCount() const;
   const std::vector<ClusterLink>& links() const { return links_; }
 
  private:
-  void link(ClusterRef r, ClusterRef s, std::vector<size_t>& next);
+  void link(ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next);
   bool wantsRefinement(const ClusterLink& l, double epsAbs) const;
   const ClusterBounds& bounds(ClusterRef r) const {
     return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];
@@ -110,7 +108,6 @@ class ClusterLinks {
   // The member tops of r: [first, last) in tree_.members() (a top: itself).
   std::pair<const uint32_t*, const uint32_t*> membersOf(ClusterRef r) const;
   void evaluateLink(ClusterLink& l);
-  void compact();
   double formFactor(const ClusterLink& l, uint32_t top) const;
   void buildReceiverLists();
 

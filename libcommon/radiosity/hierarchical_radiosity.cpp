@@ -1001,7 +1001,7 @@ class KeyTimeSolver {
       for (int t = 0; t < h_.topCount(); ++t)
         if (exposure_[size_t(t)] > 0.0)
           s_.topClusterIrradiance[size_t(t)] = clusterH_[size_t(t)] / exposure_[size_t(t)];
-      s_.clusterLinks = clusters_->activeCount();
+      s_.clusterLinks = clusters_->size();
       s_.clusterLinksReused = clusters_->reusedCount();
       s_.clusterLinkValues = clusters_->links();
       s_.clusterBounds = clusters_->clusterBounds();
