@@ -70,7 +70,6 @@ std::pair<const uint32_t*, const uint32_t*> ClusterLinks::membersOf(ClusterRef r
   return {base + n.first, base + n.first + n.count};
 }
 
-
 // A link between r and s into `next`, unless they cannot exchange energy: a top-level patch end
 // sees nothing of a cluster whose bounding box lies wholly on or behind its plane.
 void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next) {
