@@ -178,6 +178,12 @@ class KeyTimeSolver {
   }
 
   KeySolution run() {
+    auto withMargin = [](size_t n) { return n + n / 32 + 1024; };
+    if (input_.expectedLinks > 0) s_.links.reserve(withMargin(input_.expectedLinks));
+    if (input_.expectedRayPairs > 0) {
+      pairs_.reserve(withMargin(input_.expectedRayPairs));
+      pairState_.reserve(withMargin(input_.expectedRayPairs));
+    }
     if (input_.clusters && !input_.clusters->empty()) {
       topEmits_.resize(size_t(h_.topCount()));
       for (int t = 0; t < h_.topCount(); ++t)

@@ -377,6 +377,8 @@ class KeyTimePass {
     LeafFormFactorCache leafCache;
     ClusterLinkCache clusterCache;
     double secondsCoherence = 0;
+    in.expectedLinks = prev.links.size();
+    in.expectedRayPairs = prev.rayPairs.size();
     if (opt_.coherence && k > first_) {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
