@@ -53,9 +53,10 @@ CHUNK_COUNT := $(words $(CHUNKS))
 # rad-global's time windows, and the window files the merge joins. rad-global deals out the key
 # times (`--print-windows`, the key grid of --frames and --key-step), so no window is without one
 # however GLOBAL_WINDOWS and the key step meet; a plain split of the frames is not.
+# `clean` and `stage-commands` need no windows, and so no built rad-global.
 ifeq ($(GLOBAL_WINDOWS),1)
 WINDOWS := $(FRAMES)
-else
+else ifneq ($(filter-out clean stage-commands,$(or $(MAKECMDGOALS),all)),)
 WINDOWS := $(shell $(BIN)/rad-global $(SCENE) -o $(OUT)/global.rlh $(GLOBAL_ARGS) --print-windows $(GLOBAL_WINDOWS))
 ifeq ($(strip $(WINDOWS)),)
 $(error slurm.mk: GLOBAL_WINDOWS=$(GLOBAL_WINDOWS): $(BIN)/rad-global --print-windows gave no windows (build it first))
