@@ -1,10 +1,17 @@
 // rad-movies' shard loop and movie-file sink. Sources in movie_sequence.h.
 #include "formats/movie_sequence.h"
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <memory>
+#include <mutex>
+#include <thread>
+
+#include <tbb/global_control.h>
 
 #include "formats/atomic_file.h"
 #include "formats/texture_movie.h"
@@ -86,22 +93,84 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     throw outputError(options.moviesDir, "cannot create the movie directory" +
                                              (ec ? ": " + ec.message() : std::string()));
   const std::string provenanceJson = provenance.toJson().dump();
+  const std::vector<const MovieExtent*> movies = shardMovies(intervals, options.shard);
+
+  // One worker per allowed thread (--threads), each baking whole movies with its own baker:
+  // the 10k hall's movies are mostly 4 x 4 texels, too small for the per-texel loops inside a
+  // movie to keep two cores busy. `baker` is worker 0 on this thread; the others are its
+  // siblings, made, used and destroyed on their own threads (each holds a GL context). A movie
+  // is made whole by one baker, so the files do not depend on the number of workers.
+  const size_t workers = std::clamp<size_t>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1,
+      std::max<size_t>(movies.size(), 1));
+  struct Worker {
+    double secondsWrite = 0.0;
+    TextureMovieBakerStats stats;  // a sibling's, handed over when its thread ends
+    std::string rendererName;
+  };
+  std::vector<Worker> done(workers);
+  std::vector<double> movieSeconds(movies.size(), -1.0);
+  std::atomic<size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::mutex mutex;  // progress and the first failure
+  size_t failedAt = movies.size();
+  std::exception_ptr failure;
+
+  auto work = [&](TextureMovieBaker& mine, Worker& w) {
+    MovieFileSink sink(mine.options().coherence, w.secondsWrite);
+    for (size_t i; !stop && (i = next++) < movies.size();) {
+      const MovieExtent& m = *movies[i];
+      const auto movieStart = SteadyClock::now();
+      sink.start(textureMovieOf(m, provenanceJson), textureMoviePath(options.moviesDir, m.movie));
+      try {
+        mine.bake(m, sink);
+      } catch (...) {
+        sink.discard();
+        std::lock_guard<std::mutex> lock(mutex);
+        if (i < failedAt) failedAt = i, failure = std::current_exception();  // the lowest id's
+        stop = true;
+        return;
+      }
+      movieSeconds[i] = secondsSince(movieStart);
+      if (progress) {
+        std::lock_guard<std::mutex> lock(mutex);
+        progress();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (size_t k = 1; k < workers; ++k)
+    threads.emplace_back([&, k] {
+      Worker& w = done[k];
+      try {
+        std::unique_ptr<TextureMovieBaker> sibling = baker.sibling();
+        work(*sibling, w);
+        w.stats = sibling->stats();
+        w.rendererName = sibling->rendererName();
+      } catch (...) {  // the sibling's construction or teardown
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        stop = true;
+      }
+    });
+  work(baker, done[0]);
+  for (std::thread& t : threads) t.join();
+  for (size_t k = 1; k < workers; ++k) baker.addStats(done[k].stats, done[k].rendererName);
+
   MovieSequenceReport report;
-  MovieFileSink sink(baker.options().coherence, report.secondsWrite);
-  for (const MovieExtent* m : shardMovies(intervals, options.shard)) {
-    const auto movieStart = SteadyClock::now();
-    sink.start(textureMovieOf(*m, provenanceJson), textureMoviePath(options.moviesDir, m->movie));
+  for (const Worker& w : done) report.secondsWrite += w.secondsWrite;
+  if (failure) {
     try {
-      baker.bake(*m, sink);
+      std::rethrow_exception(failure);
     } catch (const Error& e) {
-      sink.discard();
       // Name the file the bad movie came from.
       if (e.code() == ExitCode::kBadInput) throw inputError(options.intervalsPath, e.what());
       throw;
     }
+  }
+  for (size_t i = 0; i < movies.size(); ++i) {
     ++report.moviesBaked;
-    report.movieSeconds.emplace_back(m->movie, secondsSince(movieStart));
-    if (progress) progress();
+    report.movieSeconds.emplace_back(movies[i]->movie, movieSeconds[i]);
   }
   // One sync for all movies (AtomicFile::Durability::kDeferred) before the tool reports
   // success: Make's movies/.done stamp follows our exit status.

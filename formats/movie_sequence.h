@@ -1,9 +1,10 @@
 // rad-movies' movie loop (DESIGN.md §6 "rad-movies"; paper §3.1, §5), next to rad-compose's
-// (frame_sequence.h): the movies of one shard of intervals.rti are baked one after another
-// (libcommon/movies/texture_movie_baker.h) and each is streamed key by key into
+// (frame_sequence.h): the movies of one shard of intervals.rti are baked by one worker per
+// thread, each taking the next movie and baking it whole with its own baker
+// (libcommon/movies/texture_movie_baker.h), and each is streamed key by key into
 // MOVIES_DIR/MMMMMM.exr (formats/texture_movie.h TextureMovieWriter), committed atomically
 // when the movie is done and synced once for all movies at the end. Peak memory is one movie's
-// working buffers whatever the animation's length.
+// working buffers per worker whatever the animation's length.
 #pragma once
 
 #include <cstdint>
@@ -43,11 +44,15 @@ struct MovieSequenceReport {
 // The movies of `shard`, in id order.
 std::vector<const MovieExtent*> shardMovies(const TextureIntervals& intervals, MovieShard shard);
 
-// Bakes and writes every movie of the shard; `progress` is called after each movie. A movie
+// Bakes and writes every movie of the shard with as many workers as TBB's allowed parallelism
+// (the tools' --threads): `baker` and baker.sibling()s, whose stats are added to `baker`'s at
+// the end. `progress` is called after each movie, from one worker at a time. A movie
 // whose keys are all equal is stored with one key when the baker's coherence is on. Throws
 // rad::inputError(intervalsPath, ...) for a movie the baker refuses as bad input,
 // rad::outputError when MOVIES_DIR or a movie cannot be written, and passes the baker's other
-// errors on (kEnvironment for the memory budget); a movie that fails leaves no file.
+// errors on (kEnvironment for the memory budget); a movie that fails leaves no file, the
+// workers stop after their current movie, and of the movies that failed, the lowest id's
+// error is thrown.
 MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureIntervals& intervals,
                                       const MovieSequenceOptions& options,
                                       const Provenance& provenance,

@@ -878,7 +878,51 @@ OcclusionMaskRenderer& TextureMovieBaker::renderer() {
 }
 
 std::string TextureMovieBaker::rendererName() const {
-  return renderer_ ? renderer_->rendererName() : std::string();
+  return renderer_ ? renderer_->rendererName() : siblingRendererName_;
+}
+
+std::unique_ptr<TextureMovieBaker> TextureMovieBaker::sibling() const {
+  return std::make_unique<TextureMovieBaker>(scene_, solution_, fps_, options_, backends_);
+}
+
+void TextureMovieBaker::addStats(const TextureMovieBakerStats& stats,
+                                 const std::string& rendererName) {
+  stats_ += stats;
+  if (siblingRendererName_.empty()) siblingRendererName_ = rendererName;
+}
+
+TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBakerStats& o) {
+  movies += o.movies;
+  constantMovies += o.constantMovies;
+  keys += o.keys;
+  texels += o.texels;
+  badPairs += o.badPairs;
+  staticPairs += o.staticPairs;
+  dynamicPairs += o.dynamicPairs;
+  samples += o.samples;
+  staticBlockers += o.staticBlockers;
+  dynamicBlockers += o.dynamicBlockers;
+  passes += o.passes;
+  samplePasses += o.samplePasses;
+  rayCastPasses += o.rayCastPasses;
+  passesSavedByCoherence += o.passesSavedByCoherence;
+  coveredTexelsFilled += o.coveredTexelsFilled;
+  gather.links += o.gather.links;
+  gather.entries += o.gather.entries;
+  gather.cachedEntries += o.gather.cachedEntries;
+  gather.tileEntries += o.gather.tileEntries;
+  gather.partialLinks += o.gather.partialLinks;
+  gather.partialLinksMovingBlockers += o.gather.partialLinksMovingBlockers;
+  gather.nearShooterLeaves += o.gather.nearShooterLeaves;
+  gather.nearShooterSeconds += o.gather.nearShooterSeconds;
+  secondsGood += o.secondsGood;
+  secondsFormFactor += o.secondsFormFactor;
+  secondsTransmittance += o.secondsTransmittance;
+  secondsCombine += o.secondsCombine;
+  secondsFormFactorScan += o.secondsFormFactorScan;
+  for (const std::string& w : o.warnings)
+    if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
+  return *this;
 }
 
 double TextureMovieBaker::movieWorkingBytes(int width, int height, size_t badShooters) {

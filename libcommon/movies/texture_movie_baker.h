@@ -164,6 +164,8 @@ struct TextureMovieBakerStats {
   // (which fixes N): the price of baking key by key without every key's form factors held.
   double secondsFormFactorScan = 0;
   std::vector<std::string> warnings;
+  // Adds another baker's counters and seconds (bakeMovieSequence's workers, one baker each).
+  TextureMovieBakerStats& operator+=(const TextureMovieBakerStats& other);
   nlohmann::json toJson() const;
 };
 
@@ -196,6 +198,15 @@ class TextureMovieBaker {
   // The renderer's GL_RENDERER, or "" when no render was needed yet.
   std::string rendererName() const;
 
+  // A baker of the same scene, solution, options and backends for another thread. It has its
+  // own mask renderer (a GL context is current in one thread at a time), blocker and good-link
+  // indexes and scene visibility (whose moving part is set to each key's time, and whose
+  // near-shooter store fills as movies go; the values stored do not depend on the order, so
+  // every movie comes out the same whichever baker makes it).
+  std::unique_ptr<TextureMovieBaker> sibling() const;
+  // Adds a sibling's counters; takes its renderer's name when this baker rendered nothing.
+  void addStats(const TextureMovieBakerStats& stats, const std::string& rendererName);
+
  private:
   const Scene& scene_;
   const GlobalSolution& solution_;
@@ -204,6 +215,7 @@ class TextureMovieBaker {
   TextureMovieBakerBackends backends_;
   std::vector<InputPolygon> tops_;
   std::unique_ptr<OcclusionMaskRenderer> renderer_;
+  std::string siblingRendererName_;                 // addStats: a sibling's, if this one has none
   std::unique_ptr<BlockerIndex> blockers_;          // made on the first bake
   std::unique_ptr<GoodLinksByReceiver> goodLinks_;  // --good-layer gather
   std::unique_ptr<SceneVisibility> visibility_;     // the gather's rays and the covered texels

@@ -151,6 +151,25 @@ TEST_F(RadMoviesCli, ShardsPartitionTheMoviesAndBaselineAgrees) {
   EXPECT_EQ(files, movieCount_);
 }
 
+// rad-movies bakes whole movies on one worker per thread (formats/movie_sequence.h): the
+// movies must not depend on how many there are, and the report adds the workers' counts up.
+TEST_F(RadMoviesCli, WorkersPerThreadChangeNoMovieAndTheReportAddsUp) {
+  ASSERT_EQ(runCommand(command("one", "--threads 1 --report " + path("one.json"))).exitCode, 0);
+  ASSERT_EQ(runCommand(command("three", "--threads 3 --report " + path("three.json"))).exitCode, 0);
+  for (int id = 0; id < movieCount_; ++id) {
+    TextureMovie a = readTextureMovie(textureMoviePath(path("one"), uint32_t(id)));
+    TextureMovie b = readTextureMovie(textureMoviePath(path("three"), uint32_t(id)));
+    EXPECT_EQ(a.keys, b.keys) << id;
+  }
+  nlohmann::json one = nlohmann::json::parse(readWholeFile(path("one.json")));
+  nlohmann::json three = nlohmann::json::parse(readWholeFile(path("three.json")));
+  for (const char* count : {"movies", "keys", "texels", "bad_pairs", "samples", "render_passes",
+                            "sample_passes", "blockers_static", "good_layer_gather"})
+    EXPECT_EQ(one[count], three[count]) << count;
+  EXPECT_EQ(three["movie_seconds"].size(), size_t(movieCount_));
+  EXPECT_EQ(one["renderer"], three["renderer"]);
+}
+
 TEST_F(RadMoviesCli, UsageAndInputErrorsAreOneLine) {
   CommandResult r = runCommand(command("x", "--shard 3/2"));
   EXPECT_EQ(r.exitCode, 2) << r.err;
