@@ -549,10 +549,13 @@ CameraView Scene::cameraAt(int node, double t) const {
 
 std::vector<int> movingNodesOf(const Scene& scene, const std::vector<InputPolygon>& polygons,
                                double t0, double t1) {
-  std::vector<int> seen, moving;
+  // In the order of first appearance; a flag per scene node (rad-movies asks per movie, and
+  // a search of the nodes seen so far made this quadratic in the hall's thousands of nodes).
+  std::vector<char> seen(scene.nodes.size(), 0);
+  std::vector<int> moving;
   for (const InputPolygon& p : polygons) {
-    if (p.node < 0 || std::find(seen.begin(), seen.end(), p.node) != seen.end()) continue;
-    seen.push_back(p.node);
+    if (p.node < 0 || size_t(p.node) >= seen.size() || seen[size_t(p.node)]) continue;
+    seen[size_t(p.node)] = 1;
     if (scene.isDynamic(p.node, t0, t1)) moving.push_back(p.node);
   }
   return moving;
