@@ -16,6 +16,7 @@ nlohmann::json IntervalsOptions::toJson() const {
           {"min-size", b.minSize},
           {"max-size", b.maxSize},
           {"resize-tolerance", b.resizeTolerance},
+          {"size-ratio", b.sizeRatio},
           {"max-length", b.maxLength}};
 }
 

@@ -43,6 +43,7 @@ void TextureIntervalsOptions::validate() const {
     throw bad("--level-hysteresis", "must be in [0, 1]");
   if (!(resizeTolerance >= 0.0) || !std::isfinite(resizeTolerance))
     throw bad("--resize-tolerance", "must be >= 0");
+  if (!(sizeRatio >= 1.2 && sizeRatio <= 4.0)) throw bad("--size-ratio", "must be in [1.2, 4]");
   if (maxLength < 0) throw bad("--max-length", "must be >= 0 (0 = unlimited)");
 }
 
@@ -51,10 +52,12 @@ int textureSideFor(double projectedPixels, int current, const TextureIntervalsOp
   double n = std::sqrt(std::max(0.0, projectedPixels) * o.texelDensity);
   if (current > 0) {
     double tol = 1.0 + o.resizeTolerance;
-    if (n > current / (2.0 * tol) && n <= current * tol) return current;
+    if (n > current / (o.sizeRatio * tol) && n <= current * tol) return current;
   }
+  // The first side of the ladder round(r^k), k = 0, 1, ... that holds n texels.
   long side = 1;
-  while (side < n && side < (1L << 20)) side <<= 1;
+  for (int k = 1; side < n && side < (1L << 20); ++k)
+    side = std::lround(std::pow(o.sizeRatio, double(k)));
   side = std::clamp<long>(side, o.minSize, o.maxSize);
   return int(side);
 }

@@ -97,6 +97,7 @@ std::vector<MovieExtent> moviesOfTop(const std::vector<MovieExtent>& all, int to
 
 TEST(TextureSize, PowerOfTwoClampedWithHysteresis) {
   TextureIntervalsOptions o;
+  o.sizeRatio = 2.0;
   EXPECT_EQ(textureSideFor(30.0 * 30.0, 0, o), 32);
   EXPECT_EQ(textureSideFor(33.0 * 33.0, 0, o), 64);
   EXPECT_EQ(textureSideFor(1.0, 0, o), 4);            // min size
@@ -112,6 +113,30 @@ TEST(TextureSize, PowerOfTwoClampedWithHysteresis) {
   EXPECT_EQ(textureSideFor(33.0 * 33.0, 32, o), 64);
   EXPECT_EQ(textureSideFor(16.5 * 16.5, 32, o), 32);
   EXPECT_EQ(textureSideFor(16.0 * 16.0, 32, o), 16);
+}
+
+// --size-ratio sqrt 2: sides round(sqrt(2)^k), so a texture holds its patch's pixels with at most
+// twice the texels (powers of two: up to four times).
+TEST(TextureSize, SquareRootOfTwoLadderHoldsEveryPixelWithAtMostTwiceTheTexels) {
+  TextureIntervalsOptions o;
+  o.sizeRatio = std::sqrt(2.0);
+  EXPECT_EQ(textureSideFor(30.0 * 30.0, 0, o), 32);
+  EXPECT_EQ(textureSideFor(23.0 * 23.0, 0, o), 23);
+  EXPECT_EQ(textureSideFor(24.0 * 24.0, 0, o), 32);
+  EXPECT_EQ(textureSideFor(40.0 * 40.0, 0, o), 45);
+  EXPECT_EQ(textureSideFor(5.0 * 5.0, 0, o), 6);
+  EXPECT_EQ(textureSideFor(1.0, 0, o), 4);  // min size
+  EXPECT_EQ(textureSideFor(1e6, 0, o), 256);
+  for (int n = 4; n <= 256; ++n) {
+    const int side = textureSideFor(double(n) * n, 0, o);
+    EXPECT_GE(side, n);
+    EXPECT_LE(double(side) * side, 2.0 * (n + 0.5) * (n + 0.5)) << n;
+  }
+  // Hysteresis: 32 is kept while the ideal side is in (32 / (sqrt 2 x 1.5), 32 x 1.5].
+  EXPECT_EQ(textureSideFor(16.0 * 16.0, 32, o), 32);
+  EXPECT_EQ(textureSideFor(15.0 * 15.0, 32, o), 16);
+  EXPECT_EQ(textureSideFor(48.0 * 48.0, 32, o), 32);
+  EXPECT_EQ(textureSideFor(49.0 * 49.0, 32, o), 64);
 }
 
 TEST(TextureIntervalsOptions, RejectsBadValuesNamingTheFlag) {

@@ -117,6 +117,11 @@ int main(int argc, char** argv) {
                  "keep a texture size while the ideal size is within a factor 1+tol of it")
       ->capture_default_str()
       ->check(rad::nonNegativeFinite());
+  app.add_option("--size-ratio", o.build.sizeRatio,
+                 "texture sides are round(r^k): the default sqrt 2 holds a patch's pixels in at "
+                 "most twice their texels, 2 (the paper's powers of two) in up to four times")
+      ->capture_default_str()
+      ->check(rad::finiteRange(1.2, 4.0));
   app.add_option("--max-length", o.build.maxLength, "longest movie in frames (0 = no limit)")
       ->capture_default_str();
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
