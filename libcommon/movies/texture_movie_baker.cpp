@@ -97,6 +97,10 @@ struct Pair {
   std::vector<double> formFactor;          // coherent: F(x -> S), once per movie
   std::vector<SampleMask> staticMask;      // coherent: static blockers; empty = none (all 0)
   std::vector<long long> spilled;          // moving: key k's form factors in the spill, or -1
+  std::vector<double> keyZeroFormFactor;   // moving: key 0's, until the shares are made
+  double maxFormFactor = 0.0;              // over the texels and the keys scanned
+  double share = 1.0;  // the largest share of a texel's direct light its light gives
+                       // (directShares)
 };
 
 // The receiver of one movie at its key times, and what the blocker tests ask of the scene
@@ -500,10 +504,13 @@ class MovieBake {
     saturatedSamples_ = transmittanceSampleCount(std::numeric_limits<double>::infinity(),
                                                  options_.samplesPerFormFactor, options_.minSamples,
                                                  options_.maxSamples);
+    // Every pair's form factors first: a pair's share of the direct light needs them all.
     for (uint32_t S : badShooters) {
       Pair p;
-      if (planPair(S, p)) pairs_.push_back(std::move(p));
+      if (scanPair(S, p)) pairs_.push_back(std::move(p));
     }
+    directShares();
+    for (Pair& p : pairs_) planPair(p);
   }
 
   // Key k: H = G + sum over the pairs, in badShooters order, of B_S F T (the same arithmetic
@@ -529,7 +536,12 @@ class MovieBake {
   }
 
  private:
-  bool planPair(uint32_t S, Pair& p);
+  static const std::vector<double>& keyZeroFormFactors(const Pair& p) {
+    return p.coherent ? p.formFactor : p.keyZeroFormFactor;
+  }
+  bool scanPair(uint32_t S, Pair& p);
+  void directShares();
+  void planPair(Pair& p);
   double scanFormFactors(Pair& p);
   std::vector<int> blockerCandidates(uint32_t S, const Pair& p);
   void planCoherentBlockers(Pair& p, const std::vector<int>& candidates);
@@ -628,8 +640,8 @@ class MovieBake {
   std::vector<int> movingNear_;  // moving nodes whose bounds over the movie meet the receiver
 };
 
-// One bad pair's per-movie part; false when the shooter cannot reach the patch.
-bool MovieBake::planPair(uint32_t S, Pair& p) {
+// One bad pair's form factors; false when the shooter cannot reach the patch.
+bool MovieBake::scanPair(uint32_t S, Pair& p) {
   if (S >= tops_.size()) return false;
   const InputPolygon& shooterTop = tops_[S];
   ++stats_.badPairs;
@@ -644,14 +656,64 @@ bool MovieBake::planPair(uint32_t S, Pair& p) {
     p.shooterWorld[size_t(k)] =
         shooterTop.local.transformed(geo_.scene().worldTransform(shooterTop.node, geo_.keyTime(k)));
 
-  const double maxF = scanFormFactors(p);
-  if (!(maxF > 0.0)) return false;  // the shooter cannot reach this patch during the movie
+  p.maxFormFactor = scanFormFactors(p);
+  return p.maxFormFactor > 0.0;  // else the shooter cannot reach this patch during the movie
+}
 
-  // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie.
+// Each pair's share of the direct light: the largest, over the texels, of its light's
+// B_S F(x -> S) over the sum of it over every pair, at key 0 (so coherent and --no-coherence
+// agree: they share key 0's form factors). A light is the tops of one mesh node with one
+// material: a lamp split into many tops is as strong as the whole lamp.
+void MovieBake::directShares() {
+  if (!(options_.weakShare > 0.0) || pairs_.size() < 2) return;
   auto clock = SteadyClock::now();
-  p.samples = transmittanceSampleCount(maxF, options_.samplesPerFormFactor, options_.minSamples,
+  const double t = geo_.keyTime(0);
+  std::vector<int> light(pairs_.size());
+  std::vector<std::pair<int, int>> lights;  // (node, material)
+  std::vector<std::vector<double>> lightDirect;
+  std::vector<double> direct(texels_, 0.0);
+  for (size_t i = 0; i < pairs_.size(); ++i) {
+    const InputPolygon& top = tops_[pairs_[i].shooter];
+    const std::pair<int, int> key{top.node, top.material};
+    auto it = std::find(lights.begin(), lights.end(), key);
+    light[i] = int(it - lights.begin());
+    if (it == lights.end()) {
+      lights.push_back(key);
+      lightDirect.emplace_back(texels_, 0.0);
+    }
+    const glm::dvec3 B = solution_.radiosity(int(pairs_[i].shooter), t);
+    const double power = std::max(0.0, B.x + B.y + B.z);
+    const std::vector<double>& f = keyZeroFormFactors(pairs_[i]);
+    std::vector<double>& mine = lightDirect[size_t(light[i])];
+    for (size_t x = 0; x < texels_; ++x) {
+      mine[x] += power * f[x];
+      direct[x] += power * f[x];
+    }
+  }
+  std::vector<double> share(lights.size(), 0.0);
+  for (size_t g = 0; g < lights.size(); ++g)
+    for (size_t x = 0; x < texels_; ++x)
+      if (direct[x] > 0.0) share[g] = std::max(share[g], lightDirect[g][x] / direct[x]);
+  for (size_t i = 0; i < pairs_.size(); ++i) {
+    pairs_[i].share = share[size_t(light[i])];
+    pairs_[i].keyZeroFormFactor = {};
+  }
+  stats_.secondsTransmittance += secondsSince(clock);
+}
+
+// One bad pair's per-movie part after the scan: its samples and blockers.
+void MovieBake::planPair(Pair& p) {
+  const uint32_t S = p.shooter;
+  // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie. A
+  // weak pair (under --weak-share of every texel's direct light) takes a quarter of the
+  // minimum: its penumbra's steps are a quarter of its small share.
+  auto clock = SteadyClock::now();
+  const int minSamples =
+      p.share < options_.weakShare ? std::max(1, options_.minSamples / 4) : options_.minSamples;
+  p.samples = transmittanceSampleCount(p.maxFormFactor, options_.samplesPerFormFactor, minSamples,
                                        options_.maxSamples);
   stats_.samples += p.samples;
+  if (minSamples < options_.minSamples) ++stats_.weakPairs;
   // Seeded by the receiver's top-level patch, not the movie's node: the movies of one surface
   // (a parent's and its children's, neighbours at one level) then take the same sample points
   // when they take as many, and their kernel-weighted penumbrae meet without a step.
@@ -670,7 +732,6 @@ bool MovieBake::planPair(uint32_t S, Pair& p) {
     p.candidates = std::move(candidates);
   }
   stats_.secondsTransmittance += secondsSince(clock);
-  return true;
 }
 
 // The largest form factor over the movie fixes N (and whether the pair matters at all). A
@@ -690,6 +751,7 @@ double MovieBake::scanFormFactors(Pair& p) {
   p.spilled.assign(static_cast<size_t>(K), -1);
   for (int k = 0; k < K; ++k) {
     geo_.formFactorsAt(p, k, keyFormFactor_);
+    if (k == 0 && options_.weakShare > 0.0) p.keyZeroFormFactor = keyFormFactor_;
     for (double v : keyFormFactor_) maxF = std::max(maxF, v);
     p.spilled[size_t(k)] = spill_.put(keyFormFactor_);
     if (maxF > 0.0 &&
@@ -771,6 +833,7 @@ GoodLayer parseGoodLayer(const std::string& name) {
 nlohmann::json TextureMovieBakerOptions::toJson() const {
   return {{"movie-key-step", keyStep},
           {"min-samples", minSamples},
+          {"weak-share", weakShare},
           {"max-samples", maxSamples},
           {"samples-per-form-factor", samplesPerFormFactor},
           {"merge", mergeModeName(merge)},
@@ -795,6 +858,7 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"static_pairs", staticPairs},
           {"dynamic_pairs", dynamicPairs},
           {"samples", samples},
+          {"weak_pairs", weakPairs},
           {"blockers_static", staticBlockers},
           {"blockers_dynamic", dynamicBlockers},
           {"render_passes", passes},
@@ -853,6 +917,8 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
   if (options_.nearShooterLevels < 0 || options_.nearShooterLevels > 3)
     throw Error(ExitCode::kUsage, "--near-shooter-levels", "must be in 0..3");
   if (options_.minSamples < 1) throw Error(ExitCode::kUsage, "--min-samples", "must be >= 1");
+  if (!(options_.weakShare >= 0.0 && options_.weakShare <= 1.0))
+    throw Error(ExitCode::kUsage, "--weak-share", "must be in [0, 1]");
   if (!(options_.samplesPerFormFactor >= 0.0))
     throw Error(ExitCode::kUsage, "--samples-per-form-factor", "must be >= 0");
   if (!(options_.maxTextureMemoryMiB > 0.0))
@@ -900,6 +966,7 @@ TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBak
   staticPairs += o.staticPairs;
   dynamicPairs += o.dynamicPairs;
   samples += o.samples;
+  weakPairs += o.weakPairs;
   staticBlockers += o.staticBlockers;
   dynamicBlockers += o.dynamicBlockers;
   passes += o.passes;

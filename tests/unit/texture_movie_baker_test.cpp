@@ -249,6 +249,51 @@ TEST(TextureMovieBaker, CoherentEqualsTheBaselineAndSavesRenders) {
   EXPECT_LE(sa.passes, 1 + 5);
 }
 
+// --weak-share: a second, far lamp gives the floor ~0.1 % of its direct light and takes a
+// quarter of the minimum samples; the near lamp keeps its own. Coherent still equals the
+// baseline, and the frames move by far less than the weak lamp's share.
+TEST(TextureMovieBaker, AWeakLightTakesAQuarterOfTheMinimumSamples) {
+  TestScene t = makeScene(true, true);
+  const int farNode =
+      addQuadNode(t.scene, {6, -.15, 2}, {6, .15, 2}, {6.3, .15, 2}, {6.3, -.15, 2}, 1);
+  GlobalSolution& g = t.solution;
+  g.hierarchy = PatchHierarchy(t.scene.inputPolygons());
+  const int farTop = topOfNode(g, farNode);
+  ASSERT_GE(farTop, 0);
+  g.nodeRadiosity.assign(size_t(g.hierarchy.size()), glm::vec3(0.0f));
+  g.nodeRadiosity[size_t(t.lightTop)] = g.nodeRadiosity[size_t(farTop)] = glm::vec3(t.lightB);
+  g.leafRow.clear();
+  for (int i = 0; i < g.hierarchy.size(); ++i) g.leafRow.push_back(i);
+  g.leafVertexGoodIrradiance.assign(size_t(g.hierarchy.size()) * 4, glm::vec3(0.0f));
+  g.badPairs = {{uint32_t(t.floorTop), uint32_t(t.lightTop)},
+                {uint32_t(t.floorTop), uint32_t(farTop)}};
+  std::sort(g.badPairs.begin(), g.badPairs.end());
+  g.validate("test");
+
+  TextureMovieBakerOptions all = gouraud(), weak = gouraud(), weakBaseline = gouraud();
+  all.weakShare = 0.0;
+  weak.weakShare = weakBaseline.weakShare = 0.1;
+  weakBaseline.coherence = false;
+  TextureMovieBaker a(t.scene, g, kFps, all), b(t.scene, g, kFps, weak),
+      c(t.scene, g, kFps, weakBaseline);
+  const MovieExtent r = request(t, 20, 16, 0, 24);
+  const BakedMovie ma = a.bake(r), mb = b.bake(r), mc = c.bake(r);
+  EXPECT_EQ(a.stats().weakPairs, 0);
+  EXPECT_EQ(b.stats().weakPairs, 1);
+  EXPECT_EQ(a.stats().samples - b.stats().samples, 16 - 4) << "the far lamp: 16 -> 4 samples";
+  EXPECT_EQ(c.stats().weakPairs, 1);
+  ASSERT_EQ(mb.keys.size(), mc.keys.size());
+  for (size_t k = 0; k < mb.keys.size(); ++k)
+    EXPECT_EQ(0, std::memcmp(mb.keys[k].data(), mc.keys[k].data(), mb.keys[k].size() * 4))
+        << "key " << k << ": coherent and baseline differ";
+  double worst = 0.0;
+  for (size_t k = 0; k < ma.keys.size(); ++k)
+    for (size_t i = 0; i < ma.keys[k].size(); ++i)
+      worst = std::max(worst, std::abs(double(ma.keys[k][i]) - mb.keys[k][i]) /
+                                  std::max(1e-3, double(ma.keys[k][i])));
+  EXPECT_LT(worst, 1e-3);
+}
+
 TEST(TextureMovieBaker, ApproximateMergesDifferFromExactOnlyWhereLayersOverlap) {
   TestScene t = makeScene(true, true);
   MovieExtent r = request(t, 20, 16, 0, 24);

@@ -114,6 +114,11 @@ int main(int argc, char** argv) {
   app.add_option("--min-samples", b.minSamples,
                  "shooter samples per bad link, at least (at most --max-samples)")
       ->capture_default_str();
+  app.add_option("--weak-share", b.weakShare,
+                 "a bad link giving less than this share of every texel's direct light takes a "
+                 "quarter of --min-samples at least (0: off)")
+      ->capture_default_str()
+      ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--max-samples", b.maxSamples, "shooter samples per bad link, at most (<= 64)")
       ->capture_default_str();
   app.add_option("--samples-per-form-factor", b.samplesPerFormFactor,
