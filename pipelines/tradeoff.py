@@ -43,8 +43,10 @@ KNOBS = [
     ("bad-links", "global", "--bad-links", ["none", "partial", "all"]),
     ("rays", "global", "--rays", ["4", "64"]),
     ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "2"]),
+    ("size-ratio", "intervals", "--size-ratio", ["2"]),
     ("movie-key-step", "movies", "--movie-key-step", ["24", "12", "3", "1"]),
     ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32"]),
+    ("weak-share", "movies", "--weak-share", ["0", "0.3"]),
     ("gather-rays", "movies", "--gather-rays", ["0", "4", "32"]),
     ("near-shooter-levels", "movies", "--near-shooter-levels", ["1", "2"]),
     ("gather-partial-share", "movies", "--gather-partial-share", ["0.001", "0.004"]),
@@ -55,7 +57,8 @@ PRESETS = [
     ("draft", {"global": ["--eps", "0.02"]}),
     ("final", {"global": ["--eps", "1e-5", "--key-step", "4", "--rays", "64"],
                "movies": ["--min-samples", "64", "--movie-key-step", "2",
-                          "--near-shooter-levels", "2", "--gather-partial-share", "0.001"]}),
+                          "--near-shooter-levels", "2", "--gather-partial-share", "0.001",
+                          "--weak-share", "0"]}),
 ]
 TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
          "compose": "rad-compose"}
