@@ -121,8 +121,8 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     for (size_t i; !stop && (i = next++) < movies.size();) {
       const MovieExtent& m = *movies[i];
       const auto movieStart = SteadyClock::now();
-      sink.start(textureMovieOf(m, provenanceJson), textureMoviePath(options.moviesDir, m.movie));
       try {
+        sink.start(textureMovieOf(m, provenanceJson), textureMoviePath(options.moviesDir, m.movie));
         mine.bake(m, sink);
       } catch (...) {
         sink.discard();
@@ -147,13 +147,19 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
         work(*sibling, w);
         w.stats = sibling->stats();
         w.rendererName = sibling->rendererName();
-      } catch (...) {  // the sibling's construction or teardown
+      } catch (...) {  // the sibling's construction or teardown, or a failed progress report
         std::lock_guard<std::mutex> lock(mutex);
         if (!failure) failure = std::current_exception();
         stop = true;
       }
     });
-  work(baker, done[0]);
+  try {
+    work(baker, done[0]);
+  } catch (...) {  // a failed progress report: the other workers still have to be joined
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!failure) failure = std::current_exception();
+    stop = true;
+  }
   for (std::thread& t : threads) t.join();
   for (size_t k = 1; k < workers; ++k) baker.addStats(done[k].stats, done[k].rendererName);
 
