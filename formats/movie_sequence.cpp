@@ -161,9 +161,12 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     stop = true;
   }
   for (std::thread& t : threads) t.join();
-  for (size_t k = 1; k < workers; ++k) baker.addStats(done[k].stats, done[k].rendererName);
+  done[0].rendererName = baker.rendererName();
+  for (size_t k = 1; k < workers; ++k) baker.addStats(done[k].stats);
 
   MovieSequenceReport report;
+  for (const Worker& w : done)
+    if (report.rendererName.empty()) report.rendererName = w.rendererName;
   for (const Worker& w : done) report.secondsWrite += w.secondsWrite;
   if (failure) {
     try {

@@ -39,6 +39,7 @@ struct MovieSequenceReport {
   // Per movie baked, in id order: (movie id, seconds to bake and write it). The farm model
   // (pipelines/farm_model.py) re-splits a run's movies into any number of shards from these.
   std::vector<std::pair<uint32_t, double>> movieSeconds;
+  std::string rendererName;  // the first worker's that rendered a mask ("" when none did)
 };
 
 // The movies of `shard`, in id order.

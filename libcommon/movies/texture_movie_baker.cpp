@@ -97,7 +97,6 @@ struct Pair {
   std::vector<double> formFactor;          // coherent: F(x -> S), once per movie
   std::vector<SampleMask> staticMask;      // coherent: static blockers; empty = none (all 0)
   std::vector<long long> spilled;          // moving: key k's form factors in the spill, or -1
-  std::vector<double> keyZeroFormFactor;   // moving: key 0's, until the shares are made
   double maxFormFactor = 0.0;              // over the texels and the keys scanned
   double share = 1.0;  // the largest share of a texel's direct light its light gives
                        // (directShares)
@@ -536,8 +535,13 @@ class MovieBake {
   }
 
  private:
-  static const std::vector<double>& keyZeroFormFactors(const Pair& p) {
-    return p.coherent ? p.formFactor : p.keyZeroFormFactor;
+  // Key 0's form factors of a pair: a coherent pair's own, a moving pair's from the spill (its
+  // scan put them there first) or recomputed, into `scratch`.
+  const std::vector<double>& keyZeroFormFactors(const Pair& p, std::vector<double>& scratch) {
+    if (p.coherent) return p.formFactor;
+    scratch.resize(texels_);
+    if (!spill_.get(p.spilled[0], scratch)) geo_.formFactorsAt(p, 0, scratch);
+    return scratch;
   }
   bool scanPair(uint32_t S, Pair& p);
   void directShares();
@@ -683,7 +687,7 @@ void MovieBake::directShares() {
     }
     const glm::dvec3 B = solution_.radiosity(int(pairs_[i].shooter), t);
     const double power = std::max(0.0, B.x + B.y + B.z);
-    const std::vector<double>& f = keyZeroFormFactors(pairs_[i]);
+    const std::vector<double>& f = keyZeroFormFactors(pairs_[i], keyFormFactor_);
     std::vector<double>& mine = lightDirect[size_t(light[i])];
     for (size_t x = 0; x < texels_; ++x) {
       mine[x] += power * f[x];
@@ -694,10 +698,7 @@ void MovieBake::directShares() {
   for (size_t g = 0; g < lights.size(); ++g)
     for (size_t x = 0; x < texels_; ++x)
       if (direct[x] > 0.0) share[g] = std::max(share[g], lightDirect[g][x] / direct[x]);
-  for (size_t i = 0; i < pairs_.size(); ++i) {
-    pairs_[i].share = share[size_t(light[i])];
-    pairs_[i].keyZeroFormFactor = {};
-  }
+  for (size_t i = 0; i < pairs_.size(); ++i) pairs_[i].share = share[size_t(light[i])];
   stats_.secondsTransmittance += secondsSince(clock);
 }
 
@@ -751,7 +752,6 @@ double MovieBake::scanFormFactors(Pair& p) {
   p.spilled.assign(static_cast<size_t>(K), -1);
   for (int k = 0; k < K; ++k) {
     geo_.formFactorsAt(p, k, keyFormFactor_);
-    if (k == 0 && options_.weakShare > 0.0) p.keyZeroFormFactor = keyFormFactor_;
     for (double v : keyFormFactor_) maxF = std::max(maxF, v);
     p.spilled[size_t(k)] = spill_.put(keyFormFactor_);
     if (maxF > 0.0 &&
@@ -944,17 +944,15 @@ OcclusionMaskRenderer& TextureMovieBaker::renderer() {
 }
 
 std::string TextureMovieBaker::rendererName() const {
-  return renderer_ ? renderer_->rendererName() : siblingRendererName_;
+  return renderer_ ? renderer_->rendererName() : std::string();
 }
 
 std::unique_ptr<TextureMovieBaker> TextureMovieBaker::sibling() const {
   return std::make_unique<TextureMovieBaker>(scene_, solution_, fps_, options_, backends_);
 }
 
-void TextureMovieBaker::addStats(const TextureMovieBakerStats& stats,
-                                 const std::string& rendererName) {
+void TextureMovieBaker::addStats(const TextureMovieBakerStats& stats) {
   stats_ += stats;
-  if (siblingRendererName_.empty()) siblingRendererName_ = rendererName;
 }
 
 TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBakerStats& o) {

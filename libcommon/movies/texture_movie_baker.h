@@ -213,8 +213,8 @@ class TextureMovieBaker {
   // near-shooter store fills as movies go; the values stored do not depend on the order, so
   // every movie comes out the same whichever baker makes it).
   std::unique_ptr<TextureMovieBaker> sibling() const;
-  // Adds a sibling's counters; takes its renderer's name when this baker rendered nothing.
-  void addStats(const TextureMovieBakerStats& stats, const std::string& rendererName);
+  // Adds a sibling's counters.
+  void addStats(const TextureMovieBakerStats& stats);
 
  private:
   const Scene& scene_;
@@ -224,7 +224,6 @@ class TextureMovieBaker {
   TextureMovieBakerBackends backends_;
   std::vector<InputPolygon> tops_;
   std::unique_ptr<OcclusionMaskRenderer> renderer_;
-  std::string siblingRendererName_;                 // addStats: a sibling's, if this one has none
   std::unique_ptr<BlockerIndex> blockers_;          // made on the first bake
   std::unique_ptr<GoodLinksByReceiver> goodLinks_;  // --good-layer gather
   std::unique_ptr<SceneVisibility> visibility_;     // the gather's rays and the covered texels

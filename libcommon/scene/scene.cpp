@@ -549,8 +549,8 @@ CameraView Scene::cameraAt(int node, double t) const {
 
 std::vector<int> movingNodesOf(const Scene& scene, const std::vector<InputPolygon>& polygons,
                                double t0, double t1) {
-  // In the order of first appearance; a flag per scene node (rad-movies asks per movie, and
-  // a search of the nodes seen so far made this quadratic in the hall's thousands of nodes).
+  // In the order of first appearance; a flag per scene node (rad-movies asks per movie, and a
+  // search of the nodes seen so far cost tops x nodes each time).
   std::vector<char> seen(scene.nodes.size(), 0);
   std::vector<int> moving;
   for (const InputPolygon& p : polygons) {

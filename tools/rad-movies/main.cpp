@@ -65,7 +65,7 @@ int run(Options o, int argc, char** argv) {
     report["shard"] = o.shard;
     report["movies_in_file"] = intervals.movies.size();
     report["parameters"] = parameters;
-    report["renderer"] = baker.rendererName();
+    report["renderer"] = written.rendererName;
     report["seconds"]["read"] = secondsRead;
     report["seconds"]["write"] = written.secondsWrite;
     report["seconds"]["total"] = rad::secondsSince(start);
