@@ -177,11 +177,12 @@ void ClusterLinks::evaluate() {
 void ClusterLinks::evaluateLink(ClusterLink& l) {
   l.evaluated = true;
   if (reuse_) {  // the values recomputing would give (static ends, no moving object near)
-    auto it = reuse_->find({l.receiver, l.shooter});
-    if (it != reuse_->end()) {
-      l.direction = it->second.direction;
-      l.transfer = it->second.transfer;
-      l.visibility = it->second.visibility;
+    const size_t T = emits_.size();
+    if (const CachedClusterLink* c =
+            reuse_->find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))) {
+      l.direction = c->direction;
+      l.transfer = c->transfer;
+      l.visibility = c->visibility;
       ++reused_;
       return;
     }

@@ -35,6 +35,7 @@
 #include <glm/glm.hpp>
 
 #include "libcommon/radiosity/cluster_tree.h"
+#include "libcommon/radiosity/pair_table.h"
 #include "libcommon/radiosity/visibility.h"
 
 namespace rad {
@@ -48,20 +49,18 @@ struct ClusterLink {
 };
 
 // A cluster link's values that the next key time may take over (coherence, paper §4.2), keyed
-// by (receiver, shooter) as clusterLinkKey: valid while both ends are static and no moving
+// by (receiver, shooter) as clusterLinkEnd: valid while both ends are static and no moving
 // object's swept bounds meet the box around both.
 struct CachedClusterLink {
   glm::dvec3 direction{0.0};
   double transfer = 0, visibility = 1;
 };
-struct ClusterLinkKeyHash {
-  size_t operator()(const std::pair<int, int>& k) const {
-    return size_t(
-        splitMix64(uint64_t(uint32_t(k.first)) ^ splitMix64(uint64_t(uint32_t(k.second)))));
-  }
-};
-using ClusterLinkCache =
-    std::unordered_map<std::pair<int, int>, CachedClusterLink, ClusterLinkKeyHash>;
+using ClusterLinkCache = PairTable<CachedClusterLink>;
+// A cluster link end as a ClusterLinkCache row or column: top-level patch t as t, cluster c as
+// topCount + c (topCount + the tree's size rows in all).
+inline uint32_t clusterLinkEnd(ClusterRef r, size_t topCount) {
+  return isCluster(r) ? uint32_t(topCount + size_t(clusterIndex(r))) : uint32_t(r);
+}
 
 class ClusterLinks {
  public:

@@ -337,11 +337,10 @@ class KeyTimeSolver {
                  : 1.0;
     };
     if (input_.reuse) {
-      auto it = input_.reuse->find({r.id.packed(), q.id.packed()});
-      if (it != input_.reuse->end()) {
+      if (const CachedLink* known = input_.reuse->find(uint32_t(l.receiver), uint32_t(l.shooter))) {
         // The values, never a decision: F starts as the estimate as in a fresh evaluation,
         // and the accurate pass takes the known accurate F instead of integrating again.
-        const CachedLink& c = it->second;
+        const CachedLink& c = *known;
         if (input_.reuseRayPairs) l.knownRayPairs = c.rayPairs;
         l.estimate = c.estimate;
         l.spreadArea = c.spreadArea;
@@ -1112,8 +1111,9 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
     return isCluster(r) ? prev.clusterBounds[size_t(clusterIndex(r))]
                         : polygonBounds(prev.world[size_t(r)]);
   };
-  ClusterLinkCache cache;
-  cache.reserve(prev.clusterLinkValues.size());
+  const size_t T = size_t(h.topCount());
+  std::vector<std::pair<uint32_t, uint32_t>> keys;
+  std::vector<CachedClusterLink> values;
   for (const ClusterLink& l : prev.clusterLinkValues) {
     if (!l.evaluated || !isStatic(l.receiver) || !isStatic(l.shooter)) continue;
     const ClusterBounds a = box(l.receiver), b = box(l.shooter);
@@ -1122,11 +1122,12 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
     for (const auto& s : swept)
       hit =
           hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
-    if (!hit)
-      cache.emplace(std::make_pair(l.receiver, l.shooter),
-                    CachedClusterLink{l.direction, l.transfer, l.visibility});
+    if (!hit) {
+      keys.emplace_back(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
+      values.push_back(CachedClusterLink{l.direction, l.transfer, l.visibility});
+    }
   }
-  return cache;
+  return ClusterLinkCache(keys, std::move(values), uint32_t(T + size_t(tree.size())));
 }
 
 ClusterTree clusterTreeOf(const Scene& scene, const PatchHierarchy& h, double t0, double t1) {

@@ -162,9 +162,10 @@ struct LinkRayPair {
 constexpr size_t kNoRayPairs = ~size_t(0);
 
 // Link values that a key-time solve may take over instead of recomputing (paper §4.2): keyed
-// by (receiver id, shooter id). Only values are taken over, never decisions: the solve refines
-// and iterates exactly as without them, so a coherent key solve is bit-identical to an
-// independent one whenever the cached values are what recomputing would give.
+// by (receiver, shooter) dense node index, which every key of the union hierarchy shares. Only
+// values are taken over, never decisions: the solve refines and iterates exactly as without them,
+// so a coherent key solve is bit-identical to an independent one whenever the cached values are
+// what recomputing would give.
 struct CachedLink {
   double estimate = 0, spreadArea = 0;  // geometry only: valid while both ends are static
   double formFactor = -1;               // accurate unoccluded F, or < 0 when never computed
@@ -173,12 +174,7 @@ struct CachedLink {
   bool visibilityValid = false;         // false: a moving object's swept bound met the link's shaft
   size_t rayPairs = kNoRayPairs;        // its first LinkRayPair in the previous KeySolution
 };
-struct LinkKeyHash {
-  size_t operator()(const std::pair<uint64_t, uint64_t>& k) const {
-    return size_t(splitMix64(k.first ^ splitMix64(k.second)));
-  }
-};
-using LinkCache = std::unordered_map<std::pair<uint64_t, uint64_t>, CachedLink, LinkKeyHash>;
+using LinkCache = PairTable<CachedLink>;
 // The closure's leaf-to-top form factors F(leaf -> top-level patch) a key-time solve may take
 // over (both static): per dense node of the union hierarchy (whose numbering every key shares),
 // its (top index, F) pairs. A previous key's KeySolution::leafTopFormFactor as it is: a hash

@@ -232,8 +232,10 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
   std::vector<std::array<glm::dvec3, 2>> swept;
   for (int node : scene.meshNodes())
     if (scene.isDynamic(node, t0, t1)) swept.push_back(scene.sweptBounds(node, t0, t1));
-  LinkCache cache;
-  cache.reserve(prev.links.size());
+  std::vector<std::pair<uint32_t, uint32_t>> keys;
+  std::vector<CachedLink> values;
+  keys.reserve(prev.links.size());
+  values.reserve(prev.links.size());
   for (size_t li = 0; li < prev.links.size(); ++li) {
     const SolverLink& l = prev.links[li];
     const PatchNode& r = h.node(l.receiver);
@@ -256,9 +258,10 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
     c.openPairs = l.openPairs;
     c.visibilityValid = !hit;  // a moving object in the shaft: the shadow rays again
     if (li < prev.rayPairStart.size()) c.rayPairs = prev.rayPairStart[li];
-    cache.emplace(std::make_pair(r.id.packed(), s.id.packed()), c);
+    keys.emplace_back(uint32_t(l.receiver), uint32_t(l.shooter));
+    values.push_back(c);
   }
-  return cache;
+  return LinkCache(keys, std::move(values), uint32_t(h.size()));
 }
 
 namespace {
@@ -321,6 +324,12 @@ struct KeyPassResult {
 // as it is solved. It solves keys first..last of `keyTimes` (a window; key k's record and
 // intervals index is k - first) and builds what depends on the whole animation from all of
 // `keyTimes`, so a window's keys come out as the whole run's.
+// Frees a vector's capacity beyond a quarter over its size.
+template <class T>
+void shrinkWhenSpare(std::vector<T>& v) {
+  if (v.capacity() > v.size() + v.size() / 4) v.shrink_to_fit();
+}
+
 class KeyTimePass {
  public:
   KeyTimePass(const Scene& scene, const std::vector<double>& keyTimes, size_t first, size_t last,
@@ -353,6 +362,10 @@ class KeyTimePass {
       records_[r].clusterIrradiance.assign(s.topClusterIrradiance.begin(),
                                            s.topClusterIrradiance.end());
       nodeCount_.push_back(uint32_t(h_.size()));
+      // Key 0 grew its ray pairs by doubling (no previous key to reserve by): held through the
+      // next key's solve, the spare half had been 100 MB of the 10k-triangle hall's peak.
+      shrinkWhenSpare(s.rayPairs);
+      shrinkWhenSpare(s.rayPairStart);
       prev = std::move(s);
     }
   }
@@ -395,9 +408,11 @@ class KeyTimePass {
       // itself it still reads the ray pairs (reuseRayPairs). The rest is freed before the
       // solve: held beside the caches and the new key's links, it was ~200 MB of the
       // 10k-triangle hall's peak.
-      prev.links = {};
-      prev.clusterLinkValues = {};
-      prev.leafTopFormFactor = {};
+      // Swapped with empty vectors: `v = {}` would pick operator=(initializer_list), which
+      // empties v but keeps its capacity (it had freed 11 MB of the hall's 220).
+      std::vector<SolverLink>().swap(prev.links);
+      std::vector<ClusterLink>().swap(prev.clusterLinkValues);
+      LeafFormFactorCache().swap(prev.leafTopFormFactor);
       secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);
