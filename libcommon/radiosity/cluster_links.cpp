@@ -117,7 +117,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
   // The links keep the order they had that way (each level's survivors after the last's).
   std::vector<ClusterLink> work, kept;
   work.swap(links_);
-  kept.reserve(work.size());
+  kept.reserve(std::max(work.size(), expectedLinks_));
   size_t made = 0, count = 0;
   listsValid_ = false;
   auto pairOrLink = [&](ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next) {

@@ -191,6 +191,8 @@ class KeyTimeSolver {
       clusters_ = std::make_unique<ClusterLinks>(*input_.clusters, s_.world, s_.area, topEmits_,
                                                  input_.visibility, opt_.rays,
                                                  opt_.clusterSeparation, input_.reuseClusterLinks);
+      if (input_.expectedClusterLinks > 0)
+        clusters_->expectLinks(withMargin(input_.expectedClusterLinks));
     } else {
       s_.links = linkTopLevel(s_.world, s_.area, h_.topCount());
     }
@@ -426,8 +428,9 @@ class KeyTimeSolver {
         VisibilityScene::pairsFrom(VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)),
                                    P.normal(), Q, linkSeed(r.id, q.id), bPoints, kernel);
         for (int i = 0; i < k; ++i)
-          pair[i] = {clampToParameterDomain(polygonUvAt(Q, bPoints[size_t(i)]), triangle),
-                     kernel[size_t(i)]};
+          pair[i] = {
+              glm::vec2(clampToParameterDomain(polygonUvAt(Q, bPoints[size_t(i)]), triangle)),
+              float(kernel[size_t(i)])};
       }
     });
     tbb::parallel_for(size_t(0), L, [&](size_t li) {
@@ -447,7 +450,7 @@ class KeyTimeSolver {
         int& node = leaf[i];
         if (s_.split[size_t(node)]) {
           node = l.shooter;
-          glm::dvec2 uv = pair[i].uv;
+          glm::dvec2 uv(pair[i].uv);
           while (s_.split[size_t(node)])
             node = h_.node(node).firstChild + descendToChild(uv, triangle);
         }

@@ -392,6 +392,7 @@ class KeyTimePass {
     double secondsCoherence = 0;
     in.expectedLinks = prev.links.size();
     in.expectedRayPairs = prev.rayPairs.size();
+    in.expectedClusterLinks = prev.clusterLinkValues.size();
     if (opt_.coherence && k > first_) {
       auto tc = std::chrono::steady_clock::now();
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
