@@ -192,11 +192,12 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
   const glm::dvec3 d = S.centre() - R.centre();
   const double r2 = glm::dot(d, d);
   if (!(r2 > 0.0)) return;
-  l.direction = d / std::sqrt(r2);
+  l.direction = glm::vec3(d / std::sqrt(r2));
+  const glm::dvec3 omega(l.direction);  // as stored: the same whether computed or taken over
   // P_S(omega): the area of S facing R.
   double shown = 0.0;
   auto show = [&](uint32_t j) {
-    shown += area_[j] * std::max(0.0, -glm::dot(world_[j].normal(), l.direction));
+    shown += area_[j] * std::max(0.0, -glm::dot(world_[j].normal(), omega));
   };
   if (isCluster(l.shooter)) {
     auto [b, e] = membersOf(l.shooter);
@@ -240,7 +241,7 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
     }
     v = sumK > 0.0 ? openK / sumK : double(open) / double(rays_);
   }
-  l.visibility = v;
+  l.visibility = float(v);
   l.transfer = v * shown / M_PI;
 }
 
@@ -346,7 +347,7 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, std::vector<glm::
     glm::dvec3 num(0.0);
     double den = 0.0;
     for (int k = 0; k < 6; ++k) {
-      const double w = std::max(0.0, -glm::dot(l.direction, kAxis[k]));
+      const double w = std::max(0.0, -glm::dot(glm::dvec3(l.direction), kAxis[k]));
       num += w * w * b.n[k];
       den += w * w * b.d[k];
     }

@@ -339,15 +339,15 @@ class KeyTimeSolver {
                  : 1.0;
     };
     if (input_.reuse) {
-      if (const CachedLink* known = input_.reuse->find(uint32_t(l.receiver), uint32_t(l.shooter))) {
+      const uint32_t known = input_.reuse->indexOf(uint32_t(l.receiver), uint32_t(l.shooter));
+      if (known != LinkCache::kNotFound) {
         // The values, never a decision: F starts as the estimate as in a fresh evaluation,
         // and the accurate pass takes the known accurate F instead of integrating again.
-        const CachedLink& c = *known;
-        if (input_.reuseRayPairs) l.knownRayPairs = c.rayPairs;
+        const CachedLink& c = input_.reuse->value(known);
+        l.known = known;
         l.estimate = c.estimate;
         l.spreadArea = c.spreadArea;
         l.formFactor = l.estimate;
-        l.knownFormFactor = c.formFactor;
         if (c.visibilityValid) {
           l.rayVisibility = c.visibility;
           l.openPairs = c.openPairs;
@@ -363,10 +363,11 @@ class KeyTimeSolver {
     double ap = s_.area[size_t(l.receiver)], aq = s_.area[size_t(l.shooter)];
     // Both directions: the centroid estimate alone can miss a near-contact pair.
     const double fpq = formFactorEstimate(P, Q), fqp = formFactorEstimate(Q, P);
-    l.estimate = std::min(1.0, std::max(fpq, fqp * aq / ap));
+    l.estimate = float(std::min(1.0, std::max(fpq, fqp * aq / ap)));
     l.formFactor = l.estimate;
     if (opt_.oracle != RefinementOracle::kPower)
-      l.spreadArea = std::max(ap * formFactorSpread(P, Q, fpq), aq * formFactorSpread(Q, P, fqp));
+      l.spreadArea =
+          float(std::max(ap * formFactorSpread(P, Q, fpq), aq * formFactorSpread(Q, P, fqp)));
     l.rayVisibility = shadowRays();
     l.visibility = l.rayVisibility;
   }
@@ -406,7 +407,7 @@ class KeyTimeSolver {
     std::vector<size_t> fresh;
     for (size_t li = 0; li < L; ++li)
       if (pairStart_[li] == kNoRayPairs && weighted(s_.links[li])) {
-        pairStart_[li] = pairs_.size() + fresh.size() * size_t(k);
+        pairStart_[li] = uint32_t(pairs_.size() + fresh.size() * size_t(k));
         fresh.push_back(li);
       }
     pairs_.resize(pairs_.size() + fresh.size() * size_t(k));
@@ -415,8 +416,10 @@ class KeyTimeSolver {
       const SolverLink& l = s_.links[fresh[f]];
       LinkRayPair* pair = &pairs_[pairStart_[fresh[f]]];
       std::fill_n(&pairLeaf_[pairStart_[fresh[f]]], k, l.shooter);
-      if (l.knownRayPairs != kNoRayPairs && input_.reuseRayPairs) {
-        std::copy_n(input_.reuseRayPairs->begin() + std::ptrdiff_t(l.knownRayPairs), k, pair);
+      const uint32_t knownPairs =
+          l.known != SolverLink::kNotKnown ? input_.reuse->value(l.known).rayPairs : kNoRayPairs;
+      if (knownPairs != kNoRayPairs && input_.reuseRayPairs) {
+        std::copy_n(input_.reuseRayPairs->begin() + std::ptrdiff_t(knownPairs), k, pair);
       } else {
         const PatchNode& r = h_.node(l.receiver);
         const PatchNode& q = h_.node(l.shooter);
@@ -476,7 +479,7 @@ class KeyTimeSolver {
     if (l.rayVisibility < 1.0) l.visibility = v;
     const glm::dvec3 mean = B_[size_t(l.shooter)];
     if (opt_.shooterShape && seen >= 0.0 && mean.x + mean.y + mean.z > 0.0)
-      l.shooterShape = seen / (mean.x + mean.y + mean.z);
+      l.shooterShape = float(seen / (mean.x + mean.y + mean.z));
   }
 
   // weightVisibilityByShooterRadiosity for one link, its pairs made again (more rays than
@@ -588,8 +591,10 @@ class KeyTimeSolver {
       if (l.refined || l.accurate) return;
       if (l.rayVisibility > 0.0) {
         l.integrated = true;
-        if (l.knownFormFactor >= 0.0) {
-          l.formFactor = l.knownFormFactor;
+        const double knownFormFactor =
+            l.known != SolverLink::kNotKnown ? input_.reuse->value(l.known).formFactor : -1.0;
+        if (knownFormFactor >= 0.0) {
+          l.formFactor = knownFormFactor;
         } else {
           l.formFactor = linkFormFactor(s_.world[size_t(l.receiver)], s_.world[size_t(l.shooter)],
                                         opt_.quadratureOrder, opt_.formFactorTolerance);
@@ -1063,7 +1068,7 @@ class KeyTimeSolver {
   // weightVisibilityByShooterRadiosity's ray pairs, opt_.rays per link from pairStart_[link]
   // (kNoRayPairs: not weighted yet in this key solve), and per pair the shooter leaf it last
   // descended to.
-  std::vector<size_t> pairStart_;
+  std::vector<uint32_t> pairStart_;
   std::vector<LinkRayPair> pairs_;
   std::vector<int> pairLeaf_;
   double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
@@ -1127,7 +1132,7 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
           hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
     if (!hit) {
       keys.emplace_back(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
-      values.push_back(CachedClusterLink{l.direction, l.transfer, l.visibility});
+      values.push_back(CachedClusterLink{l.direction, l.visibility, l.transfer});
     }
   }
   return ClusterLinkCache(keys, std::move(values), uint32_t(T + size_t(tree.size())));

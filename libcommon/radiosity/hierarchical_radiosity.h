@@ -127,28 +127,32 @@ struct SurfaceProperties {
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
                                                    const PatchHierarchy& hierarchy);
 
-// One link of a key-time solve.
+// One link of a key-time solve. 64 bytes: a key of the 10k-triangle hall holds 1.5 M of them
+// (88 bytes each had been 137 MB of rad-global's peak). The oracle's F~ and spread, and the
+// shooter's shape, are single precision: they steer refinement and weight the gather by
+// factors whose own error is far above 6e-8; F and V stay double.
 struct SolverLink {
-  int receiver = 0;          // dense node index (gathers)
-  int shooter = 0;           // dense node index (shoots)
-  double formFactor = 0;     // unoccluded F(receiver -> shooter); the estimate until `accurate`
-  double visibility = 0;     // V in [0, 1] as gathered: rayVisibility weighted by the
-                             // shooter's radiosity at the rays' ends (weightVisibility...)
-  double rayVisibility = 0;  // V of the shadow rays, kernel-weighted (visibilityFrom)
-  uint64_t openPairs = 0;    // which of those ray pairs were unoccluded (bit i: pair i < 64)
+  static constexpr uint32_t kNotKnown = ~uint32_t(0);
+  int receiver = 0;  // dense node index (gathers)
+  int shooter = 0;   // dense node index (shoots)
+  // Its entry in KeySolveInput::reuse (the previous key's values: the accurate F when that key
+  // computed one, and its ray pairs), else kNotKnown.
+  uint32_t known = kNotKnown;
   // The shooter's radiosity as the receiver sees it over its mean (weightVisibility...): the
   // ray pairs' kernel-weighted mean of its leaves' B, divided by B_q; 1 for a leaf shooter.
-  double shooterShape = 1.0;
-  double estimate = 0;          // F~ of the oracle
-  double spreadArea = 0;        // max(A_p dF(p -> q), A_q dF(q -> p)) of the error oracle (m^2)
+  float shooterShape = 1.0f;
+  double formFactor = 0;        // unoccluded F(receiver -> shooter); the estimate until `accurate`
+  double visibility = 0;        // V in [0, 1] as gathered: rayVisibility weighted by the
+                                // shooter's radiosity at the rays' ends (weightVisibility...)
+  double rayVisibility = 0;     // V of the shadow rays, kernel-weighted (visibilityFrom)
+  uint64_t openPairs = 0;       // which of those ray pairs were unoccluded (bit i: pair i < 64)
+  float estimate = 0;           // F~ of the oracle
+  float spreadArea = 0;         // max(A_p dF(p -> q), A_q dF(q -> p)) of the error oracle (m^2)
   bool refined = false;         // kept for the hierarchy, not gathered
   bool accurate = false;        // the accurate pass has seen it (an invisible link may keep F~)
   bool integrated = false;      // formFactor is the quadrature value
   bool reused = false;          // F and V taken from the previous key time (coherence)
   bool visibilityOnly = false;  // F taken over, V recomputed (the shaft met a moving object)
-  double knownFormFactor = -1;  // the accurate F when the previous key computed it, else < 0
-  // The previous key's ray pairs of this link (KeySolveInput::reuseRayPairs), else kNoRayPairs.
-  size_t knownRayPairs = ~size_t(0);
   double fv() const { return formFactor * visibility; }
 };
 
@@ -162,7 +166,9 @@ struct LinkRayPair {
   glm::vec2 uv{0.0f};
   float kernel = 0;
 };
-constexpr size_t kNoRayPairs = ~size_t(0);
+// A link's first ray pair is a 32-bit index: at most RadiosityOptions::maxLinks (4 M) times
+// kMaxRecordedPairs (64) pairs.
+constexpr uint32_t kNoRayPairs = ~uint32_t(0);
 
 // Link values that a key-time solve may take over instead of recomputing (paper §4.2): keyed
 // by (receiver, shooter) dense node index, which every key of the union hierarchy shares. Only
@@ -170,12 +176,12 @@ constexpr size_t kNoRayPairs = ~size_t(0);
 // so a coherent key solve is bit-identical to an independent one whenever the cached values are
 // what recomputing would give.
 struct CachedLink {
-  double estimate = 0, spreadArea = 0;  // geometry only: valid while both ends are static
-  double formFactor = -1;               // accurate unoccluded F, or < 0 when never computed
-  double visibility = 0;                // the shadow rays' V (SolverLink::rayVisibility)
-  uint64_t openPairs = 0;               // and their unoccluded pairs
-  bool visibilityValid = false;         // false: a moving object's swept bound met the link's shaft
-  size_t rayPairs = kNoRayPairs;        // its first LinkRayPair in the previous KeySolution
+  float estimate = 0, spreadArea = 0;  // geometry only: valid while both ends are static
+  double formFactor = -1;              // accurate unoccluded F, or < 0 when never computed
+  double visibility = 0;               // the shadow rays' V (SolverLink::rayVisibility)
+  uint64_t openPairs = 0;              // and their unoccluded pairs
+  uint32_t rayPairs = kNoRayPairs;     // its first LinkRayPair in the previous KeySolution
+  bool visibilityValid = false;        // false: a moving object's swept bound met the link's shaft
 };
 using LinkCache = PairTable<CachedLink>;
 // The closure's leaf-to-top form factors F(leaf -> top-level patch) a key-time solve may take
@@ -239,7 +245,7 @@ struct KeySolution {
   // The ray pairs of the links the radiosity weighting saw, RadiosityOptions::rays of them per
   // link from rayPairStart[link] (kNoRayPairs: none), for the next key's coherence.
   std::vector<LinkRayPair> rayPairs;
-  std::vector<size_t> rayPairStart;
+  std::vector<uint32_t> rayPairStart;
   int iterations = 0;  // Gauss-Seidel sweeps, all rounds
   int refineRounds = 0;
   bool linkCapReached = false;     // refinement stopped at RadiosityOptions::maxLinks

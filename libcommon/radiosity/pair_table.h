@@ -43,13 +43,21 @@ class PairTable {
     }
   }
 
-  // The value of (row, column), or null.
-  const V* find(uint32_t row, uint32_t column) const {
-    if (size_t(row) + 1 >= rowStart_.size()) return nullptr;
+  static constexpr uint32_t kNotFound = ~uint32_t(0);
+
+  // The entry of (row, column), or kNotFound.
+  uint32_t indexOf(uint32_t row, uint32_t column) const {
+    if (size_t(row) + 1 >= rowStart_.size()) return kNotFound;
     auto first = column_.begin() + rowStart_[row], last = column_.begin() + rowStart_[row + 1];
     auto it = std::lower_bound(first, last, column);
-    return it != last && *it == column ? &values_[size_t(it - column_.begin())] : nullptr;
+    return it != last && *it == column ? uint32_t(it - column_.begin()) : kNotFound;
   }
+  // The value of (row, column), or null.
+  const V* find(uint32_t row, uint32_t column) const {
+    const uint32_t i = indexOf(row, column);
+    return i == kNotFound ? nullptr : &values_[i];
+  }
+  const V& value(uint32_t index) const { return values_[index]; }
 
   size_t size() const { return values_.size(); }
   bool empty() const { return values_.empty(); }
