@@ -290,7 +290,7 @@ void ClusterLinks::buildReceiverLists() {
   for (size_t t = 0; t < T; ++t) {
     for (size_t k = 0; k < perTop[t].size(); ++k) {
       gatherLink_[gatherStart_[t] + k] = perTop[t][k].first;
-      gatherFormFactor_[gatherStart_[t] + k] = perTop[t][k].second;
+      gatherFormFactor_[gatherStart_[t] + k] = float(perTop[t][k].second);
     }
     std::vector<std::pair<uint32_t, double>>().swap(perTop[t]);
   }
@@ -335,12 +335,12 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, std::vector<glm::
     clusterMaxB_[size_t(c)] = maxB;
   }
   // Per link: its shooter's B towards its receiver.
-  linkB_.assign(links_.size(), glm::dvec3(0.0));
+  linkB_.assign(links_.size(), glm::vec3(0.0f));
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t i) {
     const ClusterLink& l = links_[i];
     if (!l.evaluated) return;
     if (!isCluster(l.shooter)) {
-      linkB_[i] = topB[size_t(l.shooter)];
+      linkB_[i] = glm::vec3(topB[size_t(l.shooter)]);
       return;
     }
     const Binned& b = bins[size_t(clusterIndex(l.shooter))];
@@ -351,13 +351,13 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, std::vector<glm::
       num += w * w * b.n[k];
       den += w * w * b.d[k];
     }
-    linkB_[i] = den > 0.0 ? num / den : glm::dvec3(0.0);
+    linkB_[i] = den > 0.0 ? glm::vec3(num / den) : glm::vec3(0.0f);
   });
   out.assign(T, glm::dvec3(0.0));
   tbb::parallel_for(size_t(0), T, [&](size_t t) {
     glm::dvec3 h(0.0);
     for (size_t e = gatherStart_[t]; e < gatherStart_[t + 1]; ++e)
-      h += gatherFormFactor_[e] * linkB_[gatherLink_[e]];
+      h += double(gatherFormFactor_[e]) * glm::dvec3(linkB_[gatherLink_[e]]);
     out[t] = h;
   });
 }

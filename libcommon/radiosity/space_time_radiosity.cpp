@@ -56,10 +56,44 @@ class LinkIntervals {
     bool refined = false, constant = true, visibilityChanged = false;
   };
 
-  // The link's value at key `key`; keys arrive in non-decreasing order.
-  void add(uint64_t link, uint32_t key, float fv, float visibility, bool refined) {
-    auto [it, fresh] = links_.try_emplace(link, LinkRows{kNone, kNone});
-    LinkRows& lr = it->second;
+  struct LinkRows {
+    uint32_t first, last;  // the link's first and last row
+  };
+  // One link's value at one key.
+  struct KeyValue {
+    uint64_t link;  // receiver << 32 | shooter
+    float fv, visibility;
+    bool refined;
+  };
+
+  // Every link's value at key `key`; keys arrive in increasing order. The links so far are a
+  // vector sorted by link, merged with this key's sorted values: 16 bytes per link instead of
+  // a hash map's ~40 (60 MB of the 10k-triangle hall's 1.5 M links).
+  void addKey(std::vector<KeyValue> values, uint32_t key) {
+    std::stable_sort(values.begin(), values.end(),
+                     [](const KeyValue& a, const KeyValue& b) { return a.link < b.link; });
+    size_t fresh = 0;
+    for (size_t i = 0, j = 0; i < values.size(); ++i) {
+      while (j < links_.size() && links_[j].first < values[i].link) ++j;
+      const bool known = j < links_.size() && links_[j].first == values[i].link;
+      fresh += !known && (i == 0 || values[i - 1].link != values[i].link) ? 1 : 0;
+    }
+    std::vector<std::pair<uint64_t, LinkRows>> merged;
+    merged.reserve(links_.size() + fresh);
+    size_t j = 0;
+    for (const KeyValue& v : values) {
+      while (j < links_.size() && links_[j].first < v.link) merged.push_back(links_[j++]);
+      if (j < links_.size() && links_[j].first == v.link) merged.push_back(links_[j++]);
+      const bool isNew = merged.empty() || merged.back().first != v.link;
+      if (isNew) merged.emplace_back(v.link, LinkRows{kNone, kNone});
+      add(merged.back().second, isNew, key, v.fv, v.visibility, v.refined);
+    }
+    while (j < links_.size()) merged.push_back(links_[j++]);
+    links_.swap(merged);
+  }
+
+  // The link's value at key `key` (`fresh`: its first).
+  void add(LinkRows& lr, bool fresh, uint32_t key, float fv, float visibility, bool refined) {
     if (!fresh) {
       Row& r = rows_[lr.last];
       if (r.lastKey + 1 == key && r.refined == refined) {  // the run goes on
@@ -82,6 +116,9 @@ class LinkIntervals {
     r.firstVisibility = visibility;
     r.refined = refined;
     uint32_t index = uint32_t(rows_.size());
+    // Grown by an eighth, not doubled: key 0 makes nearly every row at once (1.5 M of 36
+    // bytes on the 10k-triangle hall), and doubling had left up to as much again unused.
+    if (rows_.size() == rows_.capacity()) rows_.reserve(rows_.size() + rows_.size() / 8 + 1024);
     rows_.push_back(r);
     if (fresh)
       lr.first = index;
@@ -95,8 +132,7 @@ class LinkIntervals {
     std::vector<std::pair<uint64_t, uint32_t>> v;
     v.reserve(links_.size());
     for (const auto& [key, lr] : links_) v.emplace_back(key, lr.first);
-    std::unordered_map<uint64_t, LinkRows>().swap(links_);
-    std::sort(v.begin(), v.end());
+    std::vector<std::pair<uint64_t, LinkRows>>().swap(links_);
     return v;
   }
   const Row& row(uint32_t i) const { return rows_[i]; }
@@ -133,9 +169,6 @@ class LinkIntervals {
   };
   static bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
   static constexpr uint32_t kSlabShift = 14;  // 16384 blocks of 64 bytes: 1 MiB slabs
-  struct LinkRows {
-    uint32_t first, last;
-  };
 
   Block& block(uint32_t i) { return slabs_[i >> kSlabShift][i & ((1u << kSlabShift) - 1)]; }
   const Block& block(uint32_t i) const {
@@ -162,7 +195,7 @@ class LinkIntervals {
     ++r.valueCount;
   }
 
-  std::unordered_map<uint64_t, LinkRows> links_;
+  std::vector<std::pair<uint64_t, LinkRows>> links_;  // sorted by link
   std::vector<Row> rows_;
   std::vector<std::unique_ptr<Block[]>> slabs_;
   uint32_t blockCount_ = 0;
@@ -427,14 +460,17 @@ class KeyTimePass {
   // Per link (receiver << 32 | shooter): its value at key k into the activity intervals, and
   // its (receiver top, shooter top) pair into the bad pairs.
   void foldLinks(const KeySolution& s, uint32_t k) {
+    std::vector<LinkIntervals::KeyValue> values;
+    values.reserve(s.links.size());
     for (const SolverLink& l : s.links) {
-      intervals_.add((uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter), k, float(l.fv()),
-                     float(l.visibility), l.refined);
+      values.push_back({(uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter), float(l.fv()),
+                        float(l.visibility), l.refined});
       uint32_t rt = h_.node(l.receiver).id.top, st = h_.node(l.shooter).id.top;
       char bad = 0;
       markBadPair(bad, opt_.badLinks, l, surfaces_[st].isEmitter(), opt_.partialThreshold);
       if (bad) badPairs_.insert((uint64_t(rt) << 32) | st);
     }
+    intervals_.addKey(std::move(values), k);
   }
 
   const Scene& scene_;
@@ -948,25 +984,28 @@ KeyRecord recordOf(const KeyWindow& w, size_t kw, const std::vector<int>& window
   return r;
 }
 
-// Re-adds window w's link values at the keys it owns to `intervals`, in key order per link
-// (the windows are taken in order of their first keys, so a link's keys keep increasing): the
-// rows that span windows join as in the whole run.
+// Re-adds window w's link values at the keys it owns to `intervals`, key by key (the windows
+// are taken in order of their first keys, so the keys keep increasing): the rows that span
+// windows join as in the whole run.
 void addWindowLinks(const KeyWindow& w, size_t self, const std::vector<size_t>& owner,
                     const std::vector<int>& mergedIndex, const std::vector<uint32_t>& count,
                     const std::string& name, LinkIntervals& intervals) {
-  for (size_t li = 0; li < w.links.size(); ++li) {
-    const GlobalLink& l = w.links[li];
-    const int rcv = mergedIndex[l.receiver], sh = mergedIndex[l.shooter];
-    for (uint32_t kw = l.firstKey; kw <= l.lastKey; ++kw) {
-      const size_t k = w.firstKey + kw;
-      if (owner[k] != self) continue;
+  for (uint32_t kw = 0; kw < uint32_t(w.keyCount()); ++kw) {
+    const size_t k = w.firstKey + kw;
+    if (owner[k] != self) continue;
+    std::vector<LinkIntervals::KeyValue> values;
+    for (size_t li = 0; li < w.links.size(); ++li) {
+      const GlobalLink& l = w.links[li];
+      if (kw < l.firstKey || kw > l.lastKey) continue;
+      const int rcv = mergedIndex[l.receiver], sh = mergedIndex[l.shooter];
       if (rcv < 0 || sh < 0 || uint32_t(rcv) >= count[k] || uint32_t(sh) >= count[k])
         throw inputError(name, "link row " + std::to_string(li) + " names a node key " +
                                    std::to_string(k) + " does not have");
       const uint32_t j = l.sampleOffset + (l.sampleCount == 1 ? 0 : kw - l.firstKey);
-      intervals.add((uint64_t(uint32_t(rcv)) << 32) | uint32_t(sh), uint32_t(k), w.linkValues[j],
-                    w.linkVisibility[j], (l.flags & kLinkRefined) != 0);
+      values.push_back({(uint64_t(uint32_t(rcv)) << 32) | uint32_t(sh), w.linkValues[j],
+                        w.linkVisibility[j], (l.flags & kLinkRefined) != 0});
     }
+    intervals.addKey(std::move(values), uint32_t(k));
   }
 }
 
