@@ -203,6 +203,11 @@ class GoodLinkGather {
   // is at least this share of what its receiver chain carries (TextureMovieBakerOptions).
   double partialShare_;
   static constexpr double kTileFarRatio = 2.0;
+  // The same for the links of the nodes below a tile's common node (Tile::groups), which hold
+  // only some of its texels. At 2 the bundled scene's frame 20 went from 2.46 to 2.50 % RMSE /
+  // mean against its references; at 4 it stays at 2.46 % with 29 % fewer per-texel form factors
+  // than none at all (8: 2.46 %, 10 % fewer).
+  static constexpr double kTileFarRatioBelow = 4.0;
   struct Tile {
     int i0 = 0, j0 = 0, i1 = 0, j1 = 0;  // first texel and the corner texels (last column, row)
     // The corner texels (i0,j0), (i1,j0), (i1,j1), (i0,j1) of a texture `width` wide.
@@ -210,9 +215,17 @@ class GoodLinkGather {
       return {size_t(j0) * width + i0, size_t(j0) * width + i1, size_t(j1) * width + i1,
               size_t(j1) * width + i0};
     }
-    int common = -1;                    // deepest node holding every texel of the tile
-    std::vector<uint32_t> links;        // links_ indices interpolated over the tile
+    int common = -1;              // deepest node holding every texel of the tile
+    std::vector<uint32_t> links;  // links_ indices interpolated over the tile
+    // The links in groups by the texels they reach: links [groups[g - 1].second,
+    // groups[g].second) reach the texels of mask groups[g].first (bit (j - j0) kTile + i - i0).
+    // The common node's chain reaches all; a node below it only its own texels, where a
+    // texture side that is not a power of two cuts the nodes between texels.
+    std::vector<std::pair<uint64_t, uint32_t>> groups;
     std::vector<uint32_t> cornerEntry;  // per tile link, its 4 corners' cornerLink_ entries
+    static uint64_t bit(int i, int j, const Tile& t) {
+      return uint64_t(1) << ((j - t.j0) * kTile + (i - t.i0));
+    }
   };
   // The corner texels of the tiles, each with its far links (sorted links_ indices)
   // cornerLink_[corners_[i].first .. corners_[i + 1].first) (a last entry ends the list), and

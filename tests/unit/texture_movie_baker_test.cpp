@@ -661,6 +661,67 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
   EXPECT_LT(worst, 0.01) << "step across the edge";
 }
 
+// A texture whose side is not a power of two (the sqrt 2 ladder's 45) cuts the receiver's nodes
+// between texels, so most 8 x 8 tiles straddle two nodes. The far links of the nodes below a
+// tile's common one are interpolated over the tile too, for their own texels only: as few
+// per-texel form factors as at 64 x 64, where the floor's 8 x 8 leaves fit the tiles (4 per
+// texel at 45 before), and the irradiance within 1 % of the 64 x 64 bake's at the same points
+// (sampled bilinearly between its texel centres).
+TEST(TextureMovieBaker, TilesStraddlingTwoNodesInterpolateTheirFarLinksToo) {
+  Scene s;
+  Material white, lamp;
+  white.reflectance = glm::dvec3(0.7);
+  lamp.emission = glm::dvec3(5.0);
+  lamp.reflectance = glm::dvec3(0.0);
+  s.materials = {white, lamp};
+  const int floor = addQuadNode(s, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, 0);
+  addQuadNode(s, {0, 0, 3}, {0, 1, 3}, {1, 1, 3}, {1, 0, 3}, 0);  // ceiling, down
+  addQuadNode(s, {0.3, 0.4, 2.9}, {0.3, 0.6, 2.9}, {0.5, 0.6, 2.9}, {0.5, 0.4, 2.9}, 1);  // lamp
+  SpaceTimeOptions so;
+  so.badLinks = BadLinkRule::kNone;
+  so.radiosity.eps = 1e-4;
+  so.radiosity.minArea = 0.02;  // leaves of 1/64 m^2: 8 x 8 texels at 64 x 64
+  GlobalSolution g = solveSpaceTime(s, {0.0}, so);
+  const int top = topOfNode(g, floor);
+  int leaves = 0;
+  for (int i = 0; i < g.hierarchy.size(); ++i)
+    leaves += g.hierarchy.isLeaf(i) && int(g.hierarchy.node(i).id.top) == top;
+  ASSERT_EQ(leaves, 64) << "the floor must be refined to 8 x 8 leaves";
+
+  auto bake = [&](int n, GoodLinkGatherStats& stats) {
+    TextureMovieBaker baker(s, g, kFps, {});
+    MovieExtent r;
+    r.patch = PatchId{uint32_t(top), 1u};
+    r.width = r.height = n;
+    std::vector<float> key = baker.bake(r).keys[0];
+    stats = baker.stats().gather;
+    return key;
+  };
+  GoodLinkGatherStats s45, s64;
+  const std::vector<float> k45 = bake(45, s45), k64 = bake(64, s64);
+  const double perTexel45 = double(s45.entries) / (45 * 45);
+  const double perTexel64 = double(s64.entries) / (64 * 64);
+  EXPECT_GT(s45.tileEntries, 0);
+  EXPECT_LE(perTexel45, perTexel64 + 0.5)
+      << perTexel45 << " per-texel form factors per texel at 45, " << perTexel64 << " at 64";
+  auto at64 = [&](double u, double v) {  // bilinear between the 64 x 64 texel centres
+    const double x = std::clamp(u * 64 - 0.5, 0.0, 63.0), y = std::clamp(v * 64 - 0.5, 0.0, 63.0);
+    const int i = std::min(int(x), 62), j = std::min(int(y), 62);
+    const double a = x - i, b = y - j;
+    auto h = [&](int ii, int jj) { return double(k64[(size_t(jj) * 64 + size_t(ii)) * 3]); };
+    return (1 - a) * (1 - b) * h(i, j) + a * (1 - b) * h(i + 1, j) + a * b * h(i + 1, j + 1) +
+           (1 - a) * b * h(i, j + 1);
+  };
+  double worst = 0.0;
+  for (int j = 1; j < 44; ++j)
+    for (int i = 1; i < 44; ++i) {
+      const double h45 = k45[(size_t(j) * 45 + size_t(i)) * 3];
+      const double ref = at64((i + 0.5) / 45, (j + 0.5) / 45);
+      worst = std::max(worst, std::abs(h45 - ref) / ref);
+    }
+  EXPECT_LT(worst, 0.01);
+}
+
 // The scenes of the per-texel visibility tests: a floor [0,2] x [0,1] at z = 0 (white, up)
 // under an emitting, non-reflecting ceiling at z = 1 (B = pi, down); material 2 is black, for
 // blockers that reflect nothing.
