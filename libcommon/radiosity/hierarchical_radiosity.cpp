@@ -209,6 +209,7 @@ class KeyTimeSolver {
       }
       computeAccurateFormFactors();
       weightVisibilityByShooterRadiosity();
+      if (round == 0) releaseRayPairs();
       computeExposures();  // the closure of a closed leaf divides by them too
       if (opt_.closure) computeClosure();
       s_.secondsLinks += secondsSince(tl);
@@ -224,6 +225,13 @@ class KeyTimeSolver {
   }
 
  private:
+  // After the first round: the previous key's ray pairs are no longer copied, and their owner
+  // frees them (KeySolveInput::releaseRayPairs).
+  void releaseRayPairs() {
+    reuseRayPairs_ = nullptr;
+    if (input_.releaseRayPairs) input_.releaseRayPairs();
+  }
+
   // World geometry and starting radiosity of the nodes of the union hierarchy this solve has
   // not seen yet (the ones made before it, then the ones each subdivision appends). A node
   // starts with its parent's B, a top-level patch with its emission.
@@ -410,6 +418,11 @@ class KeyTimeSolver {
         pairStart_[li] = uint32_t(pairs_.size() + fresh.size() * size_t(k));
         fresh.push_back(li);
       }
+    // Pair starts are 32-bit (kNoRayPairs): 4 M links (the default --max-links) of 64 pairs
+    // stay far below; a link bound raised past a billion pairs is refused, not wrapped.
+    if (pairs_.size() + fresh.size() * size_t(k) >= size_t(kNoRayPairs))
+      throw Error(ExitCode::kEnvironment, "",
+                  "more than 4 G shadow-ray pairs in one key time; lower --max-links or --rays");
     pairs_.resize(pairs_.size() + fresh.size() * size_t(k));
     pairLeaf_.resize(pairs_.size());
     tbb::parallel_for(size_t(0), fresh.size(), [&](size_t f) {
@@ -418,8 +431,8 @@ class KeyTimeSolver {
       std::fill_n(&pairLeaf_[pairStart_[fresh[f]]], k, l.shooter);
       const uint32_t knownPairs =
           l.known != SolverLink::kNotKnown ? input_.reuse->value(l.known).rayPairs : kNoRayPairs;
-      if (knownPairs != kNoRayPairs && input_.reuseRayPairs) {
-        std::copy_n(input_.reuseRayPairs->begin() + std::ptrdiff_t(knownPairs), k, pair);
+      if (knownPairs != kNoRayPairs && reuseRayPairs_) {
+        std::copy_n(reuseRayPairs_->begin() + std::ptrdiff_t(knownPairs), k, pair);
       } else {
         const PatchNode& r = h_.node(l.receiver);
         const PatchNode& q = h_.node(l.shooter);
@@ -1044,6 +1057,8 @@ class KeyTimeSolver {
   PatchHierarchy& h_;
   const std::vector<SurfaceProperties>& surfaces_;
   const KeySolveInput& input_;
+  // input_.reuseRayPairs until the first round has copied them (releaseRayPairs).
+  const std::vector<LinkRayPair>* reuseRayPairs_ = input_.reuseRayPairs;
   const RadiosityOptions& opt_;
   KeySolution s_;
   std::vector<glm::dvec3> B_;  // per dense node: radiosity (W/m^2), area average of a parent

@@ -351,18 +351,18 @@ struct KeyPassResult {
   std::vector<uint32_t> nodeCount;
 };
 
-// The key-time pass (paper §4.2): one hierarchical solve per key time on the shared union
-// hierarchy, each taking over what stays valid of the previous key's links (coherence), and
-// folded into the links' activity intervals, the bad pairs and the per-key radiosity as soon
-// as it is solved. It solves keys first..last of `keyTimes` (a window; key k's record and
-// intervals index is k - first) and builds what depends on the whole animation from all of
-// `keyTimes`, so a window's keys come out as the whole run's.
 // Frees a vector's capacity beyond a quarter over its size.
 template <class T>
 void shrinkWhenSpare(std::vector<T>& v) {
   if (v.capacity() > v.size() + v.size() / 4) v.shrink_to_fit();
 }
 
+// The key-time pass (paper §4.2): one hierarchical solve per key time on the shared union
+// hierarchy, each taking over what stays valid of the previous key's links (coherence), and
+// folded into the links' activity intervals, the bad pairs and the per-key radiosity as soon
+// as it is solved. It solves keys first..last of `keyTimes` (a window; key k's record and
+// intervals index is k - first) and builds what depends on the whole animation from all of
+// `keyTimes`, so a window's keys come out as the whole run's.
 class KeyTimePass {
  public:
   KeyTimePass(const Scene& scene, const std::vector<double>& keyTimes, size_t first, size_t last,
@@ -438,6 +438,7 @@ class KeyTimePass {
         in.reuseClusterLinks = &clusterCache;
       }
       in.reuseClosed = &closedCache_;
+      in.releaseRayPairs = [&] { std::vector<LinkRayPair>().swap(prev.rayPairs); };
       // The caches hold what the solve takes over of prev's links and cluster links; of prev
       // itself it still reads the ray pairs (reuseRayPairs). The rest is freed before the
       // solve: held beside the caches and the new key's links, it was ~200 MB of the
@@ -447,6 +448,7 @@ class KeyTimePass {
       std::vector<SolverLink>().swap(prev.links);
       std::vector<ClusterLink>().swap(prev.clusterLinkValues);
       LeafFormFactorCache().swap(prev.leafTopFormFactor);
+      std::vector<uint32_t>().swap(prev.rayPairStart);  // the caches hold each link's start
       secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);
