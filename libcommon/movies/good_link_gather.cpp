@@ -1004,34 +1004,38 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   });
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     const Tile& tile = tiles_[ti];
-    // The tile's far links at its corners (corner c: (i0,j0), (i1,j0), (i1,j1), (i0,j1)), per
-    // group of the texels they reach.
-    struct GroupCorners {
-      uint64_t mask;
-      glm::dvec3 corner[4];
+    const int iEnd = std::min(tile.i0 + kTile, width), jEnd = std::min(tile.j0 + kTile, height);
+    auto bilinear = [&](int i, int j) {  // (u, v) of texel (i, j) between the tile's corners
+      return glm::dvec2(tile.i1 > tile.i0 ? double(i - tile.i0) / (tile.i1 - tile.i0) : 0.0,
+                        tile.j1 > tile.j0 ? double(j - tile.j0) / (tile.j1 - tile.j0) : 0.0);
     };
-    std::vector<GroupCorners> group(tile.groups.size());
+    // The tile's far links at its corners (corner c: (i0,j0), (i1,j0), (i1,j1), (i0,j1)), group
+    // by group, interpolated to the texels each group reaches (on the stack: this runs per tile
+    // and key).
+    std::array<glm::dvec3, size_t(kTile * kTile)> far;
+    far.fill(glm::dvec3(0.0));
     for (size_t g = 0, k = 0; g < tile.groups.size(); ++g) {
-      group[g].mask = tile.groups[g].first;
-      for (int c = 0; c < 4; ++c) group[g].corner[c] = glm::dvec3(0.0);
+      glm::dvec3 corner[4] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
       for (; k < tile.groups[g].second; ++k) {
         const uint32_t j = tile.links[k];
         if (weight[j] == glm::dvec3(0.0)) continue;
         for (int c = 0; c < 4; ++c)
-          group[g].corner[c] += cornerValue[tile.cornerEntry[k * 4 + size_t(c)]] * weight[j];
+          corner[c] += cornerValue[tile.cornerEntry[k * 4 + size_t(c)]] * weight[j];
       }
+      for (int j = tile.j0; j < jEnd; ++j)
+        for (int i = tile.i0; i < iEnd; ++i)
+          if (tile.groups[g].first & Tile::bit(i, j, tile)) {
+            const glm::dvec2 uv = bilinear(i, j);
+            const double u = uv.x, v = uv.y;
+            far[size_t((j - tile.j0) * kTile + (i - tile.i0))] +=
+                (1 - u) * (1 - v) * corner[0] + u * (1 - v) * corner[1] + u * v * corner[2] +
+                (1 - u) * v * corner[3];
+          }
     }
-    for (int j = tile.j0; j < std::min(tile.j0 + kTile, height); ++j)
-      for (int i = tile.i0; i < std::min(tile.i0 + kTile, width); ++i) {
+    for (int j = tile.j0; j < jEnd; ++j)
+      for (int i = tile.i0; i < iEnd; ++i) {
         const size_t x = size_t(j) * width + i;
-        const double u = tile.i1 > tile.i0 ? double(i - tile.i0) / (tile.i1 - tile.i0) : 0.0;
-        const double v = tile.j1 > tile.j0 ? double(j - tile.j0) / (tile.j1 - tile.j0) : 0.0;
-        const uint64_t b = Tile::bit(i, j, tile);
-        glm::dvec3 H(0.0);
-        for (const GroupCorners& gc : group)
-          if (gc.mask & b)
-            H += (1 - u) * (1 - v) * gc.corner[0] + u * (1 - v) * gc.corner[1] +
-                 u * v * gc.corner[2] + (1 - u) * v * gc.corner[3];
+        glm::dvec3 H = far[size_t((j - tile.j0) * kTile + (i - tile.i0))];
         const glm::dvec3 p = world(x), nx = normal(x);
         for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
           const uint32_t l = texelLinks_[e];

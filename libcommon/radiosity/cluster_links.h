@@ -28,7 +28,6 @@
 
 #include <atomic>
 #include <cstdint>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 

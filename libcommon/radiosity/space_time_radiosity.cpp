@@ -61,10 +61,13 @@ class LinkIntervals {
   };
   // One link's value at one key.
   struct KeyValue {
-    uint64_t link;  // receiver << 32 | shooter
+    uint64_t link;  // linkOf(receiver, shooter)
     float fv, visibility;
     bool refined;
   };
+  static uint64_t linkOf(int receiver, int shooter) {
+    return (uint64_t(uint32_t(receiver)) << 32) | uint32_t(shooter);
+  }
 
   // Every link's value at key `key`; keys arrive in increasing order. The links so far are a
   // vector sorted by link, merged with this key's sorted values: 16 bytes per link instead of
@@ -72,6 +75,7 @@ class LinkIntervals {
   void addKey(std::vector<KeyValue> values, uint32_t key) {
     std::stable_sort(values.begin(), values.end(),
                      [](const KeyValue& a, const KeyValue& b) { return a.link < b.link; });
+    // The new links counted first, so that the merged vector is allocated once at its size.
     size_t fresh = 0;
     for (size_t i = 0, j = 0; i < values.size(); ++i) {
       while (j < links_.size() && links_[j].first < values[i].link) ++j;
@@ -351,12 +355,6 @@ struct KeyPassResult {
   std::vector<uint32_t> nodeCount;
 };
 
-// Frees a vector's capacity beyond a quarter over its size.
-template <class T>
-void shrinkWhenSpare(std::vector<T>& v) {
-  if (v.capacity() > v.size() + v.size() / 4) v.shrink_to_fit();
-}
-
 // The key-time pass (paper §4.2): one hierarchical solve per key time on the shared union
 // hierarchy, each taking over what stays valid of the previous key's links (coherence), and
 // folded into the links' activity intervals, the bad pairs and the per-key radiosity as soon
@@ -397,8 +395,8 @@ class KeyTimePass {
       nodeCount_.push_back(uint32_t(h_.size()));
       // Key 0 grew its ray pairs by doubling (no previous key to reserve by): held through the
       // next key's solve, the spare half had been 100 MB of the 10k-triangle hall's peak.
-      shrinkWhenSpare(s.rayPairs);
-      shrinkWhenSpare(s.rayPairStart);
+      if (s.rayPairs.capacity() > s.rayPairs.size() + s.rayPairs.size() / 4)
+        s.rayPairs.shrink_to_fit();
       prev = std::move(s);
     }
   }
@@ -465,7 +463,7 @@ class KeyTimePass {
     std::vector<LinkIntervals::KeyValue> values;
     values.reserve(s.links.size());
     for (const SolverLink& l : s.links) {
-      values.push_back({(uint64_t(uint32_t(l.receiver)) << 32) | uint32_t(l.shooter), float(l.fv()),
+      values.push_back({LinkIntervals::linkOf(l.receiver, l.shooter), float(l.fv()),
                         float(l.visibility), l.refined});
       uint32_t rt = h_.node(l.receiver).id.top, st = h_.node(l.shooter).id.top;
       char bad = 0;
@@ -1004,8 +1002,8 @@ void addWindowLinks(const KeyWindow& w, size_t self, const std::vector<size_t>& 
         throw inputError(name, "link row " + std::to_string(li) + " names a node key " +
                                    std::to_string(k) + " does not have");
       const uint32_t j = l.sampleOffset + (l.sampleCount == 1 ? 0 : kw - l.firstKey);
-      values.push_back({(uint64_t(uint32_t(rcv)) << 32) | uint32_t(sh), w.linkValues[j],
-                        w.linkVisibility[j], (l.flags & kLinkRefined) != 0});
+      values.push_back({LinkIntervals::linkOf(rcv, sh), w.linkValues[j], w.linkVisibility[j],
+                        (l.flags & kLinkRefined) != 0});
     }
     intervals.addKey(std::move(values), uint32_t(k));
   }

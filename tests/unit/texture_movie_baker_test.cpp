@@ -538,7 +538,8 @@ struct BakedTexel {
   double h;
 };
 std::vector<BakedTexel> bakeTop(const Scene& s, const GlobalSolution& g, int top, int w, int h,
-                                const TextureMovieBakerOptions& o = {}, uint32_t path = 1u) {
+                                const TextureMovieBakerOptions& o = {}, uint32_t path = 1u,
+                                GoodLinkGatherStats* gatherStats = nullptr) {
   TextureMovieBaker baker(s, g, kFps, o);
   MovieExtent r;
   r.patch = PatchId{uint32_t(top), path};
@@ -546,6 +547,7 @@ std::vector<BakedTexel> bakeTop(const Scene& s, const GlobalSolution& g, int top
   r.width = w;
   r.height = h;
   const std::vector<float> key = baker.bake(r).keys[0];
+  if (gatherStats) *gatherStats = baker.stats().gather;
   std::vector<BakedTexel> out;
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i)
@@ -623,17 +625,31 @@ TEST(TextureMovieBaker, GatheredGoodLayerIsTheExactPointFormFactorIntoACorner) {
   EXPECT_GT(gouraudWorst, 2.0 * gatherWorst) << "Gouraud misses the corner by " << gouraudWorst;
 }
 
-// No visible facets with the gather (issue 15): a floor of two coplanar tiles under a white
-// ceiling, a small lamp over the first tile only, so the tiles and the ceiling above them are
-// refined differently and the ceiling's radiosity varies. The baked irradiance of both sides,
-// extrapolated to the tiles' shared edge, agrees within 1 %.
-TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTiles) {
+// A scene with material 0 white (reflectance 0.7) and material 1 a lamp (emission 5, black).
+Scene sceneWithWhiteAndLamp() {
   Scene s;
   Material white, lamp;
   white.reflectance = glm::dvec3(0.7);
   lamp.emission = glm::dvec3(5.0);
   lamp.reflectance = glm::dvec3(0.0);
   s.materials = {white, lamp};
+  return s;
+}
+
+// The leaves of top-level patch `top` in g's hierarchy.
+int leavesOfTop(const GlobalSolution& g, int top) {
+  int leaves = 0;
+  for (int i = 0; i < g.hierarchy.size(); ++i)
+    leaves += g.hierarchy.isLeaf(i) && int(g.hierarchy.node(i).id.top) == top;
+  return leaves;
+}
+
+// No visible facets with the gather (issue 15): a floor of two coplanar tiles under a white
+// ceiling, a small lamp over the first tile only, so the tiles and the ceiling above them are
+// refined differently and the ceiling's radiosity varies. The baked irradiance of both sides,
+// extrapolated to the tiles' shared edge, agrees within 1 %.
+TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTiles) {
+  Scene s = sceneWithWhiteAndLamp();
   const int tileA = addQuadNode(s, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, 0);
   const int tileB = addQuadNode(s, {1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, 0);
   addQuadNode(s, {0, 0, 1}, {0, 1, 1}, {2, 1, 1}, {2, 0, 1}, 0);  // ceiling, down
@@ -643,13 +659,7 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
   so.radiosity.minArea = 1e-4;
   GlobalSolution g = solveSpaceTime(s, {0.0}, so);
   const int topA = topOfNode(g, tileA), topB = topOfNode(g, tileB);
-  int leavesA = 0, leavesB = 0;
-  for (int i = 0; i < g.hierarchy.size(); ++i)
-    if (g.hierarchy.isLeaf(i)) {
-      leavesA += int(g.hierarchy.node(i).id.top) == topA;
-      leavesB += int(g.hierarchy.node(i).id.top) == topB;
-    }
-  ASSERT_NE(leavesA, leavesB) << "the tiles must be refined differently";
+  ASSERT_NE(leavesOfTop(g, topA), leavesOfTop(g, topB)) << "the tiles must be refined differently";
 
   const int n = 64;
   // The lamp's direct light alone falls 3 % from one texel to the next at the edge x = 1.
@@ -668,12 +678,7 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
 // texel at 45 before), and the irradiance within 1 % of the 64 x 64 bake's at the same points
 // (sampled bilinearly between its texel centres).
 TEST(TextureMovieBaker, TilesStraddlingTwoNodesInterpolateTheirFarLinksToo) {
-  Scene s;
-  Material white, lamp;
-  white.reflectance = glm::dvec3(0.7);
-  lamp.emission = glm::dvec3(5.0);
-  lamp.reflectance = glm::dvec3(0.0);
-  s.materials = {white, lamp};
+  Scene s = sceneWithWhiteAndLamp();
   const int floor = addQuadNode(s, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, 0);
   addQuadNode(s, {0, 0, 3}, {0, 1, 3}, {1, 1, 3}, {1, 0, 3}, 0);  // ceiling, down
   addQuadNode(s, {0.3, 0.4, 2.9}, {0.3, 0.6, 2.9}, {0.5, 0.6, 2.9}, {0.5, 0.4, 2.9}, 1);  // lamp
@@ -683,22 +688,11 @@ TEST(TextureMovieBaker, TilesStraddlingTwoNodesInterpolateTheirFarLinksToo) {
   so.radiosity.minArea = 0.02;  // leaves of 1/64 m^2: 8 x 8 texels at 64 x 64
   GlobalSolution g = solveSpaceTime(s, {0.0}, so);
   const int top = topOfNode(g, floor);
-  int leaves = 0;
-  for (int i = 0; i < g.hierarchy.size(); ++i)
-    leaves += g.hierarchy.isLeaf(i) && int(g.hierarchy.node(i).id.top) == top;
-  ASSERT_EQ(leaves, 64) << "the floor must be refined to 8 x 8 leaves";
+  ASSERT_EQ(leavesOfTop(g, top), 64) << "the floor must be refined to 8 x 8 leaves";
 
-  auto bake = [&](int n, GoodLinkGatherStats& stats) {
-    TextureMovieBaker baker(s, g, kFps, {});
-    MovieExtent r;
-    r.patch = PatchId{uint32_t(top), 1u};
-    r.width = r.height = n;
-    std::vector<float> key = baker.bake(r).keys[0];
-    stats = baker.stats().gather;
-    return key;
-  };
   GoodLinkGatherStats s45, s64;
-  const std::vector<float> k45 = bake(45, s45), k64 = bake(64, s64);
+  const std::vector<BakedTexel> k45 = bakeTop(s, g, top, 45, 45, {}, 1u, &s45);
+  const std::vector<BakedTexel> k64 = bakeTop(s, g, top, 64, 64, {}, 1u, &s64);
   const double perTexel45 = double(s45.entries) / (45 * 45);
   const double perTexel64 = double(s64.entries) / (64 * 64);
   EXPECT_GT(s45.tileEntries, 0);
@@ -708,14 +702,14 @@ TEST(TextureMovieBaker, TilesStraddlingTwoNodesInterpolateTheirFarLinksToo) {
     const double x = std::clamp(u * 64 - 0.5, 0.0, 63.0), y = std::clamp(v * 64 - 0.5, 0.0, 63.0);
     const int i = std::min(int(x), 62), j = std::min(int(y), 62);
     const double a = x - i, b = y - j;
-    auto h = [&](int ii, int jj) { return double(k64[(size_t(jj) * 64 + size_t(ii)) * 3]); };
+    auto h = [&](int ii, int jj) { return k64[size_t(jj) * 64 + size_t(ii)].h; };
     return (1 - a) * (1 - b) * h(i, j) + a * (1 - b) * h(i + 1, j) + a * b * h(i + 1, j + 1) +
            (1 - a) * b * h(i, j + 1);
   };
   double worst = 0.0;
   for (int j = 1; j < 44; ++j)
     for (int i = 1; i < 44; ++i) {
-      const double h45 = k45[(size_t(j) * 45 + size_t(i)) * 3];
+      const double h45 = k45[size_t(j) * 45 + size_t(i)].h;
       const double ref = at64((i + 0.5) / 45, (j + 0.5) / 45);
       worst = std::max(worst, std::abs(h45 - ref) / ref);
     }
