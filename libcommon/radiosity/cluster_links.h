@@ -6,8 +6,13 @@
 // between every ordered pair of the cluster's children (and the children's self-links); a link
 // R <- S is refined, by splitting the larger of its two clusters (a top-level patch end is not
 // split here), while
-//  * S holds an emitter: links to lights end as patch links, which the second pass recomputes
-//    per texel (the bad links) and the closure keeps exact;
+//  * S holds an emitter and the link's power bound (below, with S's emitted radiosity where that
+//    is larger) exceeds lightShare eps Phi: such links end as patch links, which the second
+//    pass recomputes per texel (the bad links, with shadows) and the closure keeps exact; a
+//    light's weaker links stay cluster links (smooth light, no per-texel shadows). lightShare
+//    0: every link from a light ends as patch links; the lights' links then grow as the
+//    top-level patches times the lights, which is quadratic in a hall whose lights grow with
+//    its floor;
 //  * the two bounding spheres come closer than their radii (the point approximation below
 //    does not hold): near geometry ends as patch links;
 //  * or its power bound exceeds eps Phi: $\max B_S \, V \, \min(A_R \tilde F, A_S)$ with
@@ -66,10 +71,11 @@ inline uint32_t clusterLinkEnd(ClusterRef r, size_t topCount) {
 
 class ClusterLinks {
  public:
-  // `world`, `area`: per top-level patch at this key; `emits`: per top.
+  // `world`, `area`: per top-level patch at this key; `topEmission`: per top, its emitted
+  // radiosity's largest channel (> 0: a light). `lightShare`: see the top of this file.
   ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
-               const std::vector<double>& area, const std::vector<char>& emits,
-               const VisibilityScene* visibility, int rays, double separation,
+               const std::vector<double>& area, const std::vector<double>& topEmission,
+               const VisibilityScene* visibility, int rays, double separation, double lightShare,
                const ClusterLinkCache* reuse = nullptr);
 
   // One round of refinement (see the top of this file) with eps Phi = epsAbs (refineAll: every
@@ -104,9 +110,11 @@ class ClusterLinks {
   const ClusterBounds& bounds(ClusterRef r) const {
     return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];
   }
-  bool emits(ClusterRef r) const {
-    return isCluster(r) ? clusterEmits_[size_t(clusterIndex(r))] != 0 : emits_[size_t(r)] != 0;
+  // The largest emitted radiosity channel of r's tops (> 0: r holds a light).
+  double emission(ClusterRef r) const {
+    return isCluster(r) ? clusterEmission_[size_t(clusterIndex(r))] : emission_[size_t(r)];
   }
+  bool emits(ClusterRef r) const { return emission(r) > 0.0; }
   double maxRadiosity(ClusterRef r) const {
     return isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)];
   }
@@ -119,18 +127,20 @@ class ClusterLinks {
   const ClusterTree& tree_;
   const std::vector<Polygon>& world_;
   const std::vector<double>& area_;
-  const std::vector<char>& emits_;
+  const std::vector<double>& emission_;
   const VisibilityScene* visibility_;
   int rays_;
   double separation_;
+  double lightShare_;
   const ClusterLinkCache* reuse_;
   std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
   std::vector<ClusterBounds> clusterBounds_, topBounds_;
   std::vector<glm::dvec4> clusterSphere_, topSphere_;  // (centre, radius) of the bounds
-  std::vector<char> clusterEmits_;
+  std::vector<double> clusterEmission_;
   std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
+  std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;
   size_t expectedLinks_ = 0;
   // Per link: its shooter's B towards its receiver (gather). This and the gather's form

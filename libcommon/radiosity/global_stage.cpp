@@ -27,6 +27,7 @@ nlohmann::json GlobalOptions::toJson() const {
           {"no-closed-rooms", !r.closedRooms},
           {"no-clustering", !r.clustering},
           {"cluster-separation", r.clusterSeparation},
+          {"light-cluster-share", r.lightClusterShare},
           {"no-shooter-shape", !r.shooterShape},
           {"no-coherence", !spaceTime.coherence}};
 }

@@ -185,12 +185,12 @@ class KeyTimeSolver {
       pairLeaf_.reserve(withMargin(input_.expectedRayPairs));
     }
     if (input_.clusters && !input_.clusters->empty()) {
-      topEmits_.resize(size_t(h_.topCount()));
+      topEmission_.resize(size_t(h_.topCount()));
       for (int t = 0; t < h_.topCount(); ++t)
-        topEmits_[size_t(t)] = surfaces_[size_t(t)].isEmitter();
-      clusters_ = std::make_unique<ClusterLinks>(*input_.clusters, s_.world, s_.area, topEmits_,
-                                                 input_.visibility, opt_.rays,
-                                                 opt_.clusterSeparation, input_.reuseClusterLinks);
+        topEmission_[size_t(t)] = maxComponent(surfaces_[size_t(t)].emission);
+      clusters_ = std::make_unique<ClusterLinks>(
+          *input_.clusters, s_.world, s_.area, topEmission_, input_.visibility, opt_.rays,
+          opt_.clusterSeparation, opt_.lightClusterShare, input_.reuseClusterLinks);
       if (input_.expectedClusterLinks > 0)
         clusters_->expectLinks(withMargin(input_.expectedClusterLinks));
     } else {
@@ -1090,7 +1090,7 @@ class KeyTimeSolver {
   bool nonFinite_ = false;          // a sweep produced NaN or Inf
   double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges
   std::unique_ptr<ClusterLinks> clusters_;  // null: all-pairs linking
-  std::vector<char> topEmits_;              // per top: emits (clusters_)
+  std::vector<double> topEmission_;         // per top: largest emitted channel (clusters_)
   std::vector<glm::dvec3> clusterH_;        // per top: irradiance through cluster links
   std::vector<double> clusterRow_;          // per top: its cluster links' form factor sum
 };

@@ -114,6 +114,11 @@ struct RadiosityOptions {
   // (same time). 2 and 1 gave 1.71 and 1.95 % on the 3k hall.
   // ClusterLinks.ExposedFloorMatchesAllPairsAtTheDefaultSeparation: 3 is 2.2 % dark there.
   double clusterSeparation = 4.0;
+  // A link from a light stays a cluster link while its power bound is under this share of
+  // eps Phi (cluster_links.h); stronger ones end as patch links, whose shadows the second pass
+  // takes per texel. 0: every light link ends as patch links (per-texel shadows from every
+  // light, links growing as the top-level patches times the lights).
+  double lightClusterShare = 0.1;
 };
 
 // Diffuse reflectance and emitted radiosity B_e = pi L_e (W/m^2) of one top-level patch.

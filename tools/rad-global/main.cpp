@@ -93,6 +93,12 @@ void addOptions(CLI::App& app, Options& o) {
                  "the sum of their bounding radii apart; larger is more accurate and slower")
       ->capture_default_str()
       ->check(rad::finiteRange(1.0, 1e6));
+  app.add_option("--light-cluster-share", r.lightClusterShare,
+                 "a link from a light stays a cluster link (smooth light, no per-texel shadows) "
+                 "while its power bound is under this share of eps times the power; 0 refines "
+                 "every light's links to patch pairs")
+      ->capture_default_str()
+      ->check(rad::finiteRange(0.0, 1e6));
   app.add_flag_callback(
       "--no-clustering", [&r] { r.clustering = false; },
       "link every pair of top-level patches (the baseline) instead of starting from the root "
