@@ -147,13 +147,18 @@ class ClusterLinks {
   // factors in single precision: 1.2 M links and 2.5 M entries on the 10k-triangle hall.
   std::vector<glm::vec3> linkB_;
   // Per top, what the gather sums at every sweep: the links at the top and at its ancestor
-  // clusters, in that order, with their form factor to the top where it is > 0; top t's are
-  // [gatherStart_[t], gatherStart_[t + 1]). The geometry is fixed within a key time, and
-  // walking the links themselves at every sweep (each a cache miss) had been a third of a
-  // coherent key's time on the 10k-triangle hall.
-  std::vector<size_t> gatherStart_;
-  std::vector<uint32_t> gatherLink_;
-  std::vector<float> gatherFormFactor_;
+  // clusters, in that order, with their form factor to the top where it is > 0. The geometry is
+  // fixed within a key time, and walking the links themselves at every sweep (each a cache
+  // miss) had been a third of a coherent key's time on the 10k-triangle hall. Held in blocks of
+  // kGatherBlockTops tops, each built by one task: top t's entries start at gatherStart_[t] in
+  // its block and end where the next top's start (its block's end for the block's last top).
+  struct GatherEntry {
+    uint32_t link;
+    float formFactor;
+  };
+  static constexpr size_t kGatherBlockTops = 256;
+  std::vector<std::vector<GatherEntry>> gatherBlocks_;
+  std::vector<uint32_t> gatherStart_;
   bool listsValid_ = false;
 };
 
