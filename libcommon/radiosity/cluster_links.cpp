@@ -75,7 +75,7 @@ std::pair<const uint32_t*, const uint32_t*> ClusterLinks::membersOf(ClusterRef r
 
 // A link between r and s into `next`, unless they cannot exchange energy: a top-level patch end
 // sees nothing of a cluster whose bounding box lies wholly on or behind its plane.
-void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next) {
+void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<LinkEnds>& next) {
   auto behind = [&](ClusterRef patch, ClusterRef other) {
     if (isCluster(patch) || !isCluster(other)) return false;
     // The normal and centroid kept per top (the same values): recomputing them here for each
@@ -90,10 +90,7 @@ void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<ClusterLink>& ne
     return true;
   };
   if (behind(r, s) || behind(s, r)) return;
-  ClusterLink l;
-  l.receiver = r;
-  l.shooter = s;
-  next.push_back(l);
+  next.push_back({r, s});
 }
 
 bool ClusterLinks::wantsRefinement(const ClusterLink& l, double epsAbs) const {
@@ -123,13 +120,17 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
   // that stay. A refined link is dropped at once, so memory holds the links in use and one
   // level's children, not every link refinement went through: on the 10k-triangle hall the
   // vector that kept them all until the end had reached 470 MB for 1.2 M live links (heaptrack).
-  // The links keep the order they had that way (each level's survivors after the last's).
-  std::vector<ClusterLink> work, kept;
-  work.swap(links_);
-  kept.reserve(std::max(work.size(), expectedLinks_));
+  // The links keep the order they had that way (each level's survivors after the last's). The
+  // levels below the first hold new links, which have only their ends (8 bytes instead of a
+  // link's 40: on the 10k-triangle hall a level and its children had been 105 MB of
+  // rad-global's peak).
+  std::vector<ClusterLink> first, kept;
+  first.swap(links_);
+  kept.reserve(std::max(first.size(), expectedLinks_));
+  std::vector<LinkEnds> work;
   size_t made = 0, count = 0;
   listsValid_ = false;
-  auto pairOrLink = [&](ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next) {
+  auto pairOrLink = [&](ClusterRef r, ClusterRef s, std::vector<LinkEnds>& next) {
     if (!isCluster(r) && !isCluster(s)) {
       if (r != s) patchPairs.emplace_back(r, s);
     } else {
@@ -138,9 +139,10 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
       made += next.size() - before;
     }
   };
-  while (!work.empty()) {
-    std::vector<ClusterLink> next;
-    for (const ClusterLink& l : work) {
+  auto refineLevel = [&](size_t size, auto&& linkAt) {
+    std::vector<LinkEnds> next;
+    for (size_t i = 0; i < size; ++i) {
+      const ClusterLink l = linkAt(i);
       // Past the link bound only the lights' links go on (as far as the light share asks): a
       // light left inside a cluster link reaches its receivers without shadows (stopped
       // wherever the bound fell, the 30k-triangle hall had lost 92 % of its bad pairs). A refined
@@ -171,7 +173,16 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
       ++count;
     }
     work.swap(next);
-  }
+  };
+  refineLevel(first.size(), [&](size_t i) { return first[i]; });
+  std::vector<ClusterLink>().swap(first);
+  while (!work.empty())
+    refineLevel(work.size(), [&](size_t i) {
+      ClusterLink l;
+      l.receiver = work[i].receiver;
+      l.shooter = work[i].shooter;
+      return l;
+    });
   links_.swap(kept);
   return count;
 }

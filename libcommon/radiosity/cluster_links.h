@@ -105,7 +105,10 @@ class ClusterLinks {
   const std::vector<ClusterLink>& links() const { return links_; }
 
  private:
-  void link(ClusterRef r, ClusterRef s, std::vector<ClusterLink>& next);
+  struct LinkEnds {
+    ClusterRef receiver, shooter;
+  };
+  void link(ClusterRef r, ClusterRef s, std::vector<LinkEnds>& next);
   bool wantsRefinement(const ClusterLink& l, double epsAbs) const;
   const ClusterBounds& bounds(ClusterRef r) const {
     return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];
