@@ -117,7 +117,11 @@ struct RadiosityOptions {
   // A link from a light stays a cluster link while its power bound is under this share of
   // eps Phi (cluster_links.h); stronger ones end as patch links, whose shadows the second pass
   // takes per texel. 0: every light link ends as patch links (per-texel shadows from every
-  // light, links growing as the top-level patches times the lights).
+  // light, links growing as the top-level patches times the lights). The 10k-triangle hall
+  // (make_hall.py, 35 lights; frame 48 against 4096-spp references, RMSE / mean, bias; bad
+  // pairs; rad-movies on frames 40-56): 0: 3.34 %, -0.88 %, 95 k, 15.0 s; 0.1: 3.37 %,
+  // -0.90 %, 42 k, 12.9 s; 1: 4.10 %, -1.14 %, 12 k, 11.1 s. The 100k hall (247 lights):
+  // rad-global 533.5 -> 247.7 s, 4,183 -> 2,147 MiB, rad-movies ~36 min -> 104 s at 0.1.
   double lightClusterShare = 0.1;
 };
 
