@@ -289,19 +289,14 @@ void ClusterLinks::buildReceiverLists() {
   const size_t T = emission_.size(), C = size_t(tree_.size());
   // The stale lists go before the new ones are made (600 MB on the 100k-triangle hall).
   std::vector<std::vector<GatherEntry>>().swap(gatherBlocks_);
-  // Per receiver (tops 0..T-1, then the clusters): its active links in link order, a compressed
-  // row table by counting sort.
-  auto row = [&](const ClusterLink& l) {
-    return isCluster(l.receiver) ? T + size_t(clusterIndex(l.receiver)) : size_t(l.receiver);
-  };
-  std::vector<uint32_t> rowStart(T + C + 1, 0);
-  for (const ClusterLink& l : links_)
-    if (l.evaluated) ++rowStart[row(l) + 1];
-  for (size_t r = 0; r < T + C; ++r) rowStart[r + 1] += rowStart[r];
-  std::vector<uint32_t> byReceiver(rowStart.back()), next(rowStart.begin(), rowStart.end() - 1);
-  for (uint32_t i = 0; i < uint32_t(links_.size()); ++i)
-    if (links_[i].evaluated) byReceiver[next[row(links_[i])]++] = i;
-  std::vector<uint32_t>().swap(next);
+  // Per receiver (tops 0..T-1, then the clusters): its active links in link order (the links
+  // not evaluated go to one more row, left unread).
+  const RowOrder byReceiver = sortByRow(links_.size(), uint32_t(T + C + 1), [&](size_t i) {
+    const ClusterLink& l = links_[i];
+    if (!l.evaluated) return uint32_t(T + C);
+    return uint32_t(isCluster(l.receiver) ? T + size_t(clusterIndex(l.receiver))
+                                          : size_t(l.receiver));
+  });
   // Top t's entries: the links at it, then at its ancestor clusters, where F > 0, written into
   // its block of tops. One array for all tops needs their counts first; the pairs held per top
   // until then had peaked at 900 MB on the 100k-triangle hall (heaptrack), next to the lists
@@ -314,9 +309,10 @@ void ClusterLinks::buildReceiverLists() {
     for (size_t t = b * kGatherBlockTops; t < std::min(T, (b + 1) * kGatherBlockTops); ++t) {
       gatherStart_[t] = uint32_t(entries.size());
       auto add = [&](size_t r) {
-        for (uint32_t k = rowStart[r]; k < rowStart[r + 1]; ++k) {
-          const double f = formFactor(links_[byReceiver[k]], uint32_t(t));
-          if (f > 0.0) entries.push_back({byReceiver[k], float(f)});
+        for (uint32_t k = byReceiver.rowStart[r]; k < byReceiver.rowStart[r + 1]; ++k) {
+          const uint32_t i = byReceiver.order[k];
+          const double f = formFactor(links_[i], uint32_t(t));
+          if (f > 0.0) entries.push_back({i, float(f)});
         }
       };
       add(t);

@@ -14,6 +14,23 @@
 
 namespace rad {
 
+// n items in row order by a stable counting sort (every rowOf(i) < rows): rowStart (rows + 1
+// entries) and order, whose [rowStart[r], rowStart[r + 1]) are row r's items in their order.
+struct RowOrder {
+  std::vector<uint32_t> rowStart, order;
+};
+template <class RowOf>
+RowOrder sortByRow(size_t n, uint32_t rows, RowOf rowOf) {
+  RowOrder out;
+  out.rowStart.assign(size_t(rows) + 1, 0);
+  for (size_t i = 0; i < n; ++i) ++out.rowStart[size_t(rowOf(i)) + 1];
+  std::partial_sum(out.rowStart.begin(), out.rowStart.end(), out.rowStart.begin());
+  out.order.resize(n);
+  std::vector<uint32_t> fill(out.rowStart.begin(), out.rowStart.end() - 1);
+  for (size_t i = 0; i < n; ++i) out.order[fill[rowOf(i)]++] = uint32_t(i);
+  return out;
+}
+
 template <class V>
 class PairTable {
  public:
@@ -22,16 +39,13 @@ class PairTable {
   // Entry i is (keys[i].first, keys[i].second) -> values[i]; every row < rows. Of entries with
   // the same key, the first one is found.
   PairTable(const std::vector<std::pair<uint32_t, uint32_t>>& keys, std::vector<V> values,
-            uint32_t rows)
-      : rowStart_(size_t(rows) + 1, 0) {
+            uint32_t rows) {
     const size_t n = keys.size();
-    for (const auto& k : keys) ++rowStart_[size_t(k.first) + 1];
-    std::partial_sum(rowStart_.begin(), rowStart_.end(), rowStart_.begin());
     // Counting sort by row (stable), then each row by column (stable: the first of equal keys
     // stays first, and lower_bound finds it).
-    std::vector<uint32_t> order(n);
-    std::vector<uint32_t> fill(rowStart_.begin(), rowStart_.end() - 1);
-    for (size_t i = 0; i < n; ++i) order[fill[keys[i].first]++] = uint32_t(i);
+    RowOrder byRow = sortByRow(n, rows, [&](size_t i) { return keys[i].first; });
+    rowStart_ = std::move(byRow.rowStart);
+    std::vector<uint32_t>& order = byRow.order;
     for (uint32_t r = 0; r < rows; ++r)
       std::stable_sort(order.begin() + rowStart_[r], order.begin() + rowStart_[r + 1],
                        [&](uint32_t a, uint32_t b) { return keys[a].second < keys[b].second; });
