@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/container.h"
-#include "libcommon/radiosity/space_time_radiosity.h"
+#include "libcommon/radiosity/key_window.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {

@@ -62,6 +62,13 @@ TEST(FuzzRegressions, LinkHierarchy) {
   });
 }
 
+TEST(FuzzRegressions, KeyWindow) {
+  const rad::Scene scene =
+      rad::readGltfScene(RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf");
+  replay("key_window",
+         [&](const uint8_t* data, size_t size) { rad::fuzz::feedKeyWindow(data, size, scene); });
+}
+
 TEST(FuzzRegressions, Intervals) {
   replay("intervals", rad::fuzz::feedIntervals);
 }

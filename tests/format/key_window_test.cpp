@@ -2,6 +2,7 @@
 // inconsistent (checksums valid) and future-version files, another scene and another run's
 // parameters are one-line errors naming the file, never a crash.
 #include "formats/key_window.h"
+#include "libcommon/radiosity/space_time_radiosity.h"
 
 #include <filesystem>
 #include <fstream>

@@ -13,6 +13,7 @@
 #include "formats/exr_info.h"
 #include "formats/frame_image.h"
 #include "formats/gltf_scene.h"
+#include "formats/key_window.h"
 #include "formats/link_hierarchy.h"
 #include "formats/texture_intervals.h"
 #include "formats/texture_movie.h"
@@ -42,8 +43,7 @@ inline void feedGltf(const uint8_t* data, size_t size) {
 }
 
 // Raw bytes as a container, then what rad-inspect prints of one: the summary and the kind's
-// content summary. Not through summarizeContainerContent: its keywindow case links
-// libcommon's space-time solver, which the fuzz build leaves out (keywindow is not fuzzed).
+// content summary.
 inline void feedContainer(const uint8_t* data, size_t size) {
   runReader([&] {
     const ContainerReader reader =
@@ -51,6 +51,7 @@ inline void feedContainer(const uint8_t* data, size_t size) {
     (void)reader.summary();
     if (reader.kind() == kLinkHierarchyKind) (void)summarizeLinkHierarchy(reader).dump();
     if (reader.kind() == kTextureIntervalsKind) (void)summarizeTextureIntervals(reader).dump();
+    if (reader.kind() == kKeyWindowKind) (void)summarizeKeyWindow(reader).dump();
   });
 }
 
@@ -64,6 +65,18 @@ inline void feedLinkHierarchy(const uint8_t* data, size_t size, const Scene& sce
     runReader([&] { (void)summarizeLinkHierarchy(reader); });
     runReader([&] { (void)readLinkHierarchyRadiosity(reader, scene); });
     (void)readLinkHierarchy(reader, scene);
+  });
+}
+
+// A key window file (rad-global --window) with re-sealed checksums against `scene`, the one its
+// seeds were computed for, as rad-global --merge (readKeyWindow) and rad-inspect
+// (summarizeKeyWindow) read it.
+inline void feedKeyWindow(const uint8_t* data, size_t size, const Scene& scene) {
+  runReader([&] {
+    const ContainerReader reader =
+        ContainerReader::fromBytes(resealContainer(data, size), "fuzz.rkw");
+    runReader([&] { (void)summarizeKeyWindow(reader).dump(); });
+    (void)readKeyWindow(reader, scene);
   });
 }
 
