@@ -340,7 +340,8 @@ double polygonToPolygonFormFactor(const std::vector<glm::dvec3>& from,
   order = std::clamp(order, 1, kMaxQuadratureOrder);
   Target target{to.data(), to.size()};
   double sum = 0.0;
-  for (const Cell& cell : initialCells(frontPart(from, toNormal, to[0], kPlaneTolerance * scale)))
+  for (const Cell& cell :
+       initialCells(frontPart(from, toNormal, to[0], kPlaneTolerance * diameter(from))))
     sum += integrateCell(cell, normal, target, order, order);
   double f = sum / area;
   return std::isfinite(f) ? std::clamp(f, 0.0, 1.0) : 0.0;
@@ -366,7 +367,7 @@ AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const std::vector<glm::dve
   }
   Target target{to.data(), to.size()};
   const std::vector<glm::dvec3> front =
-      frontPart(from, toNormal, to[0], kPlaneTolerance * std::max(diameter(from), diameter(to)));
+      frontPart(from, toNormal, to[0], kPlaneTolerance * diameter(from));
 
   constexpr int kHigh = 8, kLow = 5;
   // Absolute error in F below which refining only chases rounding noise.
@@ -508,7 +509,8 @@ double distanceToPolygon(const glm::dvec3& x, const Polygon& q) {
 double areaAverageFormFactor(const Polygon& r, const Polygon& q, double relTol) {
   const double size = polygonSize(r);
   const double ratio = size > 0.0 ? distanceToPolygon(r.centroid(), q) / size : 0.0;
-  if (ratio < 0.25) return polygonToPolygonFormFactorAdaptive(r, q, relTol, 1e-12, 4096).value;
+  if (ratio < 0.25)
+    return polygonToPolygonFormFactorAdaptive(r, q, relTol, kLinkFormFactorAbsTol, 4096).value;
   const int order = ratio >= 20 ? 2 : ratio >= 5 ? 4 : ratio >= 2 ? 6 : ratio >= 1 ? 8 : 12;
   return polygonToPolygonFormFactor(r, q, order);
 }

@@ -88,6 +88,13 @@ AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const Polygon& from, const
                                                       double relTol = 1e-12, double absTol = 0.0,
                                                       int maxCells = 200000);
 
+// The absolute error in F that the link form factors (areaAverageFormFactor, rad-global's
+// linkFormFactor) are computed to besides their relative tolerance. Below it a link carries
+// less than 1e-8 of its shooter's radiosity, far beneath any eps the refinement uses; without
+// it, slivers kilometres long seen edge-on (a mutated vertex, issue 18) took the adaptive rule
+// to its 4096 cells for each link, chasing 1e-5 of an F of 5e-9.
+constexpr double kLinkFormFactorAbsTol = 1e-8;
+
 // F(r -> q) as an area average over r to about relTol, at the cost the pair needs: F(x -> q) is
 // smooth over r on the scale of x's distance to q (its plane and its contour), so a fixed
 // Gauss rule on r is accurate once that distance is large against r's size, and the adaptive

@@ -91,7 +91,7 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relT
   double size = std::max(polygonSize(from), polygonSize(to));
   double f;
   if (d < size)  // near contact: no fixed rule is accurate, adapt
-    f = polygonToPolygonFormFactorAdaptive(from, to, relTol, 1e-12, 4096).value;
+    f = polygonToPolygonFormFactorAdaptive(from, to, relTol, kLinkFormFactorAbsTol, 4096).value;
   else
     f = polygonToPolygonFormFactor(from, to, kAutoOrder);
   return swap ? std::min(1.0, f * aq / ap) : f;
