@@ -124,9 +124,21 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
   // levels below the first hold new links, which have only their ends (8 bytes instead of a
   // link's 40: on the 10k-triangle hall a level and its children had been 105 MB of
   // rad-global's peak).
-  std::vector<ClusterLink> first, kept;
-  first.swap(links_);
-  kept.reserve(std::max(first.size(), expectedLinks_));
+  // The first level is compacted in place (a kept link goes to an index at or below its own),
+  // and the deeper levels' survivors are appended behind it: a second array of the links next
+  // to the first had been the whole 48 MB by which rad-global's peak on the 10k-triangle hall
+  // rose in each refinement round after the first.
+  std::vector<ClusterLink> kept;
+  kept.swap(links_);
+  kept.reserve(std::max(kept.size(), expectedLinks_));
+  size_t firstSize = kept.size(), written = 0;
+  bool firstLevel = true;
+  auto keep = [&](const ClusterLink& l) {
+    if (firstLevel)
+      kept[written++] = l;
+    else
+      kept.push_back(l);
+  };
   std::vector<LinkEnds> work;
   size_t made = 0, count = 0;
   listsValid_ = false;
@@ -149,7 +161,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
       // link is replaced by its children, so it no longer counts (`count` of them this call).
       if (made + patchPairs.size() > budget + count) overBudget = true;
       if (overBudget && !emits(l.shooter)) {
-        kept.push_back(l);
+        keep(l);
         continue;
       }
       if (l.receiver == l.shooter) {  // a cluster's self-link: its children's pairs
@@ -159,7 +171,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
             if (a != b || isCluster(a)) pairOrLink(a, b, next);
       } else {
         if (!refineAll && !wantsRefinement(l, epsAbs)) {
-          kept.push_back(l);
+          keep(l);
           continue;
         }
         // Split the larger cluster (a top-level patch end is split by the patch hierarchy).
@@ -174,8 +186,9 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
     }
     work.swap(next);
   };
-  refineLevel(first.size(), [&](size_t i) { return first[i]; });
-  std::vector<ClusterLink>().swap(first);
+  refineLevel(firstSize, [&](size_t i) { return kept[i]; });
+  kept.resize(written);
+  firstLevel = false;
   while (!work.empty())
     refineLevel(work.size(), [&](size_t i) {
       ClusterLink l;

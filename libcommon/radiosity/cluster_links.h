@@ -103,6 +103,7 @@ class ClusterLinks {
   size_t reusedCount() const { return reused_; }
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
   const std::vector<ClusterLink>& links() const { return links_; }
+  std::vector<ClusterLink> takeLinks() && { return std::move(links_); }
 
  private:
   struct LinkEnds {

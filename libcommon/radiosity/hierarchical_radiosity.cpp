@@ -177,13 +177,12 @@ class KeyTimeSolver {
     setThresholds();
   }
 
+  // A vector's size from the previous key's, with a margin: this key makes about as many, so
+  // its vectors are reserved once instead of doubling as they grow (KeySolveInput::expected*).
+  static size_t withMargin(size_t n) { return n + n / 32 + 1024; }
+
   KeySolution run() {
-    auto withMargin = [](size_t n) { return n + n / 32 + 1024; };
     if (input_.expectedLinks > 0) s_.links.reserve(withMargin(input_.expectedLinks));
-    if (input_.expectedRayPairs > 0) {
-      pairs_.reserve(withMargin(input_.expectedRayPairs));
-      pairLeaf_.reserve(withMargin(input_.expectedRayPairs));
-    }
     if (input_.clusters && !input_.clusters->empty()) {
       topEmission_.resize(size_t(h_.topCount()));
       for (int t = 0; t < h_.topCount(); ++t)
@@ -423,6 +422,13 @@ class KeyTimeSolver {
     if (pairs_.size() + fresh.size() * size_t(k) >= size_t(kNoRayPairs))
       throw Error(ExitCode::kEnvironment, "",
                   "more than 4 G shadow-ray pairs in one key time; lower --max-links or --rays");
+    // Reserved at their first use, not when the solve starts: the cluster refinement before it
+    // holds a level of links and its children at once, and the two together had made
+    // rad-global's peak on the 10k-triangle hall.
+    if (pairs_.capacity() == 0 && input_.expectedRayPairs > 0) {
+      pairs_.reserve(withMargin(input_.expectedRayPairs));
+      pairLeaf_.reserve(withMargin(input_.expectedRayPairs));
+    }
     pairs_.resize(pairs_.size() + fresh.size() * size_t(k));
     pairLeaf_.resize(pairs_.size());
     tbb::parallel_for(size_t(0), fresh.size(), [&](size_t f) {
@@ -647,7 +653,7 @@ class KeyTimeSolver {
     // The previous key's values (coherence) start each node's list: closeLeaf finds them as
     // its own, and they are kept for the next key (all of them static pairs, valid at every key).
     if (leafTopFormFactor_.empty() && input_.reuseLeafFormFactors)
-      leafTopFormFactor_ = *input_.reuseLeafFormFactors;
+      leafTopFormFactor_ = std::move(*input_.reuseLeafFormFactors);
     leafTopFormFactor_.resize(N);
     topExcess_.assign(N, {});
     std::vector<int> leaves;
@@ -1034,8 +1040,12 @@ class KeyTimeSolver {
           s_.topClusterIrradiance[size_t(t)] = clusterH_[size_t(t)] / exposure_[size_t(t)];
       s_.clusterLinks = clusters_->size();
       s_.clusterLinksReused = clusters_->reusedCount();
-      s_.clusterLinkValues = clusters_->links();
       s_.clusterBounds = clusters_->clusterBounds();
+      // Moved out, and the rest of the cluster links (their gather lists) freed here, not when
+      // the solver goes: a copy beside them had made rad-global's peak on the 10k-triangle
+      // hall (+47 MB at the end of each key's solve).
+      s_.clusterLinkValues = std::move(*clusters_).takeLinks();
+      clusters_.reset();
     }
     s_.radiosity = std::move(B_);
     pairStart_.resize(s_.links.size(), kNoRayPairs);

@@ -214,8 +214,10 @@ struct KeySolveInput {
   size_t expectedLinks = 0, expectedRayPairs = 0, expectedClusterLinks = 0;
   // coherence: the previous key's KeySolution::rayPairs (CachedLink::rayPairs indexes them)
   const std::vector<LinkRayPair>* reuseRayPairs = nullptr;
-  const LeafFormFactorCache* reuseLeafFormFactors = nullptr;  // coherence: the closure's
-  const ClosedNodeCache* reuseClosed = nullptr;               // coherence: closed-room tests
+  // coherence: the closure's, moved into the solve at its first closure (a copy beside it had
+  // held 22 MB through the 10k-triangle hall's key solves)
+  LeafFormFactorCache* reuseLeafFormFactors = nullptr;
+  const ClosedNodeCache* reuseClosed = nullptr;  // coherence: closed-room tests
   // Per top-level patch: it moves at some time of the animation. The closure corrects only
   // pairs of patches that never move (empty: none moves).
   std::vector<char> movingTops;

@@ -254,11 +254,12 @@ const char* badLinkRuleName(BadLinkRule r) {
   return "?";
 }
 
-LeafFormFactorCache reusableLeafFormFactors(const KeySolution& prev, const PatchHierarchy&) {
+LeafFormFactorCache reusableLeafFormFactors(LeafFormFactorCache&& previous) {
   // The closure integrates only pairs of patches that never move (KeySolveInput::movingTops),
   // so every value it kept stays valid at the next key time; the union hierarchy's dense node
-  // numbering is the same at every key.
-  return prev.leafTopFormFactor;
+  // numbering is the same at every key. Taken over, not copied (a copy had been 22 MB of the
+  // 10k-triangle hall's peak).
+  return std::move(previous);
 }
 
 LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const Scene& scene,
@@ -426,27 +427,27 @@ class KeyTimePass {
     in.expectedClusterLinks = prev.clusterLinkValues.size();
     if (opt_.coherence && k > first_) {
       auto tc = std::chrono::steady_clock::now();
+      // The caches hold what the solve takes over of prev's links and cluster links; of prev
+      // itself it still reads the ray pairs (reuseRayPairs). Each part of prev goes as soon as
+      // its cache is made, so that at most one cache is being built beside all of prev: held
+      // beside the caches and the new key's links, prev was ~200 MB of the 10k-triangle hall's
+      // peak, and building all three before freeing any made the peak between keys (+50 MB).
+      // Swapped with empty vectors: `v = {}` would pick operator=(initializer_list), which
+      // empties v but keeps its capacity (it had freed 11 MB of the hall's 220).
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
       in.reuse = &cache;
+      std::vector<SolverLink>().swap(prev.links);
+      std::vector<uint32_t>().swap(prev.rayPairStart);  // the cache holds each link's start
       in.reuseRayPairs = &prev.rayPairs;
-      leafCache = reusableLeafFormFactors(prev, h_);
-      in.reuseLeafFormFactors = &leafCache;
       if (!clusters_.empty()) {
         clusterCache = reusableClusterLinks(prev, clusters_, h_, scene_, keyTimes_[k - 1], t);
         in.reuseClusterLinks = &clusterCache;
       }
+      std::vector<ClusterLink>().swap(prev.clusterLinkValues);
+      leafCache = reusableLeafFormFactors(std::move(prev.leafTopFormFactor));
+      in.reuseLeafFormFactors = &leafCache;
       in.reuseClosed = &closedCache_;
       in.releaseRayPairs = [&] { std::vector<LinkRayPair>().swap(prev.rayPairs); };
-      // The caches hold what the solve takes over of prev's links and cluster links; of prev
-      // itself it still reads the ray pairs (reuseRayPairs). The rest is freed before the
-      // solve: held beside the caches and the new key's links, it was ~200 MB of the
-      // 10k-triangle hall's peak.
-      // Swapped with empty vectors: `v = {}` would pick operator=(initializer_list), which
-      // empties v but keeps its capacity (it had freed 11 MB of the hall's 220).
-      std::vector<SolverLink>().swap(prev.links);
-      std::vector<ClusterLink>().swap(prev.clusterLinkValues);
-      LeafFormFactorCache().swap(prev.leafTopFormFactor);
-      std::vector<uint32_t>().swap(prev.rayPairStart);  // the caches hold each link's start
       secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);

@@ -55,8 +55,7 @@ LinkCache reusableLinks(const KeySolution& previous, const PatchHierarchy& hiera
 
 // The closure's leaf-to-top form factors of `previous`, all valid at the next key time: the
 // closure integrates only pairs of patches that never move.
-LeafFormFactorCache reusableLeafFormFactors(const KeySolution& previous,
-                                            const PatchHierarchy& hierarchy);
+LeafFormFactorCache reusableLeafFormFactors(LeafFormFactorCache&& previous);
 
 // The whole first pass: key times must be strictly increasing. Two passes: the key-time pass
 // (per key: the visibility scene at t, the links coherence keeps from the previous key,
