@@ -104,6 +104,8 @@ class ClusterLinks {
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
   const std::vector<ClusterLink>& links() const { return links_; }
   std::vector<ClusterLink> takeLinks() && { return std::move(links_); }
+  // Links evaluated from now on are computed, not taken over (the cache is about to go).
+  void forgetReuse() { reuse_ = nullptr; }
 
  private:
   struct LinkEnds {

@@ -448,6 +448,7 @@ class KeyTimePass {
       in.reuseLeafFormFactors = &leafCache;
       in.reuseClosed = &closedCache_;
       in.releaseRayPairs = [&] { std::vector<LinkRayPair>().swap(prev.rayPairs); };
+      in.releaseClusterLinks = [&] { clusterCache = ClusterLinkCache(); };
       secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);
