@@ -168,6 +168,10 @@ namespace {
 // One key-time solve as its named passes (see the header): link top level, then rounds of
 // evaluate + refine, accurate pass, gather + push-pull, until a round refines nothing. The
 // passes share the solution being built, the radiosity B of every node and the thresholds.
+// A link's index in a key solve's links: 32 bits (RadiosityOptions::maxLinks is at most
+// kMaxLinkBound), half the size_t lists of links the refinement and the gather hold.
+using LinkIndex = uint32_t;
+
 class KeyTimeSolver {
  public:
   KeyTimeSolver(PatchHierarchy& h, const std::vector<SurfaceProperties>& surfaces,
@@ -227,6 +231,7 @@ class KeyTimeSolver {
   // After the first round: the previous key's ray pairs are no longer copied, and their owner
   // frees them (KeySolveInput::releaseRayPairs).
   void releaseRayPairs() {
+    if (!reuseRayPairs_) return;
     reuseRayPairs_ = nullptr;
     if (input_.releaseRayPairs) input_.releaseRayPairs();
   }
@@ -430,16 +435,12 @@ class KeyTimeSolver {
     // Reserved at their first use, not when the solve starts: the cluster refinement before it
     // holds a level of links and its children at once, and the two together had made
     // rad-global's peak on the 10k-triangle hall.
-    if (pairs_.capacity() == 0 && input_.expectedRayPairs > 0) {
+    if (pairs_.capacity() == 0 && input_.expectedRayPairs > 0)
       pairs_.reserve(withMargin(input_.expectedRayPairs));
-      pairLeaf_.reserve(withMargin(input_.expectedRayPairs));
-    }
     pairs_.resize(pairs_.size() + fresh.size() * size_t(k));
-    pairLeaf_.resize(pairs_.size());
     tbb::parallel_for(size_t(0), fresh.size(), [&](size_t f) {
       const SolverLink& l = s_.links[fresh[f]];
       LinkRayPair* pair = &pairs_[pairStart_[fresh[f]]];
-      std::fill_n(&pairLeaf_[pairStart_[fresh[f]]], k, l.shooter);
       const uint32_t knownPairs =
           l.known != SolverLink::kNotKnown ? input_.reuse->value(l.known).rayPairs : kNoRayPairs;
       if (knownPairs != kNoRayPairs && reuseRayPairs_) {
@@ -460,6 +461,14 @@ class KeyTimeSolver {
               float(kernel[size_t(i)])};
       }
     });
+    // The previous key's pairs are copied: they go before the pairs' leaves are made (held
+    // together, the two had made rad-global's peak on the 10k-triangle hall).
+    releaseRayPairs();
+    if (pairLeaf_.capacity() == 0 && input_.expectedRayPairs > 0)
+      pairLeaf_.reserve(withMargin(input_.expectedRayPairs));
+    pairLeaf_.resize(pairs_.size());
+    for (size_t f = 0; f < fresh.size(); ++f)
+      std::fill_n(&pairLeaf_[pairStart_[fresh[f]]], k, s_.links[fresh[f]].shooter);
     tbb::parallel_for(size_t(0), L, [&](size_t li) {
       SolverLink& l = s_.links[li];
       l.visibility = l.rayVisibility;
@@ -558,7 +567,7 @@ class KeyTimeSolver {
 
   // Subdivides `node` (one end of link li) and replaces the link by its four children's links,
   // whose indices go to `next`.
-  void splitLink(size_t li, int node, std::vector<size_t>& next) {
+  void splitLink(LinkIndex li, int node, std::vector<LinkIndex>& next) {
     const SolverLink l = s_.links[li];  // a copy: push_back below may move the links
     bool fresh = !s_.split[size_t(node)];
     int first = h_.subdivide(node);
@@ -571,19 +580,19 @@ class KeyTimeSolver {
       SolverLink child;
       child.receiver = node == l.receiver ? first + c : l.receiver;
       child.shooter = node == l.receiver ? l.shooter : first + c;
-      next.push_back(s_.links.size());
+      next.push_back(LinkIndex(s_.links.size()));
       s_.links.push_back(child);
     }
   }
 
   // Refine: the links of `work`, and the links that makes, until the oracle is satisfied
   // (each generation evaluated first). Returns the number of links refined.
-  size_t refine(std::vector<size_t> work) {
+  size_t refine(std::vector<LinkIndex> work) {
     size_t count = 0;
     while (!work.empty()) {
       evaluateNewLinks();
-      std::vector<size_t> next;
-      for (size_t li : work) {
+      std::vector<LinkIndex> next;
+      for (LinkIndex li : work) {
         if (s_.links[li].refined || !oracleWantsRefinement(s_.links[li])) continue;
         int node = nodeToSplit(s_.links[li]);
         if (node < 0) continue;
@@ -600,10 +609,10 @@ class KeyTimeSolver {
     return count;
   }
 
-  std::vector<size_t> unrefinedLinks() const {
-    std::vector<size_t> work;
+  std::vector<LinkIndex> unrefinedLinks() const {
+    std::vector<LinkIndex> work;
     for (size_t i = 0; i < s_.links.size(); ++i)
-      if (!s_.links[i].refined) work.push_back(i);
+      if (!s_.links[i].refined) work.push_back(LinkIndex(i));
     return work;
   }
 
@@ -934,7 +943,7 @@ class KeyTimeSolver {
     adj_.assign(adjStart_[N], 0);
     std::vector<size_t> fill(adjStart_.begin(), adjStart_.end() - 1);
     for (size_t li = 0; li < s_.links.size(); ++li)
-      if (!s_.links[li].refined) adj_[fill[size_t(s_.links[li].receiver)]++] = li;
+      if (!s_.links[li].refined) adj_[fill[size_t(s_.links[li].receiver)]++] = LinkIndex(li);
     shooterEmits_.resize(s_.links.size());
     for (size_t k = 0; k < s_.links.size(); ++k)
       shooterEmits_[k] = surfaces_[h_.node(s_.links[k].shooter).id.top].isEmitter() ? 1 : 0;
@@ -1081,7 +1090,8 @@ class KeyTimeSolver {
   double epsAbs_ = 0;          // eps * Phi
   bool refineOn_ = false;
   double stopChange_ = 0;  // tol * (1 - rho_max)
-  std::vector<size_t> adjStart_, adj_;
+  std::vector<size_t> adjStart_;
+  std::vector<LinkIndex> adj_;
   std::vector<glm::dvec3> irr_;   // per dense node: H gathered at it and its ancestors
   std::vector<double> exposure_;  // per dense node: exposureOf once computed, else < 0
   // Per dense node: the closure factor of a leaf's links to shooters that do not emit (its

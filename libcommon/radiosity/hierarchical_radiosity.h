@@ -62,6 +62,9 @@ enum class RefinementOracle {
 RefinementOracle parseRefinementOracle(const std::string& name);
 const char* refinementOracleName(RefinementOracle oracle);
 
+// The largest RadiosityOptions::maxLinks (rad-global --max-links): 2^31 links, ~340 GB.
+constexpr size_t kMaxLinkBound = size_t(1) << 31;
+
 struct RadiosityOptions {
   // both, not power: on the bundled scene and the Cornell box of tests/data/external it halves
   // the bias (-1.7 % -> -0.9 %, -1.9 % -> -1.5 %) and lowers the RMSE by 1-2 points, at ~1.2x
@@ -89,7 +92,8 @@ struct RadiosityOptions {
   // included), and the solve goes on with the links it has; KeySolution::linkCapReached says
   // so. About 160 bytes each through rad-global's peak (the closed furnace at rho = 0.99: 0.8 M
   // links, 128 MB), so the default bounds a key's links to ~0.6 GB instead of running out of
-  // memory where the oracle never stops refining (the furnace at rho = 0.999).
+  // memory where the oracle never stops refining (the furnace at rho = 0.999). At most
+  // kMaxLinkBound: a key solve indexes its links with 32 bits.
   size_t maxLinks = 4000000;
   // Scale each leaf's gathered irradiance so that its row sum is its own (see computeClosure in
   // the .cpp): exact energy balance in closed rooms whatever the refinement. false: the plain

@@ -81,9 +81,10 @@ void addOptions(CLI::App& app, Options& o) {
       ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--max-links", r.maxLinks,
                  "memory bound: a key time stops refining at this many links (~160 bytes each) "
-                 "and warns")
+                 "and warns; at most 2^31")
       ->capture_default_str()
-      ->check(rad::positiveInteger());
+      ->check(rad::positiveInteger())
+      ->check(CLI::Range(size_t(1), rad::kMaxLinkBound));
   app.add_flag_callback(
       "--no-closure", [&r] { r.closure = false; },
       "gather without the closure factor (each leaf's row sum its own; exact energy balance in "
