@@ -21,9 +21,11 @@
 #   make -f pipelines/bench.mk furnace [FURNACE_RHO=0.5,0.9,0.99,0.999] [FURNACE_FLAGS="global=--eps 1e-4"]
 #       the closed furnace through the whole pipeline at each rho: frame mean against the exact
 #       L_e / (1 - rho), time and peak memory; out/furnace/
-#   make -f pipelines/bench.mk fuzz [FUZZ_SECONDS=600]
-#       every reader's libFuzzer harness for FUZZ_SECONDS each (tests/fuzz/run.sh, clang build in
-#       build-fuzz/): executions and crashes per harness; reproducers in build-fuzz/fuzz-work/
+#   make -f pipelines/bench.mk fuzz [FUZZ_SECONDS=600] [FUZZ_RUNS=-1]
+#       every reader's libFuzzer harness for FUZZ_SECONDS each, or until FUZZ_RUNS executions
+#       (-1: no bound but the time; the issue's long run: FUZZ_RUNS=1000000 FUZZ_SECONDS=5400)
+#       (tests/fuzz/run.sh, clang build in build-fuzz/): executions and crashes per harness;
+#       reproducers in build-fuzz/fuzz-work/
 
 BIN ?= build/bin
 BENCH_FRAMES ?= 400
@@ -51,6 +53,7 @@ FURNACE_RHO ?= 0.5,0.9,0.99,0.999
 FURNACE_FLAGS ?=
 
 FUZZ_SECONDS ?= 600
+FUZZ_RUNS ?= -1
 
 .PHONY: tables tradeoff furnace contact scale farm-model fuzz
 tables:
@@ -80,4 +83,4 @@ farm-model:
 	  --size $(BENCH_SIZE) --nodes $(FARM_NODES) --out out/farm-model $(FARM_FLAGS)
 
 fuzz:
-	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=-1 bash tests/fuzz/run.sh
+	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) bash tests/fuzz/run.sh
