@@ -165,13 +165,13 @@ std::vector<SolverLink> linkTopLevel(const std::vector<Polygon>& world,
 
 namespace {
 
-// One key-time solve as its named passes (see the header): link top level, then rounds of
-// evaluate + refine, accurate pass, gather + push-pull, until a round refines nothing. The
-// passes share the solution being built, the radiosity B of every node and the thresholds.
 // A link's index in a key solve's links: 32 bits (RadiosityOptions::maxLinks is at most
 // kMaxLinkBound), half the size_t lists of links the refinement and the gather hold.
 using LinkIndex = uint32_t;
 
+// One key-time solve as its named passes (see the header): link top level, then rounds of
+// evaluate + refine, accurate pass, gather + push-pull, until a round refines nothing. The
+// passes share the solution being built, the radiosity B of every node and the thresholds.
 class KeyTimeSolver {
  public:
   KeyTimeSolver(PatchHierarchy& h, const std::vector<SurfaceProperties>& surfaces,
