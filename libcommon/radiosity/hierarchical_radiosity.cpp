@@ -1030,8 +1030,12 @@ class KeyTimeSolver {
         gatherPushPull(t, top);
       }
       ++s_.iterations;
+      // Bad input, not a bug: surfaces that overlap (coincident triangles facing each other, a
+      // strip or fan read from a triangle list) or a reflectance near 1 with the refinement's
+      // row-sum error make the form factors of a row sum past 1 / rho (exit 5 had called the
+      // mode-5/6 mutants of issue 18 a bug).
       if (nonFinite_ || maxB_ > radiosityBound_)
-        throw Error(ExitCode::kInternal, "",
+        throw Error(ExitCode::kBadInput, "",
                     "the radiosity solve diverges (B reached " + numberText(maxB_) +
                         " W/m^2, a million times E/(1 - rho) = " + numberText(radiosityBound_) +
                         "): the refined links' form factors sum to more than 1/reflectance "
