@@ -106,6 +106,7 @@ class ClusterLinks {
   std::vector<ClusterLink> takeLinks() && { return std::move(links_); }
   // Links evaluated from now on are computed, not taken over (the cache is about to go).
   void forgetReuse() { reuse_ = nullptr; }
+  bool reusing() const { return reuse_ != nullptr; }
 
  private:
   struct LinkEnds {

@@ -39,6 +39,23 @@ class VertexBuffer {
   std::size_t size_ = 0;
 };
 
+// Sutherland-Hodgman against one plane: the vertices of v[0..count) on or in front of the plane
+// through `at` with normal `n`, and the points where edges cross it, in order, to push(x).
+template <class Push>
+void clipToFront(const glm::dvec3* v, std::size_t count, const glm::dvec3& n, const glm::dvec3& at,
+                 Push&& push) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const glm::dvec3& a = v[k];
+    const glm::dvec3& b = v[(k + 1) % count];
+    const double da = glm::dot(n, a - at), db = glm::dot(n, b - at);
+    if (da >= 0.0) push(a);
+    if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) {
+      const double t = da / (da - db);  // in (0, 1)
+      push(a + t * (b - a));
+    }
+  }
+}
+
 // Contour sum for a polygon entirely in front of the element's tangent plane:
 // \frac{1}{2\pi} \sum_k \gamma_k \hat n \cdot \widehat{R_{k+1} \times R_k}.
 // R_k \times R_{k+1} is computed as R_k \times (v_{k+1} - v_k): same value, no cancellation
@@ -194,30 +211,23 @@ bool facesAway(const std::vector<glm::dvec3>& from, const glm::dvec3& fromNormal
   return !fromInFront || !toInFront;
 }
 
-// The part of `from` on or in front of the plane through `at` with normal `m` (Sutherland-
-// Hodgman), or `from` itself when no vertex is behind it by more than `eps`. Points behind
-// `to`'s plane see none of its front (pointToPolygonFormFactor is 0 there), and where `from`
-// passes through `to` the point factor jumps from 0 to as much as 1/2: inside a cell, that line
-// kept the adaptive rule refining along it to its cell bound (30 ms a pair of interpenetrating
-// triangles, 35x a scene's time: issue 18) and no fixed rule resolves it. Over the front part
-// only, the jump lies on the cells' boundary; the integral is the same.
-std::vector<glm::dvec3> frontPart(const std::vector<glm::dvec3>& from, const glm::dvec3& m,
-                                  const glm::dvec3& at, double eps) {
+// The part of `from` on or in front of the plane through `at` with normal `m`: `from` itself
+// when no vertex is behind it by more than `eps`, else its clipped part, made in `clipped`.
+// Points behind `to`'s plane see none of its front (pointToPolygonFormFactor is 0 there), and
+// where `from` passes through `to` the point factor jumps from 0 to as much as 1/2: inside a
+// cell, that line kept the adaptive rule refining along it to its cell bound (30 ms a pair of
+// interpenetrating triangles, 35x a scene's time: issue 18) and no fixed rule resolves it. Over
+// the front part only, the jump lies on the cells' boundary; the integral is the same.
+const std::vector<glm::dvec3>& frontPart(const std::vector<glm::dvec3>& from, const glm::dvec3& m,
+                                         const glm::dvec3& at, double eps,
+                                         std::vector<glm::dvec3>& clipped) {
   bool behind = false;
   for (const auto& x : from) behind |= glm::dot(m, x - at) < -eps;
   if (!behind) return from;
-  std::vector<glm::dvec3> out;
-  out.reserve(from.size() + 1);
-  for (std::size_t k = 0; k < from.size(); ++k) {
-    const glm::dvec3& a = from[k];
-    const glm::dvec3& b = from[(k + 1) % from.size()];
-    const double da = glm::dot(m, a - at), db = glm::dot(m, b - at);
-    if (da >= 0.0) out.push_back(a);
-    if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0))
-      out.push_back(a + da / (da - db) * (b - a));
-  }
-  if (out.size() < 3) out.clear();
-  return out;
+  clipped.clear();
+  clipToFront(from.data(), from.size(), m, at, [&](const glm::dvec3& x) { clipped.push_back(x); });
+  if (clipped.size() < 3) clipped.clear();
+  return clipped;
 }
 
 glm::dvec3 vertexCentroid(const std::vector<glm::dvec3>& v) {
@@ -281,17 +291,7 @@ double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& nIn, cons
     f = contourSum(p, n, v, count);
   } else {
     VertexBuffer w(count + 2);
-    for (std::size_t k = 0; k < count; ++k) {
-      const glm::dvec3& a = v[k];
-      const glm::dvec3& b = v[(k + 1) % count];
-      double da = glm::dot(n, a - p);
-      double db = glm::dot(n, b - p);
-      if (da >= 0.0) w.push(a);
-      if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) {
-        double t = da / (da - db);  // in (0, 1)
-        w.push(a + t * (b - a));
-      }
-    }
+    clipToFront(v, count, n, p, [&](const glm::dvec3& x) { w.push(x); });
     if (w.size() < 3) return 0.0;
     f = contourSum(p, n, w.data(), w.size());
   }
@@ -334,14 +334,15 @@ double polygonToPolygonFormFactor(const std::vector<glm::dvec3>& from,
   if (!(area > 0.0) || normal == glm::dvec3(0.0)) return 0.0;
   glm::dvec3 toNormal = polygonNormal(to.data(), to.size());
   if (toNormal == glm::dvec3(0.0)) return 0.0;
-  const double scale = std::max(diameter(from), diameter(to));
-  if (facesAway(from, normal, to, toNormal, scale)) return 0.0;
+  const double fromSize = diameter(from);
+  if (facesAway(from, normal, to, toNormal, std::max(fromSize, diameter(to)))) return 0.0;
   if (order <= 0) order = autoQuadratureOrder(from, to);
   order = std::clamp(order, 1, kMaxQuadratureOrder);
   Target target{to.data(), to.size()};
   double sum = 0.0;
+  std::vector<glm::dvec3> clipped;
   for (const Cell& cell :
-       initialCells(frontPart(from, toNormal, to[0], kPlaneTolerance * diameter(from))))
+       initialCells(frontPart(from, toNormal, to[0], kPlaneTolerance * fromSize, clipped)))
     sum += integrateCell(cell, normal, target, order, order);
   double f = sum / area;
   return std::isfinite(f) ? std::clamp(f, 0.0, 1.0) : 0.0;
@@ -360,14 +361,16 @@ AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const std::vector<glm::dve
   glm::dvec3 normal = polygonNormal(from.data(), from.size());
   if (!(area > 0.0) || normal == glm::dvec3(0.0)) return result;
   glm::dvec3 toNormal = polygonNormal(to.data(), to.size());
+  const double fromSize = diameter(from);
   if (toNormal == glm::dvec3(0.0) ||
-      facesAway(from, normal, to, toNormal, std::max(diameter(from), diameter(to)))) {
+      facesAway(from, normal, to, toNormal, std::max(fromSize, diameter(to)))) {
     result.converged = true;
     return result;
   }
   Target target{to.data(), to.size()};
-  const std::vector<glm::dvec3> front =
-      frontPart(from, toNormal, to[0], kPlaneTolerance * diameter(from));
+  std::vector<glm::dvec3> clipped;
+  const std::vector<glm::dvec3>& front =
+      frontPart(from, toNormal, to[0], kPlaneTolerance * fromSize, clipped);
 
   constexpr int kHigh = 8, kLow = 5;
   // Absolute error in F below which refining only chases rounding noise.

@@ -303,10 +303,9 @@ class KeyTimeSolver {
         s_.links.push_back(l);
       }
     clusters_->evaluate();
-    if (input_.releaseClusterLinks && !clusterLinksReleased_) {
+    if (input_.releaseClusterLinks && clusters_->reusing()) {
       clusters_->forgetReuse();
       input_.releaseClusterLinks();
-      clusterLinksReleased_ = true;
     }
     clusterRow_ = clusters_->rowSums();
     return refined;
@@ -1119,7 +1118,6 @@ class KeyTimeSolver {
   bool nonFinite_ = false;          // a sweep produced NaN or Inf
   double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges
   std::unique_ptr<ClusterLinks> clusters_;  // null: all-pairs linking
-  bool clusterLinksReleased_ = false;       // KeySolveInput::releaseClusterLinks called
   std::vector<double> topEmission_;         // per top: largest emitted channel (clusters_)
   std::vector<glm::dvec3> clusterH_;        // per top: irradiance through cluster links
   std::vector<double> clusterRow_;          // per top: its cluster links' form factor sum

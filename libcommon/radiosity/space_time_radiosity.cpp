@@ -254,14 +254,6 @@ const char* badLinkRuleName(BadLinkRule r) {
   return "?";
 }
 
-LeafFormFactorCache reusableLeafFormFactors(LeafFormFactorCache&& previous) {
-  // The closure integrates only pairs of patches that never move (KeySolveInput::movingTops),
-  // so every value it kept stays valid at the next key time; the union hierarchy's dense node
-  // numbering is the same at every key. Taken over, not copied (a copy had been 22 MB of the
-  // 10k-triangle hall's peak).
-  return std::move(previous);
-}
-
 LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const Scene& scene,
                         double t0, double t1) {
   // Static over [t0, t1]? Moving mesh nodes contribute their swept bounds.
@@ -419,7 +411,6 @@ class KeyTimePass {
     in.visibility = &vis_->visibility();
     in.clusters = &clusters_;
     LinkCache cache;
-    LeafFormFactorCache leafCache;
     ClusterLinkCache clusterCache;
     double secondsCoherence = 0;
     in.expectedLinks = prev.links.size();
@@ -444,8 +435,10 @@ class KeyTimePass {
         in.reuseClusterLinks = &clusterCache;
       }
       std::vector<ClusterLink>().swap(prev.clusterLinkValues);
-      leafCache = reusableLeafFormFactors(std::move(prev.leafTopFormFactor));
-      in.reuseLeafFormFactors = &leafCache;
+      // The closure integrates only pairs of patches that never move (KeySolveInput::
+      // movingTops), so every leaf-to-top form factor prev kept stays valid; the union
+      // hierarchy's dense node numbering is the same at every key. The solve takes them over.
+      in.reuseLeafFormFactors = &prev.leafTopFormFactor;
       in.reuseClosed = &closedCache_;
       in.releaseRayPairs = [&] { std::vector<LinkRayPair>().swap(prev.rayPairs); };
       in.releaseClusterLinks = [&] { clusterCache = ClusterLinkCache(); };

@@ -53,10 +53,6 @@ struct SpaceTimeReport {
 LinkCache reusableLinks(const KeySolution& previous, const PatchHierarchy& hierarchy,
                         const Scene& scene, double t0, double t1);
 
-// The closure's leaf-to-top form factors of `previous`, all valid at the next key time: the
-// closure integrates only pairs of patches that never move.
-LeafFormFactorCache reusableLeafFormFactors(LeafFormFactorCache&& previous);
-
 // The whole first pass: key times must be strictly increasing. Two passes: the key-time pass
 // (per key: the visibility scene at t, the links coherence keeps from the previous key,
 // solveKeyTime, its links folded into activity intervals and bad pairs), then the merge into

@@ -55,18 +55,15 @@ TEST(FuzzRegressions, Container) {
 }
 
 TEST(FuzzRegressions, LinkHierarchy) {
-  const rad::Scene scene =
-      rad::readGltfScene(RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf");
-  replay("link_hierarchy", [&](const uint8_t* data, size_t size) {
-    rad::fuzz::feedLinkHierarchy(data, size, scene);
+  replay("link_hierarchy", [](const uint8_t* data, size_t size) {
+    rad::fuzz::feedLinkHierarchy(data, size, rad::fuzz::bundledScene());
   });
 }
 
 TEST(FuzzRegressions, KeyWindow) {
-  const rad::Scene scene =
-      rad::readGltfScene(RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf");
-  replay("key_window",
-         [&](const uint8_t* data, size_t size) { rad::fuzz::feedKeyWindow(data, size, scene); });
+  replay("key_window", [](const uint8_t* data, size_t size) {
+    rad::fuzz::feedKeyWindow(data, size, rad::fuzz::bundledScene());
+  });
 }
 
 TEST(FuzzRegressions, Intervals) {

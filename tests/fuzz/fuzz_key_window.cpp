@@ -5,15 +5,7 @@
 
 #include "tests/fuzz/fuzz_readers.h"
 
-namespace {
-const rad::Scene& scene() {
-  static const rad::Scene s =
-      rad::readGltfScene(RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf");
-  return s;
-}
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  rad::fuzz::feedKeyWindow(data, size, scene());
+  rad::fuzz::feedKeyWindow(data, size, rad::fuzz::bundledScene());
   return 0;
 }

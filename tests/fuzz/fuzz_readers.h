@@ -13,6 +13,7 @@
 #include "formats/exr_info.h"
 #include "formats/frame_image.h"
 #include "formats/gltf_scene.h"
+#include "formats/inspect_kinds.h"
 #include "formats/key_window.h"
 #include "formats/link_hierarchy.h"
 #include "formats/texture_intervals.h"
@@ -43,16 +44,21 @@ inline void feedGltf(const uint8_t* data, size_t size) {
 }
 
 // Raw bytes as a container, then what rad-inspect prints of one: the summary and the kind's
-// content summary.
+// content summary (summarizeContainerContent, as rad-inspect calls it).
 inline void feedContainer(const uint8_t* data, size_t size) {
   runReader([&] {
     const ContainerReader reader =
         ContainerReader::fromBytes(std::vector<uint8_t>(data, data + size), "fuzz.rad");
     (void)reader.summary();
-    if (reader.kind() == kLinkHierarchyKind) (void)summarizeLinkHierarchy(reader).dump();
-    if (reader.kind() == kTextureIntervalsKind) (void)summarizeTextureIntervals(reader).dump();
-    if (reader.kind() == kKeyWindowKind) (void)summarizeKeyWindow(reader).dump();
+    (void)summarizeContainerContent(reader).dump();
   });
+}
+
+// The bundled scene, which the seeds of the link hierarchy and key window harnesses were
+// computed for (tests/fuzz/make_seeds.sh), read once.
+inline const Scene& bundledScene() {
+  static const Scene s = readGltfScene(RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf");
+  return s;
 }
 
 // A global.rlh with re-sealed checksums (fuzz_reseal.h) against `scene`, the one its seeds were
