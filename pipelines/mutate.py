@@ -24,9 +24,12 @@ machine's load spikes) within 10x the source scene's, at least --min-limit (3 s:
 0.1 s is mostly process start-up).
 
 usage: mutate.py [--bin DIR] [--out DIR] [--count N] [--seed S] [--check] [--keep]
+                 [--default-settings] [--shard K/N]
   --count N  random structure+byte mutants (default 40: the ctest `pipeline_gltf_mutants`);
              the targeted ones always run
   --check    exit 1 when any mutant violates a bound (the summary lists them)
+  --default-settings  rad-global at its default eps and rays (the limit is then 10x ~0.6 s)
+  --shard K/N         the mutants with index K mod N, to run N of these side by side
 """
 import argparse
 import base64
@@ -46,6 +49,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 SCENE = os.path.join(HERE, "scenes", "cornell-moving.gltf")
 GLOBAL_ARGS = ["--frames", "0-1", "--eps", "0.05", "--rays", "4", "--threads", "1"]
+# --default-settings: rad-global's own eps and rays (20x the source's time: a long run).
+DEFAULT_GLOBAL_ARGS = ["--frames", "0-1", "--threads", "1"]
 ERROR_PEAK_MB = 200  # the issue's bound on what a run may take before it refuses its input
 HOSTILE = [-1, -8, 0, 1, 2, 5, 6, 5121, 0.5, 2 ** 25, 2 ** 31, 2 ** 32 + 4, 2 ** 63, 1e38, -1e38,
            3e38, 1e308, -1e308, 1e-300, "x", None, True, [], {}, [0] * 5, "A" * 20000]
@@ -238,7 +243,7 @@ def radiosity_finite(bin_dir, rlh):
 
 
 
-def check_one(bin_dir, path, limit):
+def check_one(bin_dir, path, limit, global_args):
     """Problems of one mutant (empty: fine) and what ran."""
     problems, summary = [], []
     rc, err, secs, mb = run([os.path.join(bin_dir, "rad-inspect"), "--check", path], limit)
@@ -246,8 +251,8 @@ def check_one(bin_dir, path, limit):
     stages = [("rad-inspect", rc, err, secs, mb)]
     if rc == 0:
         rlh = path + ".rlh"
-        rc, err, secs, mb = run([os.path.join(bin_dir, "rad-global"), path, "-o", rlh] + GLOBAL_ARGS,
-                            limit)
+        rc, err, secs, mb = run([os.path.join(bin_dir, "rad-global"), path, "-o", rlh] + global_args,
+                                limit)
         summary.append("global %s %.2fs" % (rc, secs))
         stages.append(("rad-global", rc, err, secs, mb))
         if rc == 0 and not radiosity_finite(bin_dir, rlh):
@@ -280,7 +285,15 @@ def main():
     ap.add_argument("--min-limit", type=float, default=3.0,
                     help="least time limit per run, s (the source's 0.1 s is mostly start-up, and "
                     "a shared machine's load varies by more than 10x that)")
+    ap.add_argument("--default-settings", action="store_true",
+                    help="run rad-global at its default eps and rays, not the coarse ones")
+    ap.add_argument("--shard", default="0/1",
+                    help="K/N: only the mutants whose index is K mod N (N runs side by side)")
     a = ap.parse_args()
+    global_args = DEFAULT_GLOBAL_ARGS if a.default_settings else GLOBAL_ARGS
+    shard, shards = (int(x) for x in a.shard.split("/"))
+    if not 0 <= shard < shards:
+        sys.exit("mutate.py: --shard %s: expected K/N with 0 <= K < N" % a.shard)
     shutil.rmtree(a.out, ignore_errors=True)
     os.makedirs(a.out)
     cases = mutants(a.count, a.seed)
@@ -291,22 +304,24 @@ def main():
         open(path, "wb").write(raw)
         for _ in range(2):
             rc, err, secs, _ = run([os.path.join(a.bin, "rad-global"), path, "-o", path + ".rlh"] +
-                                GLOBAL_ARGS, 60)
+                                global_args, 60)
             if rc != 0:
                 sys.exit("mutate.py: the source scene fails: " + err.strip())
             base.append(secs)
     limit = max(10 * min(base), a.min_limit)
-    print("source: rad-global %.2f s; limit per run %.2f s; %d mutants" %
-          (min(base), limit, len(cases)))
+    todo = [i for i in range(len(cases)) if i % shards == shard]
+    print("source: rad-global %.2f s (%s); limit per run %.2f s; %d mutants" %
+          (min(base), " ".join(global_args), limit, len(todo)))
     bad, exits, slowest, error_peak = [], {}, (0.0, ""), (0.0, "")
     t0 = time.monotonic()
-    for i, (name, ext, raw) in enumerate(cases):
+    for i in todo:
+        name, ext, raw = cases[i]
         path = os.path.join(a.out, "m%04d%s" % (i, ext))
         open(path, "wb").write(raw)
-        problems, summary, stages = check_one(a.bin, path, limit)
+        problems, summary, stages = check_one(a.bin, path, limit, global_args)
         if problems and all(" took " in p for p in problems):
             # A shared machine's load spikes: a time over the limit counts when it repeats.
-            problems, summary, stages = check_one(a.bin, path, limit)
+            problems, summary, stages = check_one(a.bin, path, limit, global_args)
         for tool, rc, err, secs, mb in stages:
             exits[(tool, rc)] = exits.get((tool, rc), 0) + 1
             what = "%s %s (%s)" % (tool, os.path.basename(path), name[:80])
@@ -327,7 +342,7 @@ def main():
     print("slowest rad-global: %.2f s, %.1fx the source's, %s" %
           (slowest[0], slowest[0] / min(base), slowest[1]))
     print("largest peak before an error: %.0f MB, %s" % error_peak)
-    print("%d mutants, %d violations, %.1f s" % (len(cases), len(bad), time.monotonic() - t0))
+    print("%d mutants, %d violations, %.1f s" % (len(todo), len(bad), time.monotonic() - t0))
     if a.check and bad:
         sys.exit(1)
 

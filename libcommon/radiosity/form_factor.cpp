@@ -39,15 +39,16 @@ class VertexBuffer {
   std::size_t size_ = 0;
 };
 
-// Sutherland-Hodgman against one plane: the vertices of v[0..count) on or in front of the plane
-// through `at` with normal `n`, and the points where edges cross it, in order, to push(x).
+// Sutherland-Hodgman against one plane: the vertices of v[0..count) at a height of at least
+// `lift` over the plane through `at` with normal `n`, and the points where edges cross that
+// height, in order, to push(x).
 template <class Push>
 void clipToFront(const glm::dvec3* v, std::size_t count, const glm::dvec3& n, const glm::dvec3& at,
-                 Push&& push) {
+                 double lift, Push&& push) {
   for (std::size_t k = 0; k < count; ++k) {
     const glm::dvec3& a = v[k];
     const glm::dvec3& b = v[(k + 1) % count];
-    const double da = glm::dot(n, a - at), db = glm::dot(n, b - at);
+    const double da = glm::dot(n, a - at) - lift, db = glm::dot(n, b - at) - lift;
     if (da >= 0.0) push(a);
     if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) {
       const double t = da / (da - db);  // in (0, 1)
@@ -58,8 +59,11 @@ void clipToFront(const glm::dvec3* v, std::size_t count, const glm::dvec3& n, co
 
 // Contour sum for a polygon entirely in front of the element's tangent plane:
 // \frac{1}{2\pi} \sum_k \gamma_k \hat n \cdot \widehat{R_{k+1} \times R_k}.
-// R_k \times R_{k+1} is computed as R_k \times (v_{k+1} - v_k): same value, no cancellation
-// when p is far away and R_k, R_{k+1} are nearly parallel.
+// R_k \times R_{k+1} is computed as R \times (v_{k+1} - v_k) with R the shorter of R_k, R_{k+1}:
+// the same value, with no cancellation when p is far away and R_k, R_{k+1} are nearly parallel,
+// nor when p is near one end of a long edge (R_k nearly -(v_{k+1} - v_k): the cross product of
+// two 1e10 m vectors left 1e-6 of noise in a needle's F of 1e-11, and the adaptive rule chased
+// it to its cell bound: issue 18).
 double contourSum(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3* w,
                   std::size_t count) {
   double sum = 0.0;
@@ -68,7 +72,8 @@ double contourSum(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3* w,
     const glm::dvec3& b = w[(k + 1) % count];
     glm::dvec3 rk = a - p;
     glm::dvec3 rk1 = b - p;
-    glm::dvec3 c = glm::cross(rk, b - a);  // = R_k x R_{k+1}
+    const glm::dvec3& r = glm::dot(rk1, rk1) < glm::dot(rk, rk) ? rk1 : rk;
+    glm::dvec3 c = glm::cross(r, b - a);  // = R_k x R_{k+1}
     double cl = glm::length(c);
     if (!(cl > 0.0)) continue;  // p on the edge's line: the term vanishes
     double gamma = std::atan2(cl, glm::dot(rk, rk1));
@@ -211,21 +216,43 @@ bool facesAway(const std::vector<glm::dvec3>& from, const glm::dvec3& fromNormal
   return !fromInFront || !toInFront;
 }
 
-// The part of `from` on or in front of the plane through `at` with normal `m`: `from` itself
-// when no vertex is behind it by more than `eps`, else its clipped part, made in `clipped`.
+// A point whose height over a polygon's plane is at most this fraction of the largest coordinate
+// involved is on the plane to rounding, and pointToPolygonFormFactor gives it 0.
+constexpr double kHeightRounding = 1e-13;
+
+double largestComponent(const glm::dvec3& x) {
+  return std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)});
+}
+
+// A height over `to`'s plane below which pointToPolygonFormFactor(x, ., to) is 0 for every x of
+// `from` (kHeightRounding of a bound on the largest coordinate that rule sees).
+double roundingHeight(const std::vector<glm::dvec3>& from, const std::vector<glm::dvec3>& to) {
+  double scale = largestComponent(to[0]);
+  for (std::size_t k = 1; k < to.size(); ++k)
+    scale = std::max(scale, largestComponent(to[k] - to[0]));
+  for (const auto& x : from) scale = std::max(scale, largestComponent(x));
+  return kHeightRounding * scale;
+}
+
+// The part of `from` in front of `to`'s plane (normal `m`): `from` itself when no vertex is
+// behind it by more than `eps`, else its part above roundingHeight, made in `clipped`.
 // Points behind `to`'s plane see none of its front (pointToPolygonFormFactor is 0 there), and
 // where `from` passes through `to` the point factor jumps from 0 to as much as 1/2: inside a
 // cell, that line kept the adaptive rule refining along it to its cell bound (30 ms a pair of
 // interpenetrating triangles, 35x a scene's time: issue 18) and no fixed rule resolves it. Over
-// the front part only, the jump lies on the cells' boundary; the integral is the same.
-const std::vector<glm::dvec3>& frontPart(const std::vector<glm::dvec3>& from, const glm::dvec3& m,
-                                         const glm::dvec3& at, double eps,
-                                         std::vector<glm::dvec3>& clipped) {
+// the front part only, the jump lies on the cells' boundary; the integral is the same. The part is
+// cut at the height where the point factor's rounding rule starts giving nonzero, not at the
+// plane: a strip between the two (a millimetre wide next to a vertex 1e10 m away, issue 18) is
+// a jump inside the cells again.
+const std::vector<glm::dvec3>& frontPart(const std::vector<glm::dvec3>& from,
+                                         const std::vector<glm::dvec3>& to, const glm::dvec3& m,
+                                         double eps, std::vector<glm::dvec3>& clipped) {
   bool behind = false;
-  for (const auto& x : from) behind |= glm::dot(m, x - at) < -eps;
+  for (const auto& x : from) behind |= glm::dot(m, x - to[0]) < -eps;
   if (!behind) return from;
   clipped.clear();
-  clipToFront(from.data(), from.size(), m, at, [&](const glm::dvec3& x) { clipped.push_back(x); });
+  clipToFront(from.data(), from.size(), m, to[0], roundingHeight(from, to),
+              [&](const glm::dvec3& x) { clipped.push_back(x); });
   if (clipped.size() < 3) clipped.clear();
   return clipped;
 }
@@ -271,12 +298,9 @@ double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& nIn, cons
   // component: no square root on this path, which every texel's every link takes).
   const double height = glm::dot(m, p - v[0]);
   if (!(height > 0.0)) return 0.0;
-  auto largest = [](const glm::dvec3& x) {
-    return std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)});
-  };
-  double scale = std::max(largest(p), largest(v[0]));
-  for (std::size_t k = 1; k < count; ++k) scale = std::max(scale, largest(v[k] - v[0]));
-  if (!(height > 1e-13 * scale)) return 0.0;
+  double scale = std::max(largestComponent(p), largestComponent(v[0]));
+  for (std::size_t k = 1; k < count; ++k) scale = std::max(scale, largestComponent(v[k] - v[0]));
+  if (!(height > kHeightRounding * scale)) return 0.0;
 
   // Horizon clipping to n . (x - p) >= 0 (Sutherland-Hodgman against one plane).
   bool anyIn = false, anyOut = false;
@@ -291,7 +315,7 @@ double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& nIn, cons
     f = contourSum(p, n, v, count);
   } else {
     VertexBuffer w(count + 2);
-    clipToFront(v, count, n, p, [&](const glm::dvec3& x) { w.push(x); });
+    clipToFront(v, count, n, p, 0.0, [&](const glm::dvec3& x) { w.push(x); });
     if (w.size() < 3) return 0.0;
     f = contourSum(p, n, w.data(), w.size());
   }
@@ -342,7 +366,7 @@ double polygonToPolygonFormFactor(const std::vector<glm::dvec3>& from,
   double sum = 0.0;
   std::vector<glm::dvec3> clipped;
   for (const Cell& cell :
-       initialCells(frontPart(from, toNormal, to[0], kPlaneTolerance * fromSize, clipped)))
+       initialCells(frontPart(from, to, toNormal, kPlaneTolerance * fromSize, clipped)))
     sum += integrateCell(cell, normal, target, order, order);
   double f = sum / area;
   return std::isfinite(f) ? std::clamp(f, 0.0, 1.0) : 0.0;
@@ -370,7 +394,7 @@ AdaptiveFormFactor polygonToPolygonFormFactorAdaptive(const std::vector<glm::dve
   Target target{to.data(), to.size()};
   std::vector<glm::dvec3> clipped;
   const std::vector<glm::dvec3>& front =
-      frontPart(from, toNormal, to[0], kPlaneTolerance * fromSize, clipped);
+      frontPart(from, to, toNormal, kPlaneTolerance * fromSize, clipped);
 
   constexpr int kHigh = 8, kLow = 5;
   // Absolute error in F below which refining only chases rounding noise.

@@ -306,10 +306,10 @@ std::vector<SolverLink> linkTopLevel(const std::vector<Polygon>& world,
                                      const std::vector<double>& area, int topCount);
 
 // Unoccluded F(p -> q) of a leaf link. kAutoOrder: integrated over the smaller of the two
-// with reciprocity (A_p F_pq = A_q F_qp), adaptively near contact (centroid distance below
-// the larger diameter, to relative tolerance relTol), else polygonToPolygonFormFactor's
-// automatic order; any other order: polygonToPolygonFormFactor(p, q, order) (one rule per
-// receiver: exact row sums).
+// with reciprocity (A_p F_pq = A_q F_qp), adaptively (to relative tolerance relTol) when the
+// smaller one's centroid is nearer the other than the smaller one's size, else with a fixed
+// Gauss rule whose order falls with that distance ratio; any other order:
+// polygonToPolygonFormFactor(p, q, order) (one rule per receiver: exact row sums).
 double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relTol = 1e-5);
 
 // True when the top-level patches p and q can exchange energy at all: some vertex of each lies

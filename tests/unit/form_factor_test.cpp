@@ -1,5 +1,6 @@
 // Form factors against the exact references in tests/data/reference (see its README).
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/radiosity/hierarchical_radiosity.h"
 
 #include <chrono>
 #include <cmath>
@@ -164,6 +165,57 @@ TEST(FormFactorReference, EveryPolygonToPolygonCaseAdaptive) {
               << f21.cells << "\n";
   }
   EXPECT_EQ(n, 20);
+}
+
+// A needle 1.1e10 m long (a mutated vertex, issue 18) whose apex is 0.17 m above a floor quad:
+// its width is 0.165 m at the far end, so F from the quad is about 1e-11. The contour terms of
+// its two long edges cancel to that; each edge's cross product taken from the far end's side
+// (two antiparallel 1e10 m vectors) left noise of 1e-6 in F, which the adaptive rule chased to
+// its 4096 cells without converging.
+TEST(FormFactor, NeedleFromAFarVertexHasNoRoundingNoise) {
+  const std::vector<glm::dvec3> quad = {{0, 0, 0.42685077880146993},
+                                        {0, 0, 0.5591999888420105},
+                                        {0.1314433401899241, 0, 0.5591999888420105},
+                                        {0.47301484904776114, 0, 0.45477132890174454}};
+  const std::vector<glm::dvec3> needle = {
+      {-10843266231.401337, 0.33000001311302185, 3315119174.6771321},
+      {0.47301525444528536, 0.16500000655651093, 0.45477265489729796},
+      {-10843266231.401339, 0.16500000655651093, 3315119174.6771302}};
+  for (int i = 0; i <= 20; ++i) {
+    const glm::dvec3 p(0.0125 * i, 0.0, 0.49);
+    EXPECT_LT(pointToPolygonFormFactor(p, glm::dvec3(0, 1, 0), needle), 1e-10) << p.x;
+  }
+  AdaptiveFormFactor f = polygonToPolygonFormFactorAdaptive(quad, needle, 1e-5, 1e-8, 4096);
+  EXPECT_TRUE(f.converged);
+  EXPECT_LT(f.cells, 16);
+  EXPECT_LT(f.value, 1e-10);
+}
+
+// rad-global's link form factor (the rule picked by distance over the smaller patch's size,
+// then reciprocity) on every reference pair of triangles and quads, both directions, within its
+// 1e-5 relative tolerance and 1e-8 absolute (kLinkFormFactorAbsTol) of the exact value, with a
+// margin for the fixed rules far away.
+TEST(FormFactorReference, LinkFormFactorOnEveryTriangleAndQuadPair) {
+  int n = 0;
+  for (const auto& c : formFactors()["cases"]) {
+    if (c["kind"] != "polygon_to_polygon") continue;
+    auto a = poly(c["polygon_1"]), b = poly(c["polygon_2"]);
+    if (a.size() > 4 || b.size() > 4) continue;
+    ++n;
+    const std::string name = c["name"];
+    double exact = c["exact"]["value"], exact21 = c["exact_reverse_F21"]["value"];
+    double f12 = linkFormFactor(toPolygon(a), toPolygon(b), kAutoOrder);
+    double f21 = linkFormFactor(toPolygon(b), toPolygon(a), kAutoOrder);
+    // A 1000:1 strip along its shared long edge: the adaptive rule stops at its 4096 cells,
+    // 3.8e-4 off (the log-singular strip is 1000 cells long at any depth).
+    const double rel = name == "perp_common_edge_l1000_w1_h1" ? 5e-4 : 2e-5;
+    EXPECT_LE(std::abs(f12 - exact), rel * exact + kLinkFormFactorAbsTol) << name << " " << f12;
+    EXPECT_LE(std::abs(f21 - exact21), rel * exact21 + kLinkFormFactorAbsTol) << name << " " << f21;
+    std::cout << std::setw(34) << std::left << name << " rel err F12 " << std::setw(10)
+              << std::abs(f12 - exact) / exact << " F21 " << std::abs(f21 - exact21) / exact21
+              << "\n";
+  }
+  EXPECT_GE(n, 10);
 }
 
 // A receiver that passes through the shooter's plane (interpenetrating triangles of a mutated
