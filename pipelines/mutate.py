@@ -291,7 +291,10 @@ def main():
                     help="K/N: only the mutants whose index is K mod N (N runs side by side)")
     a = ap.parse_args()
     global_args = DEFAULT_GLOBAL_ARGS if a.default_settings else GLOBAL_ARGS
-    shard, shards = (int(x) for x in a.shard.split("/"))
+    try:
+        shard, shards = (int(x) for x in a.shard.split("/"))
+    except ValueError:
+        shard, shards = -1, 0
     if not 0 <= shard < shards:
         sys.exit("mutate.py: --shard %s: expected K/N with 0 <= K < N" % a.shard)
     shutil.rmtree(a.out, ignore_errors=True)

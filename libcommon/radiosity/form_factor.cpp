@@ -533,10 +533,11 @@ double distanceToPolygon(const glm::dvec3& x, const Polygon& q) {
   return inside ? std::abs(glm::dot(x - q.v[0], n)) : edge;
 }
 
-double areaAverageFormFactor(const Polygon& r, const Polygon& q, double relTol) {
+double areaAverageFormFactor(const Polygon& r, const Polygon& q, double relTol,
+                             double adaptiveBelow) {
   const double size = polygonSize(r);
   const double ratio = size > 0.0 ? distanceToPolygon(r.centroid(), q) / size : 0.0;
-  if (ratio < 0.25)
+  if (ratio < adaptiveBelow)
     return polygonToPolygonFormFactorAdaptive(r, q, relTol, kLinkFormFactorAbsTol, 4096).value;
   const int order = ratio >= 20 ? 2 : ratio >= 5 ? 4 : ratio >= 2 ? 6 : ratio >= 1 ? 8 : 12;
   return polygonToPolygonFormFactor(r, q, order);

@@ -98,9 +98,11 @@ constexpr double kLinkFormFactorAbsTol = 1e-8;
 // F(r -> q) as an area average over r to about relTol, at the cost the pair needs: F(x -> q) is
 // smooth over r on the scale of x's distance to q (its plane and its contour), so a fixed
 // Gauss rule on r is accurate once that distance is large against r's size, and the adaptive
-// rule takes over below a quarter of it (contact, shared edges). rad-global's closure and
-// rad-movies' good-link gather use it, so both see the same F.
-double areaAverageFormFactor(const Polygon& r, const Polygon& q, double relTol);
+// rule takes over below adaptiveBelow times it (contact, shared edges). rad-global's closure
+// and rad-movies' good-link gather use it, so both see the same F; rad-global's link form factor
+// (linkFormFactor) too, adaptive up to a ratio of 1.
+double areaAverageFormFactor(const Polygon& r, const Polygon& q, double relTol,
+                             double adaptiveBelow = 0.25);
 
 // Size of a polygon (largest vertex distance from the first vertex), for relative tolerances.
 double polygonSize(const Polygon& p);

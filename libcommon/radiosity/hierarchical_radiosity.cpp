@@ -92,13 +92,7 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relT
   // over `from` on the scale of x's distance to `to`, whatever `to`'s size. The larger patch's
   // size had made every pair with a giant patch adaptive (issue 18: a mutated vertex 1e10 m
   // away cost 5x as much per link).
-  const double size = polygonSize(from);
-  const double ratio = size > 0.0 ? distanceToPolygon(from.centroid(), to) / size : 0.0;
-  double f;
-  if (ratio < 1.0)
-    f = polygonToPolygonFormFactorAdaptive(from, to, relTol, kLinkFormFactorAbsTol, 4096).value;
-  else
-    f = polygonToPolygonFormFactor(from, to, ratio >= 20 ? 2 : ratio >= 5 ? 4 : ratio >= 2 ? 6 : 8);
+  const double f = areaAverageFormFactor(from, to, relTol, 1.0);
   return swap ? std::min(1.0, f * aq / ap) : f;
 }
 
