@@ -224,12 +224,18 @@ double largestComponent(const glm::dvec3& x) {
   return std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)});
 }
 
+// The polygon's part of the largest coordinate that the rounding rule sees: its first vertex
+// and its extent from it (the point's own coordinates are the rest).
+double polygonRoundingScale(const glm::dvec3* v, std::size_t count) {
+  double scale = largestComponent(v[0]);
+  for (std::size_t k = 1; k < count; ++k) scale = std::max(scale, largestComponent(v[k] - v[0]));
+  return scale;
+}
+
 // A height over `to`'s plane below which pointToPolygonFormFactor(x, ., to) is 0 for every x of
 // `from` (kHeightRounding of a bound on the largest coordinate that rule sees).
 double roundingHeight(const std::vector<glm::dvec3>& from, const std::vector<glm::dvec3>& to) {
-  double scale = largestComponent(to[0]);
-  for (std::size_t k = 1; k < to.size(); ++k)
-    scale = std::max(scale, largestComponent(to[k] - to[0]));
+  double scale = polygonRoundingScale(to.data(), to.size());
   for (const auto& x : from) scale = std::max(scale, largestComponent(x));
   return kHeightRounding * scale;
 }
@@ -298,8 +304,7 @@ double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& nIn, cons
   // component: no square root on this path, which every texel's every link takes).
   const double height = glm::dot(m, p - v[0]);
   if (!(height > 0.0)) return 0.0;
-  double scale = std::max(largestComponent(p), largestComponent(v[0]));
-  for (std::size_t k = 1; k < count; ++k) scale = std::max(scale, largestComponent(v[k] - v[0]));
+  const double scale = std::max(largestComponent(p), polygonRoundingScale(v, count));
   if (!(height > kHeightRounding * scale)) return 0.0;
 
   // Horizon clipping to n . (x - p) >= 0 (Sutherland-Hodgman against one plane).
