@@ -100,6 +100,10 @@ struct Pair {
   double maxFormFactor = 0.0;              // over the texels and the keys scanned
   double share = 1.0;  // the largest share of a texel's direct light its light gives
                        // (directShares)
+  // A subdivided shooter: the union leaf under each sample, whose radiosity over the shooter's
+  // mean weights the sample (shapedTransmittance); empty: the shooter is one leaf.
+  std::vector<int> sampleLeaf;
+  std::vector<int> leaves;  // its union leaves (the near texels' exact shape)
 };
 
 // The receiver of one movie at its key times, and what the blocker tests ask of the scene
@@ -187,6 +191,39 @@ class MovieGeometry {
     return kernelWeightedTransmittance(texelPoint(k, x), texelNormal(k, x), samples, shooterNormal,
                                        occluded, valid);
   }
+  // A subdivided shooter's shaped transmittance at texel x (shapedTransmittance). Near the shooter
+  // (nearer than its samples' spacing) the samples' kernel peaks within one of them, and their
+  // quadrature of the shooter's radiosity does not hold (a Cornell-box wall's leaves beside the
+  // corner it shares with the receiver): there the shape is the leaves' own point form factors,
+  //   sum_l beta_l F(x -> l) / F(x -> S),
+  // times the kernel-weighted transmittance.
+  glm::dvec3 shapedTransmittanceAt(int k, size_t x, const std::vector<glm::dvec3>& samples,
+                                   const glm::dvec3& shooterNormal, SampleMask occluded,
+                                   SampleMask valid, const std::vector<glm::vec3>& shape) const {
+    const glm::dvec3 pt = texelPoint(k, x), n = texelNormal(k, x);
+    if (!nearShape_.leafWorld.empty() &&
+        distanceToPolygon(pt, nearShape_.shooter) < nearShape_.distance) {
+      const double T = kernelWeightedTransmittance(pt, n, samples, shooterNormal, occluded, valid);
+      const double whole = pointToPolygonFormFactor(pt, n, nearShape_.shooter);
+      if (T == 0.0 || !(whole > 0.0)) return glm::dvec3(T);
+      glm::dvec3 shaped(0.0);
+      for (size_t l = 0; l < nearShape_.leafWorld.size(); ++l)
+        shaped +=
+            nearShape_.leafShape[l] * pointToPolygonFormFactor(pt, n, nearShape_.leafWorld[l]);
+      return T * shaped / whole;
+    }
+    return shapedTransmittance(pt, n, samples, shooterNormal, occluded, valid, shape);
+  }
+  // The current pair's near-texel shape (MovieBake::shapeAt): the shooter and its union leaves
+  // in the world at the key whose geometry the masks use, each leaf's B over the shooter's.
+  struct NearShape {
+    Polygon shooter;
+    double distance = 0.0;
+    std::vector<Polygon> leafWorld;
+    std::vector<glm::dvec3> leafShape;
+  };
+  NearShape nearShape_;
+
   std::vector<glm::dvec3> samplesAt(const Pair& p, int k) const {
     std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
     for (int i = 0; i < p.samples; ++i)
@@ -518,6 +555,7 @@ class MovieBake {
     goodLayer(t);
     for (const Pair& p : pairs_) {
       OcclusionMaskRenderer& gl = renderer_();
+      shapeAt(p, p.coherent ? 0 : k, t);
       const std::vector<double>& f =
           p.coherent ? coherentTransmittance(gl, p, k) : movingTransmittance(gl, p, k);
       combine(p, t, f);
@@ -581,6 +619,16 @@ class MovieBake {
     gl.render(geo_.receiverWorld(0), geo_.width(), geo_.height(), p.keyZeroSamples, dynamicTris,
               keyMask_);
     const glm::dvec3 shooterNormal = p.shooterWorld[0].normal();
+    if (!shape_.empty()) {  // exact merge only (shapeAt)
+      tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
+        const SampleMask occluded =
+            (p.staticMask.empty() ? SampleMask(0) : p.staticMask[x]) | keyMask_[x];
+        shapedTransmittance_[x] = geo_.shapedTransmittanceAt(0, x, p.keyZeroSamples, shooterNormal,
+                                                             occluded, p.valid, shape_);
+      });
+      stats_.secondsTransmittance += secondsSince(clock);
+      return p.formFactor;
+    }
     mergeOcclusion(
         options_.merge, p.staticMask, keyMask_, p.valid,
         [&](size_t x, SampleMask occluded) {
@@ -601,8 +649,12 @@ class MovieBake {
               geo_.blockersAt(p, p.candidates, k), keyMask_);
     const glm::dvec3 shooterNormal = p.shooterWorld[size_t(k)].normal();
     tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
-      transmittance_[x] =
-          float(geo_.texelTransmittance(k, x, samples, shooterNormal, keyMask_[x], valid));
+      if (!shape_.empty())
+        shapedTransmittance_[x] =
+            geo_.shapedTransmittanceAt(k, x, samples, shooterNormal, keyMask_[x], valid, shape_);
+      else
+        transmittance_[x] =
+            float(geo_.texelTransmittance(k, x, samples, shooterNormal, keyMask_[x], valid));
     });
     stats_.secondsTransmittance += secondsSince(clock);
     clock = SteadyClock::now();
@@ -612,11 +664,61 @@ class MovieBake {
     return keyFormFactor_;
   }
 
+  // The shape of a subdivided shooter at time t into shape_, per channel (colour bleeds unevenly
+  // over a wall: the back wall's part beside the red wall is redder). Empty: uniform within
+  // 1e-3 (a light's leaves, whose transmittance then stays the kernel-weighted one bit for
+  // bit), or an approximate --merge (popcount transmittances only).
+  void shapeAt(const Pair& p, int geometryKey, double t) {
+    shape_.clear();
+    MovieGeometry::NearShape& near = geo_.nearShape_;
+    near.leafWorld.clear();
+    near.leafShape.clear();
+    if (p.sampleLeaf.empty() || options_.merge != MergeMode::kExact) return;
+    const glm::dvec3 mean = solution_.radiosity(int(p.shooter), t);
+    const auto ratio = [&](const glm::dvec3& b) {
+      glm::dvec3 r(1.0);
+      for (int c = 0; c < 3; ++c)
+        if (mean[c] > 0.0) r[c] = b[c] / mean[c];
+      return r;
+    };
+    bool uniform = true;
+    shape_.resize(p.sampleLeaf.size());
+    for (size_t i = 0; i < p.sampleLeaf.size(); ++i) {
+      shape_[i] = glm::vec3(ratio(solution_.radiosity(p.sampleLeaf[i], t)));
+      for (int c = 0; c < 3; ++c) uniform = uniform && std::abs(shape_[i][c] - 1.0f) < 1e-3f;
+    }
+    if (uniform) {
+      shape_.clear();
+      return;
+    }
+    if (shapedTransmittance_.size() != texels_) shapedTransmittance_.resize(texels_);
+    const PatchHierarchy& h = solution_.hierarchy;
+    const bool triangle = h.top(int(p.shooter)).local.count == 3;
+    static const glm::dvec2 quadCorners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    static const glm::dvec2 triCorners[3] = {{0, 0}, {1, 0}, {0, 1}};
+    near.shooter = p.shooterWorld[size_t(geometryKey)];
+    // The samples' spacing: the shooter's size over sqrt(N).
+    near.distance = polygonSize(near.shooter) / std::sqrt(double(std::max(1, p.samples)));
+    for (int leaf : p.leaves) {
+      Polygon w;
+      w.count = near.shooter.count;
+      for (int c = 0; c < w.count; ++c)
+        w.v[c] = polygonPointAt(
+            near.shooter,
+            topUvFromNodeUv(h.node(leaf).id, triangle ? triCorners[c] : quadCorners[c], triangle));
+      near.leafWorld.push_back(w);
+      near.leafShape.push_back(ratio(solution_.radiosity(leaf, t)));
+    }
+  }
+
   // Combine: the bad layer B_S(t) F T added to the irradiance.
   void combine(const Pair& p, double t, const std::vector<double>& f) {
     auto clock = SteadyClock::now();
     const glm::dvec3 B = solution_.radiosity(int(p.shooter), t);
-    for (size_t x = 0; x < texels_; ++x) acc_[x] += B * (f[x] * double(transmittance_[x]));
+    if (!shape_.empty())
+      for (size_t x = 0; x < texels_; ++x) acc_[x] += B * f[x] * shapedTransmittance_[x];
+    else
+      for (size_t x = 0; x < texels_; ++x) acc_[x] += B * (f[x] * double(transmittance_[x]));
     stats_.secondsCombine += secondsSince(clock);
   }
 
@@ -638,7 +740,9 @@ class MovieBake {
   std::vector<glm::dvec3> acc_;
   std::vector<float> transmittance_, texture_;
   std::vector<SampleMask> keyMask_;
-  std::vector<double> keyFormFactor_;  // also the scan's scratch
+  std::vector<double> keyFormFactor_;            // also the scan's scratch
+  std::vector<glm::vec3> shape_;                 // the current pair's at the current key (shapeAt)
+  std::vector<glm::dvec3> shapedTransmittance_;  // per texel, when shape_ is not empty
   // fillCoveredTexels: under static solids (once per movie), and at the current key.
   std::vector<char> staticCovered_, covered_;
   std::vector<int> movingNear_;  // moving nodes whose bounds over the movie meet the receiver
@@ -720,6 +824,23 @@ void MovieBake::planPair(Pair& p) {
   // when they take as many, and their kernel-weighted penumbrae meet without a step.
   const uint32_t seed = mix32(uint64_t(req_.patch.top) * 0x9e3779b97f4a7c15ull ^ S);
   p.unitSamples = multiJitteredPoints(p.samples, seed);
+  const PatchHierarchy& h = solution_.hierarchy;
+  if (!h.isLeaf(int(S))) {
+    const Polygon& shooter = p.shooterWorld[0];
+    for (const glm::dvec2& a : p.unitSamples)
+      p.sampleLeaf.push_back(
+          leafAtTopUv(h, int(S), polygonUvAt(shooter, samplePointOnPolygon(shooter, a))));
+    std::vector<int> stack{int(S)};
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      if (h.isLeaf(i)) {
+        p.leaves.push_back(i);
+        continue;
+      }
+      for (int c = 3; c >= 0; --c) stack.push_back(h.node(i).firstChild + c);
+    }
+  }
 
   std::vector<int> candidates = blockerCandidates(S, p);
   if (p.coherent) {
@@ -993,9 +1114,10 @@ TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBak
 double TextureMovieBaker::movieWorkingBytes(int width, int height, size_t badShooters) {
   // Per texel: texel (u,v) and local point (16 + 24); the key's double accumulator (24), its
   // float texture (12) and the sink's copy of key 0 (12, constant-movie check); one pair's
-  // float transmittance (4), per-key sample mask (8) and per-key form factor (8). Per coherent
-  // bad pair: its form factors (8) and static-blocker sample mask (8).
-  const double perTexel = 16 + 24 + 24 + 12 + 12 + 4 + 8 + 8 + 16.0 * double(badShooters);
+  // float transmittance (4) or, a subdivided shooter's, per channel (24), per-key sample mask
+  // (8) and per-key form factor (8). Per coherent bad pair: its form factors (8) and
+  // static-blocker sample mask (8).
+  const double perTexel = 16 + 24 + 24 + 12 + 12 + 4 + 24 + 8 + 8 + 16.0 * double(badShooters);
   return double(width) * double(height) * perTexel;
 }
 

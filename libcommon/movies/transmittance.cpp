@@ -266,6 +266,33 @@ double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
   return total > 0.0 ? seen / total : transmittanceFromMask(occluded, valid);
 }
 
+glm::dvec3 shapedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
+                               const std::vector<glm::dvec3>& samples,
+                               const glm::dvec3& shooterNormal, SampleMask occluded,
+                               SampleMask valid, const std::vector<glm::vec3>& shape) {
+  const SampleMask open = valid & ~occluded;
+  if (open == 0) return glm::dvec3(0.0);
+  double total = 0.0;
+  glm::dvec3 seen(0.0), plainSeen(0.0);
+  int plainCount = 0;
+  const size_t count = std::min({samples.size(), shape.size(), size_t(kMaxTransmittanceSamples)});
+  for (size_t s = 0; s < count; ++s) {
+    if (!((valid >> s) & 1u)) continue;
+    ++plainCount;
+    const bool isOpen = (open >> s) & 1u;
+    if (isOpen) plainSeen += glm::dvec3(shape[s]);
+    const glm::dvec3 d = samples[s] - x;
+    const double r2 = glm::dot(d, d);
+    if (!(r2 > 0.0)) continue;
+    const double k =
+        std::max(0.0, glm::dot(n, d)) * std::abs(glm::dot(shooterNormal, d)) / (r2 * r2);
+    total += k;
+    if (isOpen) seen += k * glm::dvec3(shape[s]);
+  }
+  if (total > 0.0) return seen / total;
+  return plainCount > 0 ? plainSeen / double(plainCount) : glm::dvec3(1.0);  // no weight
+}
+
 const char* mergeModeName(MergeMode m) {
   switch (m) {
     case MergeMode::kExact:

@@ -76,6 +76,20 @@ double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
                                    const glm::dvec3& shooterNormal, SampleMask occluded,
                                    SampleMask valid);
 
+// The same quadrature for a shooter whose radiosity is not uniform (a subdivided patch that does
+// not emit, a bad pair of --bad-links partial): each sample s also weighted by the shape
+// beta_s = B(y_s) / B_S, the radiosity of the leaf under it over the shooter's mean,
+//   T_B(x) = sum_{s open} K(x, s) beta_s / sum_s K(x, s),
+// so that B_S F(x -> S) T_B(x) estimates the irradiance $\int_S B(y) V K dy$ of the shooter's
+// leaves, not of its mean (a Cornell-box wall's mean radiosity put 6.5 % too little light on
+// the ceiling, whose near parts see the wall's brighter upper half). Not 1 where every sample
+// is open: the kernel still weights the shooter's parts.
+// Per channel (beta_s for R, G, B).
+glm::dvec3 shapedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
+                               const std::vector<glm::dvec3>& samples,
+                               const glm::dvec3& shooterNormal, SampleMask occluded,
+                               SampleMask valid, const std::vector<glm::vec3>& shape);
+
 // Approximate merge operators for transmittances of two disjoint blocker sets (paper §5,
 // Figure 7): occlusions a = 1 - Ts and b = 1 - Td merge to max(a, b) (blockers overlap),
 // min(1, a + b) (disjoint) or 1 - (1 - a)(1 - b) (independent). kExact ORs the sample masks.

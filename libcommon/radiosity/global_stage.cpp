@@ -22,6 +22,7 @@ nlohmann::json GlobalOptions::toJson() const {
           {"tol", r.tol},
           {"bad-links", badLinkRuleName(spaceTime.badLinks)},
           {"partial-threshold", spaceTime.partialThreshold},
+          {"partial-power-share", spaceTime.partialPowerShare},
           {"max-links", r.maxLinks},
           {"no-closure", !r.closure},
           {"no-closed-rooms", !r.closedRooms},

@@ -38,6 +38,10 @@ struct SpaceTimeOptions {
   BadLinkRule badLinks = BadLinkRule::kLights;
   // partial: a pair is also bad when one of its gathered links has partialThreshold < V < 1.
   double partialThreshold = 0.0;
+  // partial: a pair whose shooter does not emit only when the shadow of its partly visible
+  // links, sum B_q F (1 - V) A_p, is at least this share of the power the top-level patches
+  // carry (sum A B) at some key time; 0: every such pair.
+  double partialPowerShare = 0.0;
   bool coherence = true;
   std::function<void()> onKeySolved;  // called after each key time's solve (progress)
 };

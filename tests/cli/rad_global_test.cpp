@@ -167,6 +167,36 @@ TEST(RadGlobal, LinkBoundWarnsAndIsReported) {
   fs::remove_all(d);
 }
 
+// --bad-links partial --partial-power-share: the partly visible pairs whose shadows carry the
+// least power stay in the good layer. A share of 0 keeps every partly visible pair, 1 none of
+// them (the lights' pairs alone), and the counts in between fall as the share grows; the share
+// is in the file's provenance.
+TEST(RadGlobal, PartialPowerShareKeepsTheStrongShadowsOfPartlyVisiblePairs) {
+  fs::path d = scratchDir();
+  auto badPairs = [&](const std::string& flags) {
+    const std::string out = (d / "p.rlh").string(), report = (d / "p.json").string();
+    auto r = runCommand(tool("rad-global") + " " + kScene + " -o " + out + kFlags + flags +
+                        " --report " + report);
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return nlohmann::json::parse(readWholeFile(report))["totals"]["bad_pairs"].get<size_t>();
+  };
+  const size_t lights = badPairs(""), all = badPairs(" --bad-links partial");
+  const size_t some = badPairs(" --bad-links partial --partial-power-share 1e-4");
+  EXPECT_EQ(ContainerReader::open((d / "p.rlh").string())
+                .metadata()
+                .at("parameters")
+                .at("partial-power-share"),
+            1e-4);
+  const size_t fewer = badPairs(" --bad-links partial --partial-power-share 1e-3");
+  const size_t none = badPairs(" --bad-links partial --partial-power-share 1");
+  EXPECT_LT(lights, all);
+  EXPECT_EQ(none, lights);
+  EXPECT_LT(some, all);
+  EXPECT_LT(fewer, some);
+  EXPECT_GT(fewer, lights);
+  fs::remove_all(d);
+}
+
 // The render farm (issue 17): windows of the run's key times solved apart (on any number of
 // threads, overlapping or not) and merged give the bytes of the run itself, provenance
 // included: the merge is the run's command line plus --merge. Keys of frames 0-12 at key step

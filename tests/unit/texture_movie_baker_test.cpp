@@ -168,6 +168,71 @@ TEST(TextureMovieBaker, UnoccludedIrradianceIsGoodPlusRadiosityTimesFormFactor) 
   EXPECT_EQ(s.passes, 0) << "no blocker in the shaft: nothing to render";
 }
 
+// A bad shooter that the global pass subdivided, with leaves of uneven radiosity (a wall of the
+// Cornell box under --bad-links partial): each texel gets its leaves' light, sum_l B_l F(x -> l),
+// not the mean radiosity times F(x -> S) (13.8 % RMSE on the bundled scene before). The samples'
+// kernel weighs the leaves (the mean's error cut 10x or more at every height); nearer than the
+// samples' spacing (size / sqrt(N), 0.177 m here) the leaves' own point form factors (exact).
+TEST(TextureMovieBaker, AnUnevenShooterLightsEachTexelAsItsLeavesDo) {
+  for (const double height : {2.0, 1.0, 0.5, 0.3, 0.15}) {
+    TestScene t = makeScene(false, false);
+    Scene& s = t.scene;
+    s.nodes[size_t(t.lightNode)].translation = glm::dvec3(0.0, 0.0, height - 2.0);
+    GlobalSolution& g = t.solution;
+    const int first = g.hierarchy.subdivide(t.lightTop);
+    const glm::vec3 leafB[4] = {{40, 1, 1}, {1, 40, 1}, {1, 1, 40}, {2, 2, 2}};
+    g.nodeRadiosity.resize(size_t(g.hierarchy.size()));
+    glm::vec3 mean(0.0f);
+    for (int c = 0; c < 4; ++c) {
+      g.nodeRadiosity[size_t(first + c)] = leafB[c];
+      mean += 0.25f * leafB[c];
+    }
+    g.nodeRadiosity[size_t(t.lightTop)] = mean;
+    g.leafRow.clear();  // the leaves' rows, consecutive; the light is an interior node now
+    int rows = 0;
+    for (int i = 0; i < g.hierarchy.size(); ++i)
+      g.leafRow.push_back(g.hierarchy.isLeaf(i) ? rows++ : -1);
+    g.leafVertexGoodIrradiance.assign(size_t(rows) * 4, glm::vec3(0.0f));
+    for (int c = 0; c < 4; ++c)
+      g.leafVertexGoodIrradiance[size_t(g.leafRow[size_t(t.floorTop)]) * 4 + c] = glm::vec3(t.good);
+    g.validate("test");
+    TextureMovieBakerOptions o = gouraud();
+    o.minSamples = 64;  // N = 64: spacing sqrt(2) / 8
+    TextureMovieBaker baker(s, g, kFps, o);
+    const int w = 12, h = 9;
+    BakedMovie m = baker.bake(request(t, w, h));
+    const glm::dmat4 lightToWorld = s.worldTransform(t.lightNode, 0.0);
+    const Polygon light = g.hierarchy.top(t.lightTop).local.transformed(lightToWorld);
+    const Polygon& floor = g.hierarchy.top(t.floorTop).local;
+    double worstFar = 0.0, worstNear = 0.0, worstMean = 0.0;
+    int near = 0;
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i) {
+        const glm::dvec3 x = polygonPointAt(floor, {(i + 0.5) / w, (j + 0.5) / h});
+        const bool isNear = distanceToPolygon(x, light) < std::sqrt(2.0) / 8.0;
+        near += isNear ? 1 : 0;
+        glm::dvec3 leaves(0.0), whole(0.0);
+        for (int c = 0; c < 4; ++c) {
+          const double f = pointToPolygonFormFactor(
+              x, {0, 0, 1}, g.hierarchy.node(first + c).local.transformed(lightToWorld));
+          leaves += glm::dvec3(leafB[c]) * f;
+          whole += glm::dvec3(mean) * f;
+        }
+        for (int c = 0; c < 3; ++c) {
+          const double expected = t.good[c] + leaves[c];
+          const double got = m.keys[0][(size_t(j) * w + i) * 3 + size_t(c)];
+          double& worst = isNear ? worstNear : worstFar;
+          worst = std::max(worst, std::abs(got - expected) / expected);
+          worstMean = std::max(worstMean, std::abs(t.good[c] + whole[c] - expected) / expected);
+        }
+      }
+    EXPECT_GT(worstMean, 0.15) << "height " << height << ": the mean radiosity is off";
+    EXPECT_LT(worstFar, 0.1 * worstMean) << "height " << height;
+    EXPECT_LT(worstNear, 1e-6) << "height " << height;
+    if (height < 0.177) EXPECT_GT(near, 4) << "texels under the shooter, nearer than a spacing";
+  }
+}
+
 TEST(TextureMovieBaker, HalfPlaneShadowGivesUmbraAndAnalyticPenumbra) {
   TestScene t = makeScene(true, false);
   TextureMovieBaker baker(t.scene, t.solution, kFps, gouraud());

@@ -154,6 +154,46 @@ TEST(Transmittance, KernelWeightedTransmittanceIsTheVisibleFormFactorShare) {
   EXPECT_EQ(kernelWeightedTransmittance(x, n, samples, -light.normal(), occluded, valid), t);
 }
 
+// A shooter whose radiosity is not uniform (a subdivided wall, --bad-links partial): the samples
+// also weigh by their leaf's B over the mean, per channel. Here the light's near half (x > 0)
+// is 3x brighter in red than the mean and its far half dark in red: the texel, whose kernel
+// favours the near half, gets more red than the mean radiosity says, and exactly the near
+// half's share when the far half is occluded.
+TEST(Transmittance, ShapedTransmittanceWeighsEachSampleByItsLeafsRadiosity) {
+  const glm::dvec3 x(0.7, 0.0, 1.6), n(-1.0, 0.0, 0.0);
+  const Polygon light = ceilingLight();
+  const Polygon nearHalf = quad({0, -0.5, 2}, {0, 0.5, 2}, {0.5, 0.5, 2}, {0.5, -0.5, 2});
+  const double whole = pointToPolygonFormFactor(x, n, light);
+  const double nearShare = pointToPolygonFormFactor(x, n, nearHalf) / whole;
+  const std::vector<glm::dvec3> samples = lightSamples(64);
+  SampleMask farHalf = 0, valid = 0;
+  std::vector<glm::vec3> uniform(samples.size(), glm::vec3(1.0f)), shape(samples.size());
+  for (size_t s = 0; s < samples.size(); ++s) {
+    valid |= SampleMask(1) << s;
+    const bool nearSide = samples[s].x > 0.0;
+    if (!nearSide) farHalf |= SampleMask(1) << s;
+    shape[s] = nearSide ? glm::vec3(1.8f, 1.0f, 0.5f) : glm::vec3(0.2f, 1.0f, 1.5f);
+  }
+  // Uniform shape: the kernel-weighted transmittance, and exactly 1 / 0 fully open / occluded.
+  const double t = kernelWeightedTransmittance(x, n, samples, light.normal(), farHalf, valid);
+  EXPECT_NEAR(shapedTransmittance(x, n, samples, light.normal(), farHalf, valid, uniform).x, t,
+              1e-12);
+  EXPECT_NEAR(shapedTransmittance(x, n, samples, light.normal(), 0, valid, uniform).y, 1.0, 1e-12);
+  EXPECT_EQ(shapedTransmittance(x, n, samples, light.normal(), valid, valid, shape),
+            glm::dvec3(0.0));
+  // Uneven: fully open, sum_l beta_l F_l / F per channel (not 1); the far half occluded, the
+  // near half's share times its beta.
+  const glm::dvec3 open = shapedTransmittance(x, n, samples, light.normal(), 0, valid, shape);
+  EXPECT_NEAR(open.x, 1.8 * nearShare + 0.2 * (1.0 - nearShare), 0.03);
+  EXPECT_NEAR(open.y, 1.0, 1e-12);
+  EXPECT_NEAR(open.z, 0.5 * nearShare + 1.5 * (1.0 - nearShare), 0.03);
+  EXPECT_GT(open.x, 1.15) << "the kernel favours the brighter near half";
+  const glm::dvec3 shadowed =
+      shapedTransmittance(x, n, samples, light.normal(), farHalf, valid, shape);
+  EXPECT_NEAR(shadowed.x, 1.8 * nearShare, 0.04);
+  EXPECT_NEAR(shadowed.z, 0.5 * nearShare, 0.02);
+}
+
 // The occlusion-mask tests run on both methods: OSMesa projective shadows and CPU ray casting.
 template <class Renderer>
 class MaskRenderers : public ::testing::Test {};

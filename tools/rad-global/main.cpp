@@ -79,6 +79,12 @@ void addOptions(CLI::App& app, Options& o) {
                  "partial: a link is partly visible when threshold < V < 1")
       ->capture_default_str()
       ->check(rad::finiteRange(0.0, 1.0));
+  app.add_option("--partial-power-share", g.spaceTime.partialPowerShare,
+                 "partial: a pair whose shooter does not emit only when its partly visible "
+                 "links' shadow, sum B F (1 - V) A, is at least this share of the power the "
+                 "surfaces carry (sum A B); 0: every such pair")
+      ->capture_default_str()
+      ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--max-links", r.maxLinks,
                  "memory bound: a key time stops refining at this many links (~160 bytes each) "
                  "and warns; at most 2^31")
