@@ -665,9 +665,8 @@ class MovieBake {
   }
 
   // The shape of a subdivided shooter at time t into shape_, per channel (colour bleeds unevenly
-  // over a wall: the back wall's part beside the red wall is redder). Empty: uniform within
-  // 1e-3 (a light's leaves, whose transmittance then stays the kernel-weighted one bit for
-  // bit), or an approximate --merge (popcount transmittances only).
+  // over a wall: the back wall's part beside the red wall is redder). Empty: a light or a leaf
+  // (planPair), uniform within 1e-3, or an approximate --merge (popcount transmittances only).
   void shapeAt(const Pair& p, int geometryKey, double t) {
     shape_.clear();
     MovieGeometry::NearShape& near = geo_.nearShape_;
@@ -824,8 +823,13 @@ void MovieBake::planPair(Pair& p) {
   // when they take as many, and their kernel-weighted penumbrae meet without a step.
   const uint32_t seed = mix32(uint64_t(req_.patch.top) * 0x9e3779b97f4a7c15ull ^ S);
   p.unitSamples = multiJitteredPoints(p.samples, seed);
+  // A subdivided shooter that does not emit: its leaves' radiosity shapes its light (a light's
+  // is its emission, uniform; skipping it keeps the lights' pairs as they were, at no cost).
   const PatchHierarchy& h = solution_.hierarchy;
-  if (!h.isLeaf(int(S))) {
+  const int material = tops_[S].material;
+  const bool emits = material >= 0 && size_t(material) < geo_.scene().materials.size() &&
+                     geo_.scene().materials[size_t(material)].isEmitter();
+  if (!h.isLeaf(int(S)) && !emits) {
     const Polygon& shooter = p.shooterWorld[0];
     for (const glm::dvec2& a : p.unitSamples)
       p.sampleLeaf.push_back(
