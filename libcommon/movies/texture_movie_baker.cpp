@@ -692,19 +692,11 @@ class MovieBake {
     }
     if (shapedTransmittance_.size() != texels_) shapedTransmittance_.resize(texels_);
     const PatchHierarchy& h = solution_.hierarchy;
-    const bool triangle = h.top(int(p.shooter)).local.count == 3;
-    static const glm::dvec2 quadCorners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    static const glm::dvec2 triCorners[3] = {{0, 0}, {1, 0}, {0, 1}};
     near.shooter = p.shooterWorld[size_t(geometryKey)];
     // The samples' spacing: the shooter's size over sqrt(N).
     near.distance = polygonSize(near.shooter) / std::sqrt(double(std::max(1, p.samples)));
     for (int leaf : p.leaves) {
-      Polygon w;
-      w.count = near.shooter.count;
-      for (int c = 0; c < w.count; ++c)
-        w.v[c] = polygonPointAt(
-            near.shooter,
-            topUvFromNodeUv(h.node(leaf).id, triangle ? triCorners[c] : quadCorners[c], triangle));
+      const Polygon w = nodePolygonIn(near.shooter, h.node(leaf).id);
       near.leafWorld.push_back(w);
       near.leafShape.push_back(ratio(solution_.radiosity(leaf, t)));
     }
@@ -1009,16 +1001,20 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
           {"warnings", warnings}};
 }
 
-Polygon nodeWorldPolygon(const Scene& scene, const InputPolygon& top, PatchId node, double t) {
-  const bool triangle = top.local.count == 3;
+Polygon nodePolygonIn(const Polygon& top, PatchId node) {
+  const bool triangle = top.count == 3;
   static const glm::dvec2 quadCorners[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   static const glm::dvec2 triCorners[3] = {{0, 0}, {1, 0}, {0, 1}};
-  Polygon local;
-  local.count = top.local.count;
-  for (int k = 0; k < local.count; ++k)
-    local.v[k] = polygonPointAt(
-        top.local, topUvFromNodeUv(node, triangle ? triCorners[k] : quadCorners[k], triangle));
-  return local.transformed(scene.worldTransform(top.node, t));
+  Polygon out;
+  out.count = top.count;
+  for (int k = 0; k < out.count; ++k)
+    out.v[k] = polygonPointAt(
+        top, topUvFromNodeUv(node, triangle ? triCorners[k] : quadCorners[k], triangle));
+  return out;
+}
+
+Polygon nodeWorldPolygon(const Scene& scene, const InputPolygon& top, PatchId node, double t) {
+  return nodePolygonIn(top.local, node).transformed(scene.worldTransform(top.node, t));
 }
 
 TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& solution, double fps,

@@ -239,5 +239,7 @@ class TextureMovieBaker {
 // Texel centres of a node: world points at time t via the top polygon's (u,v) map.
 // out[j * w + i]; also the node's world polygon (corners in the patch (u,v) order).
 Polygon nodeWorldPolygon(const Scene& scene, const InputPolygon& top, PatchId node, double t);
+// The polygon of `node` in the frame `top` (its top-level patch's polygon) is given in.
+Polygon nodePolygonIn(const Polygon& top, PatchId node);
 
 }  // namespace rad
