@@ -8,6 +8,7 @@
 #include <memory>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
@@ -92,8 +93,12 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relT
   // over `from` on the scale of x's distance to `to`, whatever `to`'s size. The larger patch's
   // size had made every pair with a giant patch adaptive (issue 18: a mutated vertex 1e10 m
   // away cost 5x as much per link).
-  const double f = areaAverageFormFactor(from, to, relTol, 1.0);
-  return swap ? std::min(1.0, f * aq / ap) : f;
+  return linkFormFactorFrom(p, q, areaAverageFormFactor(from, to, relTol, 1.0));
+}
+
+double linkFormFactorFrom(const Polygon& p, const Polygon& q, double fromSmaller) {
+  const double ap = p.area(), aq = q.area();
+  return ap > aq ? std::min(1.0, fromSmaller * aq / ap) : fromSmaller;
 }
 
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
@@ -617,23 +622,60 @@ class KeyTimeSolver {
   // Accurate pass: the quadrature F (linkFormFactor) of every visible leaf link not yet
   // computed, or the accurate F the previous key time already computed (coherence).
   void computeAccurateFormFactors() {
-    tbb::parallel_for(size_t(0), s_.links.size(), [&](size_t li) {
+    std::vector<LinkIndex> fresh;  // the links whose F is integrated here
+    for (size_t li = 0; li < s_.links.size(); ++li) {
       SolverLink& l = s_.links[li];
-      if (l.refined || l.accurate) return;
-      if (l.rayVisibility > 0.0) {
-        l.integrated = true;
-        const double knownFormFactor =
-            l.known != SolverLink::kNotKnown ? input_.reuse->value(l.known).formFactor : -1.0;
-        if (knownFormFactor >= 0.0) {
-          l.formFactor = knownFormFactor;
-        } else {
-          l.formFactor = linkFormFactor(s_.world[size_t(l.receiver)], s_.world[size_t(l.shooter)],
-                                        opt_.quadratureOrder, opt_.formFactorTolerance);
-          l.reused = false;  // computed here after all
-          l.visibilityOnly = false;
-        }
-      }
+      if (l.refined || l.accurate) continue;
       l.accurate = true;
+      if (!(l.rayVisibility > 0.0)) continue;
+      l.integrated = true;
+      const double knownFormFactor =
+          l.known != SolverLink::kNotKnown ? input_.reuse->value(l.known).formFactor : -1.0;
+      if (knownFormFactor >= 0.0) {
+        l.formFactor = knownFormFactor;
+        continue;
+      }
+      l.reused = false;  // computed here after all
+      l.visibilityOnly = false;
+      fresh.push_back(LinkIndex(li));
+    }
+    // Reciprocity: linkFormFactor integrates over the smaller patch of a pair, so a link and its
+    // reverse (p <- q, q <- p: 93 % of the 1.2 M links of the 10k-triangle hall's first key)
+    // take one integral, bit for bit what each would have computed. Pairs of equal area (the
+    // rule's tie keeps the receiver as the patch integrated over) are computed per link.
+    std::vector<std::pair<uint64_t, LinkIndex>> byPair(fresh.size());
+    tbb::parallel_for(size_t(0), fresh.size(), [&](size_t i) {
+      const SolverLink& l = s_.links[fresh[i]];
+      const uint64_t a = uint32_t(std::min(l.receiver, l.shooter)),
+                     b = uint32_t(std::max(l.receiver, l.shooter));
+      byPair[i] = {(a << 32) | b, fresh[i]};
+    });
+    std::vector<LinkIndex>().swap(fresh);
+    tbb::parallel_sort(byPair.begin(), byPair.end());  // distinct: deterministic
+    std::vector<size_t> groupStart;
+    for (size_t i = 0; i < byPair.size(); ++i)
+      if (i == 0 || byPair[i].first != byPair[i - 1].first) groupStart.push_back(i);
+    groupStart.push_back(byPair.size());
+    const bool autoOrder = opt_.quadratureOrder == kAutoOrder;
+    tbb::parallel_for(size_t(0), groupStart.size() - 1, [&](size_t g) {
+      const size_t first = groupStart[g], count = groupStart[g + 1] - first;
+      SolverLink& l = s_.links[byPair[first].second];
+      const Polygon& p = s_.world[size_t(l.receiver)];
+      const Polygon& q = s_.world[size_t(l.shooter)];
+      if (count == 2 && autoOrder && p.area() != q.area()) {
+        const bool pSmaller = p.area() < q.area();
+        const double f = areaAverageFormFactor(pSmaller ? p : q, pSmaller ? q : p,
+                                               opt_.formFactorTolerance, 1.0);
+        l.formFactor = linkFormFactorFrom(p, q, f);
+        SolverLink& reverse = s_.links[byPair[first + 1].second];
+        reverse.formFactor = linkFormFactorFrom(q, p, f);
+        return;
+      }
+      for (size_t i = first; i < first + count; ++i) {
+        SolverLink& li = s_.links[byPair[i].second];
+        li.formFactor = linkFormFactor(s_.world[size_t(li.receiver)], s_.world[size_t(li.shooter)],
+                                       opt_.quadratureOrder, opt_.formFactorTolerance);
+      }
     });
   }
 
