@@ -467,11 +467,6 @@ class KeyTimeSolver {
     // The previous key's pairs are copied: they go before the pairs' leaves are made (held
     // together, the two had made rad-global's peak on the 10k-triangle hall).
     releaseRayPairs();
-    if (pairLeaf_.capacity() == 0 && input_.expectedRayPairs > 0)
-      pairLeaf_.reserve(withMargin(input_.expectedRayPairs));
-    pairLeaf_.resize(pairs_.size());
-    for (size_t f = 0; f < fresh.size(); ++f)
-      std::fill_n(&pairLeaf_[pairStart_[fresh[f]]], k, s_.links[fresh[f]].shooter);
     tbb::parallel_for(size_t(0), L, [&](size_t li) {
       SolverLink& l = s_.links[li];
       l.visibility = l.rayVisibility;
@@ -479,20 +474,16 @@ class KeyTimeSolver {
       if (!weighted(l)) return;
       const bool triangle = s_.world[size_t(l.shooter)].count == 3;
       const LinkRayPair* pair = &pairs_[pairStart_[li]];
-      int* leaf = &pairLeaf_[pairStart_[li]];
       double kernel[VisibilityScene::kMaxRecordedPairs], weight[VisibilityScene::kMaxRecordedPairs];
       for (int i = 0; i < k; ++i) {
-        // The leaf under the pair's end. It stays the leaf until a round splits it; then the
-        // pair descends again from the shooter, by the same steps as on from where it was, so
-        // to the same leaf and (u,v). Keeping the leaf's (u,v) for that instead had held 24
-        // bytes per pair (110 MB of the 10k-triangle hall's peak).
-        int& node = leaf[i];
-        if (s_.split[size_t(node)]) {
-          node = l.shooter;
-          glm::dvec2 uv(pair[i].uv);
-          while (s_.split[size_t(node)])
-            node = h_.node(node).firstChild + descendToChild(uv, triangle);
-        }
+        // The leaf under the pair's end, found again at every round from the shooter (a few
+        // levels). Keeping it per pair between rounds had held 4 bytes a pair (18 MB of the
+        // 10k-triangle hall's peak, once the sweeps' lists were made), its (u,v) too before
+        // that 24 (110 MB).
+        int node = l.shooter;
+        glm::dvec2 uv(pair[i].uv);
+        while (s_.split[size_t(node)])
+          node = h_.node(node).firstChild + descendToChild(uv, triangle);
         const glm::dvec3 b = B_[size_t(node)];
         kernel[i] = pair[i].kernel;
         weight[i] = b.x + b.y + b.z;
@@ -1171,11 +1162,9 @@ class KeyTimeSolver {
   // Per dense node: F(node -> top-level patch) computed for the closure in this key's solve.
   std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor_;
   // weightVisibilityByShooterRadiosity's ray pairs, opt_.rays per link from pairStart_[link]
-  // (kNoRayPairs: not weighted yet in this key solve), and per pair the shooter leaf it last
-  // descended to.
+  // (kNoRayPairs: not weighted yet in this key solve).
   std::vector<uint32_t> pairStart_;
   std::vector<LinkRayPair> pairs_;
-  std::vector<int> pairLeaf_;
   double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
   bool nonFinite_ = false;          // a sweep produced NaN or Inf
   double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges
