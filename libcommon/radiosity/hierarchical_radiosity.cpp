@@ -82,10 +82,13 @@ const char* refinementOracleName(RefinementOracle oracle) {
 
 double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relTol) {
   if (order != kAutoOrder) return polygonToPolygonFormFactor(p, q, order);
+  return linkFormFactorFrom(p, q, linkFormFactorIntegral(p, q, relTol));
+}
+
+double linkFormFactorIntegral(const Polygon& p, const Polygon& q, double relTol) {
   // Integrate over the smaller patch and use reciprocity: a Gauss rule on the larger one misses
   // the log-singular strip along a shared edge (README of the reference: perp_common_edge_*).
-  double ap = p.area(), aq = q.area();
-  bool swap = ap > aq;
+  const bool swap = p.area() > q.area();
   const Polygon& from = swap ? q : p;
   const Polygon& to = swap ? p : q;
   // How near is measured against the patch integrated over (areaAverageFormFactor's rule, with
@@ -93,7 +96,7 @@ double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relT
   // over `from` on the scale of x's distance to `to`, whatever `to`'s size. The larger patch's
   // size had made every pair with a giant patch adaptive (issue 18: a mutated vertex 1e10 m
   // away cost 5x as much per link).
-  return linkFormFactorFrom(p, q, areaAverageFormFactor(from, to, relTol, 1.0));
+  return areaAverageFormFactor(from, to, relTol, 1.0);
 }
 
 double linkFormFactorFrom(const Polygon& p, const Polygon& q, double fromSmaller) {
@@ -653,13 +656,11 @@ class KeyTimeSolver {
       SolverLink& l = s_.links[byPair[first].second];
       const Polygon& p = s_.world[size_t(l.receiver)];
       const Polygon& q = s_.world[size_t(l.shooter)];
-      if (count == 2 && autoOrder && p.area() != q.area()) {
-        const bool pSmaller = p.area() < q.area();
-        const double f = areaAverageFormFactor(pSmaller ? p : q, pSmaller ? q : p,
-                                               opt_.formFactorTolerance, 1.0);
+      SolverLink& next = s_.links[byPair[first + (count > 1 ? 1 : 0)].second];
+      if (count == 2 && autoOrder && next.receiver == l.shooter && p.area() != q.area()) {
+        const double f = linkFormFactorIntegral(p, q, opt_.formFactorTolerance);
         l.formFactor = linkFormFactorFrom(p, q, f);
-        SolverLink& reverse = s_.links[byPair[first + 1].second];
-        reverse.formFactor = linkFormFactorFrom(q, p, f);
+        next.formFactor = linkFormFactorFrom(q, p, f);
         return;
       }
       for (size_t i = first; i < first + count; ++i) {

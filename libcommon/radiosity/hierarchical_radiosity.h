@@ -311,8 +311,10 @@ std::vector<SolverLink> linkTopLevel(const std::vector<Polygon>& world,
 // Gauss rule whose order falls with that distance ratio; any other order:
 // polygonToPolygonFormFactor(p, q, order) (one rule per receiver: exact row sums).
 double linkFormFactor(const Polygon& p, const Polygon& q, int order, double relTol = 1e-5);
-// linkFormFactor's F(p -> q) from its integral over the smaller patch, F(smaller -> other):
-// the link and its reverse share that integral.
+// kAutoOrder's two steps: the integral over the smaller patch, F(smaller -> other) (the same
+// for p, q and q, p unless their areas are equal: a link and its reverse share it), and
+// F(p -> q) from it by reciprocity.
+double linkFormFactorIntegral(const Polygon& p, const Polygon& q, double relTol);
 double linkFormFactorFrom(const Polygon& p, const Polygon& q, double fromSmaller);
 
 // True when the top-level patches p and q can exchange energy at all: some vertex of each lies
