@@ -247,9 +247,7 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
       for (double t : times) receiverAt.push_back(nodeWorld(uint32_t(r), t));
       shooterParts(receiverAt, times, shooter, shooters);
       for (uint32_t q : shooters) {
-        const int m = h.topOf(int(q)).material;
-        const bool emitter =
-            m >= 0 && m < int(scene_.materials.size()) && scene_.materials[size_t(m)].isEmitter();
+        const bool emitter = scene_.emits(h.topOf(int(q)));
         if (nearShooterLevels_ > 0 && h.isLeaf(int(q)) && !emitter)
           nearCells(receiverAt, times, q, cells);
         else

@@ -106,6 +106,19 @@ struct Pair {
   std::vector<int> leaves;  // its union leaves (the near texels' exact shape)
 };
 
+// A subdivided bad shooter's radiosity over its mean at one key (MovieBake::shapeAt): per
+// shadow sample, the union leaf's under it (shapedTransmittance), and for the texels nearer than
+// the samples' spacing the leaves themselves, in the world at the key whose geometry the masks
+// use. Empty: the shooter is taken as uniform.
+struct ShooterShape {
+  std::vector<glm::vec3> sample;  // per sample, per channel
+  Polygon shooter;
+  double nearDistance = 0.0;
+  std::vector<Polygon> leafWorld;
+  std::vector<glm::dvec3> leafShape;
+  bool empty() const { return sample.empty(); }
+};
+
 // The receiver of one movie at its key times, and what the blocker tests ask of the scene
 // over the movie (each node's answer computed once).
 class MovieGeometry {
@@ -199,30 +212,19 @@ class MovieGeometry {
   // times the kernel-weighted transmittance.
   glm::dvec3 shapedTransmittanceAt(int k, size_t x, const std::vector<glm::dvec3>& samples,
                                    const glm::dvec3& shooterNormal, SampleMask occluded,
-                                   SampleMask valid, const std::vector<glm::vec3>& shape) const {
+                                   SampleMask valid, const ShooterShape& shape) const {
     const glm::dvec3 pt = texelPoint(k, x), n = texelNormal(k, x);
-    if (!nearShape_.leafWorld.empty() &&
-        distanceToPolygon(pt, nearShape_.shooter) < nearShape_.distance) {
+    if (!shape.leafWorld.empty() && distanceToPolygon(pt, shape.shooter) < shape.nearDistance) {
       const double T = kernelWeightedTransmittance(pt, n, samples, shooterNormal, occluded, valid);
-      const double whole = pointToPolygonFormFactor(pt, n, nearShape_.shooter);
+      const double whole = pointToPolygonFormFactor(pt, n, shape.shooter);
       if (T == 0.0 || !(whole > 0.0)) return glm::dvec3(T);
       glm::dvec3 shaped(0.0);
-      for (size_t l = 0; l < nearShape_.leafWorld.size(); ++l)
-        shaped +=
-            nearShape_.leafShape[l] * pointToPolygonFormFactor(pt, n, nearShape_.leafWorld[l]);
+      for (size_t l = 0; l < shape.leafWorld.size(); ++l)
+        shaped += shape.leafShape[l] * pointToPolygonFormFactor(pt, n, shape.leafWorld[l]);
       return T * shaped / whole;
     }
-    return shapedTransmittance(pt, n, samples, shooterNormal, occluded, valid, shape);
+    return shapedTransmittance(pt, n, samples, shooterNormal, occluded, valid, shape.sample);
   }
-  // The current pair's near-texel shape (MovieBake::shapeAt): the shooter and its union leaves
-  // in the world at the key whose geometry the masks use, each leaf's B over the shooter's.
-  struct NearShape {
-    Polygon shooter;
-    double distance = 0.0;
-    std::vector<Polygon> leafWorld;
-    std::vector<glm::dvec3> leafShape;
-  };
-  NearShape nearShape_;
 
   std::vector<glm::dvec3> samplesAt(const Pair& p, int k) const {
     std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
@@ -668,10 +670,9 @@ class MovieBake {
   // over a wall: the back wall's part beside the red wall is redder). Empty: a light or a leaf
   // (planPair), uniform within 1e-3, or an approximate --merge (popcount transmittances only).
   void shapeAt(const Pair& p, int geometryKey, double t) {
-    shape_.clear();
-    MovieGeometry::NearShape& near = geo_.nearShape_;
-    near.leafWorld.clear();
-    near.leafShape.clear();
+    shape_.sample.clear();
+    shape_.leafWorld.clear();
+    shape_.leafShape.clear();
     if (p.sampleLeaf.empty() || options_.merge != MergeMode::kExact) return;
     const glm::dvec3 mean = solution_.radiosity(int(p.shooter), t);
     const auto ratio = [&](const glm::dvec3& b) {
@@ -681,24 +682,24 @@ class MovieBake {
       return r;
     };
     bool uniform = true;
-    shape_.resize(p.sampleLeaf.size());
+    shape_.sample.resize(p.sampleLeaf.size());
     for (size_t i = 0; i < p.sampleLeaf.size(); ++i) {
-      shape_[i] = glm::vec3(ratio(solution_.radiosity(p.sampleLeaf[i], t)));
-      for (int c = 0; c < 3; ++c) uniform = uniform && std::abs(shape_[i][c] - 1.0f) < 1e-3f;
+      const glm::vec3 b = glm::vec3(ratio(solution_.radiosity(p.sampleLeaf[i], t)));
+      shape_.sample[i] = b;
+      for (int c = 0; c < 3; ++c) uniform = uniform && std::abs(b[c] - 1.0f) < 1e-3f;
     }
     if (uniform) {
-      shape_.clear();
+      shape_.sample.clear();
       return;
     }
     if (shapedTransmittance_.size() != texels_) shapedTransmittance_.resize(texels_);
     const PatchHierarchy& h = solution_.hierarchy;
-    near.shooter = p.shooterWorld[size_t(geometryKey)];
+    shape_.shooter = p.shooterWorld[size_t(geometryKey)];
     // The samples' spacing: the shooter's size over sqrt(N).
-    near.distance = polygonSize(near.shooter) / std::sqrt(double(std::max(1, p.samples)));
+    shape_.nearDistance = polygonSize(shape_.shooter) / std::sqrt(double(std::max(1, p.samples)));
     for (int leaf : p.leaves) {
-      const Polygon w = nodePolygonIn(near.shooter, h.node(leaf).id);
-      near.leafWorld.push_back(w);
-      near.leafShape.push_back(ratio(solution_.radiosity(leaf, t)));
+      shape_.leafWorld.push_back(nodePolygonIn(shape_.shooter, h.node(leaf).id));
+      shape_.leafShape.push_back(ratio(solution_.radiosity(leaf, t)));
     }
   }
 
@@ -732,7 +733,7 @@ class MovieBake {
   std::vector<float> transmittance_, texture_;
   std::vector<SampleMask> keyMask_;
   std::vector<double> keyFormFactor_;            // also the scan's scratch
-  std::vector<glm::vec3> shape_;                 // the current pair's at the current key (shapeAt)
+  ShooterShape shape_;                           // the current pair's at the current key (shapeAt)
   std::vector<glm::dvec3> shapedTransmittance_;  // per texel, when shape_ is not empty
   // fillCoveredTexels: under static solids (once per movie), and at the current key.
   std::vector<char> staticCovered_, covered_;
@@ -818,10 +819,7 @@ void MovieBake::planPair(Pair& p) {
   // A subdivided shooter that does not emit: its leaves' radiosity shapes its light (a light's
   // is its emission, uniform; skipping it keeps the lights' pairs as they were, at no cost).
   const PatchHierarchy& h = solution_.hierarchy;
-  const int material = tops_[S].material;
-  const bool emits = material >= 0 && size_t(material) < geo_.scene().materials.size() &&
-                     geo_.scene().materials[size_t(material)].isEmitter();
-  if (!h.isLeaf(int(S)) && !emits) {
+  if (!h.isLeaf(int(S)) && !geo_.scene().emits(tops_[S])) {
     const Polygon& shooter = p.shooterWorld[0];
     for (const glm::dvec2& a : p.unitSamples)
       p.sampleLeaf.push_back(

@@ -244,6 +244,20 @@ double transmittanceFromMask(SampleMask occluded, SampleMask valid) {
   return double(std::bitset<64>(valid & ~occluded).count()) / n;
 }
 
+namespace {
+
+// The point-to-area kernel cos(theta_x) cos(theta_s) / r^2 of shooter sample s seen from the
+// texel at x (up to the 1 / pi and the r^2 the unnormalised directions carry); 0 at s = x.
+double sampleKernel(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& sample,
+                    const glm::dvec3& shooterNormal) {
+  const glm::dvec3 d = sample - x;
+  const double r2 = glm::dot(d, d);
+  if (!(r2 > 0.0)) return 0.0;
+  return std::max(0.0, glm::dot(n, d)) * std::abs(glm::dot(shooterNormal, d)) / (r2 * r2);
+}
+
+}  // namespace
+
 double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
                                    const std::vector<glm::dvec3>& samples,
                                    const glm::dvec3& shooterNormal, SampleMask occluded,
@@ -255,11 +269,7 @@ double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
   const size_t count = std::min(samples.size(), size_t(kMaxTransmittanceSamples));
   for (size_t s = 0; s < count; ++s) {
     if (!((valid >> s) & 1u)) continue;
-    const glm::dvec3 d = samples[s] - x;
-    const double r2 = glm::dot(d, d);
-    if (!(r2 > 0.0)) continue;
-    const double k =
-        std::max(0.0, glm::dot(n, d)) * std::abs(glm::dot(shooterNormal, d)) / (r2 * r2);
+    const double k = sampleKernel(x, n, samples[s], shooterNormal);
     total += k;
     if ((open >> s) & 1u) seen += k;
   }
@@ -281,11 +291,7 @@ glm::dvec3 shapedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
     ++plainCount;
     const bool isOpen = (open >> s) & 1u;
     if (isOpen) plainSeen += glm::dvec3(shape[s]);
-    const glm::dvec3 d = samples[s] - x;
-    const double r2 = glm::dot(d, d);
-    if (!(r2 > 0.0)) continue;
-    const double k =
-        std::max(0.0, glm::dot(n, d)) * std::abs(glm::dot(shooterNormal, d)) / (r2 * r2);
+    const double k = sampleKernel(x, n, samples[s], shooterNormal);
     total += k;
     if (isOpen) seen += k * glm::dvec3(shape[s]);
   }

@@ -299,6 +299,11 @@ namespace {
 // Paper §3.1: the second pass recomputes a (receiver, shooter) pair of top-level patches per
 // texel when it is bad. Marks the pair of link l under `rule`, over all key times (a pair once
 // bad stays bad).
+// --bad-links partial's partly visible link: gathered, threshold < V < 1.
+bool partlyVisible(const SolverLink& l, double partialThreshold) {
+  return !l.refined && float(l.rayVisibility) > partialThreshold && float(l.rayVisibility) < 1.0f;
+}
+
 void markBadPair(char& bad, BadLinkRule rule, const SolverLink& l, bool shooterEmits,
                  double partialThreshold) {
   switch (rule) {
@@ -311,8 +316,7 @@ void markBadPair(char& bad, BadLinkRule rule, const SolverLink& l, bool shooterE
       bad |= shooterEmits;
       break;
     case BadLinkRule::kPartial:
-      bad |= shooterEmits || (!l.refined && float(l.rayVisibility) > partialThreshold &&
-                              float(l.rayVisibility) < 1.0f);
+      bad |= shooterEmits || partlyVisible(l, partialThreshold);
       break;
   }
 }
@@ -321,17 +325,19 @@ void markBadPair(char& bad, BadLinkRule rule, const SolverLink& l, bool shooterE
 // B_q F (1 - V) A_p (the mean of the channels), summed per pair. The pairs whose shadows are
 // strong move to the second pass's per-texel shadows; the weak ones stay with the gathered good
 // layer (the 10k-triangle hall's 1.0 M partly visible pairs made rad-movies 10x slower).
+double meanChannel(const glm::dvec3& B) {
+  return (B.x + B.y + B.z) / 3.0;
+}
+
 double partialShadowPower(const KeySolution& s, const SolverLink& l) {
-  const glm::dvec3& B = s.radiosity[size_t(l.shooter)];
-  return (B.x + B.y + B.z) / 3.0 * l.formFactor * (1.0 - l.rayVisibility) *
+  return meanChannel(s.radiosity[size_t(l.shooter)]) * l.formFactor * (1.0 - l.rayVisibility) *
          s.area[size_t(l.receiver)];
 }
 
 // The power the surfaces carry, sum A B over the top-level patches (the mean of the channels).
 double carriedPower(const KeySolution& s, int topCount) {
   double sum = 0.0;
-  for (size_t t = 0; t < size_t(topCount); ++t)
-    sum += s.area[t] * (s.radiosity[t].x + s.radiosity[t].y + s.radiosity[t].z) / 3.0;
+  for (size_t t = 0; t < size_t(topCount); ++t) sum += s.area[t] * meanChannel(s.radiosity[t]);
   return sum;
 }
 
@@ -484,9 +490,7 @@ class KeyTimePass {
       const uint64_t pair = (uint64_t(rt) << 32) | st;
       const bool emits = surfaces_[st].isEmitter();
       if (byPower && !emits) {
-        if (!l.refined && float(l.rayVisibility) > opt_.partialThreshold &&
-            float(l.rayVisibility) < 1.0f)
-          shadowPower[pair] += partialShadowPower(s, l);
+        if (partlyVisible(l, opt_.partialThreshold)) shadowPower[pair] += partialShadowPower(s, l);
         continue;
       }
       char bad = 0;

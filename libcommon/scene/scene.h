@@ -159,6 +159,11 @@ class Scene {
   std::vector<int> meshNodes() const;
   // True when the node's world transform changes somewhere in [t0, t1].
   bool isDynamic(int node, double t0, double t1) const;
+  // Whether the polygon's material emits (false without a material).
+  bool emits(const InputPolygon& p) const {
+    return p.material >= 0 && size_t(p.material) < materials.size() &&
+           materials[size_t(p.material)].isEmitter();
+  }
   // World-space axis-aligned bounds swept by a mesh node's geometry over [t0, t1]:
   // {min, max}. Conservative (exact for static nodes).
   // Static nodes: bounds of the transformed vertices. Dynamic nodes: the 8 corners of the
