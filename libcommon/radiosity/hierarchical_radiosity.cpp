@@ -1227,7 +1227,7 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
           hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
     if (!hit) {
       keys.emplace_back(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
-      values.push_back(CachedClusterLink{l.direction, l.visibility, l.transfer});
+      values.push_back(CachedClusterLink{l.direction, l.visibility});
     }
   }
   return ClusterLinkCache(keys, std::move(values), uint32_t(T + size_t(tree.size())));

@@ -816,11 +816,62 @@ TEST(ClusterLinks, OpenRoomMatchesAllPairsWithFewerLinks) {
   EXPECT_FALSE(clustered.topClusterIrradiance.empty());
 }
 
+// A cluster link's form factor at each receiver top against the exact point-to-polygon sum over
+// the shooter's tiles: two walls of 4 x 4 tiles, the second 8 m along and perpendicular to the
+// first (each sees the other at a grazing angle). One point and one direction for the whole
+// shooter, from the receiver's centre, gave 0.6 to 1.4 times the exact sums; the shooter's
+// facing groups, seen from each top, are within a few percent.
+TEST(ClusterLinks, FormFactorsFollowEachReceiverTopAtGrazingAngles) {
+  std::vector<Polygon> polys;
+  auto quad = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
+    Polygon p;
+    p.count = 4;
+    p.v = {a, b, c, d};
+    polys.push_back(p);
+  };
+  const double s = 0.5;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {  // x = 0, facing +x, z in [0, 2]
+      const double y = i * s, z = j * s;
+      quad({0, y, z}, {0, y + s, z}, {0, y + s, z + s}, {0, y, z + s});
+    }
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {  // z = 0, facing +z, x in [8, 10]
+      const double x = 8.0 + i * s, y = j * s;
+      quad({x, y, 0}, {x + s, y, 0}, {x + s, y + s, 0}, {x, y + s, 0});
+    }
+  ASSERT_NEAR(polys[0].normal().x, 1.0, 1e-12);
+  ASSERT_NEAR(polys[16].normal().z, 1.0, 1e-12);
+  PatchHierarchy h = hierarchyOf(polys);
+  ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
+  std::vector<double> area, emission(polys.size(), 0.0);
+  for (const Polygon& p : polys) area.push_back(p.area());
+  ClusterLinks links(tree, polys, area, emission, nullptr, 4, 2.0, 0.1);
+  std::vector<std::pair<int, int>> pairs;
+  bool over = false;
+  while (links.refine(1.0, false, 1u << 20, pairs, over) > 0) links.evaluate();
+  links.evaluate();
+  const std::vector<double> row = links.rowSums();
+  double worst = 0.0;
+  for (size_t t = 0; t < polys.size(); ++t) {
+    const size_t first = t < 16 ? 16 : 0;  // the other wall's tiles
+    double exact = 0.0;
+    for (size_t j = first; j < first + 16; ++j)
+      exact += pointToPolygonFormFactor(polys[t].centroid(), polys[t].normal(), polys[j]);
+    ASSERT_GT(exact, 0.0);
+    worst = std::max(worst, std::abs(row[t] / exact - 1.0));
+  }
+  std::cout << "worst cluster row sum against the exact sums: " << worst << "\n";
+  EXPECT_LT(worst, 0.05);
+}
+
 // The point approximation of a cluster link holds only for well separated ends. An open room
 // 12 m long, a light at one end, two tables at the other: the floor tiles there take the far
 // walls' light through cluster links. Against all pairs, the floor beside the tables came out
-// 2.2 % dark with links kept from 3 times the radii's sum apart (its 1/r^2 taken at the
-// shooter's centre, not averaged over it); from 4 times (the default), within 1 %.
+// 1.6 % dark with links kept from 3 times the radii's sum apart and 0.7 % from 4 times, when
+// each link took one point and one direction for its whole shooter (first order wrong at
+// grazing angles); with the shooter's facing groups, each seen from each receiver top, 0.6 %
+// and 0.4 %.
 TEST(ClusterLinks, ExposedFloorMatchesAllPairsAtTheDefaultSeparation) {
   std::vector<Polygon> room = tiledBoxFaces({0, 0, 0}, {12, 3, 4}, true, 8);
   std::vector<Polygon> polys(room.begin(), room.end() - 64);  // +z wall open
@@ -860,8 +911,8 @@ TEST(ClusterLinks, ExposedFloorMatchesAllPairsAtTheDefaultSeparation) {
             << near.clusterLinks << " cluster links), default: " << exposedBias(byDefault) << " ("
             << byDefault.clusterLinks << ")\n";
   EXPECT_GT(byDefault.clusterLinks, 1000u);
-  EXPECT_LT(exposedBias(near), -0.015);
-  EXPECT_LT(std::abs(exposedBias(byDefault)), 0.01);
+  EXPECT_LT(std::abs(exposedBias(near)), 0.01);
+  EXPECT_LT(std::abs(exposedBias(byDefault)), 0.005);
 }
 
 // A hall 24 x 3 x 8 m tiled 6 x 6 per wall, two rows of twelve 0.5 m lights facing down 5 cm
