@@ -291,8 +291,8 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
   l.visibility = float(v);
 }
 
-// F(top t <- S) of a link at t's centroid: V P_S / (pi r^2) max(0, n_t . omega), with r and
-// omega from t's centroid to S's centre (P_S from the receiver's centre).
+// F(top t <- S) of a link at t's centroid: H_i / B_S of the transfer at the top of
+// cluster_links.h, summed over S's facing groups (a top-level patch shooter is its own group).
 double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
   const glm::dvec4& sphere = isCluster(l.shooter) ? clusterSphere_[size_t(clusterIndex(l.shooter))]
                                                   : topSphere_[size_t(l.shooter)];
