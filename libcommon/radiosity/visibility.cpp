@@ -441,11 +441,13 @@ double VisibilityScene::weightedVisibilityFrom(
   const glm::dvec3 bNormal = b.normal();
   const bool known = knownOpenPairs && k <= kMaxRecordedPairs;
   PairTally tally;
-  std::uint64_t open = 0;
+  std::uint64_t open = 0, chunk = 0;
   for (int i = 0; i < k; ++i) {
     const glm::dvec3 pa = aPoints[size_t(i)], pb = bPoints[size_t(i)];
-    const bool isOpen =
-        known ? ((*knownOpenPairs >> i) & 1u) != 0 : !occluded(pa, pb, ignoreA, ignoreB);
+    const int bit = i % kMaxRecordedPairs;
+    if (!known && bit == 0)  // the next (up to) 64 pairs' segments, in packets
+      chunk = openSegments(&aPoints[size_t(i)], 1, &bPoints[size_t(i)], k - i, ignoreA, ignoreB);
+    const bool isOpen = known ? ((*knownOpenPairs >> i) & 1u) != 0 : ((chunk >> bit) & 1u) != 0;
     if (isOpen && i < kMaxRecordedPairs) open |= std::uint64_t(1) << i;
     tally.add(isOpen, pairKernel(pa, aNormal, pb, bNormal),
               weightAtB ? std::max(0.0, weightAtB(pb)) : 1.0);
@@ -483,11 +485,52 @@ double VisibilityScene::weightedVisibilityOfPairs(int k, const double* kernel, s
 std::uint64_t VisibilityScene::openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,
                                         std::uint32_t ignoreA, std::uint32_t ignoreB,
                                         std::uint64_t candidates) const {
+  return openSegments(&x, 0, bPoints.data(), std::min(int(bPoints.size()), kMaxRecordedPairs),
+                      ignoreA, ignoreB, candidates);
+}
+
+std::uint64_t VisibilityScene::openSegments(const glm::dvec3* from, size_t fromStep,
+                                            const glm::dvec3* to, int k, std::uint32_t ignoreA,
+                                            std::uint32_t ignoreB, std::uint64_t candidates) const {
+  // Packets of 8 segments (Embree's AVX2 width), one traversal for 8 rays instead of 8: the
+  // cubic scene's rad-movies had spent 71 % of its time in rtcOccluded1, nearly all of it on the
+  // per-texel rays of one texel, which share their origin. Each lane is the segment occluded()
+  // tests, so the answers are the same.
   std::uint64_t open = 0;
-  const int k = std::min(int(bPoints.size()), kMaxRecordedPairs);
-  for (int i = 0; i < k; ++i)
-    if (((candidates >> i) & 1u) && !occluded(x, bPoints[size_t(i)], ignoreA, ignoreB))
-      open |= std::uint64_t(1) << i;
+  k = std::min(k, kMaxRecordedPairs);
+  FilterContext fc;
+  rtcInitIntersectContext(&fc.context);
+  fc.ignoreA = ignoreA;
+  fc.ignoreB = ignoreB;
+  for (int first = 0; first < k; first += 8) {
+    alignas(32) int valid[8];
+    alignas(32) RTCRay8 rays;
+    bool any = false;
+    for (int lane = 0; lane < 8; ++lane) {
+      const int i = first + lane;
+      valid[lane] = 0;
+      if (i >= k || !((candidates >> i) & 1u)) continue;
+      const glm::dvec3& a = from[size_t(i) * fromStep];
+      const glm::dvec3& b = to[size_t(i)];
+      const RTCRay ray = rayOf(a, b - a, 1.0 - kSegmentEpsilon);
+      if ((impl_->boundsTest && !segmentMayHit(a, b)) ||
+          !(ray.dir_x != 0.0f || ray.dir_y != 0.0f || ray.dir_z != 0.0f)) {
+        open |= std::uint64_t(1) << i;  // nothing it could hit
+        continue;
+      }
+      rays.org_x[lane] = ray.org_x, rays.org_y[lane] = ray.org_y, rays.org_z[lane] = ray.org_z;
+      rays.dir_x[lane] = ray.dir_x, rays.dir_y[lane] = ray.dir_y, rays.dir_z[lane] = ray.dir_z;
+      rays.tnear[lane] = ray.tnear, rays.tfar[lane] = ray.tfar, rays.time[lane] = ray.time;
+      rays.mask[lane] = ray.mask, rays.id[lane] = ray.id, rays.flags[lane] = ray.flags;
+      valid[lane] = -1;
+      any = true;
+    }
+    if (!any) continue;
+    rtcOccluded8(valid, impl_->top, &fc.context, &rays);
+    for (int lane = 0; lane < 8; ++lane)
+      if (valid[lane] == -1 && !(rays.tfar[lane] < 0.0f))  // tfar = -inf on a hit
+        open |= std::uint64_t(1) << (first + lane);
+  }
   return open;
 }
 

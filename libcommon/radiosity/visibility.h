@@ -125,6 +125,11 @@ class VisibilityScene {
   std::uint64_t openFrom(const glm::dvec3& x, const std::vector<glm::dvec3>& bPoints,
                          std::uint32_t ignoreA = kNoSurface, std::uint32_t ignoreB = kNoSurface,
                          std::uint64_t candidates = ~std::uint64_t(0)) const;
+  // The same for the k (at most kMaxRecordedPairs) segments from from[i * fromStep] to to[i]
+  // (fromStep 0: one shared origin), each as occluded() tests it. Thread-safe after commit().
+  std::uint64_t openSegments(const glm::dvec3* from, size_t fromStep, const glm::dvec3* to, int k,
+                             std::uint32_t ignoreA, std::uint32_t ignoreB,
+                             std::uint64_t candidates = ~std::uint64_t(0)) const;
   // k stratified, area-uniform points on p (the strata of visibility()), from `seed`.
   static std::vector<glm::dvec3> samplePoints(const Polygon& p, int k, std::uint64_t seed);
   // The surface id of the first triangle that the ray origin + t direction, t in
