@@ -60,6 +60,14 @@ struct FilterContext {
   std::uint32_t ignoreB;
 };
 
+FilterContext filterContext(std::uint32_t ignoreA, std::uint32_t ignoreB) {
+  FilterContext fc;
+  rtcInitIntersectContext(&fc.context);
+  fc.ignoreA = ignoreA;
+  fc.ignoreB = ignoreB;
+  return fc;
+}
+
 void ignoreEndSurfaces(const RTCFilterFunctionNArguments* args) {
   const auto* fc = reinterpret_cast<const FilterContext*>(args->context);
   const auto* surfaces = static_cast<const std::uint32_t*>(args->geometryUserPtr);
@@ -365,15 +373,17 @@ int VisibilityScene::instanceCount() const {
   return static_cast<int>(impl_->instances.size());
 }
 
+bool VisibilityScene::segmentRay(const glm::dvec3& a, const glm::dvec3& b, RTCRay& ray) const {
+  if (impl_->boundsTest && !segmentMayHit(a, b)) return false;
+  ray = rayOf(a, b - a, 1.0 - kSegmentEpsilon);
+  return ray.dir_x != 0.0f || ray.dir_y != 0.0f || ray.dir_z != 0.0f;
+}
+
 bool VisibilityScene::occluded(const glm::dvec3& from, const glm::dvec3& to, std::uint32_t ignoreA,
                                std::uint32_t ignoreB) const {
-  if (impl_->boundsTest && !segmentMayHit(from, to)) return false;
-  RTCRay ray = rayOf(from, to - from, 1.0 - kSegmentEpsilon);
-  if (!(ray.dir_x != 0.0f || ray.dir_y != 0.0f || ray.dir_z != 0.0f)) return false;
-  FilterContext fc;
-  rtcInitIntersectContext(&fc.context);
-  fc.ignoreA = ignoreA;
-  fc.ignoreB = ignoreB;
+  RTCRay ray;
+  if (!segmentRay(from, to, ray)) return false;
+  FilterContext fc = filterContext(ignoreA, ignoreB);
   rtcOccluded1(impl_->top, &fc.context, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
@@ -498,10 +508,7 @@ std::uint64_t VisibilityScene::openSegments(const glm::dvec3* from, size_t fromS
   // tests, so the answers are the same.
   std::uint64_t open = 0;
   k = std::min(k, kMaxRecordedPairs);
-  FilterContext fc;
-  rtcInitIntersectContext(&fc.context);
-  fc.ignoreA = ignoreA;
-  fc.ignoreB = ignoreB;
+  FilterContext fc = filterContext(ignoreA, ignoreB);
   for (int first = 0; first < k; first += 8) {
     alignas(32) int valid[8];
     alignas(32) RTCRay8 rays;
@@ -510,11 +517,8 @@ std::uint64_t VisibilityScene::openSegments(const glm::dvec3* from, size_t fromS
       const int i = first + lane;
       valid[lane] = 0;
       if (i >= k || !((candidates >> i) & 1u)) continue;
-      const glm::dvec3& a = from[size_t(i) * fromStep];
-      const glm::dvec3& b = to[size_t(i)];
-      const RTCRay ray = rayOf(a, b - a, 1.0 - kSegmentEpsilon);
-      if ((impl_->boundsTest && !segmentMayHit(a, b)) ||
-          !(ray.dir_x != 0.0f || ray.dir_y != 0.0f || ray.dir_z != 0.0f)) {
+      RTCRay ray;
+      if (!segmentRay(from[size_t(i) * fromStep], to[size_t(i)], ray)) {
         open |= std::uint64_t(1) << i;  // nothing it could hit
         continue;
       }
@@ -572,10 +576,7 @@ VisibilityScene::Hit firstHitIn(RTCScene scene, const glm::dvec3& origin,
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   if (!(rh.ray.dir_x != 0.0f || rh.ray.dir_y != 0.0f || rh.ray.dir_z != 0.0f)) return none;
-  FilterContext fc;
-  rtcInitIntersectContext(&fc.context);
-  fc.ignoreA = ignoreA;
-  fc.ignoreB = ignoreB;
+  FilterContext fc = filterContext(ignoreA, ignoreB);
   rtcIntersect1(scene, &fc.context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return none;
   if (rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID) child = rh.hit.instID[0];

@@ -29,6 +29,8 @@
 
 #include "libcommon/scene/geometry.h"
 
+struct RTCRay;  // embree3/rtcore_ray.h
+
 namespace rad {
 
 struct VisibilityTriangle {
@@ -160,6 +162,9 @@ class VisibilityScene {
 
  private:
   bool segmentMayHit(const glm::dvec3& a, const glm::dvec3& b) const;
+  // The segment from a to b as the occlusion ray occluded() traces; false when it cannot hit
+  // anything (outside the scene's bounds, or no direction in single precision).
+  bool segmentRay(const glm::dvec3& a, const glm::dvec3& b, RTCRay& ray) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
