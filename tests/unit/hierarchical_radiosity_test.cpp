@@ -819,8 +819,9 @@ TEST(ClusterLinks, OpenRoomMatchesAllPairsWithFewerLinks) {
 // A cluster link's form factor at each receiver top against the exact point-to-polygon sum over
 // the shooter's tiles: two walls of 4 x 4 tiles, the second 8 m along and perpendicular to the
 // first (each sees the other at a grazing angle). One point and one direction for the whole
-// shooter, from the receiver's centre, gave 0.6 to 1.4 times the exact sums; the shooter's
-// facing groups, seen from each top, are within a few percent.
+// shooter, from the receiver's centre, put the worst top 2.93 times off its exact sum; the
+// shooter's facing groups, seen from each top, 3.8 %. (Without cluster links the row sums are
+// 0 and the test fails too.)
 TEST(ClusterLinks, FormFactorsFollowEachReceiverTopAtGrazingAngles) {
   std::vector<Polygon> polys;
   auto quad = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
