@@ -44,10 +44,9 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
     normal_[t] = world[t].normal();
   }
   clusterBounds_ = clusterBoundsOf(tree, world);
-  // The bounding spheres as (centre, radius), read by the gather's inner loop.
-  auto sphereOf = [](const ClusterBounds& b) { return glm::dvec4(b.centre(), b.radius()); };
-  for (const ClusterBounds& b : clusterBounds_) clusterSphere_.push_back(sphereOf(b));
-  for (const ClusterBounds& b : topBounds_) topSphere_.push_back(sphereOf(b));
+  // The bounding spheres' radii, read by formFactor for every gather entry.
+  for (const ClusterBounds& b : clusterBounds_) clusterRadius_.push_back(b.radius());
+  for (const ClusterBounds& b : topBounds_) topRadius_.push_back(b.radius());
   clusterEmission_.assign(size_t(tree.size()), 0.0);
   for (int c = tree.size(); c-- > 0;)  // sub-clusters (higher indices) first
     for (ClusterRef r : tree.node(c).children)
@@ -86,13 +85,6 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
   ClusterLink root;
   root.receiver = root.shooter = clusterRef(tree.root());
   links_.push_back(root);
-}
-
-std::pair<const uint32_t*, const uint32_t*> ClusterLinks::membersOf(ClusterRef r) const {
-  if (!isCluster(r)) return {nullptr, nullptr};  // callers handle a top themselves
-  const ClusterNode& n = tree_.node(clusterIndex(r));
-  const uint32_t* base = tree_.members().data();
-  return {base + n.first, base + n.first + n.count};
 }
 
 // A link between r and s into `next`, unless they cannot exchange energy: a top-level patch end
@@ -294,8 +286,8 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
 // F(top t <- S) of a link at t's centroid: H_i / B_S of the transfer at the top of
 // cluster_links.h, summed over S's facing groups (a top-level patch shooter is its own group).
 double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
-  const glm::dvec4& sphere = isCluster(l.shooter) ? clusterSphere_[size_t(clusterIndex(l.shooter))]
-                                                  : topSphere_[size_t(l.shooter)];
+  const double radius = isCluster(l.shooter) ? clusterRadius_[size_t(clusterIndex(l.shooter))]
+                                             : topRadius_[size_t(l.shooter)];
   const glm::dvec3 x = centroid_[t], n = normal_[t];
   // One facing group: max(0, -N_g . d) max(0, n_i . d) / |d|^4. A link kept at the link bound
   // may have receivers within S's reach; S's patches are spread over its bounding sphere, so
@@ -304,7 +296,7 @@ double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
     const glm::dvec3 d = centre - x;
     const double cosines = std::max(0.0, -glm::dot(normalArea, d)) * std::max(0.0, glm::dot(n, d));
     if (!(cosines > 0.0)) return 0.0;
-    const double r2 = glm::dot(d, d), rs2 = std::max(r2, sphere.w * sphere.w);
+    const double r2 = glm::dot(d, d), rs2 = std::max(r2, radius * radius);
     return cosines / (r2 * rs2);
   };
   double sum = 0.0;

@@ -131,8 +131,6 @@ class ClusterLinks {
   double maxRadiosity(ClusterRef r) const {
     return isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)];
   }
-  // The member tops of r: [first, last) in tree_.members() (a top: itself).
-  std::pair<const uint32_t*, const uint32_t*> membersOf(ClusterRef r) const;
   void evaluateLink(ClusterLink& l);
   double formFactor(const ClusterLink& l, uint32_t top) const;
   void buildReceiverLists();
@@ -149,7 +147,7 @@ class ClusterLinks {
   std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
   std::vector<ClusterBounds> clusterBounds_, topBounds_;
-  std::vector<glm::dvec4> clusterSphere_, topSphere_;  // (centre, radius) of the bounds
+  std::vector<double> clusterRadius_, topRadius_;  // of the bounding spheres
   // A cluster's facing groups (see the top of this file), the non-empty ones first.
   struct FacingGroup {
     glm::vec3 normalArea{0.0f};  // N_g

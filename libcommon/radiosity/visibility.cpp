@@ -3,6 +3,7 @@
 #include "libcommon/radiosity/visibility.h"
 
 #include <algorithm>
+#include <bitset>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -391,10 +392,13 @@ bool VisibilityScene::occluded(const glm::dvec3& from, const glm::dvec3& to, std
 double VisibilityScene::visibility(const Polygon& a, const Polygon& b, int k, std::uint64_t seed,
                                    std::uint32_t ignoreA, std::uint32_t ignoreB) const {
   const std::vector<glm::dvec3> pa = samplePoints(a, k, seed), pb = pairedPoints(b, k, seed);
-  int unoccluded = 0;
-  for (size_t i = 0; i < pa.size(); ++i)
-    if (!occluded(pa[i], pb[i], ignoreA, ignoreB)) ++unoccluded;
-  return static_cast<double>(unoccluded) / static_cast<double>(pa.size());
+  const int n = int(pa.size());
+  size_t unoccluded = 0;
+  for (int i = 0; i < n; i += kMaxRecordedPairs)  // in packets, as weightedVisibilityFrom
+    unoccluded +=
+        std::bitset<64>(openSegments(&pa[size_t(i)], 1, &pb[size_t(i)], n - i, ignoreA, ignoreB))
+            .count();
+  return static_cast<double>(unoccluded) / static_cast<double>(n);
 }
 
 std::vector<glm::dvec3> VisibilityScene::samplePoints(const Polygon& p, int k, std::uint64_t seed) {
