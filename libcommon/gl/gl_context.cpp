@@ -5,6 +5,7 @@
 
 #include <GL/osmesa.h>
 #include <fcntl.h>
+#include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,6 +15,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <string>
+#include <vector>
 
 #include "libcommon/core/error.h"
 
@@ -97,24 +100,49 @@ std::string driverChoice() {
   return driver ? std::string(" with GALLIUM_DRIVER=") + driver : std::string();
 }
 
+// The environment variable that makes a copy of this program the probe's child (below).
+constexpr const char* kProbeChildVariable = "RAD_GL_PROBE_CHILD";
+
+// The probe's child, before main: a fresh copy of this program (probeContextInChild spawns
+// /proc/self/exe with kProbeChildVariable=1) creates a context and exits, 0 when it worked.
+// Its static initialisers run first, none of which starts a thread or takes a lock a context
+// needs.
+[[maybe_unused]] const bool kProbeChild = [] {
+  const char* value = std::getenv(kProbeChildVariable);
+  if (!value || std::strcmp(value, "1") != 0) return false;
+  const rlimit noCore{0, 0};  // a crash here is expected, not a core file to leave behind
+  setrlimit(RLIMIT_CORE, &noCore);
+  _exit(createCoreContext() ? 0 : 1);
+}();
+
 // How creating a context went in a child process: "" when it worked, else why not. Mesa 22.3
 // dereferences a null screen when GALLIUM_DRIVER names a driver it cannot load (nonexistent,
 // or zink without Vulkan): a SIGSEGV inside OSMesaCreateContextAttribs that no check in this
-// process can catch. The child (its stderr silenced: Mesa's own complaints are several lines)
+// process can catch. The child (its output silenced: Mesa's own complaints are several lines)
 // takes the fall; the screen is made once per process, so one probe serves every context.
+// The child is a new copy of the program (posix_spawn), not a fork: the first context is often
+// made by a worker thread, and a fork copies the locks other threads hold at that moment;
+// Mesa's atexit registration in a forked child waited forever on glibc's exit-function lock,
+// and rad-movies with it (the 10k hall, 17 minutes at 0 % CPU before it was killed).
 std::string probeContextInChild() {
-  const pid_t pid = fork();
-  if (pid < 0) return "";  // cannot probe (no memory for a process): try in this one
-  if (pid == 0) {
-    const rlimit noCore{0, 0};  // a crash here is expected, not a core file to leave behind
-    setrlimit(RLIMIT_CORE, &noCore);
-    const int null = open("/dev/null", O_WRONLY);
-    if (null >= 0) {
-      dup2(null, STDOUT_FILENO);
-      dup2(null, STDERR_FILENO);
-    }
-    _exit(createCoreContext() ? 0 : 1);  // no destructors, no atexit: the parent's state
-  }
+  std::vector<std::string> env;
+  for (char** e = environ; *e; ++e)
+    if (std::strncmp(*e, kProbeChildVariable, std::strlen(kProbeChildVariable)) != 0)
+      env.emplace_back(*e);
+  env.push_back(std::string(kProbeChildVariable) + "=1");
+  std::vector<char*> envp;
+  for (std::string& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  char name[] = "rad-gl-probe";
+  char* argv[] = {name, nullptr};
+  posix_spawn_file_actions_t silence;
+  posix_spawn_file_actions_init(&silence);
+  posix_spawn_file_actions_addopen(&silence, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_adddup2(&silence, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = -1;
+  const int spawned = posix_spawn(&pid, "/proc/self/exe", &silence, nullptr, argv, envp.data());
+  posix_spawn_file_actions_destroy(&silence);
+  if (spawned != 0) return "";  // cannot probe (no /proc, no memory): try in this process
   int status = 0;
   while (waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) return "";
