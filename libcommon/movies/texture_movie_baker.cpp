@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -74,6 +75,11 @@ uint32_t mix32(uint64_t x) {
   x ^= x >> 33;
   return uint32_t(x);
 }
+
+// Bad pairs' unoccluded form factors over tiles (MovieGeometry::formFactorsAt). At 4, twice
+// the good layer's ratio for a tile's own links: these are mostly the lights' direct light.
+constexpr int kFormFactorTile = 8;
+constexpr double kFarFormFactorRatio = 4.0;
 
 template <class F>
 void parallelRows(int height, F&& body) {
@@ -175,18 +181,77 @@ class MovieGeometry {
   }
 
   // Unoccluded form factors F(x -> S) per texel at key k, about the texel's shading normal.
-  void formFactorsAt(const Pair& p, int k, std::vector<double>& f) const {
+  // Texels in tiles of kFormFactorTile x kFormFactorTile: where every corner of a tile is farther
+  // from the shooter than kFarFormFactorRatio times the tile's diagonal, F is evaluated at the
+  // corners (texel centres shared with the neighbouring tiles) and interpolated bilinearly, as
+  // the good layer's far links are (GoodLinkGather::planTexels; the error falls as (size /
+  // distance)^2). The shadow stays per texel: only the smooth unoccluded factor is
+  // interpolated. Per texel, the lights' form factors had been 13 % of rad-movies' time on the
+  // 10k-triangle hall, whose movies are mostly 4 x 4 texels under lights metres away.
+  // Returns how many texels were interpolated.
+  size_t formFactorsAt(const Pair& p, int k, std::vector<double>& f) const {
     f.resize(texels());
-    const glm::dmat4& m = receiverTransform_[size_t(k)];
-    const glm::dmat3 normalMap = glm::transpose(glm::inverse(glm::dmat3(m)));
     const Polygon& sw = p.shooterWorld[size_t(k)];
-    parallelRows(h_, [&](int j) {
-      for (int i = 0; i < w_; ++i) {
-        size_t x = size_t(j) * w_ + i;
-        glm::dvec3 pt(m * glm::dvec4(localPoint_[x], 1.0));
-        f[x] = pointToPolygonFormFactor(pt, glm::normalize(normalMap * localNormal_[x]), sw);
+    auto exact = [&](size_t x) {
+      return pointToPolygonFormFactor(texelPoint(k, x), texelNormal(k, x), sw);
+    };
+    const int tilesX = (w_ + kFormFactorTile - 1) / kFormFactorTile;
+    const int tilesY = (h_ + kFormFactorTile - 1) / kFormFactorTile;
+    std::atomic<size_t> interpolated{0};
+    tbb::parallel_for(0, tilesX * tilesY, [&](int ti) {
+      const int i0 = (ti % tilesX) * kFormFactorTile, j0 = (ti / tilesX) * kFormFactorTile;
+      const int iEnd = std::min(i0 + kFormFactorTile, w_),
+                jEnd = std::min(j0 + kFormFactorTile, h_);
+      const int i1 = std::min(i0 + kFormFactorTile, w_ - 1),
+                j1 = std::min(j0 + kFormFactorTile, h_ - 1);
+      const std::array<size_t, 4> corner = {size_t(j0) * w_ + i0, size_t(j0) * w_ + i1,
+                                            size_t(j1) * w_ + i0, size_t(j1) * w_ + i1};
+      bool far = i1 > i0 && j1 > j0;
+      if (far) {
+        std::array<glm::dvec3, 4> c;
+        for (int q = 0; q < 4; ++q) c[size_t(q)] = texelPoint(k, corner[size_t(q)]);
+        const double size = std::max(glm::length(c[3] - c[0]), glm::length(c[2] - c[1]));
+        for (int q = 0; q < 4 && far; ++q)
+          far = distanceToPolygon(c[size_t(q)], sw) > kFarFormFactorRatio * size;
+      }
+      if (!far) {
+        for (int j = j0; j < jEnd; ++j)
+          for (int i = i0; i < iEnd; ++i) f[size_t(j) * w_ + i] = exact(size_t(j) * w_ + i);
+        return;
+      }
+      // What is interpolated is F over the point kernel max(0, n.d) max(0, -n_S.d) / |d|^4
+      // (d from the texel to the shooter's centroid), which varies far more slowly than F: F's
+      // fall-off and both cosines are the kernel's, evaluated per texel. Where the kernel is 0
+      // at a corner (the shooter across a horizon), F itself.
+      const glm::dvec3 centre = sw.centroid(), shooterNormal = sw.normal();
+      auto kernel = [&](size_t x) {
+        const glm::dvec3 d = centre - texelPoint(k, x);
+        const double r2 = glm::dot(d, d);
+        return std::max(0.0, glm::dot(texelNormal(k, x), d)) *
+               std::max(0.0, -glm::dot(shooterNormal, d)) / (r2 * r2);
+      };
+      std::array<double, 4> fc, kc;
+      bool ratio = true;
+      for (int q = 0; q < 4; ++q) {
+        fc[size_t(q)] = exact(corner[size_t(q)]);
+        kc[size_t(q)] = kernel(corner[size_t(q)]);
+        ratio = ratio && kc[size_t(q)] > 0.0;
+      }
+      if (ratio)
+        for (int q = 0; q < 4; ++q) fc[size_t(q)] /= kc[size_t(q)];
+      interpolated += size_t(jEnd - j0) * size_t(iEnd - i0);
+      for (int j = j0; j < jEnd; ++j) {
+        const double v = double(j - j0) / double(j1 - j0);
+        for (int i = i0; i < iEnd; ++i) {
+          const double u = double(i - i0) / double(i1 - i0);
+          const size_t x = size_t(j) * w_ + i;
+          const double b =
+              (1.0 - v) * ((1.0 - u) * fc[0] + u * fc[1]) + v * ((1.0 - u) * fc[2] + u * fc[3]);
+          f[x] = ratio ? b * kernel(x) : b;
+        }
       }
     });
+    return interpolated;
   }
   glm::dvec3 texelPoint(int k, size_t x) const {
     return glm::dvec3(receiverTransform_[size_t(k)] * glm::dvec4(localPoint_[x], 1.0));
@@ -575,12 +640,17 @@ class MovieBake {
   }
 
  private:
+  // Counts one formFactorsAt call's texels (`interpolated` of them from a tile's corners).
+  void countFormFactors(size_t interpolated) {
+    stats_.formFactorTexels += long(texels_);
+    stats_.formFactorTexelsInterpolated += long(interpolated);
+  }
   // Key 0's form factors of a pair: a coherent pair's own, a moving pair's from the spill (its
   // scan put them there first) or recomputed, into `scratch`.
   const std::vector<double>& keyZeroFormFactors(const Pair& p, std::vector<double>& scratch) {
     if (p.coherent) return p.formFactor;
     scratch.resize(texels_);
-    if (!spill_.get(p.spilled[0], scratch)) geo_.formFactorsAt(p, 0, scratch);
+    if (!spill_.get(p.spilled[0], scratch)) countFormFactors(geo_.formFactorsAt(p, 0, scratch));
     return scratch;
   }
   bool scanPair(uint32_t S, Pair& p);
@@ -661,7 +731,8 @@ class MovieBake {
     stats_.secondsTransmittance += secondsSince(clock);
     clock = SteadyClock::now();
     keyFormFactor_.resize(texels_);
-    if (!spill_.get(p.spilled[size_t(k)], keyFormFactor_)) geo_.formFactorsAt(p, k, keyFormFactor_);
+    if (!spill_.get(p.spilled[size_t(k)], keyFormFactor_))
+      countFormFactors(geo_.formFactorsAt(p, k, keyFormFactor_));
     stats_.secondsFormFactor += secondsSince(clock);
     return keyFormFactor_;
   }
@@ -858,7 +929,7 @@ double MovieBake::scanFormFactors(Pair& p) {
   auto clock = SteadyClock::now();
   double maxF = 0.0;
   if (p.coherent) {
-    geo_.formFactorsAt(p, 0, p.formFactor);
+    countFormFactors(geo_.formFactorsAt(p, 0, p.formFactor));
     for (double v : p.formFactor) maxF = std::max(maxF, v);
     stats_.secondsFormFactor += secondsSince(clock);
     return maxF;
@@ -866,7 +937,7 @@ double MovieBake::scanFormFactors(Pair& p) {
   const int K = geo_.keys();
   p.spilled.assign(static_cast<size_t>(K), -1);
   for (int k = 0; k < K; ++k) {
-    geo_.formFactorsAt(p, k, keyFormFactor_);
+    countFormFactors(geo_.formFactorsAt(p, k, keyFormFactor_));
     for (double v : keyFormFactor_) maxF = std::max(maxF, v);
     p.spilled[size_t(k)] = spill_.put(keyFormFactor_);
     if (maxF > 0.0 &&
@@ -990,6 +1061,8 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
             {"near_shooter_leaves", gather.nearShooterLeaves},
             {"near_shooter_seconds", gather.nearShooterSeconds}}},
           {"covered_texels_filled", coveredTexelsFilled},
+          {"form_factor_texels", formFactorTexels},
+          {"form_factor_texels_interpolated", formFactorTexelsInterpolated},
           {"seconds",
            {{"good_layer", secondsGood},
             {"form_factors", secondsFormFactor},
@@ -1099,6 +1172,8 @@ TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBak
   gather.partialLinksMovingBlockers += o.gather.partialLinksMovingBlockers;
   gather.nearShooterLeaves += o.gather.nearShooterLeaves;
   gather.nearShooterSeconds += o.gather.nearShooterSeconds;
+  formFactorTexels += o.formFactorTexels;
+  formFactorTexelsInterpolated += o.formFactorTexelsInterpolated;
   secondsGood += o.secondsGood;
   secondsFormFactor += o.secondsFormFactor;
   secondsTransmittance += o.secondsTransmittance;

@@ -166,6 +166,9 @@ struct TextureMovieBakerStats {
   long rayCastPasses = 0;                        // of them, ray cast (ray_cast_masks.h)
   long passesSavedByCoherence = 0;               // static-blocker renders not repeated
   long coveredTexelsFilled = 0;  // texels under a touching solid given their exposed neighbours'
+  // Bad pairs' unoccluded form factors per texel: evaluated, and interpolated over a tile from
+  // its corners (a far shooter: MovieGeometry::formFactorsAt).
+  long formFactorTexels = 0, formFactorTexelsInterpolated = 0;
 
   GoodLinkGatherStats gather;  // --good-layer gather
   double secondsGood = 0, secondsFormFactor = 0, secondsTransmittance = 0, secondsCombine = 0;

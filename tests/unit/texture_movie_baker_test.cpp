@@ -168,6 +168,42 @@ TEST(TextureMovieBaker, UnoccludedIrradianceIsGoodPlusRadiosityTimesFormFactor) 
   EXPECT_EQ(s.passes, 0) << "no blocker in the shaft: nothing to render";
 }
 
+// A light far from the receiver (every corner of a texel tile farther than 4 tile diagonals):
+// F(x -> light) is evaluated at the tiles' corners and interpolated, the shadow staying per
+// texel; near (the test above, 2 m over a 2 m floor) every texel is exact.
+TEST(TextureMovieBaker, AFarLightsFormFactorIsInterpolatedOverTilesOfTexels) {
+  for (const double height : {2.0, 6.0, 12.0}) {
+    TestScene t = makeScene(false, false);
+    t.scene.nodes[size_t(t.lightNode)].translation = glm::dvec3(0.0, 0.0, height - 2.0);
+    TextureMovieBaker baker(t.scene, t.solution, kFps, gouraud());
+    const int w = 24, h = 24;  // tiles of 8 x 8 texels, 0.67 m: 0.94 m across
+    BakedMovie m = baker.bake(request(t, w, h));
+    Polygon light = t.solution.hierarchy.top(t.lightTop).local;
+    for (auto& v : light.v) v.z += height - 2.0;
+    const Polygon& floor = t.solution.hierarchy.top(t.floorTop).local;
+    double worst = 0.0;
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i) {
+        glm::dvec3 x = polygonPointAt(floor, {(i + 0.5) / w, (j + 0.5) / h});
+        double f = pointToPolygonFormFactor(x, {0, 0, 1}, light);
+        for (int c = 0; c < 3; ++c) {  // the light's part of the texel
+          double got = m.keys[0][(size_t(j) * w + i) * 3 + size_t(c)] - t.good[c];
+          worst = std::max(worst, std::abs(got - t.lightB[c] * f) / (t.lightB[c] * f));
+        }
+      }
+    const TextureMovieBakerStats& s = baker.stats();
+    EXPECT_EQ(s.formFactorTexels, w * h) << height;
+    if (height < 4.0) {
+      EXPECT_EQ(s.formFactorTexelsInterpolated, 0) << height;
+      EXPECT_LT(worst, 1e-5) << height;
+    } else {
+      EXPECT_EQ(s.formFactorTexelsInterpolated, w * h) << height;
+      EXPECT_LT(worst, height < 10.0 ? 1e-3 : 1e-4) << height;
+    }
+    std::printf("light at %.0f m: worst texel %.2e off the exact form factor\n", height, worst);
+  }
+}
+
 // A bad shooter that the global pass subdivided, with leaves of uneven radiosity (a wall of the
 // Cornell box under --bad-links partial): each texel gets its leaves' light, sum_l B_l F(x -> l),
 // not the mean radiosity times F(x -> S) (13.8 % RMSE on the bundled scene before). The samples'
