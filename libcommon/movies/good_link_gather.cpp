@@ -513,11 +513,24 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
   // little: the cubic scene's door jambs 3.4 % too dark (in a closed furnace the sum of F V over
   // a jamb texel's links 0.98-0.99, with every partial link per texel 1.000).
   std::vector<double> carried(links_.size(), 0.0), risk(links_.size(), -1.0);
+  // The hidden links' F that this baker's earlier movies integrated are read here (no writes
+  // while the loop runs); the new ones are added after it.
+  // Cached only for links whose ends do not move over the whole solution, so that every movie
+  // sees them where they are in this one.
+  const auto& knownHidden = byReceiver_.hiddenFormFactor;
+  std::vector<double> newHidden(links_.size(), -1.0);
+  const double first = solution_.keyTimes.front(), last = solution_.keyTimes.back();
+  const PatchHierarchy& hierarchy = solution_.hierarchy;
+  const bool receiverFixed = !scene_.isDynamic(hierarchy.top(receiverTop_).node, first, last);
+  auto fixedEnds = [&](const Link& l) {
+    return receiverFixed && !scene_.isDynamic(hierarchy.topOf(int(l.shooter)).node, first, last);
+  };
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
     Link& l = links_[j];
     const GlobalLink& g = solution_.links[l.row];
     l.weight.assign(size_t(K), glm::dvec3(0.0));
     double fixedF = -1.0, hiddenF = -1.0;
+    int cacheable = -1;  // whether fixedEnds(l), once asked
     for (int k = 0; k < K; ++k) {
       if (!needed[size_t(k)]) continue;
       const double fv = solution_.linkFvAtKey(g, k);
@@ -530,10 +543,16 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
         // furnace, 0.99-1.00 with these. Its risk is what it would carry unoccluded, B_q F.
         if (visibility_ && storedVisibility && GlobalSolution::linkActiveAtKey(g, k)) {
           double f = hiddenF;
+          if (f < 0.0 && cacheable < 0) {
+            cacheable = fixedEnds(l) ? 1 : 0;
+            auto it = cacheable ? knownHidden.find({l.row, l.shooter, l.cell}) : knownHidden.end();
+            if (it != knownHidden.end()) f = hiddenF = it->second;
+          }
           if (f < 0.0) {
             const double t = solution_.keyTimes[size_t(k)];
             f = areaAverageFormFactor(nodeWorld(g.receiver, t), linkWorld(l, t), 1e-3);
             if (!l.moves) hiddenF = f;
+            if (cacheable == 1) newHidden[j] = f;
           }
           if (f > 0.0) risk[j] = std::max(risk[j], (b.x + b.y + b.z) * f);
         }
@@ -561,6 +580,11 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
       l.weight[size_t(k)] = b * v;
     }
   });
+  for (size_t j = 0; j < links_.size(); ++j)
+    if (newHidden[j] >= 0.0)
+      byReceiver_.hiddenFormFactor.emplace(
+          GoodLinksByReceiver::HiddenLink{links_[j].row, links_[j].shooter, links_[j].cell},
+          newHidden[j]);
   if (!visibility_) return;
   // Per texel visibility where it matters: a partial link whose risk is at least
   // --gather-partial-share of what its receiver node and the node's ancestors carry (a texel
