@@ -9,7 +9,9 @@
 //
 // with G the global solution's good-link irradiance (gathered per texel over the good links,
 // good_link_gather.h, or the paper's Gouraud), B_S the shooter's radiosity,
-// F the exact point-to-polygon form factor and T the transmittance (transmittance.h).
+// F the exact point-to-polygon form factor (for a shooter far from a tile of texels, its ratio to
+// the point kernel interpolated from the tile's corners: MovieGeometry::formFactorsAt) and T the
+// transmittance (transmittance.h).
 //
 // Coherence (§5): for a bad pair whose receiver and shooter are static over the movie, F is
 // computed once and the blockers in the pair's shaft are split by Scene::isDynamic: the static
