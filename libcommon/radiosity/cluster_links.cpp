@@ -155,7 +155,6 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
   };
   std::vector<LinkEnds> work;
   size_t made = 0, count = 0;
-  listsValid_ = false;
   auto pairOrLink = [&](ClusterRef r, ClusterRef s, std::vector<LinkEnds>& next) {
     if (!isCluster(r) && !isCluster(s)) {
       if (r != s) patchPairs.emplace_back(r, s);
@@ -211,10 +210,16 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
       return l;
     });
   links_.swap(kept);
+  // A round that refined nothing left every link where it was, and the gather lists hold: at
+  // the link bound (the 100k-triangle hall, 8 rounds a key) most rounds refine only patch links.
+  if (count > 0) listsValid_ = false;
   return count;
 }
 
 void ClusterLinks::evaluate() {
+  bool any = false;
+  for (const ClusterLink& l : links_) any = any || !l.evaluated;
+  if (!any) return;
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t i) {
     if (!links_[i].evaluated) evaluateLink(links_[i]);
   });
