@@ -147,11 +147,25 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
   kept.reserve(std::max(kept.size(), expectedLinks_));
   size_t firstSize = kept.size(), written = 0;
   bool firstLevel = true;
+  // Where each link of the first level goes (kGone: refined) and which receivers' links
+  // change, so that the gather lists of the links before this round can be taken over for the
+  // tops whose links did not change (buildReceiverLists).
+  const bool remap = listsValid_;
+  const size_t T = emission_.size();
+  std::vector<uint32_t> moved(remap ? firstSize : 0, kGone);
+  std::vector<char> changed(remap ? T + size_t(tree_.size()) : 0, 0);
+  auto changes = [&](ClusterRef r) {
+    if (remap) changed[clusterLinkEnd(r, T)] = 1;
+  };
+  size_t current = 0;  // the first level's index of the link at hand
   auto keep = [&](const ClusterLink& l) {
-    if (firstLevel)
+    if (firstLevel) {
+      if (remap) moved[current] = uint32_t(written);
       kept[written++] = l;
-    else
+    } else {
+      changes(l.receiver);
       kept.push_back(l);
+    }
   };
   std::vector<LinkEnds> work;
   size_t made = 0, count = 0;
@@ -168,6 +182,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
     std::vector<LinkEnds> next;
     for (size_t i = 0; i < size; ++i) {
       const ClusterLink l = linkAt(i);
+      current = i;
       // Past the link bound only the lights' links go on (as far as the light share asks): a
       // light left inside a cluster link reaches its receivers without shadows (stopped
       // wherever the bound fell, the 30k-triangle hall had lost 92 % of its bad pairs). A refined
@@ -195,6 +210,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
         for (ClusterRef c : tree_.node(clusterIndex(split)).children)
           splitReceiver ? pairOrLink(c, l.shooter, next) : pairOrLink(l.receiver, c, next);
       }
+      if (firstLevel) changes(l.receiver);
       ++count;
     }
     work.swap(next);
@@ -210,9 +226,12 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
       return l;
     });
   links_.swap(kept);
-  // A round that refined nothing left every link where it was, and the gather lists hold: at
-  // the link bound (the 100k-triangle hall, 8 rounds a key) most rounds refine only patch links.
-  if (count > 0) listsValid_ = false;
+  // A round that refined nothing left every link where it was, and the gather lists hold.
+  if (count > 0) {
+    listsValid_ = false;
+    movedTo_.swap(moved);
+    changedReceiver_.swap(changed);
+  }
   return count;
 }
 
@@ -329,8 +348,14 @@ ClusterLinks::entriesOf(size_t t) const {
 void ClusterLinks::buildReceiverLists() {
   if (listsValid_) return;
   const size_t T = emission_.size(), C = size_t(tree_.size());
-  // The stale lists go before the new ones are made (600 MB on the 100k-triangle hall).
-  std::vector<std::vector<GatherEntry>>().swap(gatherBlocks_);
+  // The lists of the links before the last refinement round, where it left them (movedTo_):
+  // a top none of whose receivers (itself, its ancestor clusters) gained or lost a link keeps
+  // its entries, the links renumbered; the others are made anew. At the link bound (the
+  // 100k-triangle hall, 8 rounds a key, each refining a few of the lights' links) rebuilding
+  // every list each round had been most of rad-global's time.
+  const bool remap = !movedTo_.empty() && gatherStart_.size() == T;
+  if (!remap)  // the stale lists go before the new ones are made (600 MB on the 100k hall)
+    std::vector<std::vector<GatherEntry>>().swap(gatherBlocks_);
   // Per receiver (tops 0..T-1, then the clusters): its active links in link order (the links
   // not evaluated go to one more row, left unread).
   const RowOrder byReceiver = sortByRow(links_.size(), uint32_t(T + C + 1), [&](size_t i) {
@@ -345,11 +370,20 @@ void ClusterLinks::buildReceiverLists() {
   // themselves, and counting by computing F twice made its rad-global 19 % slower.
   const size_t blocks = (T + kGatherBlockTops - 1) / kGatherBlockTops;
   gatherBlocks_.resize(blocks);
-  gatherStart_.assign(T, 0);
+  std::vector<uint32_t> start(T, 0);
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
-    std::vector<GatherEntry>& entries = gatherBlocks_[b];
+    std::vector<GatherEntry> entries;
     for (size_t t = b * kGatherBlockTops; t < std::min(T, (b + 1) * kGatherBlockTops); ++t) {
-      gatherStart_[t] = uint32_t(entries.size());
+      start[t] = uint32_t(entries.size());
+      bool keepOld = remap && !changedReceiver_[t];
+      for (int c = tree_.parentOfTop(int(t)); keepOld && c >= 0; c = tree_.node(c).parent)
+        keepOld = !changedReceiver_[T + size_t(c)];
+      if (keepOld) {
+        const auto [first, last] = entriesOf(t);
+        for (const GatherEntry* e = first; e != last; ++e)
+          entries.push_back({movedTo_[e->link], e->formFactor});
+        continue;
+      }
       auto add = [&](size_t r) {
         for (uint32_t k = byReceiver.rowStart[r]; k < byReceiver.rowStart[r + 1]; ++k) {
           const uint32_t i = byReceiver.order[k];
@@ -361,7 +395,11 @@ void ClusterLinks::buildReceiverLists() {
       for (int c = tree_.parentOfTop(int(t)); c >= 0; c = tree_.node(c).parent) add(T + size_t(c));
     }
     entries.shrink_to_fit();
+    gatherBlocks_[b].swap(entries);
   });
+  gatherStart_.swap(start);
+  std::vector<uint32_t>().swap(movedTo_);
+  std::vector<char>().swap(changedReceiver_);
   listsValid_ = true;
 }
 

@@ -181,6 +181,12 @@ class ClusterLinks {
   std::vector<std::vector<GatherEntry>> gatherBlocks_;
   std::vector<uint32_t> gatherStart_;
   bool listsValid_ = false;
+  // After a refinement round that changed links, until the lists are made again: each link of
+  // the lists' link order at its new index (kGone: refined), and the receivers (clusterLinkEnd
+  // rows) that gained or lost links. Empty: the lists are made anew.
+  static constexpr uint32_t kGone = ~0u;
+  std::vector<uint32_t> movedTo_;
+  std::vector<char> changedReceiver_;
   // Top t's entries in its block.
   std::pair<const GatherEntry*, const GatherEntry*> entriesOf(size_t t) const;
 };
