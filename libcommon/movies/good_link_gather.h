@@ -123,8 +123,7 @@ struct GoodLinksByReceiver {
   };
   struct HiddenLinkHash {
     size_t operator()(const HiddenLink& k) const {
-      return size_t(((uint64_t(k.row) << 32) | k.shooter) * 0x9e3779b97f4a7c15ull ^
-                    uint64_t(k.cell) * 0xc2b2ae3d27d4eb4full);
+      return size_t(splitMix64(((uint64_t(k.row) << 32) | k.shooter) ^ splitMix64(k.cell)));
     }
   };
   std::unordered_map<HiddenLink, double, HiddenLinkHash> hiddenFormFactor;
