@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bitset>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -199,7 +200,9 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   for (const Link& l : links_) {
     stats.partialLinks += l.partial ? 1 : 0;
     stats.partialLinksMovingBlockers += l.partial && l.movingBlockers ? 1 : 0;
+    stats.partialLinksFewRays += l.partial && l.rays < visibilityRays_ && l.cell == 1 ? 1 : 0;
   }
+  stats.partialTileLinksPerTexel += long(partialTileLinksPerTexel_);
 }
 
 Polygon GoodLinkGather::nodeWorld(uint32_t node, double t) const {
@@ -586,9 +589,23 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
           GoodLinksByReceiver::HiddenLink{links_[j].row, links_[j].shooter, links_[j].cell},
           newHidden[j]);
   if (!visibility_) return;
-  // Per texel visibility where it matters: a partial link whose risk is at least
-  // --gather-partial-share of what its receiver node and the node's ancestors carry (a texel
-  // gathers at least that); the others keep the link's V, an error below that share each.
+  selectPartialLinks(risk, carried);
+  tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
+    if (links_[j].partial) planVisibility(links_[j], needed);
+  });
+}
+
+// Per texel visibility where it matters, per receiver node (what the node and its ancestors
+// carry, `total`, a texel gathers at least that), share s = --gather-partial-share:
+// - a partial link whose risk alone is at least s x total: from visibilityRays_ rays;
+// - the smaller ones keep the link's one V while their risks, smallest first, sum to at most
+//   kPartialSumShares x s x total; the rest take V per texel from a quarter of the rays (each
+//   misplaces little, and its points are the same for every texel: no noise from texel to
+//   texel). Each small link had kept its V, and a receiver with many of them (the 10k hall's
+//   floor under the desks' front edges, seeing the ceiling's leaves past the desk tops) came
+//   out 9.4 % too bright in a strip (selectPartialLinks' figures in README, issue 16).
+void GoodLinkGather::selectPartialLinks(const std::vector<double>& risk,
+                                        const std::vector<double>& carried) {
   const PatchHierarchy& h = solution_.hierarchy;
   std::map<int, double> chain;  // receiver node -> what it and its ancestors carry
   for (size_t j = 0; j < links_.size(); ++j)
@@ -602,12 +619,32 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
     }
     total[node] = sum;
   }
-  tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
-    Link& l = links_[j];
-    const int r = int(solution_.links[l.row].receiver);
-    l.partial = risk[j] >= 0.0 && risk[j] >= partialShare_ * total.at(r);
-    if (l.partial) planVisibility(l, needed);
-  });
+  std::map<int, std::vector<uint32_t>> small;  // receiver node -> its small partial links
+  linkGather_.assign(links_.size(), 0.0);
+  for (uint32_t j = 0; j < uint32_t(links_.size()); ++j) {
+    if (risk[j] < 0.0) continue;
+    const int r = int(solution_.links[links_[j].row].receiver);
+    linkGather_[j] = total.at(r);
+    if (risk[j] >= partialShare_ * total.at(r))
+      links_[j].partial = true;
+    else
+      small[r].push_back(j);
+  }
+  for (auto& [node, ids] : small) {
+    std::sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) {
+      return risk[a] != risk[b] ? risk[a] < risk[b] : a < b;
+    });
+    const double budget = kPartialSumShares * partialShare_ * total.at(node);
+    double kept = 0.0;
+    for (uint32_t j : ids) {
+      if (kept + risk[j] <= budget) {
+        kept += risk[j];
+        continue;
+      }
+      links_[j].partial = true;
+      links_[j].rays = std::max(1, links_[j].rays / 4);
+    }
+  }
 }
 
 // A texel's leaf chain, deepest first, as far up as (not including) `stop` (-1: to the top).
@@ -749,7 +786,6 @@ void GoodLinkGather::planTexels(double cacheBytes) {
       tile.groups.emplace_back(mask, uint32_t(tile.links.size()));
     }
   });
-  for (const Tile& tile : tiles_) tileLinkCount_ += tile.links.size();
   // The far links at the tiles' corners, once per corner texel and link: a corner is shared by
   // up to four tiles, which mostly interpolate the same links. Their form factors (links that
   // do not move) and open rays past the static blockers are made here, the rest per key
@@ -784,6 +820,8 @@ void GoodLinkGather::planTexels(double cacheBytes) {
   });
   std::unordered_map<size_t, size_t> cornerIndex;  // corner texel -> its corners_ index
   for (size_t i = 0; i + 1 < corners_.size(); ++i) cornerIndex[corners_[i].texel] = i;
+  perTexelOnTiles(cornerIndex, shooter, nearOfTile, nearBelow);
+  for (const Tile& tile : tiles_) tileLinkCount_ += tile.links.size();
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     Tile& tile = tiles_[ti];
     const std::array<size_t, 4> c4 = tile.cornerTexels(w);
@@ -828,6 +866,73 @@ void GoodLinkGather::planTexels(double cacheBytes) {
         texelOpen_[e] = openRays(visibility_->staticPart(), p, l, l.points);
     }
   });
+}
+
+// A partial link's V interpolated over a tile from its corners misses what changes inside:
+// near a concave edge V drops steeply only close to it (a chair's back above its seat, the floor
+// along a wall), so the straight line between a tile's corners, which lie on the texture's
+// border on a small texture, is too dark inside (the 10k hall's chairs -4.1 %, its frame's
+// bias -0.97 %, against -3.1 % and -0.83 % with every partial link per texel). So its rays are
+// also cast from the tile's middle texel, and where B_q F(x -> q) |V(x) - interpolated V| there
+// is at least --gather-partial-share of what the receiver gathers, the link goes per texel on
+// that tile. Links whose ends do not move (their corner rays are cast once per movie); a moving
+// one keeps the corners.
+void GoodLinkGather::perTexelOnTiles(
+    const std::unordered_map<size_t, size_t>& cornerIndex, const std::vector<Polygon>& shooter,
+    std::vector<std::vector<uint32_t>>& nearOfTile,
+    std::vector<std::vector<std::pair<uint64_t, uint32_t>>>& nearBelow) {
+  if (!visibility_) return;
+  const int w = texels_.width;
+  const TexelFrame frame = texelFrame(keyTimes_.front());
+  std::vector<long> moved(tiles_.size(), 0);
+  tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
+    Tile& tile = tiles_[ti];
+    const std::array<size_t, 4> c4 = tile.cornerTexels(w);
+    const size_t mid =
+        size_t((tile.j0 + tile.j1) / 2) * size_t(w) + size_t((tile.i0 + tile.i1) / 2);
+    const glm::dvec3 p = frame.point(texels_.localPoint[mid]);
+    const glm::dvec3 n = frame.normal(texels_.localNormal[mid]);
+    auto interpolates = [&](size_t k) {
+      const uint32_t j = tile.links[k];
+      const Link& l = links_[j];
+      if (!l.partial || l.moves) return true;
+      double interpolated = 0.0;
+      for (int c = 0; c < 4; ++c) {
+        const size_t i = cornerIndex.at(c4[size_t(c)]);
+        const auto first = cornerLink_.begin() + corners_[i].first;
+        const auto last = cornerLink_.begin() + corners_[i + 1].first;
+        const size_t e = size_t(std::lower_bound(first, last, j) - cornerLink_.begin());
+        interpolated += 0.25 * double(std::bitset<64>(cornerOpen_[e]).count());
+      }
+      const uint64_t open = openRays(visibility_->staticPart(), p, l, l.points);
+      const double dv =
+          std::abs(double(std::bitset<64>(open).count()) - interpolated) / double(l.rays);
+      double b = 0.0;
+      for (const glm::dvec3& wk : l.weight) b = std::max(b, wk.x + wk.y + wk.z);
+      return b * pointToPolygonFormFactor(p, n, shooter[j]) * dv < partialShare_ * linkGather_[j];
+    };
+    std::vector<uint32_t> kept;
+    std::vector<std::pair<uint64_t, uint32_t>> groups;
+    for (size_t g = 0, k = 0; g < tile.groups.size(); ++g) {
+      const uint64_t mask = tile.groups[g].first;
+      for (; k < tile.groups[g].second; ++k) {
+        if (interpolates(k)) {
+          kept.push_back(tile.links[k]);
+          continue;
+        }
+        ++moved[ti];
+        if (mask == ~uint64_t(0))
+          nearOfTile[ti].push_back(tile.links[k]);
+        else
+          nearBelow[ti].emplace_back(mask, tile.links[k]);
+      }
+      if (groups.empty() ? !kept.empty() : groups.back().second != uint32_t(kept.size()))
+        groups.emplace_back(mask, uint32_t(kept.size()));
+    }
+    tile.links.swap(kept);
+    tile.groups.swap(groups);
+  });
+  for (long m : moved) partialTileLinksPerTexel_ += size_t(m);
 }
 
 // Per tile: a corner texel is covered, at some key time of the movie, by a touching solid (its

@@ -23,10 +23,11 @@
 //
 // A link whose stored V is partial (0 < V < 1 at a key the movie needs), or 0 while the link is
 // active (none of its ray pairs got through, yet it may be partly visible), takes its
-// visibility per texel instead when its risk B_q F (1 - V) is at least --gather-partial-share of
-// what the texel gathers, V(x, q): --gather-rays shadow rays from x to points on the shooter part q
-// (the same points for every texel), each weighted by the kernel and by the global solution's B
-// at its end (pointVisibility), so that
+// visibility per texel instead when its risk B_q F (1 - V) is at least --gather-partial-share s
+// of what the texel gathers, or when it is among the smaller ones beyond the first that sum to
+// 10 s (selectPartialLinks; a quarter of the rays then), V(x, q): --gather-rays shadow rays from
+// x to points on the shooter part q (the same points for every texel), each weighted by the
+// kernel and by the global solution's B at its end (pointVisibility), so that
 //
 //   term = B_q(k) F(x -> q) V(x, q)
 //
@@ -37,7 +38,9 @@
 //
 // Cost: texels are planned in tiles of 8 x 8; a link whose shooter part is far from a tile
 // (kTileFarRatio times its size) is evaluated at the tile's corners and interpolated
-// bilinearly, so only near links cost a form factor per texel.
+// bilinearly, so only near links cost a form factor per texel. A far partial link stays on the
+// tile only while its V at the tile's middle texel is what the corners interpolate, within s of
+// what the texel gathers (perTexelOnTiles).
 //
 // Near shooters (--near-shooter-levels L > 0, issue 15): a shooter part that is a leaf and still
 // larger than shooterRatio times its distance to the receiver is split further into the cells
@@ -155,6 +158,8 @@ struct GoodLinkGatherStats {
   long tileEntries = 0;                 // (tile, far link) terms, each 4 corner form factors
   long partialLinks = 0;                // links with V per texel (partly occluded)
   long partialLinksMovingBlockers = 0;  // of which rays also meet moving blockers per key
+  long partialLinksFewRays = 0;         // of which small ones, a quarter of the rays each
+  long partialTileLinksPerTexel = 0;    // (tile, far partial link) pairs taken per texel
   long nearShooterLeaves = 0;           // (leaf, key) re-gathered (--near-shooter-levels)
   double nearShooterSeconds = 0.0;      // their time, part of the good layer's
 };
@@ -218,6 +223,13 @@ class GoodLinkGather {
   // --gather-partial-share: a partly occluded link gets V per texel when its risk B F (1 - V)
   // is at least this share of what its receiver chain carries (TextureMovieBakerOptions).
   double partialShare_;
+  // The small partial links left on the link's one V sum to at most this many shares
+  // (selectPartialLinks). On the 10k hall (frames 40-56 baked, frame 48 against its
+  // references): 10 took the floor strip's bias from 9.4 to 4.5 %.
+  static constexpr double kPartialSumShares = 10.0;
+  // Per partial link, what its receiver chain carries (selectPartialLinks' total): the scale of
+  // the tiles' visibility test.
+  std::vector<double> linkGather_;
   static constexpr double kTileFarRatio = 2.0;
   // The same for the links of the nodes below a tile's common node (Tile::groups), which hold
   // only some of its texels. At 2 the bundled scene's frame 20 went from 2.46 to 2.50 % RMSE /
@@ -257,7 +269,8 @@ class GoodLinkGather {
   std::vector<uint64_t> cornerOpen_;
   int tilesX_ = 0;
   std::vector<Tile> tiles_;
-  size_t tileLinkCount_ = 0;  // over all tiles (the stats)
+  size_t tileLinkCount_ = 0;             // over all tiles (the stats)
+  size_t partialTileLinksPerTexel_ = 0;  // (tile, partial link) pairs moved per texel (the stats)
   // Per texel its own terms: links_ indices texelLinks_[texelStart_[x] .. texelStart_[x + 1])
   // and, when cached_, the form factors of the links that do not move in the same places.
   std::vector<uint32_t> texelStart_, texelLinks_;
@@ -286,6 +299,7 @@ class GoodLinkGather {
   void shooterParts(const std::vector<Polygon>& receiverAt, const std::vector<double>& times,
                     uint32_t shooter, std::vector<uint32_t>& out) const;
   void planWeights(const std::vector<char>& neededKeys);
+  void selectPartialLinks(const std::vector<double>& risk, const std::vector<double>& carried);
   void planTexels(double cacheBytes);
   struct TexelFrame {  // the receiver's local-to-world map and its normal map at one time
     glm::dmat4 m;
@@ -297,6 +311,10 @@ class GoodLinkGather {
   };
   TexelFrame texelFrame(double t) const;
   std::vector<char> coveredTiles() const;
+  void perTexelOnTiles(const std::unordered_map<size_t, size_t>& cornerIndex,
+                       const std::vector<Polygon>& shooter,
+                       std::vector<std::vector<uint32_t>>& nearOfTile,
+                       std::vector<std::vector<std::pair<uint64_t, uint32_t>>>& nearBelow);
   void planVisibility(Link& l, const std::vector<char>& neededKeys) const;
   uint64_t openRays(const VisibilityScene& blockers, const glm::dvec3& x, const Link& l,
                     const std::vector<glm::dvec3>& points,

@@ -1060,6 +1060,8 @@ nlohmann::json TextureMovieBakerStats::toJson() const {
             {"tile_entries", gather.tileEntries},
             {"partial_links", gather.partialLinks},
             {"partial_links_moving_blockers", gather.partialLinksMovingBlockers},
+            {"partial_links_few_rays", gather.partialLinksFewRays},
+            {"partial_tile_links_per_texel", gather.partialTileLinksPerTexel},
             {"near_shooter_leaves", gather.nearShooterLeaves},
             {"near_shooter_seconds", gather.nearShooterSeconds}}},
           {"covered_texels_filled", coveredTexelsFilled},
@@ -1172,6 +1174,8 @@ TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBak
   gather.tileEntries += o.gather.tileEntries;
   gather.partialLinks += o.gather.partialLinks;
   gather.partialLinksMovingBlockers += o.gather.partialLinksMovingBlockers;
+  gather.partialLinksFewRays += o.gather.partialLinksFewRays;
+  gather.partialTileLinksPerTexel += o.gather.partialTileLinksPerTexel;
   gather.nearShooterLeaves += o.gather.nearShooterLeaves;
   gather.nearShooterSeconds += o.gather.nearShooterSeconds;
   formFactorTexels += o.formFactorTexels;

@@ -101,11 +101,13 @@ struct TextureMovieBakerOptions {
   // two receiver nodes met (the bundled scene's back wall, 4.3 %).
   int gatherRays = 16;
   // --gather-partial-share: a partly occluded gathered link takes its visibility per texel when
-  // its risk, B F (1 - V), is at least this share of what the texel gathers (good_link_gather.h).
-  // Measured at the defaults otherwise (frame 20 of 0-24 against 4096-spp references; table
-  // default 400 frames on one core): 0.001 gives the cubic scene 1.64 % RMSE / mean and the
-  // table's rad-movies 58.7 s, 0.002 1.77 % and 42 s, 0.003 2.01 % and 31 s. The default keeps
-  // the table's 0.2 s per frame; the final setting uses 0.001.
+  // its risk, B F (1 - V), is at least this share of what the texel gathers, or when the smaller
+  // ones left on their V would sum to more than 10 shares; and a far one interpolated over a
+  // tile goes per texel where the tile's middle misses by this share (good_link_gather.h).
+  // Measured before the sum and tile rules, at the defaults otherwise (frame 20 of 0-24 against
+  // 4096-spp references; table default 400 frames on one core): 0.001 gives the cubic scene
+  // 1.64 % RMSE / mean and the table's rad-movies 58.7 s, 0.002 1.77 % and 42 s, 0.003 2.01 %
+  // and 31 s. The default keeps the table's 0.2 s per frame; the final setting uses 0.001.
   double gatherPartialShare = 0.002;
   // --near-shooter-levels: a near leaf shooter is split into up to 4^L cells, each with its
   // radiosity re-gathered at its centre from the leaf's links (good_link_gather.h); 0: the

@@ -152,7 +152,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--gather-partial-share", b.gatherPartialShare,
                  "gather: a partly occluded link takes its visibility per texel when B F (1 - V) "
-                 "is at least this share of what the texel gathers (smaller: more links per "
+                 "is at least this share of what the texel gathers, or when the smaller ones "
+                 "left on their V would sum to more than 10 shares (smaller: more links per "
                  "texel, slower; the final setting uses 0.001)")
       ->capture_default_str()
       ->check(rad::finiteRange(0.0, 1.0));
