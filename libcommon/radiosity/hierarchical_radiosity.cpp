@@ -24,13 +24,11 @@ double maxComponent(const glm::dvec3& v) {
 }
 
 // Some vertex of `p` lies strictly in front of the plane of `q`.
-bool someVertexInFront(const Polygon& p, const Polygon& q) {
-  glm::dvec3 n = q.normal();
-  if (n == glm::dvec3(0.0)) return false;
-  glm::dvec3 c = q.centroid();
-  double tol = 1e-12 * std::max(polygonSize(p), polygonSize(q));
+bool someVertexInFront(const Polygon& p, const FacingPlane& pPlane, const FacingPlane& qPlane) {
+  if (qPlane.normal == glm::dvec3(0.0)) return false;
+  const double tol = 1e-12 * std::max(pPlane.size, qPlane.size);
   for (int i = 0; i < p.count; ++i)
-    if (glm::dot(n, p.v[i] - c) > tol) return true;
+    if (glm::dot(qPlane.normal, p.v[i] - qPlane.centroid) > tol) return true;
   return false;
 }
 
@@ -123,8 +121,17 @@ std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
   return out;
 }
 
+FacingPlane facingPlane(const Polygon& p) {
+  return {p.normal(), p.centroid(), polygonSize(p)};
+}
+
+bool mutuallyFacing(const Polygon& p, const FacingPlane& pPlane, const Polygon& q,
+                    const FacingPlane& qPlane) {
+  return someVertexInFront(p, pPlane, qPlane) && someVertexInFront(q, qPlane, pPlane);
+}
+
 bool mutuallyFacing(const Polygon& p, const Polygon& q) {
-  return someVertexInFront(p, q) && someVertexInFront(q, p);
+  return mutuallyFacing(p, facingPlane(p), q, facingPlane(q));
 }
 
 uint64_t linkSeed(PatchId receiver, PatchId shooter) {
@@ -158,10 +165,12 @@ glm::dvec3 KeySolution::emittedPower(const PatchHierarchy& h,
 std::vector<SolverLink> linkTopLevel(const std::vector<Polygon>& world,
                                      const std::vector<double>& area, int topCount) {
   std::vector<SolverLink> links;
+  std::vector<FacingPlane> plane(static_cast<size_t>(topCount));
+  for (int t = 0; t < topCount; ++t) plane[size_t(t)] = facingPlane(world[size_t(t)]);
   for (int p = 0; p < topCount; ++p)
     for (int q = 0; q < topCount; ++q)
       if (p != q && area[size_t(p)] > 0 && area[size_t(q)] > 0 &&
-          mutuallyFacing(world[size_t(p)], world[size_t(q)])) {
+          mutuallyFacing(world[size_t(p)], plane[size_t(p)], world[size_t(q)], plane[size_t(q)])) {
         SolverLink l;
         l.receiver = p;
         l.shooter = q;
@@ -301,12 +310,22 @@ class KeyTimeSolver {
     const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs, overBudget);
     if (overBudget || s_.links.size() + clusters_->size() + pairs.size() > opt_.maxLinks)
       s_.linkCapReached = true;
-    for (const auto& [r, q] : pairs)
-      if (s_.area[size_t(r)] > 0 && s_.area[size_t(q)] > 0 &&
-          mutuallyFacing(s_.world[size_t(r)], s_.world[size_t(q)])) {
+    if (topPlanes_.empty()) {  // the tops' planes at this key, once
+      topPlanes_.resize(size_t(h_.topCount()));
+      tbb::parallel_for(size_t(0), topPlanes_.size(),
+                        [&](size_t t) { topPlanes_[t] = facingPlane(s_.world[t]); });
+    }
+    std::vector<char> facing(pairs.size());
+    tbb::parallel_for(size_t(0), pairs.size(), [&](size_t i) {
+      const size_t r = size_t(pairs[i].first), q = size_t(pairs[i].second);
+      facing[i] = s_.area[r] > 0 && s_.area[q] > 0 &&
+                  mutuallyFacing(s_.world[r], topPlanes_[r], s_.world[q], topPlanes_[q]);
+    });
+    for (size_t i = 0; i < pairs.size(); ++i)
+      if (facing[i]) {
         SolverLink l;
-        l.receiver = r;
-        l.shooter = q;
+        l.receiver = pairs[i].first;
+        l.shooter = pairs[i].second;
         s_.links.push_back(l);
       }
     clusters_->evaluate();
@@ -1173,6 +1192,7 @@ class KeyTimeSolver {
   std::vector<double> topEmission_;         // per top: largest emitted channel (clusters_)
   std::vector<glm::dvec3> clusterH_;        // per top: irradiance through cluster links
   std::vector<double> clusterRow_;          // per top: its cluster links' form factor sum
+  std::vector<FacingPlane> topPlanes_;      // per top at this key (refineClusterLinks)
 };
 
 }  // namespace
