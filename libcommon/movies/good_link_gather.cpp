@@ -603,7 +603,7 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
 //   misplaces little, and its points are the same for every texel: no noise from texel to
 //   texel). Each small link had kept its V, and a receiver with many of them (the 10k hall's
 //   floor under the desks' front edges, seeing the ceiling's leaves past the desk tops) came
-//   out 9.4 % too bright in a strip (selectPartialLinks' figures in README, issue 16).
+//   out 9.4 % too bright in a strip (README, "At `e3297e9`").
 void GoodLinkGather::selectPartialLinks(const std::vector<double>& risk,
                                         const std::vector<double>& carried) {
   const PatchHierarchy& h = solution_.hierarchy;
