@@ -19,6 +19,14 @@ if(GIT)
       file(REAL_PATH "${SOURCE_DIR}" source)
       if(top STREQUAL source)
         set(revision "${head}")
+        # Tracked files that differ from HEAD (staged or not): the binary is not that revision's,
+        # and says so as git describe --dirty does. (A benchmark binary built before its commit had
+        # carried the parent's revision.)
+        execute_process(COMMAND "${GIT}" diff --quiet HEAD --
+                        WORKING_DIRECTORY "${SOURCE_DIR}" RESULT_VARIABLE dirty ERROR_QUIET)
+        if(dirty EQUAL 1)
+          set(revision "${head}-dirty")
+        endif()
       endif()
     endif()
   endif()

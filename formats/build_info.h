@@ -7,7 +7,9 @@
 namespace rad {
 
 // `git rev-parse --short=12 HEAD` of the source tree when this binary was built, e.g.
-// "1a2b3c4d5e6f"; "unknown" when the sources were not a git checkout (or git was missing).
+// "1a2b3c4d5e6f", with "-dirty" appended when tracked files differed from HEAD (as
+// `git describe --dirty`); "unknown" when the sources were not a git checkout (or git was
+// missing).
 const char* gitRevision();
 
 }  // namespace rad
