@@ -820,8 +820,6 @@ void GoodLinkGather::planTexels(double cacheBytes) {
   });
   std::unordered_map<size_t, size_t> cornerIndex;  // corner texel -> its corners_ index
   for (size_t i = 0; i + 1 < corners_.size(); ++i) cornerIndex[corners_[i].texel] = i;
-  perTexelOnTiles(cornerIndex, shooter, nearOfTile, nearBelow);
-  for (const Tile& tile : tiles_) tileLinkCount_ += tile.links.size();
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     Tile& tile = tiles_[ti];
     const std::array<size_t, 4> c4 = tile.cornerTexels(w);
@@ -835,6 +833,8 @@ void GoodLinkGather::planTexels(double cacheBytes) {
             uint32_t(std::lower_bound(first, last, tile.links[k]) - cornerLink_.begin());
     }
   });
+  perTexelOnTiles(shooter, nearOfTile, nearBelow);
+  for (const Tile& tile : tiles_) tileLinkCount_ += tile.links.size();
   // Per texel, in texel order: the near links of its chain below its tile's common node, then
   // the tile's near links.
   texelStart_.assign(T + 1, 0);
@@ -878,16 +878,19 @@ void GoodLinkGather::planTexels(double cacheBytes) {
 // that tile. Links whose ends do not move (their corner rays are cast once per movie); a moving
 // one keeps the corners.
 void GoodLinkGather::perTexelOnTiles(
-    const std::unordered_map<size_t, size_t>& cornerIndex, const std::vector<Polygon>& shooter,
-    std::vector<std::vector<uint32_t>>& nearOfTile,
+    const std::vector<Polygon>& shooter, std::vector<std::vector<uint32_t>>& nearOfTile,
     std::vector<std::vector<std::pair<uint64_t, uint32_t>>>& nearBelow) {
   if (!visibility_) return;
   const int w = texels_.width;
   const TexelFrame frame = texelFrame(keyTimes_.front());
+  std::vector<double> brightest(links_.size(), 0.0);  // a partial link's largest B_q (channel sum)
+  for (size_t j = 0; j < links_.size(); ++j)
+    if (links_[j].partial)
+      for (const glm::dvec3& b : links_[j].weight)
+        brightest[j] = std::max(brightest[j], b.x + b.y + b.z);
   std::vector<long> moved(tiles_.size(), 0);
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     Tile& tile = tiles_[ti];
-    const std::array<size_t, 4> c4 = tile.cornerTexels(w);
     const size_t mid =
         size_t((tile.j0 + tile.j1) / 2) * size_t(w) + size_t((tile.i0 + tile.i1) / 2);
     const glm::dvec3 p = frame.point(texels_.localPoint[mid]);
@@ -897,27 +900,24 @@ void GoodLinkGather::perTexelOnTiles(
       const Link& l = links_[j];
       if (!l.partial || l.moves) return true;
       double interpolated = 0.0;
-      for (int c = 0; c < 4; ++c) {
-        const size_t i = cornerIndex.at(c4[size_t(c)]);
-        const auto first = cornerLink_.begin() + corners_[i].first;
-        const auto last = cornerLink_.begin() + corners_[i + 1].first;
-        const size_t e = size_t(std::lower_bound(first, last, j) - cornerLink_.begin());
-        interpolated += 0.25 * double(std::bitset<64>(cornerOpen_[e]).count());
-      }
+      for (size_t c = 0; c < 4; ++c)
+        interpolated +=
+            0.25 * double(std::bitset<64>(cornerOpen_[tile.cornerEntry[k * 4 + c]]).count());
       const uint64_t open = openRays(visibility_->staticPart(), p, l, l.points);
       const double dv =
           std::abs(double(std::bitset<64>(open).count()) - interpolated) / double(l.rays);
-      double b = 0.0;
-      for (const glm::dvec3& wk : l.weight) b = std::max(b, wk.x + wk.y + wk.z);
-      return b * pointToPolygonFormFactor(p, n, shooter[j]) * dv < partialShare_ * linkGather_[j];
+      return brightest[j] * pointToPolygonFormFactor(p, n, shooter[j]) * dv <
+             partialShare_ * linkGather_[j];
     };
-    std::vector<uint32_t> kept;
+    std::vector<uint32_t> kept, keptEntry;
     std::vector<std::pair<uint64_t, uint32_t>> groups;
     for (size_t g = 0, k = 0; g < tile.groups.size(); ++g) {
       const uint64_t mask = tile.groups[g].first;
       for (; k < tile.groups[g].second; ++k) {
         if (interpolates(k)) {
           kept.push_back(tile.links[k]);
+          keptEntry.insert(keptEntry.end(), tile.cornerEntry.begin() + std::ptrdiff_t(k * 4),
+                           tile.cornerEntry.begin() + std::ptrdiff_t(k * 4 + 4));
           continue;
         }
         ++moved[ti];
@@ -930,6 +930,7 @@ void GoodLinkGather::perTexelOnTiles(
         groups.emplace_back(mask, uint32_t(kept.size()));
     }
     tile.links.swap(kept);
+    tile.cornerEntry.swap(keptEntry);
     tile.groups.swap(groups);
   });
   for (long m : moved) partialTileLinksPerTexel_ += size_t(m);

@@ -311,8 +311,7 @@ class GoodLinkGather {
   };
   TexelFrame texelFrame(double t) const;
   std::vector<char> coveredTiles() const;
-  void perTexelOnTiles(const std::unordered_map<size_t, size_t>& cornerIndex,
-                       const std::vector<Polygon>& shooter,
+  void perTexelOnTiles(const std::vector<Polygon>& shooter,
                        std::vector<std::vector<uint32_t>>& nearOfTile,
                        std::vector<std::vector<std::pair<uint64_t, uint32_t>>>& nearBelow);
   void planVisibility(Link& l, const std::vector<char>& neededKeys) const;

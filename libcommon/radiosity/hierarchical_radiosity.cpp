@@ -130,10 +130,6 @@ bool mutuallyFacing(const Polygon& p, const FacingPlane& pPlane, const Polygon& 
   return someVertexInFront(p, pPlane, qPlane) && someVertexInFront(q, qPlane, pPlane);
 }
 
-bool mutuallyFacing(const Polygon& p, const Polygon& q) {
-  return mutuallyFacing(p, facingPlane(p), q, facingPlane(q));
-}
-
 uint64_t linkSeed(PatchId receiver, PatchId shooter) {
   return splitMix64(splitMix64(splitMix64(receiver.packed()) ^ shooter.packed()) +
                     0x9E3779B97F4A7C15ull);

@@ -318,11 +318,9 @@ double linkFormFactorIntegral(const Polygon& p, const Polygon& q, double relTol)
 double linkFormFactorFrom(const Polygon& p, const Polygon& q, double fromSmaller);
 
 // True when the top-level patches p and q can exchange energy at all: some vertex of each lies
-// strictly in front of the other's plane.
-bool mutuallyFacing(const Polygon& p, const Polygon& q);
-// The same with each polygon's plane made once (facingPlane) where one polygon meets many: the
-// cluster refinement's patch pairs, 1.4 M a key on the 10k-triangle hall, tested one by one on
-// the main thread, had recomputed both normals and centroids for each.
+// strictly in front of the other's plane. Each polygon's plane is made once (facingPlane), as
+// one polygon meets many: the cluster refinement's patch pairs, 1.4 M a key on the 10k-triangle
+// hall, tested one by one on the main thread, had recomputed both normals and centroids each.
 struct FacingPlane {
   glm::dvec3 normal, centroid;
   double size = 0.0;  // polygonSize: the tolerance's scale
