@@ -57,6 +57,38 @@ void clipToFront(const glm::dvec3* v, std::size_t count, const glm::dvec3& n, co
   }
 }
 
+}  // namespace
+
+// Reduced to |t| <= tan(pi/8) with one division (atan y/x = pi/2 - atan x/y = pi/4 + atan
+// (y - x)/(y + x)), then atan t = t g(t^2) with g a degree-10 polynomial fitted to atan(sqrt z) /
+// sqrt z on [0, tan^2(pi/8)] at Chebyshev nodes (mpmath.chebyfit, 40 digits: relative error
+// 3.5e-17, below half an ulp).
+double edgeAngle(double crossLength, double dot) {
+  constexpr double kTanPi8 = 0.41421356237309504880, kTan3Pi8 = 2.41421356237309504880;
+  constexpr double kCoefficients[] = {
+      1.0,                     -0.333333333333284385718, 0.199999999988551101336,
+      -0.142857141809764668302, 0.111111061804559452198, -0.0909077307480841378967,
+      0.0768995349630685775628, -0.0664023393042940858874, 0.0568834922680901047935,
+      -0.043480522157164624777, 0.0211353731576932452057};
+  const double y = crossLength, ax = std::abs(dot);
+  if (!(y > 0.0)) return dot < 0.0 ? kPi : 0.0;  // a, b parallel (or y NaN)
+  double t, base;
+  if (y <= kTanPi8 * ax) {
+    t = y / ax, base = 0.0;
+  } else if (y >= kTan3Pi8 * ax) {
+    t = -ax / y, base = 0.5 * kPi;
+  } else {
+    t = (y - ax) / (y + ax), base = 0.25 * kPi;
+  }
+  const double z = t * t;
+  double g = kCoefficients[10];
+  for (int i = 9; i >= 0; --i) g = g * z + kCoefficients[i];
+  const double a = base + t * g;
+  return dot < 0.0 ? kPi - a : a;
+}
+
+namespace {
+
 // Contour sum for a polygon entirely in front of the element's tangent plane:
 // \frac{1}{2\pi} \sum_k \gamma_k \hat n \cdot \widehat{R_{k+1} \times R_k}.
 // R_k \times R_{k+1} is computed as R \times (v_{k+1} - v_k) with R the shorter of R_k, R_{k+1}:
@@ -76,7 +108,7 @@ double contourSum(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3* w,
     glm::dvec3 c = glm::cross(r, b - a);  // = R_k x R_{k+1}
     double cl = glm::length(c);
     if (!(cl > 0.0)) continue;  // p on the edge's line: the term vanishes
-    double gamma = std::atan2(cl, glm::dot(rk, rk1));
+    double gamma = edgeAngle(cl, glm::dot(rk, rk1));
     sum -= gamma * glm::dot(n, c) / cl;  // n . (R_{k+1} x R_k) = -n . c
   }
   return sum / (2.0 * kPi);
