@@ -2,6 +2,7 @@
 #include "libcommon/radiosity/cluster_links.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -281,28 +282,44 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
     // 10k-triangle hall's light through cluster links 2.4 % dark at --light-cluster-share 1.
     const std::vector<double>& shooterPrefix =
         emits(l.shooter) ? memberPowerPrefix_ : memberAreaPrefix_;
-    double sumK = 0.0, openK = 0.0;
-    int open = 0;
-    for (int k = 0; k < rays_; ++k) {
-      const uint64_t c = uint64_t(k) * 6;
-      const uint32_t a = pick(l.receiver, uniformOpen01(seed, c), memberAreaPrefix_);
-      const uint32_t b = pick(l.shooter, uniformOpen01(seed, c + 1), shooterPrefix);
-      const glm::dvec3 x =
-          pointOnPolygon(world_[a], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
-      const glm::dvec3 y =
-          pointOnPolygon(world_[b], uniformOpen01(seed, c + 4), uniformOpen01(seed, c + 5));
-      const glm::dvec3 xy = y - x;
+    // The pairs first, then the rays: where some pair's kernel is positive, V = open kernel /
+    // kernel, and the rays of pairs whose kernel is 0 (facing away: a chair's back, a desk's
+    // underside) count for nothing, so they are not cast. Only when every kernel is 0 does V
+    // fall back to the open rays' share, and then every ray is cast.
+    struct RayPair {
+      glm::dvec3 x, y;
+      uint32_t a, b;
+      double kernel;
+    };
+    const int k = rays_;
+    std::array<RayPair, 64> onStack;
+    std::vector<RayPair> onHeap(k > 64 ? size_t(k) : 0);
+    RayPair* pairs = k > 64 ? onHeap.data() : onStack.data();
+    double sumK = 0.0;
+    for (int i = 0; i < k; ++i) {
+      const uint64_t c = uint64_t(i) * 6;
+      RayPair& p = pairs[size_t(i)];
+      p.a = pick(l.receiver, uniformOpen01(seed, c), memberAreaPrefix_);
+      p.b = pick(l.shooter, uniformOpen01(seed, c + 1), shooterPrefix);
+      p.x = pointOnPolygon(world_[p.a], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
+      p.y = pointOnPolygon(world_[p.b], uniformOpen01(seed, c + 4), uniformOpen01(seed, c + 5));
+      const glm::dvec3 xy = p.y - p.x;
       const double len2 = glm::dot(xy, xy);
-      const double kernel = len2 > 0.0 ? std::max(0.0, glm::dot(world_[a].normal(), xy)) *
-                                             std::max(0.0, -glm::dot(world_[b].normal(), xy)) /
-                                             (len2 * len2)
-                                       : 0.0;
-      const bool isOpen = !visibility_->occluded(x, y, a, b);
-      open += isOpen ? 1 : 0;
-      sumK += kernel;
-      openK += isOpen ? kernel : 0.0;
+      p.kernel = len2 > 0.0 ? std::max(0.0, glm::dot(world_[p.a].normal(), xy)) *
+                                  std::max(0.0, -glm::dot(world_[p.b].normal(), xy)) / (len2 * len2)
+                            : 0.0;
+      sumK += p.kernel;
     }
-    v = sumK > 0.0 ? openK / sumK : double(open) / double(rays_);
+    double openK = 0.0;
+    int open = 0;
+    for (int i = 0; i < k; ++i) {
+      const RayPair& p = pairs[size_t(i)];
+      if (sumK > 0.0 && !(p.kernel > 0.0)) continue;
+      const bool isOpen = !visibility_->occluded(p.x, p.y, p.a, p.b);
+      open += isOpen ? 1 : 0;
+      openK += isOpen ? p.kernel : 0.0;
+    }
+    v = sumK > 0.0 ? openK / sumK : double(open) / double(k);
   }
   l.visibility = float(v);
 }
