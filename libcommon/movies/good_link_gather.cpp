@@ -129,8 +129,10 @@ void GoodLinksByReceiver::smoothClusterIrradiance(const GlobalSolution& s) {
     return std::make_tuple(tops[t].node, v.x + 0.0, v.y + 0.0, v.z + 0.0);  // -0 as +0
   };
   std::vector<glm::dvec3> normal(T);
+  std::vector<double> area(T);
   for (size_t t = 0; t < T; ++t) {
     normal[t] = tops[t].local.normal();
+    area[t] = tops[t].local.area();
     for (int c = 0; c < tops[t].local.count; ++c) atCorner[key(t, c)].push_back(uint32_t(t));
   }
   const double sameFacing = std::cos(8.0 * M_PI / 180.0);
@@ -139,14 +141,25 @@ void GoodLinksByReceiver::smoothClusterIrradiance(const GlobalSolution& s) {
     for (int c = 0; c < tops[t].local.count; ++c) {
       const std::vector<uint32_t>& shared = atCorner.at(key(t, c));
       for (size_t k = 0; k < K; ++k) {
-        glm::dvec3 sum(0.0);
+        // Weighted by each top's exposed area: a top mostly covered by a touching surface (a
+        // ceiling tile behind a light) takes its own cluster links' light from the few of their
+        // rays that start uncovered, over its small exposure (a noisy value), and a wholly
+        // covered one gathers none (0). Equal shares had carried both to the corners of their
+        // uncovered neighbours: streaks along every light of the 10k-triangle hall.
+        glm::dvec3 sum(0.0), plain(0.0);
+        double weight = 0.0;
         int n = 0;
         for (uint32_t o : shared)
           if (glm::dot(normal[o], normal[t]) >= sameFacing) {
-            sum += glm::dvec3(s.topClusterIrradiance[size_t(o) * K + k]);
+            const glm::dvec3 e(s.topClusterIrradiance[size_t(o) * K + k]);
+            const double w = area[o] * s.exposureAtKey(int(o), int(k));
+            sum += w * e;
+            weight += w;
+            plain += e;
             ++n;
           }
-        clusterCorners[(t * K + k) * 4 + size_t(c)] = glm::vec3(sum / double(n));
+        clusterCorners[(t * K + k) * 4 + size_t(c)] =
+            glm::vec3(weight > 0.0 ? sum / weight : plain / double(n));
       }
     }
 }

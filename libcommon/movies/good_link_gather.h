@@ -132,8 +132,9 @@ struct GoodLinksByReceiver {
   std::unordered_map<HiddenLink, double, HiddenLinkHash> hiddenFormFactor;
   void indexAllLinks(const GlobalSolution& solution);
   // The cluster irradiance at each top's corners, [(top * K + k) * 4 + c] (empty without
-  // cluster links): the mean of topClusterIrradiance over the tops of the same mesh node that
-  // share the corner's position and face the same way (normals within 8 degrees). The gather
+  // cluster links): the mean of topClusterIrradiance, weighted by exposed area, over the tops of
+  // the same mesh node that share the corner's position and face the same way (normals within 8
+  // degrees; the plain mean where all of them are covered). The gather
   // interpolates it over the top, so that a wall of tiles whose clusters link differently shades
   // smoothly instead of in steps of one value per tile (the 10k hall's back wall).
   std::vector<glm::vec3> clusterCorners;

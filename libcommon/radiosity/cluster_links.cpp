@@ -426,7 +426,8 @@ void ClusterLinks::buildReceiverLists() {
 // without B, and a link takes $\sum_k w_k N_k / \sum_k w_k D_k$, $w_k = \max(0, \omega \cdot
 // a_k)^2$ (the weights of the direction towards the receiver, which sum to 1): exact for a
 // cluster of uniform B or of one flat patch.
-void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, std::vector<glm::dvec3>& out) {
+void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
+                          std::vector<glm::dvec3>& out) {
   buildReceiverLists();
   const size_t T = emission_.size();
   static const glm::dvec3 kAxis[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
@@ -478,15 +479,18 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, std::vector<glm::
   });
   out.assign(T, glm::dvec3(0.0));
   tbb::parallel_for(size_t(0), T, [&](size_t t) {
-    glm::dvec3 h(0.0);
-    const auto [b, e] = entriesOf(t);
-    for (const GatherEntry* i = b; i != e; ++i)
-      h += double(i->formFactor) * glm::dvec3(linkB_[i->link]);
-    out[t] = h;
+    const double e = exposure.empty() ? 1.0 : exposure[t];
+    if (!(e > 0.0)) return;
+    glm::dvec3 own(0.0), above(0.0);
+    const auto [b, end] = entriesOf(t);
+    for (const GatherEntry* i = b; i != end; ++i)
+      (links_[i->link].receiver == ClusterRef(t) ? own : above) +=
+          double(i->formFactor) * glm::dvec3(linkB_[i->link]);
+    out[t] = own / e + above;
   });
 }
 
-std::vector<double> ClusterLinks::rowSums() {
+std::vector<double> ClusterLinks::rowSums(const std::vector<double>& exposure) {
   // From the gather's lists, so that the row sums are of the very form factors the gather
   // multiplies (in parallel; the serial pass over every link and member top it replaces was
   // 6 % of the 10k-triangle hall's rad-global).
@@ -494,10 +498,13 @@ std::vector<double> ClusterLinks::rowSums() {
   const size_t T = emission_.size();
   std::vector<double> out(T, 0.0);
   tbb::parallel_for(size_t(0), T, [&](size_t t) {
-    const auto [b, e] = entriesOf(t);
-    double sum = 0.0;
-    for (const GatherEntry* i = b; i != e; ++i) sum += double(i->formFactor);
-    out[t] = sum;
+    const double e = exposure.empty() ? 1.0 : exposure[t];
+    if (!(e > 0.0)) return;
+    double own = 0.0, above = 0.0;
+    const auto [b, end] = entriesOf(t);
+    for (const GatherEntry* i = b; i != end; ++i)
+      (links_[i->link].receiver == ClusterRef(t) ? own : above) += double(i->formFactor);
+    out[t] = own / e + above;
   });
   return out;
 }

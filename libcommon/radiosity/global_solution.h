@@ -71,8 +71,9 @@ class GlobalSolution {
   std::vector<std::pair<uint32_t, uint32_t>> badPairs;
   // Irradiance H_cluster (W/m^2, RGB) that top-level patch t gathers through rad-global's cluster
   // links (Smits et al. 1994; Sillion 1995: links above the top-level patches, not hierarchy
-  // nodes) at key k, of its exposed part (already divided by the top's exposure), uniform over
-  // the top and not scaled by any closure factor. Good light: never part of a bad pair.
+  // nodes) at key k, of its exposed part (the links at the top itself divided by its exposure,
+  // those at its ancestor clusters not: their V is the cluster's; 0 for a covered top), uniform
+  // over the top and not scaled by any closure factor. Good light: never part of a bad pair.
   // leafVertexGoodIrradiance already includes it; the per-texel gather adds it itself.
   // [T * K]: top t at key k at t * K + k; empty = none (files before linkhier 1.3).
   std::vector<glm::vec3> topClusterIrradiance;

@@ -226,6 +226,7 @@ class KeyTimeSolver {
       weightVisibilityByShooterRadiosity();
       if (round == 0) releaseRayPairs();
       computeExposures();  // the closure of a closed leaf divides by them too
+      if (clusters_) clusterRow_ = clusters_->rowSums(exposure_);
       if (opt_.closure) computeClosure();
       s_.secondsLinks += secondsSince(tl);
       auto ts = std::chrono::steady_clock::now();
@@ -329,7 +330,6 @@ class KeyTimeSolver {
       clusters_->forgetReuse();
       input_.releaseClusterLinks();
     }
-    clusterRow_ = clusters_->rowSums();
     return refined;
   }
 
@@ -914,8 +914,7 @@ class KeyTimeSolver {
     if (!(coef.x + coef.y > 0.0) || !closedAt(r)) return;
     // The cluster links' share (gathered at the top, over its exposure) is taken as it is.
     const uint32_t top = h_.node(r).id.top;
-    const double cluster =
-        clusterRow_.empty() || !(exposure_[top] > 0.0) ? 0.0 : clusterRow_[top] / exposure_[top];
+    const double cluster = clusterRow_.empty() ? 0.0 : clusterRow_[top];
     if (!(cluster < 1.0)) return;
     const double good =
         coef.y > 0.0 ? (1.0 - cluster - s_.closure[size_t(r)] * coef.x) / coef.y : 0.0;
@@ -1086,11 +1085,10 @@ class KeyTimeSolver {
       maxDelta_ = maxB_ = 0;
       // Cluster links gather from the B of the sweep before (Jacobi for them, Gauss-Seidel
       // for the patch links).
-      if (clusters_) clusters_->gather(B_, clusterH_);
+      if (clusters_) clusters_->gather(B_, exposure_, clusterH_);
       for (int t = 0; t < h_.topCount(); ++t) {
         Gathered top;
-        if (clusters_ && exposure_[size_t(t)] > 0.0)
-          top.cluster = clusterH_[size_t(t)] / exposure_[size_t(t)];
+        if (clusters_) top.cluster = clusterH_[size_t(t)];
         gatherPushPull(t, top);
       }
       ++s_.iterations;
@@ -1117,11 +1115,8 @@ class KeyTimeSolver {
       s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
     }
     if (clusters_) {  // at the final B, as the merge gathers the patch links
-      clusters_->gather(B_, clusterH_);
-      s_.topClusterIrradiance.assign(size_t(h_.topCount()), glm::dvec3(0.0));
-      for (int t = 0; t < h_.topCount(); ++t)
-        if (exposure_[size_t(t)] > 0.0)
-          s_.topClusterIrradiance[size_t(t)] = clusterH_[size_t(t)] / exposure_[size_t(t)];
+      clusters_->gather(B_, exposure_, clusterH_);
+      s_.topClusterIrradiance = clusterH_;
       s_.clusterLinks = clusters_->size();
       s_.clusterLinksReused = clusters_->reusedCount();
       s_.clusterBounds = clusters_->clusterBounds();
