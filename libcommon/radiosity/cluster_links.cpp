@@ -362,6 +362,18 @@ ClusterLinks::entriesOf(size_t t) const {
   return {entries.data() + gatherStart_[t], entries.data() + end};
 }
 
+template <class Sum, class Term>
+Sum ClusterLinks::overExposedPart(size_t t, const std::vector<double>& exposure, Term term) const {
+  const double e = exposure.empty() ? 1.0 : exposure[t];
+  if (!(e > 0.0)) return Sum(0.0);
+  const auto [b, end] = entriesOf(t);
+  const GatherEntry* ownEnd = b + gatherOwn_[t];  // the links at t come first
+  Sum own(0.0), above(0.0);
+  for (const GatherEntry* i = b; i != ownEnd; ++i) own += term(*i);
+  for (const GatherEntry* i = ownEnd; i != end; ++i) above += term(*i);
+  return own / e + above;
+}
+
 void ClusterLinks::buildReceiverLists() {
   if (listsValid_) return;
   const size_t T = emission_.size(), C = size_t(tree_.size());
@@ -387,7 +399,7 @@ void ClusterLinks::buildReceiverLists() {
   // themselves, and counting by computing F twice made its rad-global 19 % slower.
   const size_t blocks = (T + kGatherBlockTops - 1) / kGatherBlockTops;
   gatherBlocks_.resize(blocks);
-  std::vector<uint32_t> start(T, 0);
+  std::vector<uint32_t> start(T, 0), own(T, 0);
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
     std::vector<GatherEntry> entries;
     for (size_t t = b * kGatherBlockTops; t < std::min(T, (b + 1) * kGatherBlockTops); ++t) {
@@ -399,6 +411,7 @@ void ClusterLinks::buildReceiverLists() {
         const auto [first, last] = entriesOf(t);
         for (const GatherEntry* e = first; e != last; ++e)
           entries.push_back({movedTo_[e->link], e->formFactor});
+        own[t] = gatherOwn_[t];
         continue;
       }
       auto add = [&](size_t r) {
@@ -409,12 +422,14 @@ void ClusterLinks::buildReceiverLists() {
         }
       };
       add(t);
+      own[t] = uint32_t(entries.size()) - start[t];
       for (int c = tree_.parentOfTop(int(t)); c >= 0; c = tree_.node(c).parent) add(T + size_t(c));
     }
     entries.shrink_to_fit();
     gatherBlocks_[b].swap(entries);
   });
   gatherStart_.swap(start);
+  gatherOwn_.swap(own);
   std::vector<uint32_t>().swap(movedTo_);
   std::vector<char>().swap(changedReceiver_);
   listsValid_ = true;
@@ -479,14 +494,9 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector
   });
   out.assign(T, glm::dvec3(0.0));
   tbb::parallel_for(size_t(0), T, [&](size_t t) {
-    const double e = exposure.empty() ? 1.0 : exposure[t];
-    if (!(e > 0.0)) return;
-    glm::dvec3 own(0.0), above(0.0);
-    const auto [b, end] = entriesOf(t);
-    for (const GatherEntry* i = b; i != end; ++i)
-      (links_[i->link].receiver == ClusterRef(t) ? own : above) +=
-          double(i->formFactor) * glm::dvec3(linkB_[i->link]);
-    out[t] = own / e + above;
+    out[t] = overExposedPart<glm::dvec3>(t, exposure, [&](const GatherEntry& i) {
+      return double(i.formFactor) * glm::dvec3(linkB_[i.link]);
+    });
   });
 }
 
@@ -498,13 +508,8 @@ std::vector<double> ClusterLinks::rowSums(const std::vector<double>& exposure) {
   const size_t T = emission_.size();
   std::vector<double> out(T, 0.0);
   tbb::parallel_for(size_t(0), T, [&](size_t t) {
-    const double e = exposure.empty() ? 1.0 : exposure[t];
-    if (!(e > 0.0)) return;
-    double own = 0.0, above = 0.0;
-    const auto [b, end] = entriesOf(t);
-    for (const GatherEntry* i = b; i != end; ++i)
-      (links_[i->link].receiver == ClusterRef(t) ? own : above) += double(i->formFactor);
-    out[t] = own / e + above;
+    out[t] = overExposedPart<double>(t, exposure,
+                                     [](const GatherEntry& i) { return double(i.formFactor); });
   });
   return out;
 }

@@ -190,6 +190,9 @@ class ClusterLinks {
   static constexpr size_t kGatherBlockTops = 256;
   std::vector<std::vector<GatherEntry>> gatherBlocks_;
   std::vector<uint32_t> gatherStart_;
+  // Per top: how many of its entries, first, are the links at the top itself (gather divides
+  // them by its exposure): counted when the lists are made, so that the sweeps read no link.
+  std::vector<uint32_t> gatherOwn_;
   bool listsValid_ = false;
   // After a refinement round that changed links, until the lists are made again: each link of
   // the lists' link order at its new index (kGone: refined), and the receivers (clusterLinkEnd
@@ -199,6 +202,11 @@ class ClusterLinks {
   std::vector<char> changedReceiver_;
   // Top t's entries in its block.
   std::pair<const GatherEntry*, const GatherEntry*> entriesOf(size_t t) const;
+  // Sum of term(entry) over top t's entries for its exposed part: the links at the top over its
+  // exposure, those at its ancestor clusters as they are (gather's header comment); 0 for a
+  // covered top.
+  template <class Sum, class Term>
+  Sum overExposedPart(size_t t, const std::vector<double>& exposure, Term term) const;
 };
 
 }  // namespace rad

@@ -905,6 +905,15 @@ TEST(ClusterLinks, ListsTakenOverAfterARoundAreThoseMadeAnew) {
   for (size_t i = 0; i < anew.size(); ++i) ASSERT_EQ(takenOver[i], anew[i]) << i;
 }
 
+// Surfaces of reflectance 0.7, but `light`, which emits 50 and reflects nothing.
+std::vector<SurfaceProperties> greyWithOneLight(size_t count, size_t light) {
+  std::vector<SurfaceProperties> surf(count);
+  for (auto& s : surf) s.reflectance = glm::dvec3(0.7);
+  surf[light].emission = glm::dvec3(50.0);
+  surf[light].reflectance = glm::dvec3(0.0);
+  return surf;
+}
+
 // The point approximation of a cluster link holds only for well separated ends. An open room
 // 12 m long, a light at one end, two tables at the other: the floor tiles there take the far
 // walls' light through cluster links. Against all pairs, the floor beside the tables came out
@@ -922,10 +931,7 @@ TEST(ClusterLinks, ExposedFloorMatchesAllPairsAtTheDefaultSeparation) {
     for (const Polygon& p : tiledBoxFaces({x, 0.7, 0.5}, {x + 1.2, 0.75, 3.0}, false, 2))
       polys.push_back(p);
   VisibilityScene vis(visibilityTrianglesOf(polys));
-  std::vector<SurfaceProperties> surf(polys.size());
-  for (auto& s : surf) s.reflectance = glm::dvec3(0.7);
-  surf[light].emission = glm::dvec3(50.0);
-  surf[light].reflectance = glm::dvec3(0.0);
+  const std::vector<SurfaceProperties> surf = greyWithOneLight(polys.size(), light);
   const KeySolution all = solveTiled(polys, surf, vis, false);
   // Floor tiles at the tables' end that no table covers.
   auto exposedBias = [&](const KeySolution& s) {
@@ -980,10 +986,7 @@ TEST(ClusterLinks, ATileMostlyBehindALightGathersTheClusterLightOfItsExposedPart
   ASSERT_LT(l.normal().y, -0.9) << "faces down";
   polys.push_back(l);
   VisibilityScene vis(visibilityTrianglesOf(polys));
-  std::vector<SurfaceProperties> surf(polys.size());
-  for (auto& s : surf) s.reflectance = glm::dvec3(0.7);
-  surf[light].emission = glm::dvec3(50.0);
-  surf[light].reflectance = glm::dvec3(0.0);
+  const std::vector<SurfaceProperties> surf = greyWithOneLight(polys.size(), light);
   const KeySolution all = solveTiled(polys, surf, vis, false);
   const KeySolution clustered = solveTiled(polys, surf, vis, true);
   ASSERT_GT(clustered.clusterLinks, 100u);

@@ -1327,15 +1327,10 @@ TEST(TextureMovieBaker, ClusterIrradianceRaisesTheGatheredLayerByItsValueAtEvery
   EXPECT_EQ(bake(ramp, GoodLayer::kGouraud).keys, gouraud.keys);
 }
 
-// The cluster light is continuous across tops: a floor of two tiles in one mesh, [0,1] and
-// [1,2] along x, whose tops gather c and 3c through cluster links. The gathered layer rises by
-// c (1 + x) at every texel of both movies: c at the left tile's outer edge, the tiles' mean 2c
-// on their shared edge, 3c at the right one's outer edge. Uniform per top, the shared edge had
-// a step of 2c.
-TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
+// floorUnderCeiling with its floor two unit quads side by side (x in [0, 1] and [1, 2]).
+FloorUnderCeiling floorWithTwoTiles() {
   FloorUnderCeiling f = floorUnderCeiling();
-  Scene& s = f.scene;
-  Mesh& floor = s.meshes[size_t(s.nodes[size_t(f.floor)].mesh)];
+  Mesh& floor = f.scene.meshes[size_t(f.scene.nodes[size_t(f.floor)].mesh)];
   MeshTriangle a1, a2, b1, b2;
   a1.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 0, 0), glm::dvec3(1, 1, 0)};
   a2.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 1, 0), glm::dvec3(0, 1, 0)};
@@ -1343,6 +1338,17 @@ TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
   b2.p = {glm::dvec3(1, 0, 0), glm::dvec3(2, 1, 0), glm::dvec3(1, 1, 0)};
   a1.material = a2.material = b1.material = b2.material = 0;
   floor.triangles = {a1, a2, b1, b2};
+  return f;
+}
+
+// The cluster light is continuous across tops: a floor of two tiles in one mesh, [0,1] and
+// [1,2] along x, whose tops gather c and 3c through cluster links. The gathered layer rises by
+// c (1 + x) at every texel of both movies: c at the left tile's outer edge, the tiles' mean 2c
+// on their shared edge, 3c at the right one's outer edge. Uniform per top, the shared edge had
+// a step of 2c.
+TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
+  FloorUnderCeiling f = floorWithTwoTiles();
+  Scene& s = f.scene;
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
   g.topClusterIrradiance.clear();
   std::vector<int> tiles;
@@ -1385,16 +1391,8 @@ TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
 // Here the uncovered tile gathers its own value at every texel, its covered neighbour's 100
 // times larger one notwithstanding (before: half of it at the shared edge).
 TEST(TextureMovieBaker, ClusterIrradianceOfACoveredTopDoesNotReachItsNeighbours) {
-  FloorUnderCeiling f = floorUnderCeiling();
+  FloorUnderCeiling f = floorWithTwoTiles();
   Scene& s = f.scene;
-  Mesh& floor = s.meshes[size_t(s.nodes[size_t(f.floor)].mesh)];
-  MeshTriangle a1, a2, b1, b2;
-  a1.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 0, 0), glm::dvec3(1, 1, 0)};
-  a2.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 1, 0), glm::dvec3(0, 1, 0)};
-  b1.p = {glm::dvec3(1, 0, 0), glm::dvec3(2, 0, 0), glm::dvec3(2, 1, 0)};
-  b2.p = {glm::dvec3(1, 0, 0), glm::dvec3(2, 1, 0), glm::dvec3(1, 1, 0)};
-  a1.material = a2.material = b1.material = b2.material = 0;
-  floor.triangles = {a1, a2, b1, b2};
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
   g.topClusterIrradiance.clear();
   int left = -1, right = -1;
