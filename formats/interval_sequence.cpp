@@ -72,6 +72,7 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
   run.topPatches = ph.topCount();
   run.patchNodes = ph.size();
   run.itemBufferSeconds = builder.itemBufferSeconds();
+  run.continuedOverGaps = builder.moviesContinuedOverGaps();
   return run;
 }
 
@@ -84,6 +85,7 @@ nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::st
   report["image_size"] = {run.intervals.imageWidth, run.intervals.imageHeight};
   report["top_patches"] = run.topPatches;
   report["patch_nodes"] = run.patchNodes;
+  report["hidden_gaps_continued"] = run.continuedOverGaps;
   report["item_buffer_ms_per_frame"] = 1e3 * run.itemBufferSeconds / n;
   // The first frame pays for shader compilation and driver warm-up: the median is the figure.
   std::vector<double> itemSeconds = run.itemSeconds;

@@ -28,6 +28,7 @@ struct IntervalSequence {
   int topPatches = 0;
   int patchNodes = 0;
   double itemBufferSeconds = 0.0;   // total render + readback
+  long continuedOverGaps = 0;       // hidden gaps a movie was kept over (--hidden-gap)
   std::vector<double> itemSeconds;  // per frame, in frame order
   double setupSeconds = 0.0;        // builder set-up (GL context, hierarchy)
   double totalSeconds = 0.0;        // set-up and every frame

@@ -17,7 +17,8 @@ nlohmann::json IntervalsOptions::toJson() const {
           {"max-size", b.maxSize},
           {"resize-tolerance", b.resizeTolerance},
           {"size-ratio", b.sizeRatio},
-          {"max-length", b.maxLength}};
+          {"max-length", b.maxLength},
+          {"hidden-gap", b.hiddenGap}};
 }
 
 }  // namespace rad

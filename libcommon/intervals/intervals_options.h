@@ -26,7 +26,7 @@ struct IntervalsOptions {
 
   // Provenance parameters; keys are the long option names without "--": frames, fps, size,
   // camera, item-buffers, max-level, min-visible-fraction, level-hysteresis, texel-density,
-  // min-size, max-size, resize-tolerance, max-length.
+  // min-size, max-size, resize-tolerance, max-length, hidden-gap.
   nlohmann::json toJson() const;
 };
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <map>
 
 #include "libcommon/core/error.h"
@@ -46,6 +47,7 @@ void TextureIntervalsOptions::validate() const {
     throw bad("--resize-tolerance", "must be >= 0");
   if (!(sizeRatio >= 1.2 && sizeRatio <= 4.0)) throw bad("--size-ratio", "must be in [1.2, 4]");
   if (maxLength < 0) throw bad("--max-length", "must be >= 0 (0 = unlimited)");
+  if (hiddenGap < 0) throw bad("--hidden-gap", "must be >= 0 (0 = close when hidden)");
 }
 
 int textureSideFor(double projectedPixels, int current, const TextureIntervalsOptions& o) {
@@ -82,6 +84,11 @@ struct TextureIntervalsBuilder::Impl {
   std::vector<int> openMovie;
   std::vector<int> openList;    // dense nodes with an open movie, ascending
   std::vector<char> openBelow;  // per node: a descendant had an open movie last frame
+  // Movies whose node is hidden, kept over a gap of at most hiddenGap frames (header): per
+  // dense node its movie (-1 = none) and hidden frames so far, and the nodes, ascending.
+  std::vector<int> hiddenMovie, hiddenFrames;
+  std::vector<int> hiddenList;
+  long continuedOverGaps = 0;
   std::vector<MovieExtent> movies;
   int lastFrame = 0;
   int frames = 0;
@@ -137,6 +144,8 @@ struct TextureIntervalsBuilder::Impl {
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
     openMovie.assign(hierarchy.size(), -1);
+    hiddenMovie.assign(hierarchy.size(), -1);
+    hiddenFrames.assign(hierarchy.size(), 0);
     openBelow.assign(hierarchy.size(), 0);
   }
 
@@ -199,6 +208,33 @@ struct TextureIntervalsBuilder::Impl {
       }
     }
     return false;
+  }
+
+  // The movies of hidden nodes (hiddenList) at this frame: a node chosen again at its movie's
+  // size takes the movie back (the chosen nodes' loop then extends it over the gap); a
+  // relative chosen, a gap past hiddenGap, or a return at another size or past maxLength ends
+  // it where it was last seen, as hidden.
+  void continueOverGaps(int frame, const std::vector<char>& isChosen) {
+    std::vector<int> still;
+    for (int node : hiddenList) {
+      const int idx = hiddenMovie[node];
+      const MovieExtent& m = movies[idx];
+      bool keep = false;
+      if (isChosen[node]) {
+        const bool full = options.maxLength > 0 && frame - m.firstFrame >= options.maxLength;
+        if (!full && textureSideFor(area[node], m.width, options) == m.width) {
+          openMovie[node] = idx;
+          ++continuedOverGaps;
+        }
+      } else if (++hiddenFrames[node] <= options.hiddenGap && !relativeChosen(node, isChosen)) {
+        keep = true;
+      }
+      if (keep)
+        still.push_back(node);
+      else
+        hiddenMovie[node] = -1;
+    }
+    hiddenList.swap(still);
   }
 
   int openNew(int node, int frame, int side) {
@@ -264,13 +300,12 @@ struct TextureIntervalsBuilder::Impl {
     std::vector<char> isChosen(hierarchy.size(), 0);
     for (int i : chosen) isChosen[i] = 1;
 
-    // Close the movies whose node is no longer chosen (§4.1 events).
-    std::vector<int> stillOpen;
+    continueOverGaps(frame, isChosen);
+    // Close the movies whose node is no longer chosen (§4.1 events); a hidden node's movie
+    // waits for it over a gap (header).
+    std::vector<int> newlyHidden;
     for (int node : openList) {
-      if (isChosen[node]) {
-        stillOpen.push_back(node);
-        continue;
-      }
+      if (isChosen[node]) continue;
       MovieExtent& m = movies[openMovie[node]];
       if (relativeChosen(node, isChosen))
         m.end = MovieEnd::kLevelChange;
@@ -278,8 +313,17 @@ struct TextureIntervalsBuilder::Impl {
         m.end = MovieEnd::kLeftFrustum;
       else
         m.end = MovieEnd::kHidden;
+      if (m.end == MovieEnd::kHidden && options.hiddenGap > 0) {
+        hiddenMovie[node] = openMovie[node];
+        hiddenFrames[node] = 1;
+        newlyHidden.push_back(node);
+      }
       openMovie[node] = -1;
     }
+    std::vector<int> merged;
+    std::merge(hiddenList.begin(), hiddenList.end(), newlyHidden.begin(), newlyHidden.end(),
+               std::back_inserter(merged));
+    hiddenList.swap(merged);
     // Continue, restart (size, length) or open the chosen nodes' movies.
     chosenMovie.assign(chosen.size(), -1);
     for (size_t c = 0; c < chosen.size(); ++c) {
@@ -346,6 +390,9 @@ double TextureIntervalsBuilder::itemBufferSeconds() const {
 }
 int TextureIntervalsBuilder::framesAdded() const {
   return impl_->frames;
+}
+long TextureIntervalsBuilder::moviesContinuedOverGaps() const {
+  return impl_->continuedOverGaps;
 }
 
 std::vector<MovieExtent> TextureIntervalsBuilder::finish() {

@@ -124,6 +124,10 @@ int main(int argc, char** argv) {
       ->check(rad::finiteRange(1.2, 4.0));
   app.add_option("--max-length", o.build.maxLength, "longest movie in frames (0 = no limit)")
       ->capture_default_str();
+  app.add_option("--hidden-gap", o.build.hiddenGap,
+                 "keep a movie whose node is hidden for at most this many frames and then seen "
+                 "again at the same size (0: close it at the first hidden frame)")
+      ->capture_default_str();
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o, argc, argv); });
 }
