@@ -218,12 +218,13 @@ struct TextureIntervalsBuilder::Impl {
     std::vector<int> still;
     for (int node : hiddenList) {
       const int idx = hiddenMovie[node];
-      const MovieExtent& m = movies[idx];
+      MovieExtent& m = movies[idx];
       bool keep = false;
       if (isChosen[node]) {
         const bool full = options.maxLength > 0 && frame - m.firstFrame >= options.maxLength;
         if (!full && textureSideFor(area[node], m.width, options) == m.width) {
           openMovie[node] = idx;
+          m.end = MovieEnd::kWindow;  // open again: ends as an open movie does
           ++continuedOverGaps;
         }
       } else if (++hiddenFrames[node] <= options.hiddenGap && !relativeChosen(node, isChosen)) {

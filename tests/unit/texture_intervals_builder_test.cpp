@@ -236,6 +236,7 @@ TEST(TextureIntervalsBuilder, ShortHiddenGapKeepsTheMovie) {
       ASSERT_EQ(mine.size(), 1u) << gap;
       EXPECT_EQ(mine[0].firstFrame, 0);
       EXPECT_EQ(mine[0].lastFrame, 60);
+      EXPECT_EQ(mine[0].end, MovieEnd::kWindow);
       EXPECT_EQ(b.moviesContinuedOverGaps(), 1);
     } else {
       ASSERT_EQ(mine.size(), 2u) << gap;
@@ -521,6 +522,8 @@ long checkInvariants(const Scene& scene, int camera, const std::vector<int>& fra
     if (o.maxLength > 0) {
       EXPECT_LE(m.lastFrame - m.firstFrame + 1, o.maxLength);
     }
+    // Open at the window's last frame: it ends as kWindow, whatever gaps it went over.
+    if (m.lastFrame == frames.back()) EXPECT_EQ(m.end, MovieEnd::kWindow) << i;
     auto after = std::upper_bound(frames.begin(), frames.end(), m.lastFrame);
     int next = after == frames.end() ? m.lastFrame + 1 : *after;
     bool nodeNext = uses.count({next, m.patch.packed()}) > 0;
