@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <iterator>
 #include <map>
 
 #include "libcommon/core/error.h"
@@ -84,10 +83,12 @@ struct TextureIntervalsBuilder::Impl {
   std::vector<int> openMovie;
   std::vector<int> openList;    // dense nodes with an open movie, ascending
   std::vector<char> openBelow;  // per node: a descendant had an open movie last frame
-  // Movies whose node is hidden, kept over a gap of at most hiddenGap frames (header): per
-  // dense node its movie (-1 = none) and hidden frames so far, and the nodes, ascending.
-  std::vector<int> hiddenMovie, hiddenFrames;
-  std::vector<int> hiddenList;
+  // Movies whose node is hidden, kept over a gap of at most hiddenGap frames (header), with
+  // the frames their node has been hidden so far (each node's independently of the others').
+  struct HiddenMovie {
+    int node = 0, movie = 0, frames = 0;
+  };
+  std::vector<HiddenMovie> hidden;
   long continuedOverGaps = 0;
   std::vector<MovieExtent> movies;
   int lastFrame = 0;
@@ -144,8 +145,6 @@ struct TextureIntervalsBuilder::Impl {
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
     openMovie.assign(hierarchy.size(), -1);
-    hiddenMovie.assign(hierarchy.size(), -1);
-    hiddenFrames.assign(hierarchy.size(), 0);
     openBelow.assign(hierarchy.size(), 0);
   }
 
@@ -210,32 +209,31 @@ struct TextureIntervalsBuilder::Impl {
     return false;
   }
 
-  // The movies of hidden nodes (hiddenList) at this frame: a node chosen again at its movie's
-  // size takes the movie back (the chosen nodes' loop then extends it over the gap); a
-  // relative chosen, a gap past hiddenGap, or a return at another size or past maxLength ends
-  // it where it was last seen, as hidden.
+  // Whether movie m has lasted maxLength frames at `frame`.
+  bool reachedMaxLength(const MovieExtent& m, int frame) const {
+    return options.maxLength > 0 && frame - m.firstFrame >= options.maxLength;
+  }
+
+  // The movies of hidden nodes at this frame: a node chosen again at its movie's size takes
+  // the movie back (the chosen nodes' loop then extends it over the gap); a relative chosen, a
+  // gap past hiddenGap, or a return at another size or past maxLength ends it where it was last
+  // seen, as hidden.
   void continueOverGaps(int frame, const std::vector<char>& isChosen) {
-    std::vector<int> still;
-    for (int node : hiddenList) {
-      const int idx = hiddenMovie[node];
-      MovieExtent& m = movies[idx];
-      bool keep = false;
-      if (isChosen[node]) {
-        const bool full = options.maxLength > 0 && frame - m.firstFrame >= options.maxLength;
-        if (!full && textureSideFor(area[node], m.width, options) == m.width) {
-          openMovie[node] = idx;
+    std::vector<HiddenMovie> still;
+    for (HiddenMovie h : hidden) {
+      MovieExtent& m = movies[h.movie];
+      if (isChosen[h.node]) {
+        if (!reachedMaxLength(m, frame) &&
+            textureSideFor(area[h.node], m.width, options) == m.width) {
+          openMovie[h.node] = h.movie;
           m.end = MovieEnd::kWindow;  // open again: ends as an open movie does
           ++continuedOverGaps;
         }
-      } else if (++hiddenFrames[node] <= options.hiddenGap && !relativeChosen(node, isChosen)) {
-        keep = true;
+      } else if (++h.frames <= options.hiddenGap && !relativeChosen(h.node, isChosen)) {
+        still.push_back(h);
       }
-      if (keep)
-        still.push_back(node);
-      else
-        hiddenMovie[node] = -1;
     }
-    hiddenList.swap(still);
+    hidden.swap(still);
   }
 
   int openNew(int node, int frame, int side) {
@@ -304,7 +302,6 @@ struct TextureIntervalsBuilder::Impl {
     continueOverGaps(frame, isChosen);
     // Close the movies whose node is no longer chosen (§4.1 events); a hidden node's movie
     // waits for it over a gap (header).
-    std::vector<int> newlyHidden;
     for (int node : openList) {
       if (isChosen[node]) continue;
       MovieExtent& m = movies[openMovie[node]];
@@ -314,17 +311,10 @@ struct TextureIntervalsBuilder::Impl {
         m.end = MovieEnd::kLeftFrustum;
       else
         m.end = MovieEnd::kHidden;
-      if (m.end == MovieEnd::kHidden && options.hiddenGap > 0) {
-        hiddenMovie[node] = openMovie[node];
-        hiddenFrames[node] = 1;
-        newlyHidden.push_back(node);
-      }
+      if (m.end == MovieEnd::kHidden && options.hiddenGap > 0)
+        hidden.push_back({node, openMovie[node], 1});
       openMovie[node] = -1;
     }
-    std::vector<int> merged;
-    std::merge(hiddenList.begin(), hiddenList.end(), newlyHidden.begin(), newlyHidden.end(),
-               std::back_inserter(merged));
-    hiddenList.swap(merged);
     // Continue, restart (size, length) or open the chosen nodes' movies.
     chosenMovie.assign(chosen.size(), -1);
     for (size_t c = 0; c < chosen.size(); ++c) {
@@ -333,7 +323,7 @@ struct TextureIntervalsBuilder::Impl {
       if (idx >= 0) {
         MovieExtent& m = movies[idx];
         int side = textureSideFor(area[node], m.width, options);
-        bool full = options.maxLength > 0 && frame - m.firstFrame >= options.maxLength;
+        const bool full = reachedMaxLength(m, frame);
         if (!full && side == m.width) {
           m.lastFrame = frame;
           chosenMovie[c] = idx;

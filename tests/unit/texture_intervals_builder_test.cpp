@@ -186,19 +186,30 @@ TEST(TextureIntervalsBuilder, PatchEnteringTheFrustumOpensAtTheExactFrame) {
   for (size_t i = 0; i + 1 < mine.size(); ++i) EXPECT_EQ(mine[i].end, MovieEnd::kLevelChange) << i;
 }
 
+// A 2 m rectangle at z = -10 and an occluder `halfWidth` m either side of its centre at z = -5
+// sliding across in front of it, centre x(f) = -10 + 0.3 f; the rectangle is [-0.5, 0.5] at
+// z = -5 in projection. One level only: no level changes, only visibility events.
+struct OccluderPassing {
+  TestScene s;
+  int back = -1, occluder = -1;
+  TextureIntervalsOptions o;
+  explicit OccluderPassing(double halfWidth) {
+    back = s.addRect("back", -1.0, -1.0, 1.0, 1.0, -10.0);
+    occluder = s.addRect("occluder", -halfWidth, -3.0, halfWidth, 3.0, -5.0);
+    s.move(occluder, {-10, 0, 0}, {20, 0, 0}, 100.0 / 24.0);
+    o.imageSize = kSize;
+    o.maxLevel = 0;
+  }
+};
+
 // A wide occluder slides across in front of a small rectangle: the rectangle's movie closes
 // as hidden the frame before it is fully covered and a new one opens when it reappears.
 TEST(TextureIntervalsBuilder, OccluderPassingInFrontClosesAsHidden) {
-  TestScene s;
-  int back = s.addRect("back", -1.0, -1.0, 1.0, 1.0, -10.0);
-  int occluder = s.addRect("occluder", -2.0, -3.0, 2.0, 3.0, -5.0);
-  // Centre x(f) = -10 + 0.3 f. The occluder (4 m wide at z = -5) hides the back rectangle
-  // ([-0.5, 0.5] at z = -5 in projection) for x in [-1.5, 1.5]: frames 29..38.
-  s.move(occluder, {-10, 0, 0}, {20, 0, 0}, 100.0 / 24.0);
-  TextureIntervalsOptions o;
-  o.imageSize = kSize;
-  o.maxLevel = 0;  // no level changes: only visibility events
-  std::vector<MovieExtent> all = buildTextureIntervals(s.scene, s.camera, frameRange(0, 60), o);
+  // 4 m wide: it hides the back rectangle for x in [-1.5, 1.5], frames 29..38.
+  OccluderPassing p(2.0);
+  const TestScene& s = p.s;
+  const int back = p.back, occluder = p.occluder;
+  std::vector<MovieExtent> all = buildTextureIntervals(s.scene, s.camera, frameRange(0, 60), p.o);
   PatchHierarchy h(s.scene.inputPolygons());
   std::vector<MovieExtent> mine = moviesOfTop(all, topOfNode(h, back));
   ASSERT_EQ(mine.size(), 2u);
@@ -219,13 +230,10 @@ TEST(TextureIntervalsBuilder, OccluderPassingInFrontClosesAsHidden) {
 // hidden gap of 4 frames or more its movie goes on over them; with less, or 0 (the paper's
 // rule), it closes as hidden and a new one opens when the rectangle shows again.
 TEST(TextureIntervalsBuilder, ShortHiddenGapKeepsTheMovie) {
-  TestScene s;
-  int back = s.addRect("back", -1.0, -1.0, 1.0, 1.0, -10.0);
-  int occluder = s.addRect("occluder", -1.05, -3.0, 1.05, 3.0, -5.0);
-  s.move(occluder, {-10, 0, 0}, {20, 0, 0}, 100.0 / 24.0);
-  TextureIntervalsOptions o;
-  o.imageSize = kSize;
-  o.maxLevel = 0;
+  OccluderPassing p(1.05);
+  const TestScene& s = p.s;
+  TextureIntervalsOptions& o = p.o;
+  const int back = p.back;
   PatchHierarchy h(s.scene.inputPolygons());
   for (int gap : {0, 3, 4, 6}) {
     o.hiddenGap = gap;
