@@ -172,11 +172,13 @@ struct TextureIntervalsBuilder::Impl {
     wholeArea(i);
     // Level hysteresis: a node represented by itself last frame keeps it down to theta - h; a
     // node represented by descendants last frame needs theta + h to take over again.
+    // From scratch (maxLength 1) no movie goes on to the next frame: no hysteresis either.
+    const double h = options.maxLength == 1 ? 0.0 : options.levelHysteresis;
     double theta = options.minVisibleFraction;
     if (openMovie[i] >= 0)
-      theta -= options.levelHysteresis;
+      theta -= h;
     else if (openBelow[i])
-      theta += options.levelHysteresis;
+      theta += h;
     bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
     // A node seen on fewer pixels than its four children's smallest textures hold (4 minSize^2)
     // keeps one texture: splitting it adds movies, not resolution (the 10k-triangle hall's

@@ -31,11 +31,17 @@
 //    another size, or has lasted maxLength frames; movies open at the end of the window close
 //    with kWindow.
 //
-// Level hysteresis (levelHysteresis = h, beyond the paper, default 0): a node represented by
+// Level hysteresis (levelHysteresis = h, beyond the paper, default 0.4): a node represented by
 // itself in the previous frame stays so while its visible fraction is >= theta - h; a node
 // represented by its descendants in the previous frame goes back to one texture only when
 // its fraction is >= theta + h. Other nodes use theta. This keeps patches whose fraction
-// hovers around theta from switching level every frame.
+// hovers around theta from switching level every frame: each switch ends the movies of one
+// level and starts the other's, and a new movie pays its whole setup (links, per-texel form
+// factors, static shadows) whatever its length. With the paper's rule (h = 0) level changes
+// ended 7,480 of cubes-32's 9,541 movies over 400 frames and 2,117 of the 10k hall's 7,811 in
+// 96; at h = 0.4 (children below 10 % visible, the node again from 90 %) 2,833 and 5,661
+// movies for 1.5 % and 2.4 % more texels per frame. The from-scratch baseline (maxLength 1)
+// keeps no movie from frame to frame, so it takes theta alone: each frame's choice is its own.
 //
 // Hidden gaps (hiddenGap = g, beyond the paper): a node hidden behind a nearer surface (in the
 // frustum, no relative chosen) for at most g consecutive frames, then chosen again at the same
@@ -75,7 +81,7 @@ struct TextureIntervalsOptions {
   int maxLevel = 2;                 // depth of the regular subdivision (0 = top-level only)
   double minVisibleFraction = 0.5;  // theta of §4.3
   // Hysteresis on the level choice (0 = the paper's rule): see the header comment.
-  double levelHysteresis = 0.0;
+  double levelHysteresis = 0.4;
   double texelDensity = 1.0;       // texels per covered pixel
   int minSize = 4, maxSize = 256;  // texture side bounds (need not be rungs of the ladder)
   double resizeTolerance = 0.5;    // hysteresis factor (see above)

@@ -385,6 +385,19 @@ TEST(TextureIntervalsBuilder, LevelHysteresisKeepsTheLevelNearTheta) {
   EXPECT_EQ(movies[0].patch.level(), 0);
   EXPECT_EQ(movies[0].firstFrame, 0);
   EXPECT_EQ(movies[0].lastFrame, 29);
+  // From scratch (one-frame movies) each frame chooses by theta alone: the same movies whatever
+  // the hysteresis, children in the frames where less than half is seen.
+  o.maxLength = 1;
+  const std::vector<MovieExtent> paper = levelChanges(0.0).second;
+  const std::vector<MovieExtent> scratch = levelChanges(0.4).second;
+  ASSERT_EQ(scratch.size(), paper.size());
+  int children = 0;
+  for (size_t i = 0; i < paper.size(); ++i) {
+    EXPECT_EQ(scratch[i].patch.packed(), paper[i].patch.packed()) << i;
+    EXPECT_EQ(scratch[i].firstFrame, paper[i].firstFrame) << i;
+    children += paper[i].patch.level() == 1;
+  }
+  EXPECT_GT(children, 0);
 }
 
 TEST(TextureIntervalsBuilder, MaxLengthSplitsMovies) {
@@ -531,7 +544,9 @@ long checkInvariants(const Scene& scene, int camera, const std::vector<int>& fra
       EXPECT_LE(m.lastFrame - m.firstFrame + 1, o.maxLength);
     }
     // Open at the window's last frame: it ends as kWindow, whatever gaps it went over.
-    if (m.lastFrame == frames.back()) EXPECT_EQ(m.end, MovieEnd::kWindow) << i;
+    if (m.lastFrame == frames.back()) {
+      EXPECT_EQ(m.end, MovieEnd::kWindow) << i;
+    }
     auto after = std::upper_bound(frames.begin(), frames.end(), m.lastFrame);
     int next = after == frames.end() ? m.lastFrame + 1 : *after;
     bool nodeNext = uses.count({next, m.patch.packed()}) > 0;

@@ -105,7 +105,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--level-hysteresis", o.build.levelHysteresis,
-                 "keep a patch's level while its visible fraction stays within this of theta")
+                 "keep a patch's level while its visible fraction stays within this of theta (each "
+                 "level change ends movies and starts new ones); 0: the paper's rule; not with "
+                 "--max-length 1 (from scratch)")
       ->capture_default_str()
       ->check(rad::finiteRange(0.0, 1.0));
   app.add_option("--texel-density", o.build.texelDensity, "texels per covered pixel")
