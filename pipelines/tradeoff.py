@@ -44,6 +44,8 @@ KNOBS = [
     ("rays", "global", "--rays", ["4", "64"]),
     ("texel-density", "intervals", "--texel-density", ["0.25", "0.5", "2"]),
     ("size-ratio", "intervals", "--size-ratio", ["2"]),
+    ("level-hysteresis", "intervals", "--level-hysteresis", ["0", "0.2"]),
+    ("hidden-gap", "intervals", "--hidden-gap", ["0", "12"]),
     ("movie-key-step", "movies", "--movie-key-step", ["24", "12", "3", "1"]),
     ("max-samples", "movies", "--max-samples", ["4", "8", "16", "32"]),
     ("weak-share", "movies", "--weak-share", ["0", "0.3"]),
