@@ -180,6 +180,15 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
     }
   };
   auto refineLevel = [&](size_t size, auto&& linkAt) {
+    // The refinement test of every link first, in parallel (a pure function of the link): the
+    // serial loop below still decides in link order, so the links and their order are the same.
+    // Serial, the tests had been 3 % of the 10k-triangle hall's rad-global on one thread.
+    std::vector<char> wants(refineAll ? 0 : size);
+    if (!refineAll)
+      tbb::parallel_for(size_t(0), size, [&](size_t i) {
+        const ClusterLink l = linkAt(i);
+        wants[i] = l.receiver != l.shooter && wantsRefinement(l, epsAbs);
+      });
     std::vector<LinkEnds> next;
     for (size_t i = 0; i < size; ++i) {
       const ClusterLink l = linkAt(i);
@@ -199,7 +208,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
           for (ClusterRef b : ch)
             if (a != b || isCluster(a)) pairOrLink(a, b, next);
       } else {
-        if (!refineAll && !wantsRefinement(l, epsAbs)) {
+        if (!refineAll && !wants[i]) {
           keep(l);
           continue;
         }
