@@ -312,10 +312,17 @@ TEST_F(RadCompose, CorruptedKeyIsOneLineNamingTheFramesWritten) {
 }
 
 TEST_F(RadCompose, MissingMovieAndFramesOutsideTheWindow) {
+  // Two movies missing: the headers are read in parallel, and the first in interval order is
+  // the one reported, on one line.
+  const std::string second = textureMoviePath((dir / "movies").string(), 2);
   fs::remove(textureMoviePath((dir / "movies").string(), 1));
+  fs::rename(second, second + ".away");
   CommandResult r = runCommand(command((dir / "frames").string()));
   EXPECT_EQ(r.exitCode, 1) << r.err;
   EXPECT_NE(r.err.find("000001.exr"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("000002.exr"), std::string::npos) << r.err;
+  EXPECT_EQ(countLines(r.err), 1) << r.err;
+  fs::rename(second + ".away", second);
   r = runCommand(command((dir / "frames2").string(), "--frames 2-9"));
   EXPECT_EQ(r.exitCode, 2) << r.err;
   EXPECT_NE(r.err.find("outside the intervals' window 0-3"), std::string::npos) << r.err;
