@@ -12,6 +12,7 @@
 #include <thread>
 
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include "formats/atomic_file.h"
 #include "formats/texture_movie.h"
@@ -118,12 +119,19 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
 
   auto work = [&](TextureMovieBaker& mine, Worker& w) {
     MovieFileSink sink(mine.options().coherence, w.secondsWrite);
+    // While every worker has a movie of its own, a movie's per-texel loops run on its worker
+    // alone (an arena of one thread): shared, the workers' loops had stolen each other's
+    // tiny ranges. The last movies, fewer than the workers, take every thread again.
+    tbb::task_arena alone(1);
     for (size_t i; !stop && (i = next++) < movies.size();) {
       const MovieExtent& m = *movies[i];
       const auto movieStart = SteadyClock::now();
       try {
         sink.start(textureMovieOf(m, provenanceJson), textureMoviePath(options.moviesDir, m.movie));
-        mine.bake(m, sink);
+        if (workers > 1 && i + workers < movies.size())
+          alone.execute([&] { mine.bake(m, sink); });
+        else
+          mine.bake(m, sink);
       } catch (...) {
         sink.discard();
         std::lock_guard<std::mutex> lock(mutex);
