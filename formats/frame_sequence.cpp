@@ -21,6 +21,22 @@
 namespace rad {
 namespace {
 
+// f(i) for every i < n in parallel (the movie files, one each); when calls throw, the lowest
+// i's exception is rethrown once all have run: the same error whatever the threads.
+template <class F>
+void forEachInParallel(size_t n, F f) {
+  std::vector<std::exception_ptr> failed(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    try {
+      f(i);
+    } catch (...) {
+      failed[i] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
+}
+
 // Throws rad::inputError(path, ...) unless the movie is the one the intervals describe.
 void requireMovieMatches(const TextureMovie& movie, const MovieExtent& iv,
                          const std::string& path) {
@@ -56,25 +72,17 @@ std::map<size_t, TextureMovie> checkMovieHeaders(const TextureIntervals& interva
   for (size_t i = 0; i < intervals.movies.size(); ++i)
     if (usedByFrames(intervals.movies[i], frames)) used.push_back(i);
   std::vector<TextureMovie> read(used.size());
-  std::vector<std::exception_ptr> failed(used.size());
-  tbb::parallel_for(size_t(0), used.size(), [&](size_t u) {
-    try {
-      const MovieExtent& iv = intervals.movies[used[u]];
-      const std::string path = textureMoviePath(dir, iv.movie);
-      read[u] = readTextureMovieHeaders(path);
-      requireMovieMatches(read[u], iv, path);
-      // Kept until the movie is opened: without the baking tool's provenance, which the frames
-      // do not use (a from-scratch run's 74,000 one-frame movies held 150 MB of it).
-      std::string().swap(read[u].provenanceJson);
-    } catch (...) {
-      failed[u] = std::current_exception();
-    }
+  forEachInParallel(used.size(), [&](size_t u) {
+    const MovieExtent& iv = intervals.movies[used[u]];
+    const std::string path = textureMoviePath(dir, iv.movie);
+    read[u] = readTextureMovieHeaders(path);
+    requireMovieMatches(read[u], iv, path);
+    // Kept until the movie is opened: without the baking tool's provenance, which the frames
+    // do not use (a from-scratch run's 74,000 one-frame movies held 150 MB of it).
+    std::string().swap(read[u].provenanceJson);
   });
   std::map<size_t, TextureMovie> headers;
-  for (size_t u = 0; u < used.size(); ++u) {
-    if (failed[u]) std::rethrow_exception(failed[u]);
-    headers.emplace(used[u], std::move(read[u]));
-  }
+  for (size_t u = 0; u < used.size(); ++u) headers.emplace(used[u], std::move(read[u]));
   return headers;
 }
 
@@ -272,16 +280,8 @@ void addMoviesInput(Provenance& provenance, const TextureIntervals& intervals,
       paths.push_back(textureMoviePath(moviesDir, iv.movie));
   // Each file hashed in parallel, the hashes folded in interval order (the same hash).
   std::vector<std::string> fileHash(paths.size());
-  std::vector<std::exception_ptr> failed(paths.size());
-  tbb::parallel_for(size_t(0), paths.size(), [&](size_t i) {
-    try {
-      fileHash[i] = hashFile(paths[i]);
-    } catch (...) {
-      failed[i] = std::current_exception();
-    }
-  });
+  forEachInParallel(paths.size(), [&](size_t i) { fileHash[i] = hashFile(paths[i]); });
   for (size_t i = 0; i < paths.size(); ++i) {
-    if (failed[i]) std::rethrow_exception(failed[i]);
     const std::string& path = paths[i];
     h = fnv1a64(fileHash[i].data(), fileHash[i].size(), h);
     if (record.history.is_null()) {
