@@ -3,6 +3,7 @@
 #include "libcommon/radiosity/visibility.h"
 
 #include <algorithm>
+#include <array>
 #include <bitset>
 #include <cmath>
 #include <deque>
@@ -407,6 +408,54 @@ std::vector<glm::dvec3> VisibilityScene::samplePoints(const Polygon& p, int k, s
       stratified(k, streamSeed(seed, kJitterA), streamSeed(seed, kPermuteA));
   std::vector<glm::dvec3> out(static_cast<std::size_t>(k));
   for (int i = 0; i < k; ++i) out[size_t(i)] = onPolygon(p, s[size_t(i)]);
+  return out;
+}
+
+std::vector<glm::dvec3> VisibilityScene::samplePointsInFront(const Polygon& p, const glm::dvec3& at,
+                                                             const glm::dvec3& n, int k,
+                                                             std::uint64_t seed) {
+  // Behind beyond rounding (a wall's foot on the floor's plane is not behind it).
+  double size = 0.0;
+  for (int i = 1; i < p.count; ++i) size = std::max(size, glm::length(p.v[size_t(i)] - p.v[0]));
+  std::array<double, 4> h{};
+  bool behind = false;
+  for (int i = 0; i < p.count; ++i) {
+    h[size_t(i)] = glm::dot(n, p.v[size_t(i)] - at);
+    behind = behind || h[size_t(i)] < -1e-9 * size;
+  }
+  if (!behind) return samplePoints(p, k, seed);
+  // Sutherland-Hodgman against the plane: a convex polygon of up to 5 vertices.
+  std::array<glm::dvec3, 5> front{};
+  int m = 0;
+  for (int i = 0; i < p.count; ++i) {
+    const int j = (i + 1) % p.count;
+    if (h[size_t(i)] >= 0.0) front[size_t(m++)] = p.v[size_t(i)];
+    if ((h[size_t(i)] > 0.0 && h[size_t(j)] < 0.0) || (h[size_t(i)] < 0.0 && h[size_t(j)] > 0.0))
+      front[size_t(m++)] = p.v[size_t(i)] + h[size_t(i)] / (h[size_t(i)] - h[size_t(j)]) *
+                                                (p.v[size_t(j)] - p.v[size_t(i)]);
+  }
+  // Its fan of triangles from front[0], chosen by area with the first coordinate (strata stay
+  // strata, as onPolygon does for a quad's two halves).
+  std::array<double, 4> area{};
+  double total = 0.0;
+  for (int i = 1; i + 1 < m; ++i) {
+    area[size_t(i - 1)] =
+        glm::length(glm::cross(front[size_t(i)] - front[0], front[size_t(i + 1)] - front[0]));
+    total += area[size_t(i - 1)];
+  }
+  if (!(total > 0.0)) return samplePoints(p, k, seed);  // nothing in front: F is 0 anyway
+  k = std::max(k, 1);
+  const std::vector<glm::dvec2> s =
+      stratified(k, streamSeed(seed, kJitterA), streamSeed(seed, kPermuteA));
+  std::vector<glm::dvec3> out(static_cast<std::size_t>(k));
+  for (int i = 0; i < k; ++i) {
+    double u = s[size_t(i)].x * total;
+    int t = 0;
+    while (t + 1 < m - 2 && u >= area[size_t(t)]) u -= area[size_t(t++)];
+    const double su = std::sqrt(std::clamp(u / area[size_t(t)], 0.0, 1.0)), v = s[size_t(i)].y;
+    out[size_t(i)] = (1.0 - su) * front[0] + su * (1.0 - v) * front[size_t(t + 1)] +
+                     su * v * front[size_t(t + 2)];
+  }
   return out;
 }
 

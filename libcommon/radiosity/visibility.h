@@ -134,6 +134,12 @@ class VisibilityScene {
                              std::uint64_t candidates = ~std::uint64_t(0)) const;
   // k stratified, area-uniform points on p (the strata of visibility()), from `seed`.
   static std::vector<glm::dvec3> samplePoints(const Polygon& p, int k, std::uint64_t seed);
+  // samplePoints over the part of p in front of the plane through `at` with normal n (the same
+  // points as samplePoints where no vertex of p is behind it, or where nothing of p is in
+  // front): a receiver's rays to the part of a shooter behind its plane carry nothing.
+  static std::vector<glm::dvec3> samplePointsInFront(const Polygon& p, const glm::dvec3& at,
+                                                     const glm::dvec3& n, int k,
+                                                     std::uint64_t seed);
   // The surface id of the first triangle that the ray origin + t direction, t in
   // [kSegmentEpsilon, inf), hits, ignoring the triangles of surface `ignore`; kNoSurface when
   // it hits nothing. Thread-safe after commit().

@@ -4,6 +4,7 @@
 #include "libcommon/movies/texture_movie_baker.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -1341,12 +1342,13 @@ FloorUnderCeiling floorWithTwoTiles() {
   return f;
 }
 
-// The cluster light is continuous across tops: a floor of two tiles in one mesh, [0,1] and
-// [1,2] along x, whose tops gather c and 3c through cluster links. The gathered layer rises by
-// c (1 + x) at every texel of both movies: c at the left tile's outer edge, the tiles' mean 2c
-// on their shared edge, 3c at the right one's outer edge. Uniform per top, the shared edge had
-// a step of 2c.
-TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
+// The two floor tiles' cluster-light rise at every texel of their whole-top movies (their tops
+// gathering `left` and `right` through cluster links), against their (u,v) point's x.
+struct TileRise {
+  std::vector<double> x;
+  std::vector<glm::dvec3> rise;
+};
+std::array<TileRise, 2> clusterRiseOfTwoTiles(const glm::vec3& left, const glm::vec3& right) {
   FloorUnderCeiling f = floorWithTwoTiles();
   Scene& s = f.scene;
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
@@ -1354,33 +1356,67 @@ TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
   std::vector<int> tiles;
   for (int t = 0; t < g.hierarchy.topCount(); ++t)
     if (g.hierarchy.top(t).node == f.floor) tiles.push_back(t);
-  ASSERT_EQ(tiles.size(), 2u) << "two quads";
-  const glm::vec3 c(0.125f, 0.25f, 0.0625f);
+  EXPECT_EQ(tiles.size(), 2u) << "two quads";
   GlobalSolution clustered = g;
   clustered.topClusterIrradiance.assign(size_t(g.hierarchy.topCount()), glm::vec3(0.0f));
-  for (int t : tiles) {
-    const bool right = g.hierarchy.top(t).local.centroid().x > 1.0;
-    clustered.topClusterIrradiance[size_t(t)] = right ? 3.0f * c : c;
-  }
+  std::array<TileRise, 2> out;
+  for (int t : tiles)
+    clustered.topClusterIrradiance[size_t(t)] =
+        g.hierarchy.top(t).local.centroid().x > 1.0 ? right : left;
   clustered.validate("test");
-  double worst = 0.0;
   for (int t : tiles) {
-    MovieExtent r = wholeTopMovie(t, 0);
+    TileRise& r = out[g.hierarchy.top(t).local.centroid().x > 1.0 ? 1 : 0];
+    MovieExtent m = wholeTopMovie(t, 0);
     TextureMovieBaker plain(s, g, kFps, {}), with(s, clustered, kFps, {});
-    const BakedMovie a = plain.bake(r), b = with.bake(r);
-    ASSERT_EQ(a.keys.size(), 1u);
-    for (int j = 0; j < r.height; ++j)
-      for (int i = 0; i < r.width; ++i) {
-        const double x =
-            polygonPointAt(g.hierarchy.top(t).local, {(i + 0.5) / r.width, (j + 0.5) / r.height}).x;
-        for (int ch = 0; ch < 3; ++ch) {
-          const size_t at = (size_t(j) * size_t(r.width) + size_t(i)) * 3 + size_t(ch);
-          const double got = double(b.keys[0][at]) - double(a.keys[0][at]);
-          worst = std::max(worst, std::abs(got - c[ch] * (1.0 + x)) / (1.0 + b.keys[0][at]));
-        }
+    const BakedMovie a = plain.bake(m), b = with.bake(m);
+    EXPECT_EQ(a.keys.size(), 1u);
+    for (int j = 0; j < m.height; ++j)
+      for (int i = 0; i < m.width; ++i) {
+        r.x.push_back(
+            polygonPointAt(g.hierarchy.top(t).local, {(i + 0.5) / m.width, (j + 0.5) / m.height})
+                .x);
+        const size_t at = (size_t(j) * size_t(m.width) + size_t(i)) * 3;
+        r.rise.emplace_back(double(b.keys[0][at]) - double(a.keys[0][at]),
+                            double(b.keys[0][at + 1]) - double(a.keys[0][at + 1]),
+                            double(b.keys[0][at + 2]) - double(a.keys[0][at + 2]));
       }
   }
+  return out;
+}
+
+// The cluster light is continuous across tops: a floor of two tiles in one mesh, [0,1] and
+// [1,2] along x, whose tops gather c and 1.1 c through cluster links (within
+// GoodLinksByReceiver::kClusterBand of each other: the spread of the cluster links' estimates).
+// The gathered layer rises by c (1 + 0.05 x) at every texel of both movies: c at the left
+// tile's outer edge, the tiles' mean 1.05 c on their shared edge, 1.1 c at the right one's
+// outer edge. Uniform per top, the shared edge had a step of 0.1 c.
+TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
+  const glm::vec3 c(0.125f, 0.25f, 0.0625f);
+  double worst = 0.0;
+  for (const TileRise& r : clusterRiseOfTwoTiles(c, 1.1f * c))
+    for (size_t i = 0; i < r.x.size(); ++i)
+      for (int ch = 0; ch < 3; ++ch)
+        worst = std::max(worst, std::abs(r.rise[i][ch] - c[ch] * (1.0 + 0.05 * r.x[i])));
   EXPECT_LT(worst, 1e-6);
+}
+
+// A top whose cluster light lies far from its neighbours' (the global pass linked its far
+// surfaces through cluster links, theirs through patch links) keeps its own mean but for the
+// band: tiles gathering c and 3 c. Smoothed as within the band, the left tile's mean rise was
+// 1.5 c and the right one's 2.5 c (the 10k hall's ceiling tiles beside the lights: dark
+// streaks); now c + 0.15 c and 3 c - 0.3 c (kClusterBand of the larger of the two means).
+TEST(TextureMovieBaker, ClusterIrradianceFarFromItsNeighboursKeepsItsOwnMean) {
+  const glm::vec3 c(0.125f, 0.25f, 0.0625f);
+  const std::array<TileRise, 2> r = clusterRiseOfTwoTiles(c, 3.0f * c);
+  for (int side = 0; side < 2; ++side) {
+    glm::dvec3 mean(0.0);
+    for (const glm::dvec3& v : r[size_t(side)].rise) mean += v;
+    mean /= double(r[size_t(side)].rise.size());
+    for (int ch = 0; ch < 3; ++ch) {
+      const double expected = side == 0 ? 1.15 * c[ch] : 2.7 * c[ch];
+      EXPECT_NEAR(mean[ch], expected, 1e-6 * c[ch]) << (side == 0 ? "left" : "right");
+    }
+  }
 }
 
 // A tile that a touching surface covers (exposure 0: a ceiling tile behind a light) gathers

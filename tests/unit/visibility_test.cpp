@@ -316,5 +316,40 @@ TEST(Visibility, RadiosityWeightedVisibilityFollowsWhereTheShooterIsBright) {
   EXPECT_NEAR(seen, 0.5, 0.1);
 }
 
+// A shooter crossing the receiver's plane (S: y = 0, z from -2 to 1, seen from the square
+// z = 0): its points for a texel's rays lie on its part in front (z >= 0), spread over it as
+// samplePoints spreads them over a whole polygon (their mean within a quarter of a stratum's
+// side of the part's centroid); samplePoints put two thirds of them behind, where they carry
+// nothing, and a texel's V rested on the rest. A polygon wholly in front keeps samplePoints' very
+// points, and one wholly behind too (its form factor is 0).
+TEST(Visibility, ShooterPointsInFrontOfTheReceiverPlane) {
+  const Polygon S = quad({0, 0, -2}, {0, 0, 1}, {1, 0, 1}, {1, 0, -2});
+  const glm::dvec3 at(0.0), n(0, 0, 1);
+  for (int k : {4, 16, 15}) {
+    const std::vector<glm::dvec3> front = VisibilityScene::samplePointsInFront(S, at, n, k, 9);
+    ASSERT_EQ(front.size(), size_t(k));
+    glm::dvec3 mean(0.0);
+    for (const glm::dvec3& p : front) {
+      EXPECT_GE(p.z, -1e-12);
+      EXPECT_NEAR(p.y, 0.0, 1e-12);
+      EXPECT_GE(p.x, -1e-12);
+      EXPECT_LE(p.x, 1.0 + 1e-12);
+      mean += p / double(k);
+    }
+    // Stratified: within a quarter of a stratum's side (1 / sqrt k) of the centroid.
+    EXPECT_NEAR(mean.x, 0.5, 0.25 / std::sqrt(double(k))) << k;
+    EXPECT_NEAR(mean.z, 0.5, 0.25 / std::sqrt(double(k))) << k;
+    int behind = 0;
+    for (const glm::dvec3& p : VisibilityScene::samplePoints(S, k, 9)) behind += p.z < 0.0;
+    EXPECT_GE(behind, k / 2) << "samplePoints over the whole shooter";
+  }
+  const Polygon inFront = quad({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0});
+  EXPECT_EQ(VisibilityScene::samplePointsInFront(inFront, at, n, 16, 9),
+            VisibilityScene::samplePoints(inFront, 16, 9));
+  const Polygon behind = quad({0, 0, -2}, {0, 0, -1}, {1, 0, -1}, {1, 0, -2});
+  EXPECT_EQ(VisibilityScene::samplePointsInFront(behind, at, n, 16, 9),
+            VisibilityScene::samplePoints(behind, 16, 9));
+}
+
 }  // namespace
 }  // namespace rad
