@@ -1074,7 +1074,9 @@ void GoodLinkGather::planVisibility(Link& l, const std::vector<char>& needed) co
 // face of its cabin, a floor from a table leg's faces) had most of its points behind it, and a
 // texel's V rested on the one or two rays left: on the 10k hall's all-pairs run one ray of four
 // decided a wedge of the cabin's back face, blocked by the fin, which came out 25 % darker than
-// the references.
+// the references. Where the two ends move against each other (a floor seen from a moving box)
+// the part in front changes with t, and the points' radiosity weights (pointWeight) stay those
+// of the leaves under them at the movie's first key.
 std::vector<glm::dvec3> GoodLinkGather::pointsInFront(const Polygon& shooter, double t, int k,
                                                       uint64_t seed) const {
   const Polygon receiver = nodeWorld(uint32_t(movieNode_), t);
