@@ -913,6 +913,36 @@ void GoodLinkGather::planTexels(double cacheBytes) {
         texelOpen_[e] = openRays(visibility_->staticPart(), p, l, l.points);
     }
   });
+  if (!anyFixed) return;
+  // The kernels of the entries whose V is made per key (rays not all open, or moving blockers
+  // that may close them), within what is left of the budget.
+  std::vector<uint32_t> at(texelLinks_.size(), kNoKernels);
+  size_t kernels = 0;
+  for (size_t e = 0; e < texelLinks_.size(); ++e) {
+    const Link& l = links_[texelLinks_[e]];
+    if (!l.partial || l.moves) continue;
+    const int k = std::min(l.rays, VisibilityScene::kMaxRecordedPairs);
+    const uint64_t all = k == 64 ? ~uint64_t(0) : (uint64_t(1) << k) - 1;
+    if ((texelOpen_[e] & all) == all && !l.movingBlockers) continue;
+    at[e] = uint32_t(kernels);
+    kernels += size_t(k);
+  }
+  const double left = cacheBytes - double(texelLinks_.size()) * entryBytes;
+  if (double(kernels) * sizeof(double) + double(at.size()) * sizeof(uint32_t) > left ||
+      kernels >= size_t(kNoKernels))
+    return;
+  texelKernelAt_.swap(at);
+  texelKernel_.resize(kernels);
+  tbb::parallel_for(size_t(0), T, [&](size_t x) {
+    const glm::dvec3 p = world(x), nx = normal(x);
+    for (uint32_t e = texelStart_[x]; e < texelStart_[x + 1]; ++e) {
+      if (texelKernelAt_[e] == kNoKernels) continue;
+      const Link& l = links_[texelLinks_[e]];
+      pointKernels(p, nx, l.points, shooter[texelLinks_[e]].normal(),
+                   std::min(l.rays, VisibilityScene::kMaxRecordedPairs),
+                   &texelKernel_[texelKernelAt_[e]]);
+    }
+  });
 }
 
 // A partial link's V interpolated over a tile from its corners misses what changes inside:
@@ -1093,10 +1123,14 @@ uint64_t GoodLinkGather::openRays(const VisibilityScene& blockers, const glm::dv
 double GoodLinkGather::visibilityAt(const glm::dvec3& x, const glm::dvec3& n, const Link& l,
                                     const std::vector<glm::dvec3>& points,
                                     const glm::dvec3& shooterNormal, const uint64_t* open,
-                                    const double* weight, bool movingNow) const {
+                                    const double* weight, bool movingNow,
+                                    const double* kernels) const {
   uint64_t bits = open ? *open : openRays(visibility_->staticPart(), x, l, points);
   if (movingNow && bits != 0 && visibility_->dynamicNodeCount() > 0)
     bits = openRays(visibility_->movingPart(), x, l, points, bits);
+  if (kernels)
+    return pointVisibilityOfKernels(
+        kernels, std::min(int(points.size()), VisibilityScene::kMaxRecordedPairs), bits, weight);
   return pointVisibility(x, n, points, shooterNormal, bits, weight);
 }
 
@@ -1235,7 +1269,10 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
           if (link.partial && f > 0.0)
             f *= visibilityAt(p, nx, link, pointsOf(l), shooterNormal[l],
                               cached_ && !link.moves ? &texelOpen_[e] : nullptr,
-                              &pointWeight[l * rays], movingNow[l] != 0);
+                              &pointWeight[l * rays], movingNow[l] != 0,
+                              !texelKernelAt_.empty() && texelKernelAt_[e] != kNoKernels
+                                  ? &texelKernel_[texelKernelAt_[e]]
+                                  : nullptr);
           H += f * weight[l];
         }
         acc[x] = H + cluster(x);

@@ -285,6 +285,12 @@ class GoodLinkGather {
   std::vector<uint32_t> texelStart_, texelLinks_;
   std::vector<float> texelFormFactor_;
   std::vector<uint64_t> texelOpen_;  // with texelFormFactor_: rays open past static blockers
+  // The kernels of a texel's partial-link rays (pointKernels), the same at every key, from
+  // texelKernelAt_[e] in texelKernel_ (kNoKernels: made at each key): pointVisibility had made
+  // them again at every movie key, 8 % of the 10k hall's rad-movies samples.
+  static constexpr uint32_t kNoKernels = ~0u;
+  std::vector<uint32_t> texelKernelAt_;
+  std::vector<double> texelKernel_;
   bool cached_ = false;
   int movieNode_ = 0;
   std::vector<std::array<glm::dvec3, 2>> swept_;  // of the nodes that move during the movie
@@ -334,7 +340,8 @@ class GoodLinkGather {
   // current time, weighted by the kernel and the shooter's B at their ends (`weight`).
   double visibilityAt(const glm::dvec3& x, const glm::dvec3& n, const Link& l,
                       const std::vector<glm::dvec3>& points, const glm::dvec3& shooterNormal,
-                      const uint64_t* open, const double* weight, bool movingNow) const;
+                      const uint64_t* open, const double* weight, bool movingNow,
+                      const double* kernels = nullptr) const;
 };
 
 }  // namespace rad

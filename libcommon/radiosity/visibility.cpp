@@ -600,9 +600,26 @@ double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
   open &= all;
   if (open == all) return 1.0;  // the common cases, exact whatever the weights
   if (open == 0) return 0.0;
+  std::array<double, VisibilityScene::kMaxRecordedPairs> kernel;
+  pointKernels(x, n, bPoints, bNormal, k, kernel.data());
+  return pointVisibilityOfKernels(kernel.data(), k, open, weight);
+}
+
+void pointKernels(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& bPoints,
+                  const glm::dvec3& bNormal, int k, double* kernel) {
+  for (int i = 0; i < k; ++i) kernel[i] = pairKernel(x, n, bPoints[size_t(i)], bNormal);
+}
+
+double pointVisibilityOfKernels(const double* kernel, int k, std::uint64_t open,
+                                const double* weight) {
+  if (k == 0) return 1.0;
+  const std::uint64_t all = k == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << k) - 1;
+  open &= all;
+  if (open == all) return 1.0;
+  if (open == 0) return 0.0;
   double weighted = 0.0, total = 0.0;
   for (int i = 0; i < k; ++i) {
-    double w = pairKernel(x, n, bPoints[size_t(i)], bNormal);
+    double w = kernel[i];
     if (weight) w *= std::max(0.0, weight[i]);
     total += w;
     weighted += ((open >> i) & 1u) ? w : 0.0;

@@ -194,6 +194,12 @@ RayStart rayStart(const VisibilityScene& v, const glm::dvec3& origin, const glm:
 double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
                        const std::vector<glm::dvec3>& bPoints, const glm::dvec3& bNormal,
                        std::uint64_t open, const double* weight = nullptr);
+// pointVisibility's kernels K_i of x's first k points (k <= kMaxRecordedPairs) into `kernel`,
+// and the same V from them: a texel's kernels do not change from key to key, only the weights.
+void pointKernels(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& bPoints,
+                  const glm::dvec3& bNormal, int k, double* kernel);
+double pointVisibilityOfKernels(const double* kernel, int k, std::uint64_t open,
+                                const double* weight = nullptr);
 
 // Counter-based random numbers (Steele, Lea, Flood 2014, splitmix64 finaliser).
 std::uint64_t splitMix64(std::uint64_t x);

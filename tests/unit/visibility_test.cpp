@@ -351,5 +351,23 @@ TEST(Visibility, ShooterPointsInFrontOfTheReceiverPlane) {
             VisibilityScene::samplePoints(behind, 16, 9));
 }
 
+// rad-movies keeps a texel's kernels from key to key (pointKernels) and takes V from them with
+// each key's weights: the same value, bit for bit, as pointVisibility from the points.
+TEST(Visibility, PointVisibilityFromKeptKernelsIsTheSame) {
+  const Polygon S = quad({0, 0, -2}, {0, 0, 1}, {1, 0, 1}, {1, 0, -2});
+  const std::vector<glm::dvec3> points = VisibilityScene::samplePoints(S, 16, 5);
+  const glm::dvec3 x(0.3, 0.7, 0.2), n(0, 0, 1);
+  std::vector<double> kernel(16), weight(16);
+  pointKernels(x, n, points, S.normal(), 16, kernel.data());
+  for (int i = 0; i < 16; ++i) weight[size_t(i)] = 0.5 + 0.25 * (i % 3);
+  for (std::uint64_t open : {std::uint64_t(0), std::uint64_t(0xffff), std::uint64_t(0x5a3c),
+                             std::uint64_t(0x0f0f), std::uint64_t(1)}) {
+    EXPECT_EQ(pointVisibilityOfKernels(kernel.data(), 16, open, weight.data()),
+              pointVisibility(x, n, points, S.normal(), open, weight.data()));
+    EXPECT_EQ(pointVisibilityOfKernels(kernel.data(), 16, open),
+              pointVisibility(x, n, points, S.normal(), open));
+  }
+}
+
 }  // namespace
 }  // namespace rad
