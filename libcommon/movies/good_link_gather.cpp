@@ -922,7 +922,7 @@ void GoodLinkGather::planTexels(double cacheBytes) {
     const Link& l = links_[texelLinks_[e]];
     if (!l.partial || l.moves) continue;
     const int k = std::min(l.rays, VisibilityScene::kMaxRecordedPairs);
-    const uint64_t all = k == 64 ? ~uint64_t(0) : (uint64_t(1) << k) - 1;
+    const uint64_t all = allRaysOpen(k);
     if ((texelOpen_[e] & all) == all && !l.movingBlockers) continue;
     at[e] = uint32_t(kernels);
     kernels += size_t(k);

@@ -39,24 +39,6 @@ class VertexBuffer {
   std::size_t size_ = 0;
 };
 
-// Sutherland-Hodgman against one plane: the vertices of v[0..count) at a height of at least
-// `lift` over the plane through `at` with normal `n`, and the points where edges cross that
-// height, in order, to push(x).
-template <class Push>
-void clipToFront(const glm::dvec3* v, std::size_t count, const glm::dvec3& n, const glm::dvec3& at,
-                 double lift, Push&& push) {
-  for (std::size_t k = 0; k < count; ++k) {
-    const glm::dvec3& a = v[k];
-    const glm::dvec3& b = v[(k + 1) % count];
-    const double da = glm::dot(n, a - at) - lift, db = glm::dot(n, b - at) - lift;
-    if (da >= 0.0) push(a);
-    if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) {
-      const double t = da / (da - db);  // in (0, 1)
-      push(a + t * (b - a));
-    }
-  }
-}
-
 }  // namespace
 
 // Reduced to |t| <= tan(pi/8) with one division (atan y/x = pi/2 - atan x/y = pi/4 + atan

@@ -117,14 +117,16 @@ std::vector<glm::dvec2> stratified(int k, std::uint64_t jitterSeed, std::uint64_
   return pts;
 }
 
+// Area-uniform map of the unit square onto triangle abc.
+glm::dvec3 onTriangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, double u,
+                      double v) {
+  double su = std::sqrt(u);
+  return (1.0 - su) * a + su * (1.0 - v) * b + su * v * c;
+}
+
 // Area-uniform map of the unit square onto a triangle or a convex quad (split along v0-v2,
 // u chooses the half in proportion to its area, so strata stay strata).
 glm::dvec3 onPolygon(const Polygon& p, glm::dvec2 s) {
-  auto onTriangle = [](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, double u,
-                       double v) {
-    double su = std::sqrt(u);
-    return (1.0 - su) * a + su * (1.0 - v) * b + su * v * c;
-  };
   if (p.count == 3) return onTriangle(p.v[0], p.v[1], p.v[2], s.x, s.y);
   double a0 = glm::length(glm::cross(p.v[1] - p.v[0], p.v[2] - p.v[0]));
   double a1 = glm::length(glm::cross(p.v[2] - p.v[0], p.v[3] - p.v[0]));
@@ -417,23 +419,15 @@ std::vector<glm::dvec3> VisibilityScene::samplePointsInFront(const Polygon& p, c
   // Behind beyond rounding (a wall's foot on the floor's plane is not behind it).
   double size = 0.0;
   for (int i = 1; i < p.count; ++i) size = std::max(size, glm::length(p.v[size_t(i)] - p.v[0]));
-  std::array<double, 4> h{};
   bool behind = false;
-  for (int i = 0; i < p.count; ++i) {
-    h[size_t(i)] = glm::dot(n, p.v[size_t(i)] - at);
-    behind = behind || h[size_t(i)] < -1e-9 * size;
-  }
+  for (int i = 0; i < p.count; ++i)
+    behind = behind || glm::dot(n, p.v[size_t(i)] - at) < -1e-9 * size;
   if (!behind) return samplePoints(p, k, seed);
-  // Sutherland-Hodgman against the plane: a convex polygon of up to 5 vertices.
+  // The part in front: a convex polygon of up to 5 vertices.
   std::array<glm::dvec3, 5> front{};
   int m = 0;
-  for (int i = 0; i < p.count; ++i) {
-    const int j = (i + 1) % p.count;
-    if (h[size_t(i)] >= 0.0) front[size_t(m++)] = p.v[size_t(i)];
-    if ((h[size_t(i)] > 0.0 && h[size_t(j)] < 0.0) || (h[size_t(i)] < 0.0 && h[size_t(j)] > 0.0))
-      front[size_t(m++)] = p.v[size_t(i)] + h[size_t(i)] / (h[size_t(i)] - h[size_t(j)]) *
-                                                (p.v[size_t(j)] - p.v[size_t(i)]);
-  }
+  clipToFront(p.v.data(), size_t(p.count), n, at, 0.0,
+              [&](const glm::dvec3& x) { front[size_t(m++)] = x; });
   // Its fan of triangles from front[0], chosen by area with the first coordinate (strata stay
   // strata, as onPolygon does for a quad's two halves).
   std::array<double, 4> area{};
@@ -452,9 +446,8 @@ std::vector<glm::dvec3> VisibilityScene::samplePointsInFront(const Polygon& p, c
     double u = s[size_t(i)].x * total;
     int t = 0;
     while (t + 1 < m - 2 && u >= area[size_t(t)]) u -= area[size_t(t++)];
-    const double su = std::sqrt(std::clamp(u / area[size_t(t)], 0.0, 1.0)), v = s[size_t(i)].y;
-    out[size_t(i)] = (1.0 - su) * front[0] + su * (1.0 - v) * front[size_t(t + 1)] +
-                     su * v * front[size_t(t + 2)];
+    out[size_t(i)] = onTriangle(front[0], front[size_t(t + 1)], front[size_t(t + 2)],
+                                std::clamp(u / area[size_t(t)], 0.0, 1.0), s[size_t(i)].y);
   }
   return out;
 }
@@ -591,12 +584,16 @@ std::uint64_t VisibilityScene::openSegments(const glm::dvec3* from, size_t fromS
   return open;
 }
 
+std::uint64_t allRaysOpen(int k) {
+  return k >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << k) - 1;
+}
+
 double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
                        const std::vector<glm::dvec3>& bPoints, const glm::dvec3& bNormal,
                        std::uint64_t open, const double* weight) {
   const int k = std::min(int(bPoints.size()), VisibilityScene::kMaxRecordedPairs);
   if (k == 0) return 1.0;
-  const std::uint64_t all = k == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << k) - 1;
+  const std::uint64_t all = allRaysOpen(k);
   open &= all;
   if (open == all) return 1.0;  // the common cases, exact whatever the weights
   if (open == 0) return 0.0;
@@ -613,7 +610,7 @@ void pointKernels(const glm::dvec3& x, const glm::dvec3& n, const std::vector<gl
 double pointVisibilityOfKernels(const double* kernel, int k, std::uint64_t open,
                                 const double* weight) {
   if (k == 0) return 1.0;
-  const std::uint64_t all = k == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << k) - 1;
+  const std::uint64_t all = allRaysOpen(k);
   open &= all;
   if (open == all) return 1.0;
   if (open == 0) return 0.0;

@@ -194,6 +194,8 @@ RayStart rayStart(const VisibilityScene& v, const glm::dvec3& origin, const glm:
 double pointVisibility(const glm::dvec3& x, const glm::dvec3& n,
                        const std::vector<glm::dvec3>& bPoints, const glm::dvec3& bNormal,
                        std::uint64_t open, const double* weight = nullptr);
+// The open bits of all of k rays (k <= kMaxRecordedPairs).
+std::uint64_t allRaysOpen(int k);
 // pointVisibility's kernels K_i of x's first k points (k <= kMaxRecordedPairs) into `kernel`,
 // and the same V from them: a texel's kernels do not change from key to key, only the weights.
 void pointKernels(const glm::dvec3& x, const glm::dvec3& n, const std::vector<glm::dvec3>& bPoints,

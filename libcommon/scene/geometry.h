@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -23,6 +24,24 @@ struct Polygon {
   Polygon transformed(const glm::dmat4& m) const;
   std::string toString() const;
 };
+
+// Sutherland-Hodgman against one plane: the vertices of v[0..count) at a height of at least
+// `lift` over the plane through `at` with normal `n`, and the points where edges cross that
+// height, in order, to push(x).
+template <class Push>
+void clipToFront(const glm::dvec3* v, std::size_t count, const glm::dvec3& n, const glm::dvec3& at,
+                 double lift, Push&& push) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const glm::dvec3& a = v[k];
+    const glm::dvec3& b = v[(k + 1) % count];
+    const double da = glm::dot(n, a - at) - lift, db = glm::dot(n, b - at) - lift;
+    if (da >= 0.0) push(a);
+    if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) {
+      const double t = da / (da - db);  // in (0, 1)
+      push(a + t * (b - a));
+    }
+  }
+}
 
 // Area-uniform point on a triangle or convex quad from two numbers in [0, 1) (the quad split
 // along v0-v2, the halves chosen by area).
