@@ -32,8 +32,11 @@
 // link is seen at a grazing angle (a wall's tiles seen from the perpendicular wall beside them:
 // 0.6 and 1.4 times the exact form factor) and had made every cluster link of an open room 2 %
 // dark against the exact point-to-polygon sums (ClusterLinks.
-// ExposedFloorMatchesAllPairsAtTheDefaultSeparation). B_S is the area average of S's
-// radiosity as R sees it (gather) and V_RS the kernel-weighted share of k shadow-ray pairs
+// ExposedFloorMatchesAllPairsAtTheDefaultSeparation). B_S is S's radiosity as R sees it: its
+// facing groups' area-average radiosities B_g weighted by the groups' projected areas towards
+// R, $B_S = \sum_g \max(0, -N_g \cdot \omega) B_g / \sum_g \max(0, -N_g \cdot \omega)$, ω the
+// link's direction (gather), as the transfer above weighs the groups; and V_RS the
+// kernel-weighted share of k shadow-ray pairs
 // between area-uniform points of R's and S's patches that are unoccluded. The irradiance is
 // pushed down to every member top of R, so the gather goes through the clusters.
 #pragma once
@@ -162,7 +165,10 @@ class ClusterLinks {
   struct FacingGroup {
     glm::vec3 normalArea{0.0f};  // N_g
     glm::vec3 centre{0.0f};      // c_g
+    int axisSign = 0;            // facingGroupOf its members' normals
   };
+  // A top's facing group by its normal: the dominant axis and its sign, 2 axis + (n < 0).
+  static int facingGroupOf(const glm::dvec3& n);
   struct FacingGroups {
     std::array<FacingGroup, 6> group;
     int count = 0;

@@ -866,6 +866,66 @@ TEST(ClusterLinks, FormFactorsFollowEachReceiverTopAtGrazingAngles) {
   EXPECT_LT(worst, 0.05);
 }
 
+// A cluster's B as the receiver sees it: a shooter of two facing groups, a floor of 4 x 4 tiles
+// (B = 1, facing up) and a wall of 4 x 4 tiles standing on its edge (B = 0.1, facing +x), seen
+// from a 1 m wall of tiles 8 m along +x and above them, which sees the wall face on and the
+// floor at a slant. The gathered irradiance at each receiver top against the exact sum over the
+// shooter's tiles of B F (point to polygon, no occluder): the groups weighed by their projected
+// areas towards the link's direction put the worst top 6.9 % off (the direction is the receiver
+// cluster's; across the receiver the floor's projection differs by +-20 %, and the floor carries
+// most of the light); six axis bins with squared direction weights, 46 % (the floor's share
+// counted at about 0.3^2 of its projection).
+TEST(ClusterLinks, ShooterRadiosityWeighsItsFacingGroupsAsTheTransferDoes) {
+  std::vector<Polygon> polys;
+  auto quad = [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
+    Polygon p;
+    p.count = 4;
+    p.v = {a, b, c, d};
+    polys.push_back(p);
+  };
+  const double s = 0.5;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {  // floor y = 0, facing +y, x and z in [0, 2]
+      const double x = i * s, z = j * s;
+      quad({x, 0, z}, {x, 0, z + s}, {x + s, 0, z + s}, {x + s, 0, z});
+    }
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {  // wall x = 2, facing +x, y and z in [0, 2]
+      const double y = i * s, z = j * s;
+      quad({2, y, z}, {2, y + s, z}, {2, y + s, z + s}, {2, y, z + s});
+    }
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {  // receiver x = 10, facing -x, y in [2.5, 3.5], z in [0.5, 1.5]
+      const double r = 0.25, y = 2.5 + i * r, z = 0.5 + j * r;
+      quad({10, y, z}, {10, y, z + r}, {10, y + r, z + r}, {10, y + r, z});
+    }
+  ASSERT_NEAR(polys[0].normal().y, 1.0, 1e-12);
+  ASSERT_NEAR(polys[16].normal().x, 1.0, 1e-12);
+  ASSERT_NEAR(polys[32].normal().x, -1.0, 1e-12);
+  PatchHierarchy h = hierarchyOf(polys);
+  ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
+  std::vector<double> area, emission(polys.size(), 0.0);
+  for (const Polygon& p : polys) area.push_back(p.area());
+  ClusterLinks links(tree, polys, area, emission, nullptr, 4, 2.0, 0.1);
+  std::vector<std::pair<int, int>> pairs;
+  bool over = false;
+  while (links.refine(1.0, false, 1u << 20, pairs, over) > 0) links.evaluate();
+  links.evaluate();
+  std::vector<glm::dvec3> B(polys.size(), glm::dvec3(0.0)), H;
+  for (size_t t = 0; t < 32; ++t) B[t] = glm::dvec3(t < 16 ? 1.0 : 0.1);
+  links.gather(B, {}, H);
+  double worst = 0.0;
+  for (size_t t = 32; t < polys.size(); ++t) {
+    double exact = 0.0;
+    for (size_t j = 0; j < 32; ++j)
+      exact += B[j].x * pointToPolygonFormFactor(polys[t].centroid(), polys[t].normal(), polys[j]);
+    ASSERT_GT(exact, 0.0);
+    worst = std::max(worst, std::abs(H[t].x / exact - 1.0));
+  }
+  std::cout << "worst gathered irradiance against the exact sums: " << worst << "\n";
+  EXPECT_LT(worst, 0.08);
+}
+
 // The gather lists after a refinement round take over the entries of the tops whose links did
 // not change (the links renumbered) and make the others anew: the row sums and the gathered
 // irradiance must be the very values of lists made anew for the same links. Rounds at three
