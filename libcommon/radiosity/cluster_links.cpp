@@ -308,12 +308,36 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
     std::array<RayPair, 64> onStack;
     std::vector<RayPair> onHeap(k > 64 ? size_t(k) : 0);
     RayPair* pairs = k > 64 ? onHeap.data() : onStack.data();
+    // Each end's member is drawn among those that may face the other end (its plane has some of
+    // the other's bounding box in front): a pair with a member facing away has kernel 0 and
+    // counts for nothing, and with a cluster's six facing groups most area-uniform pairs had
+    // been such (two boxes: 1 of 36). Up to kFacingTries draws, by area (power) as before among
+    // the members that face; V = open kernel / kernel is the same quantity over them, from more
+    // pairs.
+    auto pickFacing = [&](ClusterRef ref, ClusterRef other, int i, int side,
+                          const std::vector<double>& prefix) -> uint32_t {
+      if (!isCluster(ref)) return uint32_t(ref);
+      const ClusterBounds& o = bounds(other);
+      uint32_t j = 0;
+      for (int t = 0; t < kFacingTries; ++t) {
+        const uint64_t c =
+            t == 0
+                ? uint64_t(i) * 6 + uint64_t(side)
+                : uint64_t(k) * 6 + (uint64_t(i) * kFacingTries + uint64_t(t)) * 2 + uint64_t(side);
+        j = pick(ref, uniformOpen01(seed, c), prefix);
+        const glm::dvec3& n = normal_[j];
+        double farthest = 0.0;  // the largest n . x over the other's box
+        for (int a = 0; a < 3; ++a) farthest += n[a] * (n[a] > 0.0 ? o.hi[a] : o.lo[a]);
+        if (farthest > glm::dot(n, centroid_[j])) break;
+      }
+      return j;
+    };
     double sumK = 0.0;
     for (int i = 0; i < k; ++i) {
       const uint64_t c = uint64_t(i) * 6;
       RayPair& p = pairs[size_t(i)];
-      p.a = pick(l.receiver, uniformOpen01(seed, c), memberAreaPrefix_);
-      p.b = pick(l.shooter, uniformOpen01(seed, c + 1), shooterPrefix);
+      p.a = pickFacing(l.receiver, l.shooter, i, 0, memberAreaPrefix_);
+      p.b = pickFacing(l.shooter, l.receiver, i, 1, shooterPrefix);
       p.x = pointOnPolygon(world_[p.a], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
       p.y = pointOnPolygon(world_[p.b], uniformOpen01(seed, c + 4), uniformOpen01(seed, c + 5));
       const glm::dvec3 xy = p.y - p.x;

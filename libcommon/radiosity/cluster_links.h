@@ -145,6 +145,8 @@ class ClusterLinks {
     return isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)];
   }
   void evaluateLink(ClusterLink& l);
+  // Draws of a link end's member for one ray pair until one faces the other end (evaluateLink).
+  static constexpr int kFacingTries = 8;
   double formFactor(const ClusterLink& l, uint32_t top) const;
   void buildReceiverLists();
 
