@@ -36,8 +36,9 @@
 // facing groups' area-average radiosities B_g weighted by the groups' projected areas towards
 // R, $B_S = \sum_g \max(0, -N_g \cdot \omega) B_g / \sum_g \max(0, -N_g \cdot \omega)$, ω the
 // link's direction (gather), as the transfer above weighs the groups; and V_RS the
-// kernel-weighted share of k shadow-ray pairs
-// between area-uniform points of R's and S's patches that are unoccluded. The irradiance is
+// kernel-weighted share of k shadow-ray pairs between points of R's and S's patches that are
+// unoccluded, each end's patch drawn by area among those that may face the other end
+// (evaluateLink). The irradiance is
 // pushed down to every member top of R, so the gather goes through the clusters.
 #pragma once
 
