@@ -267,6 +267,7 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
             reuse_->find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))) {
       l.direction = c->direction;
       l.visibility = c->visibility;
+      l.groupVisibility = c->groupVisibility;
       ++reused_;
       return;
     }
@@ -303,6 +304,7 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
       glm::dvec3 x, y;
       uint32_t a, b;
       double kernel;
+      bool open = false;
     };
     const int k = rays_;
     std::array<RayPair, 64> onStack;
@@ -350,13 +352,35 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
     double openK = 0.0;
     int open = 0;
     for (int i = 0; i < k; ++i) {
-      const RayPair& p = pairs[size_t(i)];
+      RayPair& p = pairs[size_t(i)];
       if (sumK > 0.0 && !(p.kernel > 0.0)) continue;
       const bool isOpen = !visibility_->occluded(p.x, p.y, p.a, p.b);
+      p.open = isOpen;
       open += isOpen ? 1 : 0;
       openK += isOpen ? p.kernel : 0.0;
     }
     v = sumK > 0.0 ? openK / sumK : double(open) / double(k);
+    // V per facing group of R's members, from the same pairs: one V for a receiver cluster
+    // spreads the light its open members see over its occluded ones (a chair's seat under a
+    // desk and its back in the open: the back, the one seen, came out dark).
+    if (isCluster(l.receiver) && sumK > 0.0) {
+      std::array<double, 6> groupK{}, groupOpenK{};
+      int positive = 0;
+      for (int i = 0; i < k; ++i) {
+        const RayPair& p = pairs[size_t(i)];
+        if (!(p.kernel > 0.0)) continue;
+        ++positive;
+        const size_t g = size_t(facingGroupOf(normal_[p.a]));
+        groupK[g] += p.kernel;
+        groupOpenK[g] += p.open ? p.kernel : 0.0;
+      }
+      const double prior = kGroupPrior * sumK / double(positive);
+      for (size_t g = 0; g < 6; ++g)
+        l.groupVisibility[g] =
+            quantizedVisibility((groupOpenK[g] + prior * v) / (groupK[g] + prior));
+    } else {
+      l.groupVisibility.fill(quantizedVisibility(v));
+    }
   }
   l.visibility = float(v);
 }
@@ -387,7 +411,11 @@ double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
     const size_t s = size_t(l.shooter);
     sum = group(area_[s] * normal_[s], centroid_[s]);
   }
-  return double(l.visibility) / M_PI * sum;
+  // A receiver cluster's member takes the V of its facing group (evaluateLink).
+  const double v = isCluster(l.receiver)
+                       ? double(l.groupVisibility[size_t(facingGroupOf(n))]) / 255.0
+                       : double(l.visibility);
+  return v / M_PI * sum;
 }
 
 std::pair<const ClusterLinks::GatherEntry*, const ClusterLinks::GatherEntry*>

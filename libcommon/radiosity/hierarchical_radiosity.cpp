@@ -1238,7 +1238,7 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
           hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
     if (!hit) {
       keys.emplace_back(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
-      values.push_back(CachedClusterLink{l.direction, l.visibility});
+      values.push_back(CachedClusterLink{l.direction, l.visibility, l.groupVisibility});
     }
   }
   return ClusterLinkCache(keys, std::move(values), uint32_t(T + size_t(tree.size())));
