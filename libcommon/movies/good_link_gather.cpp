@@ -203,7 +203,8 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
                                const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
                                double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
                                SceneVisibility* visibility, int visibilityRays,
-                               int nearShooterLevels, double partialShare)
+                               int nearShooterLevels, double partialShare,
+                               int clusterVisibilityRays)
     : scene_(scene),
       solution_(solution),
       clusterCorners_(byReceiver.clusterCorners),
@@ -216,7 +217,8 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
       byReceiver_(byReceiver),
       nearShooterLevels_(visibility && visibilityRays > 0 && shooterRatio > 0.0 ? nearShooterLevels
                                                                                 : 0),
-      partialShare_(partialShare) {
+      partialShare_(partialShare),
+      clusterVisibilityRays_(clusterVisibilityRays) {
   // The nodes in the moving part of the visibility scene, those that move anywhere in the
   // solution's time range (SceneVisibility's split), with their bounds swept over the movie:
   // one that rests during the movie still blocks. Only the nodes moving during the movie had
@@ -240,6 +242,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   planNearShooters(needed, stats);
   planWeights(needed);
   planTexels(cacheBytes);
+  planClusterVisibility();
   stats.links += long(links_.size());
   stats.entries += long(texelLinks_.size());
   if (cached_) stats.cachedEntries += long(texelLinks_.size());
@@ -250,6 +253,108 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
     stats.partialLinksFewRays += l.partial && l.rays < visibilityRays_ && l.cell == 1 ? 1 : 0;
   }
   stats.partialTileLinksPerTexel += long(partialTileLinksPerTexel_);
+}
+
+void GoodLinkGather::planClusterVisibility() {
+  clusterVisibility_.clear();
+  const int k = clusterVisibilityRays_;
+  if (k <= 0 || !visibility_ || clusterCorners_.empty()) return;
+  const PatchHierarchy& h = solution_.hierarchy;
+  const double t0 = keyTimes_.front();
+  const uint32_t R = uint32_t(receiverTop_);
+  auto moving = [&](uint32_t top) {
+    return std::find(movingNodes_.begin(), movingNodes_.end(), h.top(int(top)).node) !=
+           movingNodes_.end();
+  };
+  // A moving receiver's rays would hold only at its first key.
+  if (moving(R)) return;
+  int k0, k1;
+  double w;
+  solution_.keyWeights(t0, k0, k1, w);
+  const glm::dvec3 own = solution_.clusterIrradianceAtKey(int(R), k0);
+  if (!(own.x + own.y + own.z > 0.0)) return;
+  // The surfaces the top gathers itself (its movie's links, its bad pairs' shooters) are not
+  // the cluster light's.
+  std::vector<char> gathered(size_t(h.topCount()), 0);
+  gathered[R] = 1;
+  for (const Link& l : links_) gathered[h.node(int(l.shooter)).id.top] = 1;
+  const auto& bad = solution_.badPairs;
+  for (auto it = std::lower_bound(bad.begin(), bad.end(), std::make_pair(R, uint32_t(0)));
+       it != bad.end() && it->first == R; ++it)
+    gathered[it->second] = 1;
+  const Polygon receiver = nodeWorld(R, t0);
+  const glm::dvec3 centre = receiver.centroid(), n = receiver.normal();
+  std::vector<double> cumulative;
+  std::vector<uint32_t> far;
+  double total = 0.0;
+  for (uint32_t s = 0; s < uint32_t(h.topCount()); ++s) {
+    if (gathered[s] || moving(s)) continue;
+    const glm::dvec3 B = solution_.exposedRadiosityAtKey(int(s), k0);
+    const Polygon p = nodeWorld(s, t0);
+    const glm::dvec3 d = p.centroid() - centre;
+    const double r2 = glm::dot(d, d);
+    const double power = (B.x + B.y + B.z) * p.area() * std::max(0.0, glm::dot(n, d)) *
+                         std::max(0.0, -glm::dot(p.normal(), d)) / (r2 * r2);
+    if (!(power > 0.0)) continue;
+    total += power;
+    cumulative.push_back(total);
+    far.push_back(s);
+  }
+  if (far.empty()) return;
+  // Stratified over the cumulative power, then area-uniform on the top drawn.
+  const uint64_t seed = splitMix64(0x636c7573746572ull ^ uint64_t(R));
+  std::vector<glm::dvec3> points(static_cast<size_t>(k));
+  for (int j = 0; j < k; ++j) {
+    const double u = (double(j) + uniformOpen01(seed, 3 * uint64_t(j))) / double(k) * total;
+    const size_t i = std::min(
+        size_t(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin()),
+        far.size() - 1);
+    points[size_t(j)] =
+        pointOnPolygon(nodeWorld(far[i], t0), uniformOpen01(seed, 3 * uint64_t(j) + 1),
+                       uniformOpen01(seed, 3 * uint64_t(j) + 2));
+  }
+  const VisibilityScene& blockers = visibility_->staticPart();
+  auto openShare = [&](const glm::dvec3& x) {
+    return double(std::bitset<64>(blockers.openFrom(x, points, R)).count()) / double(k);
+  };
+  // The mean over the top's uncovered part (rad-global's cluster light is the exposed part's).
+  const double size = polygonSize(receiver);
+  double sum = 0.0;
+  int uncovered = 0;
+  for (const glm::dvec3& p :
+       VisibilityScene::samplePoints(receiver, kClusterVisibilityPoints, seed)) {
+    if (insideSolid(blockers, scene_, h, R, p, n, size, t0)) continue;
+    sum += openShare(p);
+    ++uncovered;
+  }
+  if (uncovered == 0 || !(sum > 0.0)) return;
+  const double mean = sum / double(uncovered);
+  const TexelFrame frame = texelFrame(t0);
+  const int width = texels_.width, height = texels_.height;
+  std::vector<size_t> corners;
+  for (const Tile& tile : tiles_)
+    for (size_t x : tile.cornerTexels(width)) corners.push_back(x);
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  std::vector<double> atCorner(corners.size());
+  tbb::parallel_for(size_t(0), corners.size(), [&](size_t i) {
+    atCorner[i] = openShare(frame.point(texels_.localPoint[corners[i]])) / mean;
+  });
+  auto ratioAt = [&](size_t x) {
+    return atCorner[size_t(std::lower_bound(corners.begin(), corners.end(), x) - corners.begin())];
+  };
+  clusterVisibility_.assign(size_t(width) * size_t(height), 1.0f);
+  for (const Tile& tile : tiles_) {
+    const std::array<size_t, 4> c = tile.cornerTexels(width);
+    const double m[4] = {ratioAt(c[0]), ratioAt(c[1]), ratioAt(c[2]), ratioAt(c[3])};
+    for (int j = tile.j0; j < std::min(tile.j0 + kTile, height); ++j)
+      for (int i = tile.i0; i < std::min(tile.i0 + kTile, width); ++i) {
+        const glm::dvec2 uv = tile.uv(i, j);
+        const double u = uv.x, v = uv.y;
+        clusterVisibility_[size_t(j) * size_t(width) + size_t(i)] = float(
+            (1 - u) * (1 - v) * m[0] + u * (1 - v) * m[1] + u * v * m[2] + (1 - u) * v * m[3]);
+      }
+  }
 }
 
 Polygon GoodLinkGather::nodeWorld(uint32_t node, double t) const {
@@ -1228,10 +1333,6 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
   tbb::parallel_for(size_t(0), tiles_.size(), [&](size_t ti) {
     const Tile& tile = tiles_[ti];
     const int iEnd = std::min(tile.i0 + kTile, width), jEnd = std::min(tile.j0 + kTile, height);
-    auto bilinear = [&](int i, int j) {  // (u, v) of texel (i, j) between the tile's corners
-      return glm::dvec2(tile.i1 > tile.i0 ? double(i - tile.i0) / (tile.i1 - tile.i0) : 0.0,
-                        tile.j1 > tile.j0 ? double(j - tile.j0) / (tile.j1 - tile.j0) : 0.0);
-    };
     // The tile's far links at its corners (corner c: (i0,j0), (i1,j0), (i1,j1), (i0,j1)), group
     // by group, interpolated to the texels each group reaches (on the stack: this runs per tile
     // and key).
@@ -1248,7 +1349,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
       for (int j = tile.j0; j < jEnd; ++j)
         for (int i = tile.i0; i < iEnd; ++i)
           if (tile.groups[g].first & Tile::bit(i, j, tile)) {
-            const glm::dvec2 uv = bilinear(i, j);
+            const glm::dvec2 uv = tile.uv(i, j);
             const double u = uv.x, v = uv.y;
             far[size_t((j - tile.j0) * kTile + (i - tile.i0))] +=
                 (1 - u) * (1 - v) * corner[0] + u * (1 - v) * corner[1] + u * v * corner[2] +
@@ -1275,7 +1376,8 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
                                   : nullptr);
           H += f * weight[l];
         }
-        acc[x] = H + cluster(x);
+        acc[x] = H + (clusterVisibility_.empty() ? cluster(x)
+                                                 : double(clusterVisibility_[x]) * cluster(x));
       }
   });
 }

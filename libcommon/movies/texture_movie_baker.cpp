@@ -1030,6 +1030,7 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"gather-shooter-ratio", gatherShooterRatio},
           {"gather-rays", gatherRays},
           {"gather-partial-share", gatherPartialShare},
+          {"cluster-visibility-rays", clusterVisibilityRays},
           {"near-shooter-levels", nearShooterLevels},
           {"no-fill-covered", !fillCovered},
           {"moving-shadow-key-step", movingShadowKeyStep},
@@ -1110,6 +1111,9 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
     throw Error(ExitCode::kUsage, "--gather-shooter-ratio", "must be a finite number >= 0");
   if (options_.gatherRays < 0 || options_.gatherRays > VisibilityScene::kMaxRecordedPairs)
     throw Error(ExitCode::kUsage, "--gather-rays", "must be in 0..64");
+  if (options_.clusterVisibilityRays < 0 ||
+      options_.clusterVisibilityRays > VisibilityScene::kMaxRecordedPairs)
+    throw Error(ExitCode::kUsage, "--cluster-visibility-rays", "must be in 0..64");
   if (options_.nearShooterLevels < 0 || options_.nearShooterLevels > 3)
     throw Error(ExitCode::kUsage, "--near-shooter-levels", "must be in 0..3");
   if (options_.minSamples < 1) throw Error(ExitCode::kUsage, "--min-samples", "must be >= 1");
@@ -1312,7 +1316,7 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
         scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
         options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather,
         options_.gatherRays > 0 ? sceneVisibility() : nullptr, options_.gatherRays,
-        options_.nearShooterLevels, options_.gatherPartialShare);
+        options_.nearShooterLevels, options_.gatherPartialShare, options_.clusterVisibilityRays);
     stats_.secondsGood += secondsSince(clock);
   }
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);

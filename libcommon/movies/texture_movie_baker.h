@@ -109,6 +109,11 @@ struct TextureMovieBakerOptions {
   // 1.64 % RMSE / mean and the table's rad-movies 58.7 s, 0.002 1.77 % and 42 s, 0.003 2.01 %
   // and 31 s. The default keeps the table's 0.2 s per frame; the final setting uses 0.001.
   double gatherPartialShare = 0.002;
+  // --cluster-visibility-rays: the cluster light of a texel (rad-global's, one value per top
+  // and key) scaled by the share of this many rays from the texel to points on the top's far
+  // surfaces that are open, over the same share's mean across the top (good_link_gather.h);
+  // 0: the top's one value. Needs --gather-rays > 0.
+  int clusterVisibilityRays = 32;
   // --near-shooter-levels: a near leaf shooter is split into up to 4^L cells, each with its
   // radiosity re-gathered at its centre from the leaf's links (good_link_gather.h); 0: the
   // leaf's one B (the default: the final setting's cost, rad-movies ~10x).

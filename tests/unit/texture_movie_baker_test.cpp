@@ -1419,6 +1419,69 @@ TEST(TextureMovieBaker, ClusterIrradianceFarFromItsNeighboursKeepsItsOwnMean) {
   }
 }
 
+// The cluster light per texel follows what each texel sees of the far surfaces it comes from
+// (--cluster-visibility-rays): the floor under the lamp, a white wall 4 m along x that the
+// floor reaches only through its cluster light (its link rows taken out of the good gather, as
+// rad-global's cluster links would carry it), and a black panel standing at x = 1.05 that hides
+// the wall from the floor's half x < 1. The floor top gathers c through cluster links. With 0
+// rays every texel rises by c; with 32 the hidden half by nothing and the open half by c over
+// the open share of the top's points (about 2 c). The ratio is taken at the 8 x 8 tiles'
+// corner texels (x = 0.03, 0.53, 1.03, 1.53, 1.97) and is linear between them, so the tile
+// across the panel's foot ramps from 0 to 2 c and the texels' mean comes out 0.81 c, not c.
+TEST(TextureMovieBaker, ClusterLightFollowsWhatEachTexelSeesOfTheFarSurfaces) {
+  FloorUnderCeiling f = floorUnderCeiling();
+  Scene& s = f.scene;
+  const int wall = addQuadNode(s, {6, 0, 0}, {6, 0, 2}, {6, 1, 2}, {6, 1, 0}, 0);  // faces -x
+  addQuadNode(s, {1.05, 0, 0}, {1.05, 1, 0}, {1.05, 1, 0.9}, {1.05, 0, 0.9}, 2);   // faces +x
+  GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
+  g.topClusterIrradiance.clear();
+  const int floorTop = topOfNode(g, f.floor), wallTop = topOfNode(g, wall);
+  ASSERT_GT(g.radiosityAtKey(wallTop, 0).x, 0.0) << "the lamp lights the wall";
+  int taken = 0;
+  for (GlobalLink& l : g.links)
+    if (g.hierarchy.node(int(l.receiver)).id.top == uint32_t(floorTop) &&
+        g.hierarchy.node(int(l.shooter)).id.top == uint32_t(wallTop)) {
+      l.flags |= kLinkBad;  // out of the good gather; no bad pair: nothing else gathers it
+      ++taken;
+    }
+  ASSERT_GT(taken, 0) << "the floor gathered from the wall";
+  const glm::vec3 c(0.125f, 0.25f, 0.0625f);
+  GlobalSolution clustered = g;
+  clustered.topClusterIrradiance.assign(size_t(g.hierarchy.topCount()), glm::vec3(0.0f));
+  clustered.topClusterIrradiance[size_t(floorTop)] = c;
+  clustered.validate("test");
+  const MovieExtent m = wholeTopMovie(floorTop, 0);
+  auto rise = [&](int rays) {
+    TextureMovieBakerOptions o;
+    o.clusterVisibilityRays = rays;
+    TextureMovieBaker plain(s, g, kFps, o), with(s, clustered, kFps, o);
+    const BakedMovie a = plain.bake(m), b = with.bake(m);
+    std::vector<std::pair<double, double>> out;  // (x, rise of the green channel / c)
+    for (int j = 0; j < m.height; ++j)
+      for (int i = 0; i < m.width; ++i) {
+        const size_t at = (size_t(j) * size_t(m.width) + size_t(i)) * 3 + 1;
+        out.emplace_back(polygonPointAt(g.hierarchy.top(floorTop).local,
+                                        {(i + 0.5) / m.width, (j + 0.5) / m.height})
+                             .x,
+                         (double(b.keys[0][at]) - double(a.keys[0][at])) / c.y);
+      }
+    return out;
+  };
+  for (const auto& [x, r] : rise(0)) EXPECT_NEAR(r, 1.0, 1e-5) << "x " << x;
+  double mean = 0.0, hidden = 0.0, open = 2.0;
+  const std::vector<std::pair<double, double>> r32 = rise(32);
+  for (const auto& [x, r] : r32) {
+    mean += r / double(r32.size());
+    if (x < 0.9) hidden = std::max(hidden, r);
+    if (x > 1.55) open = std::min(open, r);
+  }
+  std::printf("rise over c: mean %.4f, hidden half at most %.4f, open half at least %.4f\n", mean,
+              hidden, open);
+  EXPECT_NEAR(mean, 1.0, 0.25);
+  EXPECT_LT(hidden, 0.05);
+  EXPECT_GT(open, 1.8);
+}
+
 // A tile that a touching surface covers (exposure 0: a ceiling tile behind a light) gathers
 // nothing anyone sees, and one mostly covered gathers a noisy value over its small exposure; the
 // corners its uncovered neighbours interpolate their cluster light from weigh each tile by its

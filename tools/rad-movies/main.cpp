@@ -157,6 +157,11 @@ int main(int argc, char** argv) {
                  "texel, slower; the final setting uses 0.001)")
       ->capture_default_str()
       ->check(rad::finiteRange(0.0, 1.0));
+  app.add_option("--cluster-visibility-rays", b.clusterVisibilityRays,
+                 "gather: rays from each texel to points on its top's far surfaces, whose open "
+                 "share against the top's mean scales the cluster light, 0..64 (0: the top's "
+                 "one value)")
+      ->capture_default_str();
   app.add_option("--near-shooter-levels", b.nearShooterLevels,
                  "gather: split a near leaf shooter into up to 4^L cells, each with its radiosity "
                  "re-gathered at its centre from the leaf's links, 0..3 (0: the leaf's one "
