@@ -255,42 +255,48 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   stats.partialTileLinksPerTexel += long(partialTileLinksPerTexel_);
 }
 
-void GoodLinkGather::planClusterVisibility() {
-  clusterVisibility_.clear();
-  const int k = clusterVisibilityRays_;
-  if (k <= 0 || !visibility_ || clusterCorners_.empty()) return;
+const GoodLinksByReceiver::ClusterLightRays& GoodLinkGather::clusterLightRays(int key) {
   const PatchHierarchy& h = solution_.hierarchy;
-  const double t0 = keyTimes_.front();
-  const uint32_t R = uint32_t(receiverTop_);
-  auto moving = [&](uint32_t top) {
-    return std::find(movingNodes_.begin(), movingNodes_.end(), h.top(int(top)).node) !=
-           movingNodes_.end();
-  };
-  // A moving receiver's rays would hold only at its first key.
-  if (moving(R)) return;
-  int k0, k1;
-  double w;
-  solution_.keyWeights(t0, k0, k1, w);
-  const glm::dvec3 own = solution_.clusterIrradianceAtKey(int(R), k0);
-  if (!(own.x + own.y + own.z > 0.0)) return;
-  // The surfaces the top gathers itself (its movie's links, its bad pairs' shooters) are not
+  const uint32_t R = uint32_t(receiverTop_), T = uint32_t(h.topCount());
+  auto [at, fresh] = byReceiver_.clusterLightRays.try_emplace(
+      uint64_t(R) * uint64_t(solution_.keyCount()) + uint64_t(key));
+  GoodLinksByReceiver::ClusterLightRays& out = at->second;
+  if (!fresh) return out;
+  if (byReceiver_.staticTopWorld.empty()) {
+    byReceiver_.staticTopWorld.resize(T);
+    byReceiver_.topMoves.assign(T, 0);
+    for (uint32_t s = 0; s < T; ++s) {
+      byReceiver_.topMoves[s] = std::find(movingNodes_.begin(), movingNodes_.end(),
+                                          h.top(int(s)).node) != movingNodes_.end();
+      if (!byReceiver_.topMoves[s]) byReceiver_.staticTopWorld[s] = nodeWorld(s, keyTimes_.front());
+    }
+  }
+  const std::vector<Polygon>& world = byReceiver_.staticTopWorld;
+  // What the top gathers itself, the shooters of its nodes' links and of its bad pairs, is not
   // the cluster light's.
-  std::vector<char> gathered(size_t(h.topCount()), 0);
+  std::vector<char> gathered(T, 0);
   gathered[R] = 1;
-  for (const Link& l : links_) gathered[h.node(int(l.shooter)).id.top] = 1;
+  for (std::vector<int> stack{int(R)}; !stack.empty();) {
+    const int node = stack.back();
+    stack.pop_back();
+    for (uint32_t k = byReceiver_.start[size_t(node)]; k < byReceiver_.start[size_t(node) + 1]; ++k)
+      gathered[h.node(int(solution_.links[byReceiver_.rows[k]].shooter)).id.top] = 1;
+    if (!h.isLeaf(node))
+      for (int c = 0; c < 4; ++c) stack.push_back(h.node(node).firstChild + c);
+  }
   const auto& bad = solution_.badPairs;
   for (auto it = std::lower_bound(bad.begin(), bad.end(), std::make_pair(R, uint32_t(0)));
        it != bad.end() && it->first == R; ++it)
     gathered[it->second] = 1;
-  const Polygon receiver = nodeWorld(R, t0);
+  const Polygon& receiver = world[R];
   const glm::dvec3 centre = receiver.centroid(), n = receiver.normal();
   std::vector<double> cumulative;
   std::vector<uint32_t> far;
   double total = 0.0;
-  for (uint32_t s = 0; s < uint32_t(h.topCount()); ++s) {
-    if (gathered[s] || moving(s)) continue;
-    const glm::dvec3 B = solution_.exposedRadiosityAtKey(int(s), k0);
-    const Polygon p = nodeWorld(s, t0);
+  for (uint32_t s = 0; s < T; ++s) {
+    if (gathered[s] || byReceiver_.topMoves[s]) continue;
+    const glm::dvec3 B = solution_.exposedRadiosityAtKey(int(s), key);
+    const Polygon& p = world[s];
     const glm::dvec3 d = p.centroid() - centre;
     const double r2 = glm::dot(d, d);
     const double power = (B.x + B.y + B.z) * p.area() * std::max(0.0, glm::dot(n, d)) *
@@ -300,35 +306,52 @@ void GoodLinkGather::planClusterVisibility() {
     cumulative.push_back(total);
     far.push_back(s);
   }
-  if (far.empty()) return;
+  if (far.empty()) return out;
   // Stratified over the cumulative power, then area-uniform on the top drawn.
+  const int k = clusterVisibilityRays_;
   const uint64_t seed = splitMix64(0x636c7573746572ull ^ uint64_t(R));
-  std::vector<glm::dvec3> points(static_cast<size_t>(k));
+  out.points.resize(static_cast<size_t>(k));
   for (int j = 0; j < k; ++j) {
     const double u = (double(j) + uniformOpen01(seed, 3 * uint64_t(j))) / double(k) * total;
     const size_t i = std::min(
         size_t(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin()),
         far.size() - 1);
-    points[size_t(j)] =
-        pointOnPolygon(nodeWorld(far[i], t0), uniformOpen01(seed, 3 * uint64_t(j) + 1),
-                       uniformOpen01(seed, 3 * uint64_t(j) + 2));
+    out.points[size_t(j)] = pointOnPolygon(world[far[i]], uniformOpen01(seed, 3 * uint64_t(j) + 1),
+                                           uniformOpen01(seed, 3 * uint64_t(j) + 2));
   }
-  const VisibilityScene& blockers = visibility_->staticPart();
-  auto openShare = [&](const glm::dvec3& x) {
-    return double(std::bitset<64>(blockers.openFrom(x, points, R)).count()) / double(k);
-  };
   // The mean over the top's uncovered part (rad-global's cluster light is the exposed part's).
+  const VisibilityScene& blockers = visibility_->staticPart();
   const double size = polygonSize(receiver);
   double sum = 0.0;
   int uncovered = 0;
   for (const glm::dvec3& p :
        VisibilityScene::samplePoints(receiver, kClusterVisibilityPoints, seed)) {
-    if (insideSolid(blockers, scene_, h, R, p, n, size, t0)) continue;
-    sum += openShare(p);
+    if (insideSolid(blockers, scene_, h, R, p, n, size, keyTimes_.front())) continue;
+    sum += double(std::bitset<64>(blockers.openFrom(p, out.points, R)).count()) / double(k);
     ++uncovered;
   }
-  if (uncovered == 0 || !(sum > 0.0)) return;
-  const double mean = sum / double(uncovered);
+  out.meanOpenShare = uncovered > 0 ? sum / double(uncovered) : 0.0;
+  return out;
+}
+
+void GoodLinkGather::planClusterVisibility() {
+  clusterVisibility_.clear();
+  const int k = clusterVisibilityRays_;
+  if (k <= 0 || !visibility_ || clusterCorners_.empty()) return;
+  const PatchHierarchy& h = solution_.hierarchy;
+  const double t0 = keyTimes_.front();
+  const uint32_t R = uint32_t(receiverTop_);
+  // A moving receiver's rays would hold only at its first key.
+  if (std::find(movingNodes_.begin(), movingNodes_.end(), h.top(int(R)).node) != movingNodes_.end())
+    return;
+  int k0, k1;
+  double w;
+  solution_.keyWeights(t0, k0, k1, w);
+  const glm::dvec3 own = solution_.clusterIrradianceAtKey(int(R), k0);
+  if (!(own.x + own.y + own.z > 0.0)) return;
+  const GoodLinksByReceiver::ClusterLightRays& rays = clusterLightRays(k0);
+  if (rays.points.empty() || !(rays.meanOpenShare > 0.0)) return;
+  const VisibilityScene& blockers = visibility_->staticPart();
   const TexelFrame frame = texelFrame(t0);
   const int width = texels_.width, height = texels_.height;
   std::vector<size_t> corners;
@@ -338,7 +361,9 @@ void GoodLinkGather::planClusterVisibility() {
   corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
   std::vector<double> atCorner(corners.size());
   tbb::parallel_for(size_t(0), corners.size(), [&](size_t i) {
-    atCorner[i] = openShare(frame.point(texels_.localPoint[corners[i]])) / mean;
+    const glm::dvec3 x = frame.point(texels_.localPoint[corners[i]]);
+    atCorner[i] = double(std::bitset<64>(blockers.openFrom(x, rays.points, R)).count()) /
+                  double(k) / rays.meanOpenShare;
   });
   auto ratioAt = [&](size_t x) {
     return atCorner[size_t(std::lower_bound(corners.begin(), corners.end(), x) - corners.begin())];

@@ -130,6 +130,18 @@ struct GoodLinksByReceiver {
     }
   };
   std::unordered_map<HiddenLink, double, HiddenLinkHash> hiddenFormFactor;
+  // Per static top and global key (top * keyCount + key): the points on its far surfaces that
+  // its texels' cluster-light rays go to, and the mean open share of those rays over the top's
+  // uncovered part (GoodLinkGather::planClusterVisibility); the same for every movie of the top
+  // (none: the top gets no per-texel cluster light). And the static tops' world polygons
+  // (empty until the first movie needs them; a moving top's is left empty).
+  struct ClusterLightRays {
+    std::vector<glm::dvec3> points;
+    double meanOpenShare = 0.0;
+  };
+  std::unordered_map<uint64_t, ClusterLightRays> clusterLightRays;
+  std::vector<Polygon> staticTopWorld;
+  std::vector<char> topMoves;
   void indexAllLinks(const GlobalSolution& solution);
   // The cluster irradiance at each top's corners, [(top * K + k) * 4 + c] (empty without
   // cluster links): the mean of topClusterIrradiance, weighted by exposed area, over the tops of
@@ -337,6 +349,8 @@ class GoodLinkGather {
   // uncovered points of the top (so the top keeps rad-global's total). At the tiles' corner
   // texels, bilinear in between, once per movie against the static blockers at its first key.
   void planClusterVisibility();
+  // The top's far points and mean open share at global key k (cached in byReceiver_).
+  const GoodLinksByReceiver::ClusterLightRays& clusterLightRays(int k);
   static constexpr int kClusterVisibilityPoints = 64;
   struct TexelFrame {  // the receiver's local-to-world map and its normal map at one time
     glm::dmat4 m;
