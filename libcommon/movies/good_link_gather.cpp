@@ -288,36 +288,56 @@ const GoodLinksByReceiver::ClusterLightRays& GoodLinkGather::clusterLightRays(in
   for (auto it = std::lower_bound(bad.begin(), bad.end(), std::make_pair(R, uint32_t(0)));
        it != bad.end() && it->first == R; ++it)
     gathered[it->second] = 1;
+  std::vector<GoodLinksByReceiver::FarCandidate>& candidates = byReceiver_.farCandidates[key];
+  if (candidates.empty()) {
+    std::vector<double> cumulative(T, 0.0);
+    double total = 0.0;
+    for (uint32_t s = 0; s < T; ++s) {
+      if (!byReceiver_.topMoves[s]) {
+        const glm::dvec3 B = solution_.exposedRadiosityAtKey(int(s), key);
+        total += std::max(0.0, B.x + B.y + B.z) * world[s].area();
+      }
+      cumulative[s] = total;
+    }
+    if (!(total > 0.0)) return out;
+    const uint64_t seed = splitMix64(0x66617263616e64ull ^ uint64_t(key));
+    const int m = GoodLinksByReceiver::kFarCandidates;
+    candidates.resize(size_t(m));
+    for (int j = 0; j < m; ++j) {
+      const double u = (double(j) + uniformOpen01(seed, 3 * uint64_t(j))) / double(m) * total;
+      const uint32_t s = uint32_t(std::min(
+          size_t(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin()),
+          size_t(T) - 1));
+      candidates[size_t(j)] = {pointOnPolygon(world[s], uniformOpen01(seed, 3 * uint64_t(j) + 1),
+                                              uniformOpen01(seed, 3 * uint64_t(j) + 2)),
+                               world[s].normal(), s};
+    }
+  }
+  // The top's far points: the candidates it does not gather itself, drawn again by its kernel
+  // cos cos / d^4 from its centroid (the candidates carry B A already), stratified.
   const Polygon& receiver = world[R];
   const glm::dvec3 centre = receiver.centroid(), n = receiver.normal();
-  std::vector<double> cumulative;
-  std::vector<uint32_t> far;
+  std::vector<double> cumulative(candidates.size(), 0.0);
   double total = 0.0;
-  for (uint32_t s = 0; s < T; ++s) {
-    if (gathered[s] || byReceiver_.topMoves[s]) continue;
-    const glm::dvec3 B = solution_.exposedRadiosityAtKey(int(s), key);
-    const Polygon& p = world[s];
-    const glm::dvec3 d = p.centroid() - centre;
-    const double r2 = glm::dot(d, d);
-    const double power = (B.x + B.y + B.z) * p.area() * std::max(0.0, glm::dot(n, d)) *
-                         std::max(0.0, -glm::dot(p.normal(), d)) / (r2 * r2);
-    if (!(power > 0.0)) continue;
-    total += power;
-    cumulative.push_back(total);
-    far.push_back(s);
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    const GoodLinksByReceiver::FarCandidate& f = candidates[c];
+    if (!gathered[f.top]) {
+      const glm::dvec3 d = f.point - centre;
+      const double r2 = glm::dot(d, d);
+      total += std::max(0.0, glm::dot(n, d)) * std::max(0.0, -glm::dot(f.normal, d)) / (r2 * r2);
+    }
+    cumulative[c] = total;
   }
-  if (far.empty()) return out;
-  // Stratified over the cumulative power, then area-uniform on the top drawn.
+  if (!(total > 0.0)) return out;
   const int k = clusterVisibilityRays_;
   const uint64_t seed = splitMix64(0x636c7573746572ull ^ uint64_t(R));
   out.points.resize(static_cast<size_t>(k));
   for (int j = 0; j < k; ++j) {
-    const double u = (double(j) + uniformOpen01(seed, 3 * uint64_t(j))) / double(k) * total;
-    const size_t i = std::min(
+    const double u = (double(j) + uniformOpen01(seed, uint64_t(j))) / double(k) * total;
+    const size_t c = std::min(
         size_t(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin()),
-        far.size() - 1);
-    out.points[size_t(j)] = pointOnPolygon(world[far[i]], uniformOpen01(seed, 3 * uint64_t(j) + 1),
-                                           uniformOpen01(seed, 3 * uint64_t(j) + 2));
+        candidates.size() - 1);
+    out.points[size_t(j)] = candidates[c].point;
   }
   // The mean over the top's uncovered part (rad-global's cluster light is the exposed part's).
   const VisibilityScene& blockers = visibility_->staticPart();

@@ -142,6 +142,16 @@ struct GoodLinksByReceiver {
   std::unordered_map<uint64_t, ClusterLightRays> clusterLightRays;
   std::vector<Polygon> staticTopWorld;
   std::vector<char> topMoves;
+  // Per global key: kFarCandidates points on the static tops, the tops drawn by emitted and
+  // reflected power B A (stratified) and each point area-uniform on its top, from which every
+  // top's far points are drawn again by its own kernel. Drawing from all tops for every top had
+  // made the 100k-triangle hall's rad-movies 48 -> 140 s.
+  struct FarCandidate {
+    glm::dvec3 point, normal;
+    uint32_t top;
+  };
+  std::unordered_map<int, std::vector<FarCandidate>> farCandidates;
+  static constexpr int kFarCandidates = 4096;
   void indexAllLinks(const GlobalSolution& solution);
   // The cluster irradiance at each top's corners, [(top * K + k) * 4 + c] (empty without
   // cluster links): the mean of topClusterIrradiance, weighted by exposed area, over the tops of
