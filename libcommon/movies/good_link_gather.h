@@ -351,14 +351,14 @@ class GoodLinkGather {
   // far surfaces (a chair's seat under a desk, its back in the open) the camera sees its open
   // parts, and the all-pairs frames, whose far links take V per texel, were brighter there
   // (10k hall, frame 48: chairs -2.2 to -2.9 % against the references, -4.4 to -5.1 % with
-  // the far links' per-texel V turned off, -4.6 to -5.9 % with clusters; -2.1 to -3.9 % with
-  // this). Per top and global key: k points on its far surfaces (the static tops that are
-  // neither shooters of its nodes' good links nor of its bad pairs, drawn by B A cos cos / d^4
-  // from the top's centroid, then area-uniform), seeded by the top, and their mean open share
-  // at 64 uncovered points of the top (clusterLightRays); a texel's cluster light is scaled by
-  // the open share of its rays to them over that mean (so the top keeps rad-global's total). At
-  // the tiles' corner texels, bilinear in between, once per movie against the static blockers
-  // at its first key.
+  // the far links' per-texel V turned off, -4.6 to -5.9 % with clusters). Per top and global key: k
+  // points on its far surfaces (the static tops that are neither shooters of its nodes' good links
+  // nor of its bad pairs; drawn from the key's farCandidates by cos cos / d^4 from the top's
+  // centroid), seeded by the top, and their mean open share at 64 uncovered points of the top
+  // (clusterLightRays); a texel's cluster light is scaled by the open share of its rays to them
+  // over that mean (so the top keeps rad-global's total). At the tiles' corner texels, bilinear in
+  // between, once per movie against the static blockers at its first key. (10k hall: chairs -2.0 to
+  // -4.1 %, the frame's bias -1.10 -> -0.98 %.)
   void planClusterVisibility();
   // The top's far points and mean open share at global key k (cached in byReceiver_).
   const GoodLinksByReceiver::ClusterLightRays& clusterLightRays(int k);
