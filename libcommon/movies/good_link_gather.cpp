@@ -262,15 +262,6 @@ const GoodLinksByReceiver::ClusterLightRays& GoodLinkGather::clusterLightRays(in
       uint64_t(R) * uint64_t(solution_.keyCount()) + uint64_t(key));
   GoodLinksByReceiver::ClusterLightRays& out = at->second;
   if (!fresh) return out;
-  if (byReceiver_.staticTopWorld.empty()) {
-    byReceiver_.staticTopWorld.resize(T);
-    byReceiver_.topMoves.assign(T, 0);
-    for (uint32_t s = 0; s < T; ++s) {
-      byReceiver_.topMoves[s] = std::find(movingNodes_.begin(), movingNodes_.end(),
-                                          h.top(int(s)).node) != movingNodes_.end();
-      if (!byReceiver_.topMoves[s]) byReceiver_.staticTopWorld[s] = nodeWorld(s, keyTimes_.front());
-    }
-  }
   const std::vector<Polygon>& world = byReceiver_.staticTopWorld;
   // What the top gathers itself, the shooters of its nodes' links and of its bad pairs, is not
   // the cluster light's.
@@ -362,8 +353,17 @@ void GoodLinkGather::planClusterVisibility() {
   const double t0 = keyTimes_.front();
   const uint32_t R = uint32_t(receiverTop_);
   // A moving receiver's rays would hold only at its first key.
-  if (std::find(movingNodes_.begin(), movingNodes_.end(), h.top(int(R)).node) != movingNodes_.end())
-    return;
+  if (byReceiver_.topMoves.empty()) {  // the static tops' world polygons, once per worker
+    const uint32_t T = uint32_t(h.topCount());
+    byReceiver_.staticTopWorld.resize(T);
+    byReceiver_.topMoves.assign(T, 0);
+    for (uint32_t s = 0; s < T; ++s) {
+      byReceiver_.topMoves[s] = std::find(movingNodes_.begin(), movingNodes_.end(),
+                                          h.top(int(s)).node) != movingNodes_.end();
+      if (!byReceiver_.topMoves[s]) byReceiver_.staticTopWorld[s] = nodeWorld(s, t0);
+    }
+  }
+  if (byReceiver_.topMoves[R]) return;
   int k0, k1;
   double w;
   solution_.keyWeights(t0, k0, k1, w);

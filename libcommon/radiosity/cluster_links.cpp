@@ -304,7 +304,6 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
       glm::dvec3 x, y;
       uint32_t a, b;
       double kernel;
-      bool open = false;
     };
     const int k = rays_;
     std::array<RayPair, 64> onStack;
@@ -349,31 +348,29 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
                             : 0.0;
       sumK += p.kernel;
     }
-    double openK = 0.0;
-    int open = 0;
-    for (int i = 0; i < k; ++i) {
-      RayPair& p = pairs[size_t(i)];
-      if (sumK > 0.0 && !(p.kernel > 0.0)) continue;
-      const bool isOpen = !visibility_->occluded(p.x, p.y, p.a, p.b);
-      p.open = isOpen;
-      open += isOpen ? 1 : 0;
-      openK += isOpen ? p.kernel : 0.0;
-    }
-    v = sumK > 0.0 ? openK / sumK : double(open) / double(k);
     // V per facing group of R's members, from the same pairs: one V for a receiver cluster
     // spreads the light its open members see over its occluded ones (a chair's seat under a
     // desk and its back in the open: the back, the one seen, came out dark).
-    if (isCluster(l.receiver) && sumK > 0.0) {
-      std::array<double, 6> groupK{}, groupOpenK{};
-      int positive = 0;
-      for (int i = 0; i < k; ++i) {
-        const RayPair& p = pairs[size_t(i)];
-        if (!(p.kernel > 0.0)) continue;
+    const bool perGroup = isCluster(l.receiver) && sumK > 0.0;
+    std::array<double, 6> groupK{}, groupOpenK{};
+    int positive = 0;  // the pairs with a kernel (the only ones cast when perGroup)
+    double openK = 0.0;
+    int open = 0;
+    for (int i = 0; i < k; ++i) {
+      const RayPair& p = pairs[size_t(i)];
+      if (sumK > 0.0 && !(p.kernel > 0.0)) continue;
+      const bool isOpen = !visibility_->occluded(p.x, p.y, p.a, p.b);
+      open += isOpen ? 1 : 0;
+      openK += isOpen ? p.kernel : 0.0;
+      if (perGroup) {
         ++positive;
         const size_t g = size_t(facingGroupOf(normal_[p.a]));
         groupK[g] += p.kernel;
-        groupOpenK[g] += p.open ? p.kernel : 0.0;
+        groupOpenK[g] += isOpen ? p.kernel : 0.0;
       }
+    }
+    v = sumK > 0.0 ? openK / sumK : double(open) / double(k);
+    if (perGroup) {
       const double prior = kGroupPrior * sumK / double(positive);
       for (size_t g = 0; g < 6; ++g)
         l.groupVisibility[g] =

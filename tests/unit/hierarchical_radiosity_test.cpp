@@ -824,6 +824,21 @@ void addQuad(std::vector<Polygon>& polys, glm::dvec3 a, glm::dvec3 b, glm::dvec3
   polys.push_back(p);
 }
 
+// A grid of nu x nv quads appended to `polys`: tile (i, j) from a = origin + i du + j dv, its
+// corners a, a + du, a + du + dv, a + dv (facing du x dv), or in the other turn when
+// `alongDvFirst` (facing dv x du).
+void addTileGrid(std::vector<Polygon>& polys, glm::dvec3 origin, glm::dvec3 du, glm::dvec3 dv,
+                 int nu, int nv, bool alongDvFirst) {
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const glm::dvec3 a = origin + double(i) * du + double(j) * dv;
+      if (alongDvFirst)
+        addQuad(polys, a, a + dv, a + du + dv, a + du);
+      else
+        addQuad(polys, a, a + du, a + du + dv, a + dv);
+    }
+}
+
 // The cluster links of static tops `polys`, none of them a light, refined (separation 2, eps
 // 1: the separation decides) until no link changes, and evaluated: what the tests of the
 // cluster transfer read. Built in place (its members refer to each other).
@@ -860,16 +875,8 @@ struct SeparatedClusterLinks {
 TEST(ClusterLinks, FormFactorsFollowEachReceiverTopAtGrazingAngles) {
   std::vector<Polygon> polys;
   const double s = 0.5;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) {  // x = 0, facing +x, z in [0, 2]
-      const double y = i * s, z = j * s;
-      addQuad(polys, {0, y, z}, {0, y + s, z}, {0, y + s, z + s}, {0, y, z + s});
-    }
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) {  // z = 0, facing +z, x in [8, 10]
-      const double x = 8.0 + i * s, y = j * s;
-      addQuad(polys, {x, y, 0}, {x + s, y, 0}, {x + s, y + s, 0}, {x, y + s, 0});
-    }
+  addTileGrid(polys, {0, 0, 0}, {0, s, 0}, {0, 0, s}, 4, 4, false);  // x = 0, facing +x
+  addTileGrid(polys, {8, 0, 0}, {s, 0, 0}, {0, s, 0}, 4, 4, false);  // z = 0, facing +z
   ASSERT_NEAR(polys[0].normal().x, 1.0, 1e-12);
   ASSERT_NEAR(polys[16].normal().z, 1.0, 1e-12);
   SeparatedClusterLinks separated(polys, nullptr, 4);
@@ -900,21 +907,10 @@ TEST(ClusterLinks, FormFactorsFollowEachReceiverTopAtGrazingAngles) {
 TEST(ClusterLinks, ShooterRadiosityWeighsItsFacingGroupsAsTheTransferDoes) {
   std::vector<Polygon> polys;
   const double s = 0.5;
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) {  // floor y = 0, facing +y, x and z in [0, 2]
-      const double x = i * s, z = j * s;
-      addQuad(polys, {x, 0, z}, {x, 0, z + s}, {x + s, 0, z + s}, {x + s, 0, z});
-    }
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) {  // wall x = 2, facing +x, y and z in [0, 2]
-      const double y = i * s, z = j * s;
-      addQuad(polys, {2, y, z}, {2, y + s, z}, {2, y + s, z + s}, {2, y, z + s});
-    }
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) {  // receiver x = 10, facing -x, y in [2.5, 3.5], z in [0.5, 1.5]
-      const double r = 0.25, y = 2.5 + i * r, z = 0.5 + j * r;
-      addQuad(polys, {10, y, z}, {10, y, z + r}, {10, y + r, z + r}, {10, y + r, z});
-    }
+  addTileGrid(polys, {0, 0, 0}, {s, 0, 0}, {0, 0, s}, 4, 4, true);   // floor y = 0, facing +y
+  addTileGrid(polys, {2, 0, 0}, {0, s, 0}, {0, 0, s}, 4, 4, false);  // wall x = 2, facing +x
+  const double r = 0.25;  // receiver x = 10, facing -x, y in [2.5, 3.5], z in [0.5, 1.5]
+  addTileGrid(polys, {10, 2.5, 0.5}, {0, r, 0}, {0, 0, r}, 4, 4, true);
   ASSERT_NEAR(polys[0].normal().y, 1.0, 1e-12);
   ASSERT_NEAR(polys[16].normal().x, 1.0, 1e-12);
   ASSERT_NEAR(polys[32].normal().x, -1.0, 1e-12);
@@ -1013,21 +1009,9 @@ TEST(ClusterLinks, VisibilityIsEstimatedFromPairsThatFaceEachOther) {
 TEST(ClusterLinks, VisibilityIsTakenPerFacingGroupOfTheReceiver) {
   std::vector<Polygon> polys;
   const double s = 0.5;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) {  // floor y = 0, facing +y, x and z in [0, 1]
-      const double x = i * s, z = j * s;
-      addQuad(polys, {x, 0, z}, {x, 0, z + s}, {x + s, 0, z + s}, {x + s, 0, z});
-    }
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) {  // panel x = 1.2, facing +x, y and z in [0, 1]
-      const double y = i * s, z = j * s;
-      addQuad(polys, {1.2, y, z}, {1.2, y + s, z}, {1.2, y + s, z + s}, {1.2, y, z + s});
-    }
-  for (int i = 0; i < 8; ++i)
-    for (int j = 0; j < 2; ++j) {  // wall x = 8, facing -x, y in [0, 4], z in [0, 1]
-      const double y = i * s, z = j * s;
-      addQuad(polys, {8, y, z}, {8, y, z + s}, {8, y + s, z + s}, {8, y + s, z});
-    }
+  addTileGrid(polys, {0, 0, 0}, {s, 0, 0}, {0, 0, s}, 2, 2, true);     // floor y = 0, facing +y
+  addTileGrid(polys, {1.2, 0, 0}, {0, s, 0}, {0, 0, s}, 2, 2, false);  // panel x = 1.2, +x
+  addTileGrid(polys, {8, 0, 0}, {0, s, 0}, {0, 0, s}, 8, 2, true);     // wall x = 8, facing -x
   ASSERT_NEAR(polys[0].normal().y, 1.0, 1e-12);
   ASSERT_NEAR(polys[4].normal().x, 1.0, 1e-12);
   ASSERT_NEAR(polys[8].normal().x, -1.0, 1e-12);
