@@ -183,7 +183,12 @@ struct TextureIntervalsBuilder::Impl {
     // A node seen on fewer pixels than its four children's smallest textures hold (4 minSize^2)
     // keeps one texture: splitting it adds movies, not resolution (the 10k-triangle hall's
     // partly hidden chair triangles made 67,660 of its 75,727 movies at levels 1 and 2).
-    const bool tiny = double(visible[i]) < 4.0 * options.minSize * options.minSize;
+    // But only while its own texture is small too (at most 4 minSize a side): a big patch leaving
+    // the frustum, a few pixels left on screen, had kept its whole-area texture (the 10k hall's
+    // floor tiles at 181-256 texels a side for one frame, ~1 s of rad-movies each), where the
+    // children holding those pixels need a sixteenth of it and carry on the movies they had.
+    const bool tiny = double(visible[i]) < 4.0 * options.minSize * options.minSize &&
+                      textureSideFor(area[i], 0, options) <= 4 * options.minSize;
     if (enough || tiny || hierarchy.isLeaf(i)) {
       chosen.push_back(i);
       return;

@@ -348,6 +348,45 @@ TEST(TextureIntervalsBuilder, TinyPartlyVisiblePatchKeepsOneTexture) {
   EXPECT_EQ(chosen[0], topOfNode(b.hierarchy(), rect));
 }
 
+// But a big near patch almost out of the frustum, a sliver of it left at the image's edge, goes
+// down to its children: its whole-area texture is large (the 10k-triangle hall's floor tiles
+// took 181-256 texels a side for the one frame before they left the view, ~1 s of rad-movies
+// each), and the children holding the sliver need a fraction of its texels.
+TEST(TextureIntervalsBuilder, BigPatchLeavingTheFrustumGoesToItsChildren) {
+  TestScene s;
+  const double z = -2.0, edge = -z * std::tan(0.4) * kSize.aspect(),
+               pixel = -z * std::tan(0.4) / 60;
+  // 28 pixels tall, 1.5 pixels of it on screen, 280 beyond the right edge.
+  int rect = s.addRect("rect", edge - 1.5 * pixel, -0.2, edge + 280 * pixel, 0.2, z);
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  o.maxLevel = 1;
+  TextureIntervalsBuilder b(s.scene, s.camera, o);
+  const PatchHierarchy& h = b.hierarchy();
+  std::vector<int> chosen;
+  long visiblePixels = 0;
+  double wholeArea = 0.0;
+  b.addFrame(0, [&](const IntervalFrame& f) {
+    chosen = *f.chosen;
+    for (int t = 0; t < h.topCount(); ++t)
+      if (h.top(t).node == rect && (*f.visiblePixels)[size_t(t)] > 0) {
+        visiblePixels += (*f.visiblePixels)[size_t(t)];
+        wholeArea = std::max(wholeArea, (*f.projectedArea)[size_t(t)]);
+      }
+  });
+  const std::vector<MovieExtent> all = b.finish();
+  ASSERT_GT(visiblePixels, 0) << "it is on screen";
+  ASSERT_LT(visiblePixels, 64) << "on fewer pixels than four smallest textures hold";
+  const int ownSide = textureSideFor(wholeArea, 0, o);
+  ASSERT_GT(ownSide, 4 * o.minSize) << "and its own texture is big";
+  ASSERT_FALSE(chosen.empty());
+  for (int i : chosen) EXPECT_EQ(h.node(i).id.level(), 1) << "its children hold the sliver";
+  long texels = 0;
+  for (const MovieExtent& m : all) texels += long(m.width) * m.height;
+  EXPECT_LT(2 * texels, long(ownSide) * ownSide)
+      << "in at most half the texels of the whole patch's texture";
+}
+
 // A rectangle straddling the right image edge while the camera sways: its visible fraction
 // swings between 0.6 and 0.4 around theta = 0.5. The paper's rule switches level at every
 // swing; with a level hysteresis of 0.15 it keeps its first (top-level) movie throughout.
