@@ -373,32 +373,28 @@ void GoodLinkGather::planClusterVisibility() {
   if (rays.points.empty() || !(rays.meanOpenShare > 0.0)) return;
   const VisibilityScene& blockers = visibility_->staticPart();
   const TexelFrame frame = texelFrame(t0);
-  const int width = texels_.width, height = texels_.height;
-  std::vector<size_t> corners;
-  for (const Tile& tile : tiles_)
-    for (size_t x : tile.cornerTexels(width)) corners.push_back(x);
-  std::sort(corners.begin(), corners.end());
-  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-  std::vector<double> atCorner(corners.size());
-  tbb::parallel_for(size_t(0), corners.size(), [&](size_t i) {
-    const glm::dvec3 x = frame.point(texels_.localPoint[corners[i]]);
+  // At the tiles' corner texels (planTexels' corners_, sorted by texel; its last entry only
+  // ends the list), bilinear in between.
+  const size_t C = corners_.size() - 1;
+  std::vector<double> atCorner(C);
+  tbb::parallel_for(size_t(0), C, [&](size_t i) {
+    const glm::dvec3 x = frame.point(texels_.localPoint[corners_[i].texel]);
     atCorner[i] = double(std::bitset<64>(blockers.openFrom(x, rays.points, R)).count()) /
                   double(k) / rays.meanOpenShare;
   });
   auto ratioAt = [&](size_t x) {
-    return atCorner[size_t(std::lower_bound(corners.begin(), corners.end(), x) - corners.begin())];
+    return atCorner[size_t(std::lower_bound(corners_.begin(), corners_.begin() + long(C), x,
+                                            [](const Corner& c, size_t t) { return c.texel < t; }) -
+                           corners_.begin())];
   };
+  const int width = texels_.width, height = texels_.height;
   clusterVisibility_.assign(size_t(width) * size_t(height), 1.0f);
   for (const Tile& tile : tiles_) {
     const std::array<size_t, 4> c = tile.cornerTexels(width);
     const double m[4] = {ratioAt(c[0]), ratioAt(c[1]), ratioAt(c[2]), ratioAt(c[3])};
     for (int j = tile.j0; j < std::min(tile.j0 + kTile, height); ++j)
-      for (int i = tile.i0; i < std::min(tile.i0 + kTile, width); ++i) {
-        const glm::dvec2 uv = tile.uv(i, j);
-        const double u = uv.x, v = uv.y;
-        clusterVisibility_[size_t(j) * size_t(width) + size_t(i)] = float(
-            (1 - u) * (1 - v) * m[0] + u * (1 - v) * m[1] + u * v * m[2] + (1 - u) * v * m[3]);
-      }
+      for (int i = tile.i0; i < std::min(tile.i0 + kTile, width); ++i)
+        clusterVisibility_[size_t(j) * size_t(width) + size_t(i)] = float(tile.bilinear(i, j, m));
   }
 }
 
@@ -1394,11 +1390,7 @@ void GoodLinkGather::gather(double t, std::vector<glm::dvec3>& acc) const {
       for (int j = tile.j0; j < jEnd; ++j)
         for (int i = tile.i0; i < iEnd; ++i)
           if (tile.groups[g].first & Tile::bit(i, j, tile)) {
-            const glm::dvec2 uv = tile.uv(i, j);
-            const double u = uv.x, v = uv.y;
-            far[size_t((j - tile.j0) * kTile + (i - tile.i0))] +=
-                (1 - u) * (1 - v) * corner[0] + u * (1 - v) * corner[1] + u * v * corner[2] +
-                (1 - u) * v * corner[3];
+            far[size_t((j - tile.j0) * kTile + (i - tile.i0))] += tile.bilinear(i, j, corner);
           }
     }
     for (int j = tile.j0; j < jEnd; ++j)

@@ -274,10 +274,14 @@ class GoodLinkGather {
       return {size_t(j0) * width + i0, size_t(j0) * width + i1, size_t(j1) * width + i1,
               size_t(j1) * width + i0};
     }
-    // Texel (i, j)'s bilinear (u, v) between the corner texels.
-    glm::dvec2 uv(int i, int j) const {
-      return glm::dvec2(i1 > i0 ? double(i - i0) / (i1 - i0) : 0.0,
-                        j1 > j0 ? double(j - j0) / (j1 - j0) : 0.0);
+    // Values at the corner texels (in cornerTexels' order) interpolated bilinearly to texel
+    // (i, j): the far links' irradiance (gather) and the cluster light's ratio
+    // (planClusterVisibility).
+    template <class V>
+    V bilinear(int i, int j, const V (&c)[4]) const {
+      const double u = i1 > i0 ? double(i - i0) / (i1 - i0) : 0.0;
+      const double v = j1 > j0 ? double(j - j0) / (j1 - j0) : 0.0;
+      return (1 - u) * (1 - v) * c[0] + u * (1 - v) * c[1] + u * v * c[2] + (1 - u) * v * c[3];
     }
     int common = -1;              // deepest node holding every texel of the tile
     std::vector<uint32_t> links;  // links_ indices interpolated over the tile
