@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <tbb/global_control.h>
+
 #include "formats/container.h"
 #include "formats/item_buffer_exr.h"
 #include "libcommon/core/error.h"
@@ -45,19 +47,23 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
   const auto start = std::chrono::steady_clock::now();
   TextureIntervalsBuilder builder(scene, cameraNode, options);
   run.setupSeconds = secondsSince(start);
-  for (int f : frames) {
-    builder.addFrame(f, [&](const IntervalFrame& fr) {
-      run.itemSeconds.push_back(fr.itemBufferSeconds);
-      const std::vector<uint32_t>& ids = fr.itemBuffer->id;
-      if (std::all_of(ids.begin(), ids.end(), [](uint32_t id) { return id == kNoItem; }))
-        run.emptyFrames.push_back(fr.frame);
-      if (itemBuffersDir.empty()) return;
-      char name[32];
-      std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
-      writeItemBufferExr(itemBuffersDir + name, *fr.itemBuffer, fr.frame, fr.time, provenanceJson);
-    });
-    if (frameDone) frameDone();
-  }
+  // Item buffers drawn by one GL context a thread (TextureIntervalsBuilder::addFrames).
+  const size_t renderers = std::clamp<size_t>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1, 4);
+  builder.addFrames(
+      frames, renderers,
+      [&](const IntervalFrame& fr) {
+        run.itemSeconds.push_back(fr.itemBufferSeconds);
+        const std::vector<uint32_t>& ids = fr.itemBuffer->id;
+        if (std::all_of(ids.begin(), ids.end(), [](uint32_t id) { return id == kNoItem; }))
+          run.emptyFrames.push_back(fr.frame);
+        if (itemBuffersDir.empty()) return;
+        char name[32];
+        std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
+        writeItemBufferExr(itemBuffersDir + name, *fr.itemBuffer, fr.frame, fr.time,
+                           provenanceJson);
+      },
+      frameDone);
   const std::vector<MovieExtent> extents = builder.finish();
   run.totalSeconds = secondsSince(start);
 

@@ -4,9 +4,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
 #include <map>
+#include <mutex>
+#include <thread>
 
 #include "libcommon/core/error.h"
+#include "libcommon/core/stopwatch.h"
 #include "libcommon/intervals/projected_area.h"
 
 namespace rad {
@@ -72,6 +77,7 @@ struct TextureIntervalsBuilder::Impl {
   std::vector<int> meshNodes;   // scene mesh node of each item object
   std::vector<int> nodeObject;  // per dense node: index into meshNodes
   std::unique_ptr<ItemBufferRenderer> renderer;
+  bool uploaded = false;  // renderer has the geometry
   ItemBuffer buffer;
 
   // Per-frame state.
@@ -132,20 +138,42 @@ struct TextureIntervalsBuilder::Impl {
       obj = int(meshNodes.size());
       meshNodes.push_back(node);
     }
-    std::vector<ItemObject> objects(meshNodes.size());
     nodeObject.resize(hierarchy.size());
-    for (int i = 0; i < hierarchy.size(); ++i) {
-      nodeObject[i] = objectOf.at(hierarchy.topOf(i).node);
-      if (hierarchy.isLeaf(i))
-        objects[nodeObject[i]].addPolygon(hierarchy.node(i).local, uint32_t(i + 1));
-    }
+    for (int i = 0; i < hierarchy.size(); ++i) nodeObject[i] = objectOf.at(hierarchy.topOf(i).node);
+    // The GL context is made here, so that a machine without one fails before any frame; the
+    // geometry goes to it with the first addFrame (addFrames' renderers have their own).
     renderer = std::make_unique<ItemBufferRenderer>(options.imageSize);
-    renderer->setGeometry(objects);
     visible.assign(hierarchy.size(), 0);
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
     openMovie.assign(hierarchy.size(), -1);
     openBelow.assign(hierarchy.size(), 0);
+  }
+
+  // The leaves as item objects (one per mesh node, ids dense index + 1): made for each renderer
+  // and dropped once uploaded (at the 100k-triangle hall's 850,000 leaves ~130 MB).
+  std::vector<ItemObject> itemObjects() const {
+    std::vector<ItemObject> objects(meshNodes.size());
+    for (int i = 0; i < hierarchy.size(); ++i)
+      if (hierarchy.isLeaf(i))
+        objects[nodeObject[i]].addPolygon(hierarchy.node(i).local, uint32_t(i + 1));
+    return objects;
+  }
+
+  // The camera and the objects' placement at `frame`.
+  struct FrameView {
+    double time = 0.0;
+    CameraView camera;
+    std::vector<glm::dmat4> transforms;  // per item object
+  };
+  FrameView frameView(int frame) const {
+    FrameView v;
+    v.time = frame / options.fps;
+    v.camera = scene.cameraAt(cameraNode, v.time);
+    v.transforms.resize(meshNodes.size());
+    for (size_t o = 0; o < meshNodes.size(); ++o)
+      v.transforms[o] = scene.worldTransform(meshNodes[o], v.time);
+    return v;
   }
 
   // Whole-patch projected area (header: clipped at the near and far planes only).
@@ -255,18 +283,27 @@ struct TextureIntervalsBuilder::Impl {
   }
 
   void addFrame(int frame, const std::function<void(const IntervalFrame&)>& observer) {
+    requireIncreasing(frame);
+    if (!uploaded) renderer->setGeometry(itemObjects());
+    uploaded = true;
+    const FrameView v = frameView(frame);
+    auto start = std::chrono::steady_clock::now();
+    renderer->render(v.camera, v.transforms, buffer);
+    addRendered(frame, v, secondsSince(start), observer);
+  }
+
+  void requireIncreasing(int frame) const {
     if (frames > 0 && frame <= lastFrame)
       throw Error(ExitCode::kInternal, "", "frames must be strictly increasing");
-    double t = frame / options.fps;
-    CameraView view = scene.cameraAt(cameraNode, t);
-    std::vector<glm::dmat4> transforms(meshNodes.size());
-    for (size_t o = 0; o < meshNodes.size(); ++o)
-      transforms[o] = scene.worldTransform(meshNodes[o], t);
+  }
 
-    auto start = std::chrono::steady_clock::now();
-    renderer->render(view, transforms, buffer);
-    double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The frame whose item buffer `buffer` holds (rendered in `seconds` at the view v).
+  void addRendered(int frame, const FrameView& v, double seconds,
+                   const std::function<void(const IntervalFrame&)>& observer) {
+    requireIncreasing(frame);
+    const double t = v.time;
+    const CameraView& view = v.camera;
+    const std::vector<glm::dmat4>& transforms = v.transforms;
     itemSeconds += seconds;
 
     // Visible pixels per leaf, then summed up the tree (children come after parents).
@@ -361,6 +398,151 @@ struct TextureIntervalsBuilder::Impl {
     }
   }
 };
+
+namespace {
+
+// Item buffers rendered ahead of the builder on worker threads, frame i by worker i mod N into
+// its slot, taken in frame order (take). Each worker makes and uses its own renderer: an OSMesa
+// context is current on one thread at a time. A frame's buffer does not depend on the others',
+// and llvmpipe draws one on about one core (the 10k-triangle hall's 120,000 leaf triangles: 20
+// of the 22 ms a frame took), so the workers draw N frames at once while the builder reads the
+// last. The same buffers as one renderer's: the same driver and geometry, frame by frame.
+class ItemBufferPipeline {
+ public:
+  using View =
+      std::function<void(int frame, CameraView& camera, std::vector<glm::dmat4>& transforms)>;
+
+  struct Slot {
+    int frame = 0;
+    CameraView camera;
+    std::vector<glm::dmat4> transforms;
+    ItemBuffer buffer;
+    double seconds = 0.0;
+    bool ready = false;
+    std::exception_ptr error;
+  };
+
+  ItemBufferPipeline(size_t workers, ImageSize size, const std::vector<ItemObject>& objects,
+                     std::vector<int> frames, View view)
+      : frames_(std::move(frames)), view_(std::move(view)), slots_(workers) {
+    uploaded_ = 0;
+    for (size_t k = 0; k < workers; ++k)
+      threads_.emplace_back([this, k, size, &objects] { work(k, size, objects); });
+    // The objects are the caller's: every worker has uploaded them before this returns.
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return uploaded_ == threads_.size(); });
+  }
+
+  ~ItemBufferPipeline() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    changed_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+
+  // Frame i's slot once rendered (rethrows a worker's error); release(i) hands it back.
+  Slot& take(size_t i) {
+    Slot& s = slots_[i % slots_.size()];
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return s.ready; });
+    if (s.error) std::rethrow_exception(s.error);
+    return s;
+  }
+  void release(size_t i) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      slots_[i % slots_.size()].ready = false;
+    }
+    changed_.notify_all();
+  }
+
+ private:
+  void work(size_t k, ImageSize size, const std::vector<ItemObject>& objects) {
+    Slot& s = slots_[k];
+    std::unique_ptr<ItemBufferRenderer> renderer;
+    std::exception_ptr error;
+    try {
+      renderer = std::make_unique<ItemBufferRenderer>(size);
+      renderer->setGeometry(objects);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++uploaded_;
+    }
+    changed_.notify_all();
+    for (size_t i = k; i < frames_.size(); i += slots_.size()) {
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [&] { return stop_ || !s.ready; });
+        if (stop_) return;
+      }
+      s.frame = frames_[i];
+      if (!error) try {
+          view_(s.frame, s.camera, s.transforms);
+          auto start = std::chrono::steady_clock::now();
+          renderer->render(s.camera, s.transforms, s.buffer);
+          s.seconds = secondsSince(start);
+        } catch (...) {
+          error = std::current_exception();
+        }
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        s.error = error;
+        s.ready = true;
+      }
+      changed_.notify_all();
+      if (error) return;
+    }
+  }
+
+  const std::vector<int> frames_;
+  const View view_;
+  std::vector<Slot> slots_;
+  std::vector<std::thread> threads_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  size_t uploaded_ = 0;
+  bool stop_ = false;
+};
+
+}  // namespace
+
+void TextureIntervalsBuilder::addFrames(const std::vector<int>& frames, size_t renderers,
+                                        const std::function<void(const IntervalFrame&)>& observer,
+                                        const std::function<void()>& frameDone) {
+  Impl& b = *impl_;
+  if (renderers < 2 || frames.size() < 2) {
+    for (int f : frames) {
+      b.addFrame(f, observer);
+      if (frameDone) frameDone();
+    }
+    return;
+  }
+  ItemBufferPipeline pipeline(
+      std::min(renderers, frames.size()), b.options.imageSize, b.itemObjects(), frames,
+      [&b](int frame, CameraView& camera, std::vector<glm::dmat4>& transforms) {
+        Impl::FrameView v = b.frameView(frame);
+        camera = v.camera;
+        transforms.swap(v.transforms);
+      });
+  Impl::FrameView v;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    ItemBufferPipeline::Slot& s = pipeline.take(i);
+    v.time = s.frame / b.options.fps;
+    v.camera = s.camera;
+    v.transforms.swap(s.transforms);
+    std::swap(b.buffer, s.buffer);
+    b.addRendered(s.frame, v, s.seconds, observer);
+    std::swap(b.buffer, s.buffer);
+    v.transforms.swap(s.transforms);
+    pipeline.release(i);
+    if (frameDone) frameDone();
+  }
+}
 
 TextureIntervalsBuilder::TextureIntervalsBuilder(const Scene& scene, int cameraNode,
                                                  TextureIntervalsOptions options)

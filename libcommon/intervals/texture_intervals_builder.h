@@ -138,6 +138,12 @@ class TextureIntervalsBuilder {
   // movie is taken to cover the skipped frames between two frames where it is chosen.
   // `observer` (may be empty) sees the frame before the next one is rendered.
   void addFrame(int frame, const std::function<void(const IntervalFrame&)>& observer = {});
+  // The same for each of `frames` in order, their item buffers rendered ahead by up to
+  // `renderers` GL contexts on as many threads (one: addFrame's own); the same results whatever
+  // the count. `frameDone` (may be empty) is called after each frame.
+  void addFrames(const std::vector<int>& frames, size_t renderers,
+                 const std::function<void(const IntervalFrame&)>& observer = {},
+                 const std::function<void()>& frameDone = {});
   // Closes the movies still open (kWindow) and returns all, in id order: sorted by
   // (firstFrame, patch.packed()), MovieExtent::movie = the index (intervals.rti's ids).
   std::vector<MovieExtent> finish();

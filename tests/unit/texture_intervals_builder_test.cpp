@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -717,6 +718,65 @@ TEST(TextureIntervalsBuilder, BitIdenticalAcrossRuns) {
   EXPECT_GT(fa.size(), 100u);
   EXPECT_EQ(fa, fb);
   EXPECT_EQ(readTextureIntervals(dir + "/rad_iv_a.rti").movies.size(), a.size());
+}
+
+// addFrames draws the item buffers on several GL contexts, one a thread: the same buffers, in
+// frame order, and the same movies as addFrame's one context, whatever the count (a step
+// between frames and more renderers than there are frames included).
+TEST(TextureIntervalsBuilder, ItemBuffersDrawnOnSeveralContextsGiveTheSameMovies) {
+  Scene scene = readGltfScene(cornellPath());
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  const int camera = scene.cameraNode("");
+  for (const std::vector<int>& frames : {frameRange(0, 23), std::vector<int>{0, 5, 10, 15}}) {
+    std::vector<std::vector<uint32_t>> ids;
+    std::vector<double> depthSums;
+    TextureIntervalsBuilder one(scene, camera, o);
+    for (int f : frames)
+      one.addFrame(f, [&](const IntervalFrame& fr) {
+        ids.push_back(fr.itemBuffer->id);
+        double sum = 0.0;
+        for (float z : fr.itemBuffer->depth) sum += z;
+        depthSums.push_back(sum);
+      });
+    const std::vector<MovieExtent> expected = one.finish();
+    ASSERT_FALSE(expected.empty());
+    for (size_t renderers : {size_t(1), size_t(2), size_t(3), size_t(8)}) {
+      TextureIntervalsBuilder b(scene, camera, o);
+      size_t seen = 0, done = 0;
+      b.addFrames(
+          frames, renderers,
+          [&](const IntervalFrame& fr) {
+            ASSERT_LT(seen, frames.size());
+            EXPECT_EQ(fr.frame, frames[seen]);
+            EXPECT_TRUE(fr.itemBuffer->id == ids[seen]) << "frame " << fr.frame;
+            double sum = 0.0;
+            for (float z : fr.itemBuffer->depth) sum += z;
+            EXPECT_EQ(sum, depthSums[seen]) << "frame " << fr.frame;
+            ++seen;
+          },
+          [&] { ++done; });
+      EXPECT_EQ(seen, frames.size()) << renderers << " renderers";
+      EXPECT_EQ(done, frames.size());
+      EXPECT_EQ(b.framesAdded(), int(frames.size()));
+      EXPECT_TRUE(b.finish() == expected) << renderers << " renderers";
+    }
+  }
+}
+
+// An observer that throws stops the workers: the error reaches the caller, nothing hangs.
+TEST(TextureIntervalsBuilder, ObserverErrorStopsTheRenderers) {
+  Scene scene = readGltfScene(cornellPath());
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  TextureIntervalsBuilder b(scene, scene.cameraNode(""), o);
+  int calls = 0;
+  EXPECT_THROW(b.addFrames(frameRange(0, 23), 2,
+                           [&](const IntervalFrame&) {
+                             if (++calls == 3) throw std::runtime_error("observer");
+                           }),
+               std::runtime_error);
+  EXPECT_EQ(calls, 3);
 }
 
 // Embree with one-sided triangles (the item buffer culls back faces).
