@@ -19,9 +19,7 @@
 #include <OpenEXR/ImfDoubleAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfIntAttribute.h>
-#include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfMultiPartOutputFile.h>
 #include <OpenEXR/ImfOutputPart.h>
 #include <OpenEXR/ImfPartType.h>
@@ -291,18 +289,24 @@ void writeTextureMovie(const std::string& path, const TextureMovie& m) {
 
 namespace {
 
-// A core (C API) context on `path`, reading the file itself; its errors become rad input errors,
-// not stderr lines.
+// OpenEXR core contexts report through rad::inputError (checkExr), not stderr lines.
+void quietExrError(exr_const_context_t, exr_result_t, const char*) {}
+
+void checkExr(exr_result_t rv, const std::string& path, const char* what) {
+  if (rv != EXR_ERR_SUCCESS)
+    throw inputError(path, std::string(what) + ": " + exr_get_default_error_message(rv));
+}
+
+// A core context on `path` that reads the file itself (readTextureMovieHeaders; the streams
+// read through their own window).
 struct CoreExrFile {
   exr_context_t ctx = nullptr;
   explicit CoreExrFile(const std::string& path) {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = [](exr_const_context_t, exr_result_t, const char*) {};
+    init.error_handler_fn = quietExrError;
     const exr_result_t rv = exr_start_read(&ctx, path.c_str(), &init);
-    if (rv != EXR_ERR_SUCCESS) {
-      if (ctx) exr_finish(&ctx);
-      throw inputError(path, std::string("cannot open: ") + exr_get_default_error_message(rv));
-    }
+    if (rv != EXR_ERR_SUCCESS && ctx) exr_finish(&ctx);
+    checkExr(rv, path, "cannot open");
   }
   ~CoreExrFile() {
     if (ctx) exr_finish(&ctx);
@@ -319,15 +323,18 @@ class PartAttributes {
       : ctx_(ctx), part_(part), path_(path) {}
 
   std::string string(const char* name) const {
-    int32_t length = 0;
-    const char* text = nullptr;
-    check(exr_attr_get_string(ctx_, part_, name, &length, &text), name);
-    return length > 0 && text ? std::string(text, size_t(length)) : std::string();
+    std::optional<std::string> s = optionalString(name);
+    if (!s) check(EXR_ERR_NO_ATTR_BY_NAME, name);
+    return std::move(*s);
   }
+  // Absent, or not a string: none.
   std::optional<std::string> optionalString(const char* name) const {
     const exr_attribute_t* a = nullptr;
-    if (exr_get_attribute_by_name(ctx_, part_, name, &a) != EXR_ERR_SUCCESS || !a) return {};
-    return string(name);
+    if (exr_get_attribute_by_name(ctx_, part_, name, &a) != EXR_ERR_SUCCESS || !a ||
+        a->type != EXR_ATTR_STRING || !a->string)
+      return {};
+    const exr_attr_string_t& s = *a->string;
+    return s.length > 0 && s.str ? std::string(s.str, size_t(s.length)) : std::string();
   }
   int integer(const char* name) const {
     int32_t v = 0;
@@ -426,21 +433,6 @@ TextureMovie readHeaders(exr_const_context_t ctx, const std::string& path) {
   return m;
 }
 
-// The pixels of part k (headers already checked), finite.
-std::vector<float> readKey(Imf::MultiPartInputFile& in, int k, const TextureMovie& m,
-                           const std::string& path) {
-  std::vector<float> px(size_t(m.width) * size_t(m.height) * 3);
-  Imf::InputPart part(in, k);
-  part.setFrameBuffer(rgbFrameBuffer(px.data(), m.width));
-  part.readPixels(0, m.height - 1);
-  requirePixelChecksum(m.keyChecksums[size_t(k)], rgbPixelChecksum(px.data(), m.width, m.height),
-                       path, "part " + std::to_string(k));
-  for (float v : px)
-    if (!std::isfinite(v))
-      throw inputError(path, "non-finite irradiance in part " + std::to_string(k));
-  return px;
-}
-
 // Maps OpenEXR's exceptions to rad's one-line input error.
 template <class F>
 auto readingExr(const std::string& path, F&& f) {
@@ -455,15 +447,12 @@ auto readingExr(const std::string& path, F&& f) {
 
 }  // namespace
 
+// Every key through a stream: the one pixel reader (checksums, finite values), the file's headers
+// parsed once.
 TextureMovie readTextureMovie(const std::string& path) {
-  return readingExr(path, [&] {
-    scanExrFile(path);  // sizes the headers declare, bounded by the file's (texture_movie.md)
-    TextureMovie m = readHeaders(CoreExrFile(path).ctx, path);
-    Imf::MultiPartInputFile in(path.c_str());
-    if (size_t(in.parts()) != m.keyTimes.size()) throw inputError(path, "changed while read");
-    for (int k = 0; k < in.parts(); ++k) m.keys.push_back(readKey(in, k, m, path));
-    return m;
-  });
+  TextureMovieStream stream(path);
+  for (size_t k = 0; k < stream.movie().keyTimes.size(); ++k) stream.key(k);
+  return stream.movie();
 }
 
 TextureMovie readTextureMovieHeaders(const std::string& path) {
@@ -544,17 +533,6 @@ struct TextureMovieStream::Reader {
     windowOffset = 0;
   }
 };
-
-namespace {
-
-void quietExrError(exr_const_context_t, exr_result_t, const char*) {}
-
-void checkExr(exr_result_t rv, const std::string& path, const char* what) {
-  if (rv != EXR_ERR_SUCCESS)
-    throw inputError(path, std::string(what) + ": " + exr_get_default_error_message(rv));
-}
-
-}  // namespace
 
 TextureMovieStream::TextureMovieStream(std::string path) : path_(std::move(path)) {
   readingExr(path_, [&] { return scanExrFile(path_); });

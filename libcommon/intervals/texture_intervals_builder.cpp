@@ -69,6 +69,18 @@ int textureSideFor(double projectedPixels, int current, const TextureIntervalsOp
   return int(side);
 }
 
+namespace {
+
+// A frame's camera and the item objects' placement (Impl::frameView), for its item buffer.
+struct FrameView {
+  int frame = 0;
+  double time = 0.0;
+  CameraView camera;
+  std::vector<glm::dmat4> transforms;  // per item object
+};
+
+}  // namespace
+
 struct TextureIntervalsBuilder::Impl {
   const Scene& scene;
   int cameraNode;
@@ -78,7 +90,7 @@ struct TextureIntervalsBuilder::Impl {
   std::vector<int> nodeObject;  // per dense node: index into meshNodes
   std::unique_ptr<ItemBufferRenderer> renderer;
   bool uploaded = false;  // renderer has the geometry
-  ItemBuffer buffer;
+  ItemBuffer buffer;      // addFrame's
 
   // Per-frame state.
   std::vector<long> visible;
@@ -160,14 +172,9 @@ struct TextureIntervalsBuilder::Impl {
     return objects;
   }
 
-  // The camera and the objects' placement at `frame`.
-  struct FrameView {
-    double time = 0.0;
-    CameraView camera;
-    std::vector<glm::dmat4> transforms;  // per item object
-  };
   FrameView frameView(int frame) const {
     FrameView v;
+    v.frame = frame;
     v.time = frame / options.fps;
     v.camera = scene.cameraAt(cameraNode, v.time);
     v.transforms.resize(meshNodes.size());
@@ -283,24 +290,20 @@ struct TextureIntervalsBuilder::Impl {
   }
 
   void addFrame(int frame, const std::function<void(const IntervalFrame&)>& observer) {
-    requireIncreasing(frame);
     if (!uploaded) renderer->setGeometry(itemObjects());
     uploaded = true;
     const FrameView v = frameView(frame);
     auto start = std::chrono::steady_clock::now();
     renderer->render(v.camera, v.transforms, buffer);
-    addRendered(frame, v, secondsSince(start), observer);
+    addRendered(v, buffer, secondsSince(start), observer);
   }
 
-  void requireIncreasing(int frame) const {
+  // Frame v.frame, whose item buffer `items` was rendered at v in `seconds`.
+  void addRendered(const FrameView& v, const ItemBuffer& items, double seconds,
+                   const std::function<void(const IntervalFrame&)>& observer) {
+    const int frame = v.frame;
     if (frames > 0 && frame <= lastFrame)
       throw Error(ExitCode::kInternal, "", "frames must be strictly increasing");
-  }
-
-  // The frame whose item buffer `buffer` holds (rendered in `seconds` at the view v).
-  void addRendered(int frame, const FrameView& v, double seconds,
-                   const std::function<void(const IntervalFrame&)>& observer) {
-    requireIncreasing(frame);
     const double t = v.time;
     const CameraView& view = v.camera;
     const std::vector<glm::dmat4>& transforms = v.transforms;
@@ -309,7 +312,7 @@ struct TextureIntervalsBuilder::Impl {
     // Visible pixels per leaf, then summed up the tree (children come after parents).
     std::fill(visible.begin(), visible.end(), 0);
     const long n = long(hierarchy.size());
-    for (uint32_t id : buffer.id) {
+    for (uint32_t id : items.id) {
       if (id == kNoItem) continue;
       if (long(id) > n) throw Error(ExitCode::kInternal, "", "item buffer id out of range");
       ++visible[id - 1];
@@ -388,7 +391,7 @@ struct TextureIntervalsBuilder::Impl {
       f.frame = frame;
       f.time = t;
       f.itemBufferSeconds = seconds;
-      f.itemBuffer = &buffer;
+      f.itemBuffer = &items;
       f.visiblePixels = &visible;
       f.projectedArea = &area;
       f.areaInFrustum = &inFrustum;
@@ -409,13 +412,10 @@ namespace {
 // last. The same buffers as one renderer's: the same driver and geometry, frame by frame.
 class ItemBufferPipeline {
  public:
-  using View =
-      std::function<void(int frame, CameraView& camera, std::vector<glm::dmat4>& transforms)>;
+  using View = std::function<FrameView(int frame)>;
 
   struct Slot {
-    int frame = 0;
-    CameraView camera;
-    std::vector<glm::dmat4> transforms;
+    FrameView view;
     ItemBuffer buffer;
     double seconds = 0.0;
     bool ready = false;
@@ -425,7 +425,6 @@ class ItemBufferPipeline {
   ItemBufferPipeline(size_t workers, ImageSize size, const std::vector<ItemObject>& objects,
                      std::vector<int> frames, View view)
       : frames_(std::move(frames)), view_(std::move(view)), slots_(workers) {
-    uploaded_ = 0;
     for (size_t k = 0; k < workers; ++k)
       threads_.emplace_back([this, k, size, &objects] { work(k, size, objects); });
     // The objects are the caller's: every worker has uploaded them before this returns.
@@ -480,11 +479,10 @@ class ItemBufferPipeline {
         changed_.wait(lock, [&] { return stop_ || !s.ready; });
         if (stop_) return;
       }
-      s.frame = frames_[i];
       if (!error) try {
-          view_(s.frame, s.camera, s.transforms);
+          s.view = view_(frames_[i]);
           auto start = std::chrono::steady_clock::now();
-          renderer->render(s.camera, s.transforms, s.buffer);
+          renderer->render(s.view.camera, s.view.transforms, s.buffer);
           s.seconds = secondsSince(start);
         } catch (...) {
           error = std::current_exception();
@@ -522,23 +520,11 @@ void TextureIntervalsBuilder::addFrames(const std::vector<int>& frames, size_t r
     }
     return;
   }
-  ItemBufferPipeline pipeline(
-      std::min(renderers, frames.size()), b.options.imageSize, b.itemObjects(), frames,
-      [&b](int frame, CameraView& camera, std::vector<glm::dmat4>& transforms) {
-        Impl::FrameView v = b.frameView(frame);
-        camera = v.camera;
-        transforms.swap(v.transforms);
-      });
-  Impl::FrameView v;
+  ItemBufferPipeline pipeline(std::min(renderers, frames.size()), b.options.imageSize,
+                              b.itemObjects(), frames, [&b](int f) { return b.frameView(f); });
   for (size_t i = 0; i < frames.size(); ++i) {
-    ItemBufferPipeline::Slot& s = pipeline.take(i);
-    v.time = s.frame / b.options.fps;
-    v.camera = s.camera;
-    v.transforms.swap(s.transforms);
-    std::swap(b.buffer, s.buffer);
-    b.addRendered(s.frame, v, s.seconds, observer);
-    std::swap(b.buffer, s.buffer);
-    v.transforms.swap(s.transforms);
+    const ItemBufferPipeline::Slot& s = pipeline.take(i);
+    b.addRendered(s.view, s.buffer, s.seconds, observer);
     pipeline.release(i);
     if (frameDone) frameDone();
   }
