@@ -162,6 +162,8 @@ class ClusterLinks {
   void evaluateLink(ClusterLink& l);
   // Draws of a link end's member for one ray pair until one faces the other end (evaluateLink).
   static constexpr int kFacingTries = 8;
+  // Members whose normals' cosine is within this of 1 count as parallel (MemberPlanes).
+  static constexpr double kParallelCosine = 1e-6;
   // The group V's prior weight, in mean pair kernels: a group's V is (its open kernel + p k V)
   // / (its kernel + p k), so that a group that drew one or two of the link's pairs does not
   // take 0 or 1 from them (10k-triangle hall, frame 48 against all pairs: 1.16 % with p = 0,
@@ -181,6 +183,16 @@ class ClusterLinks {
   const ClusterLinkCache* reuse_;
   std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
+  // A cluster whose members all face one way (a wall's tiles, a row of desk tops): that
+  // normal and the lowest of its members' plane offsets, so that a link to a cluster or top
+  // lying wholly on or behind every member's plane is not made (link). `parallel` false: the
+  // members face several ways.
+  struct MemberPlanes {
+    glm::dvec3 normal{0.0};
+    double lowestOffset = 0;
+    bool parallel = false;
+  };
+  std::vector<MemberPlanes> clusterPlanes_;
   std::vector<ClusterBounds> clusterBounds_, topBounds_;
   std::vector<double> clusterRadius_, topRadius_;  // of the bounding spheres
   // A cluster's facing groups (see the top of this file), the non-empty ones first.

@@ -895,6 +895,69 @@ TEST(ClusterLinks, FormFactorsFollowEachReceiverTopAtGrazingAngles) {
   EXPECT_LT(worst, 0.05);
 }
 
+// Links only where energy can pass: a floor and a ceiling of 8 x 8 tiles each, 2 m apart, the
+// floor's tiles at two heights (a step of 1 mm: parallel, not coplanar), and a wall of 4 x 4
+// tiles facing away from both. No cluster link joins two tops of one plane or reaches the
+// wall's back (their transfer is 0: before clusters of parallel tops were tested against each
+// other's planes, two halves of the ceiling were linked and refined down to their tiles), while
+// each ceiling tile's row sum still matches its exact sum over the floor.
+TEST(ClusterLinks, NoLinkJoinsTopsThatCannotSeeEachOther) {
+  std::vector<Polygon> polys;
+  const double s = 0.5;
+  addTileGrid(polys, {0, 0, 0}, {s, 0, 0}, {0, 0, s}, 8, 4, true);     // floor y = 0, facing +y
+  addTileGrid(polys, {0, 1e-3, 2}, {s, 0, 0}, {0, 0, s}, 8, 4, true);  // floor y = 1 mm
+  addTileGrid(polys, {0, 2, 0}, {s, 0, 0}, {0, 0, s}, 8, 8, false);    // ceiling, facing -y
+  addTileGrid(polys, {9, 0, 0}, {0, s, 0}, {0, 0, s}, 4, 4, false);    // wall x = 9, facing +x
+  ASSERT_NEAR(polys[0].normal().y, 1.0, 1e-12);
+  ASSERT_NEAR(polys[64].normal().y, -1.0, 1e-12);
+  ASSERT_NEAR(polys[128].normal().x, 1.0, 1e-12);
+  // The tops' plane: 0 and 1 the floor's two heights, 2 the ceiling, 3 the wall.
+  auto plane = [](size_t t) { return t < 32 ? 0 : t < 64 ? 1 : t < 128 ? 2 : 3; };
+  PatchHierarchy h = hierarchyOf(polys);
+  ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
+  std::vector<double> area = SeparatedClusterLinks::areasOf(polys), emission(polys.size(), 0.0);
+  ClusterLinks links(tree, polys, area, emission, nullptr, 4, 4.0, 0.1);
+  std::vector<std::pair<int, int>> pairs;
+  bool over = false;
+  // A tiny threshold: every link is refined until the separation holds.
+  while (links.refine(1e-12, false, 1u << 20, pairs, over) > 0) links.evaluate();
+  links.evaluate();
+  // One plane (or -1: several) and the wall's part of each end's tops.
+  auto planeOf = [&](ClusterRef r) {
+    if (!isCluster(r)) return plane(size_t(r));
+    const ClusterNode& n = tree.node(clusterIndex(r));
+    const int first = plane(tree.members()[n.first]);
+    for (uint32_t i = n.first; i < n.first + n.count; ++i)
+      if (plane(tree.members()[i]) != first) return -1;
+    return first;
+  };
+  // (Pairs of tops are the patch links' to drop by their own facing test.)
+  for (const ClusterLink& l : links.links()) {
+    const int a = planeOf(l.receiver), b = planeOf(l.shooter);
+    EXPECT_FALSE(a >= 0 && a == b) << "a link within plane " << a;
+    EXPECT_FALSE(a == 3 || b == 3) << "a link to the wall's back";
+  }
+  EXPECT_GT(links.size(), 16u);
+  // Each ceiling tile's row over the floor: its cluster links' part plus its pairs' (exact
+  // point-to-polygon form factors, as the patch links start from) against the exact sum.
+  std::vector<double> row = links.rowSums({}), fromClusters = row;
+  for (const auto& [r, q] : pairs)
+    row[size_t(r)] += pointToPolygonFormFactor(polys[size_t(r)].centroid(),
+                                               polys[size_t(r)].normal(), polys[size_t(q)]);
+  double worst = 0.0, clusterShare = 0.0;
+  for (size_t t = 64; t < 128; ++t) {
+    double exact = 0.0;
+    for (size_t j = 0; j < 64; ++j)
+      exact += pointToPolygonFormFactor(polys[t].centroid(), polys[t].normal(), polys[j]);
+    worst = std::max(worst, std::abs(row[t] / exact - 1.0));
+    clusterShare = std::max(clusterShare, fromClusters[t] / exact);
+  }
+  std::cout << "worst ceiling row sum against the exact sums: " << worst
+            << " (cluster links' share up to " << clusterShare << ")\n";
+  EXPECT_GT(clusterShare, 0.05);
+  EXPECT_LT(worst, 0.05);
+}
+
 // A cluster's B as the receiver sees it: a shooter of two facing groups, a floor of 4 x 4 tiles
 // (B = 1, facing up) and a wall of 4 x 4 tiles standing on its edge (B = 0.1, facing +x), seen
 // from a 1 m wall of tiles 8 m along +x and above them, which sees the wall face on and the
