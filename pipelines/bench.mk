@@ -13,7 +13,8 @@
 #       and tradeoff.png (gnuplot)
 #   make -f pipelines/bench.mk scale [SCALE_TRIANGLES=1000,3000,10000,30000,100000] [SCALE_FRAMES=0-95] [SCALE_MAX_SECONDS=1800] [SCALE_MOVING_LIGHT=1]
 #       the lecture hall of make_hall.py at each triangle count through the four stages: each
-#       stage's time and peak memory, rad-global's links, the log-log slopes of links and
+#       stage's time and peak memory, rad-global's links, the log-log slopes of links (at the
+#       first key with no link bound: one more rad-global run a size, 3.2 GB at 100k) and of
 #       rad-global's time against the triangle count; out/scale/scale.csv and scale.png
 #   make -f pipelines/bench.mk farm-model [FARM_SCENE=pipelines/scenes/cornell-moving.gltf] [FARM_FRAMES=0-95] [FARM_NODES=1,4,16,64] [FARM_FLAGS=--global-windows]
 #       one run of animation.mk on one core, then the wall time slurm.mk would take on N nodes
