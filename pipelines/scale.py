@@ -213,7 +213,7 @@ def main():
                   "set xlabel 'triangles'; set ylabel 'links'; set y2label 'rad-global seconds';"
                   "set y2tics; set logscale y2; set key left top;"
                   "plot '%s' using 1:2 with linespoints title '%s',"
-                  " '' using 1:3 axes x1y2 with linespoints title 'rad-global seconds'"
+                  " '' using 1:3 axes x1y2 with linespoints title 'rad-global seconds (the pipeline run)'"
                   % (png, data, "links (first key, no link bound)" if unbounded
                      else "links (largest key)"))
         subprocess.run(["gnuplot", "-e", script], check=False)
