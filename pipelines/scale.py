@@ -9,9 +9,9 @@ finished (a linear fit of log y on log x). The links' slope is that of the links
 makes at the first key time with no link bound (a second rad-global run, --frames F-F
 --max-links 2^31, after the pipeline): the pipeline's own runs stop refining at the 4 M link
 bound from the 30k-triangle hall on, and a count held at the bound says nothing about how the
-links grow (it had put the slope over 1k-100k at 0.88). A stage that runs past --max-seconds is killed and
-reported; the larger sizes are then skipped (they would take longer still). Writes
-OUT/scale.csv and, with gnuplot, OUT/scale.png.
+links grow (it had put the slope over 1k-100k at 0.88). A stage that runs past --max-seconds
+is killed and reported; the larger sizes are then skipped (they would take longer still).
+Writes OUT/scale.csv and, with gnuplot, OUT/scale.png.
 
 usage: scale.py [--triangles 1000,3000,10000,30000,100000] [--frames 0-95] [--size 352x240]
                 [--moving-light] [--max-seconds 1800] [--bin DIR] [--out DIR] [--no-unbounded]
