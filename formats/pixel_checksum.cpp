@@ -92,13 +92,16 @@ std::optional<uint64_t> storedPixelChecksum(const Imf::Header& header, const std
     }
   }
   const auto* stored = header.findTypedAttribute<Imf::StringAttribute>(kPixelChecksumAttribute);
-  if (!stored) {
-    if (required) throw inputError(path, part + ": no " + kPixelChecksumAttribute);
-    return {};
-  }
-  std::optional<uint64_t> v = parseFnv1a64(stored->value());
+  if (!stored && !required) return {};
+  return requiredPixelChecksum(stored ? &stored->value() : nullptr, path, part);
+}
+
+uint64_t requiredPixelChecksum(const std::string* stored, const std::string& path,
+                               const std::string& part) {
+  if (!stored) throw inputError(path, part + ": no " + kPixelChecksumAttribute);
+  const std::optional<uint64_t> v = parseFnv1a64(*stored);
   if (!v) throw inputError(path, part + ": malformed " + kPixelChecksumAttribute);
-  return v;
+  return *v;
 }
 
 void requirePixelChecksum(uint64_t stored, uint64_t computed, const std::string& path,

@@ -38,6 +38,11 @@ uint64_t rgbPixelChecksum(const float* rgb, int width, int height);
 // The value of "fnv1a64:<16 lowercase hex>", or nothing if `text` is not one.
 std::optional<uint64_t> parseFnv1a64(const std::string& text);
 
+// A part's stored checksum attribute value (null: the part has none) parsed. Throws
+// rad::inputError(path, "<part>: no ...") or "<part>: malformed ..." unless it is one.
+uint64_t requiredPixelChecksum(const std::string* stored, const std::string& path,
+                               const std::string& part);
+
 // The checksum a part's header stores, parsed. Throws rad::inputError(path, "<part>: ...") if
 // the attribute is malformed, or missing where the part's rad.format version requires it
 // (frame >= 2, texture-movie >= 2); an older version of those is refused with the stage to

@@ -380,10 +380,7 @@ TextureMovie readHeaders(exr_const_context_t ctx, const std::string& path) {
       throw inputError(path, "texture-movie version " + fmt.substr(14) + ", expected " +
                                  std::to_string(kTextureMovieMajor) + ".x");
     const std::optional<std::string> stored = h.optionalString(kPixelChecksumAttribute);
-    if (!stored) throw inputError(path, part + ": no " + kPixelChecksumAttribute);
-    const std::optional<uint64_t> checksum = parseFnv1a64(*stored);
-    if (!checksum) throw inputError(path, part + ": malformed " + kPixelChecksumAttribute);
-    m.keyChecksums.push_back(*checksum);
+    m.keyChecksums.push_back(requiredPixelChecksum(stored ? &*stored : nullptr, path, part));
     exr_attr_box2i_t dw;
     if (exr_get_data_window(ctx, k, &dw) != EXR_ERR_SUCCESS)
       throw inputError(path, part + ": invalid data window");

@@ -80,14 +80,17 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
         f.group[size_t(f.count++)] = {glm::vec3(normalArea[g]), glm::vec3(moment[g] / groupArea[g]),
                                       int(g)};
   }
-  // Parallel members (MemberPlanes): normals within about a milliradian of the first's.
+  // Every top's plane; a cluster's when its members are parallel (MemberPlanes): normals within
+  // about a milliradian of the first's, which with rounding is the tolerance of a box on it.
+  topPlanes_.resize(T);
+  for (size_t t = 0; t < T; ++t)
+    topPlanes_[t] = {normal_[t], glm::dot(normal_[t], centroid_[t]), 0.0, true};
   clusterPlanes_.resize(size_t(tree.size()));
   for (int c = 0; c < tree.size(); ++c) {
     const ClusterNode& n = tree.node(c);
     MemberPlanes& p = clusterPlanes_[size_t(c)];
-    p.normal = normal_[m[n.first]];
-    p.parallel = true;
-    p.lowestOffset = glm::dot(p.normal, centroid_[m[n.first]]);
+    p = topPlanes_[m[n.first]];
+    p.tolerance = kParallelCosine * clusterRadius_[size_t(c)];
     for (uint32_t i = n.first + 1; i < n.first + n.count && p.parallel; ++i) {
       const uint32_t j = m[i];
       p.parallel = glm::dot(normal_[j], p.normal) >= 1.0 - kParallelCosine;
@@ -116,26 +119,13 @@ int ClusterLinks::facingGroupOf(const glm::dvec3& n) {
 void ClusterLinks::link(ClusterRef r, ClusterRef s, std::vector<LinkEnds>& next) {
   auto behind = [&](ClusterRef end, ClusterRef other) {
     if (!isCluster(end) && !isCluster(other)) return false;  // the patch links' own test
-    glm::dvec3 n;
-    double offset, tolerance = 0.0;
-    if (isCluster(end)) {
-      const MemberPlanes& p = clusterPlanes_[size_t(clusterIndex(end))];
-      if (!p.parallel) return false;
-      n = p.normal;
-      offset = p.lowestOffset;
-      // Normals a milliradian apart, and rounding: a box on the plane is taken as behind it.
-      tolerance = kParallelCosine * bounds(end).radius();
-    } else {
-      // The normal and centroid kept per top (the same values): recomputing them here for
-      // each of the ~1 M links a key makes was 0.15 s per key on the 10k-triangle hall.
-      n = normal_[size_t(end)];
-      offset = glm::dot(n, centroid_[size_t(end)]);
-    }
+    const MemberPlanes& p = planes(end);
+    if (!p.parallel) return false;
     const ClusterBounds& b = bounds(other);
     for (int k = 0; k < 8; ++k) {
       const glm::dvec3 corner((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y,
                               (k & 4) ? b.hi.z : b.lo.z);
-      if (glm::dot(n, corner) - offset > tolerance) return false;
+      if (glm::dot(p.normal, corner) - p.lowestOffset > p.tolerance) return false;
     }
     return true;
   };

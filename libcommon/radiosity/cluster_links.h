@@ -183,16 +183,20 @@ class ClusterLinks {
   const ClusterLinkCache* reuse_;
   std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
-  // A cluster whose members all face one way (a wall's tiles, a row of desk tops): that
-  // normal and the lowest of its members' plane offsets, so that a link to a cluster or top
-  // lying wholly on or behind every member's plane is not made (link). `parallel` false: the
-  // members face several ways.
+  // A link end whose members all face one way (a top; a cluster of a wall's tiles, of a row of
+  // desk tops): that normal and the lowest of its members' plane offsets, so that a link to a
+  // cluster or top lying wholly on or behind every member's plane is not made (link), and how
+  // far in front of that plane a box may reach and still count as on it (0 for a top).
+  // `parallel` false: the members face several ways.
   struct MemberPlanes {
     glm::dvec3 normal{0.0};
-    double lowestOffset = 0;
+    double lowestOffset = 0, tolerance = 0;
     bool parallel = false;
   };
-  std::vector<MemberPlanes> clusterPlanes_;
+  std::vector<MemberPlanes> clusterPlanes_, topPlanes_;
+  const MemberPlanes& planes(ClusterRef r) const {
+    return isCluster(r) ? clusterPlanes_[size_t(clusterIndex(r))] : topPlanes_[size_t(r)];
+  }
   std::vector<ClusterBounds> clusterBounds_, topBounds_;
   std::vector<double> clusterRadius_, topRadius_;  // of the bounding spheres
   // A cluster's facing groups (see the top of this file), the non-empty ones first.
