@@ -146,7 +146,12 @@ class ClusterLinks {
   struct LinkEnds {
     ClusterRef receiver, shooter;
   };
-  void link(ClusterRef r, ClusterRef s, std::vector<LinkEnds>& next);
+  // Whether a link between r and s may carry energy (see link's comment in the .cpp).
+  bool canExchange(ClusterRef r, ClusterRef s) const;
+  // The children of refined link l, in order: links through sink.link(r, s), pairs of
+  // top-level patches through sink.pair(r, s).
+  template <class Sink>
+  void expand(const ClusterLink& l, Sink& sink) const;
   bool wantsRefinement(const ClusterLink& l, double epsAbs) const;
   const ClusterBounds& bounds(ClusterRef r) const {
     return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];

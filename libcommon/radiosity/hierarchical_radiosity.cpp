@@ -442,12 +442,12 @@ class KeyTimeSolver {
     // time on the table scene (perf: samplePoints, pairedPoints, polygonUvAt, descendToChild).
     const size_t L = s_.links.size();
     pairStart_.resize(L, kNoRayPairs);
-    std::vector<size_t> fresh;
-    for (size_t li = 0; li < L; ++li)
-      if (pairStart_[li] == kNoRayPairs && weighted(s_.links[li])) {
-        pairStart_[li] = uint32_t(pairs_.size() + fresh.size() * size_t(k));
-        fresh.push_back(li);
-      }
+    // The links without pairs yet, in link order (found in parallel parts).
+    RowOrder withPairs = sortByRow(L, 2u, [&](size_t li) {
+      return pairStart_[li] == kNoRayPairs && weighted(s_.links[li]) ? 0u : 1u;
+    });
+    std::vector<uint32_t> fresh = std::move(withPairs.order);
+    fresh.resize(withPairs.rowStart[1]);
     // Pair starts are 32-bit (kNoRayPairs): 4 M links (the default --max-links) of 64 pairs
     // stay far below; a link bound raised past a billion pairs is refused, not wrapped.
     if (pairs_.size() + fresh.size() * size_t(k) >= size_t(kNoRayPairs))
@@ -458,8 +458,10 @@ class KeyTimeSolver {
     // rad-global's peak on the 10k-triangle hall.
     if (pairs_.capacity() == 0 && input_.expectedRayPairs > 0)
       pairs_.reserve(withMargin(input_.expectedRayPairs));
+    const size_t firstFresh = pairs_.size();
     pairs_.resize(pairs_.size() + fresh.size() * size_t(k));
     tbb::parallel_for(size_t(0), fresh.size(), [&](size_t f) {
+      pairStart_[fresh[f]] = uint32_t(firstFresh + f * size_t(k));
       const SolverLink& l = s_.links[fresh[f]];
       LinkRayPair* pair = &pairs_[pairStart_[fresh[f]]];
       const uint32_t knownPairs =
@@ -603,11 +605,20 @@ class KeyTimeSolver {
     size_t count = 0;
     while (!work.empty()) {
       evaluateNewLinks();
+      // The oracle of every link first, in parallel: a pure function of the link and of B, which
+      // splitting other links of this generation does not change (a new node's B is its
+      // parent's, and an existing node keeps its own), so the decisions below are the same.
+      // Asked one link after the other it had been 2 % of the 10k-triangle hall's rad-global.
+      std::vector<char> wants(work.size());
+      tbb::parallel_for(size_t(0), work.size(), [&](size_t j) {
+        const SolverLink& l = s_.links[work[j]];
+        wants[j] = !l.refined && oracleWantsRefinement(l) && nodeToSplit(l) >= 0;
+      });
       std::vector<LinkIndex> next;
-      for (LinkIndex li : work) {
-        if (s_.links[li].refined || !oracleWantsRefinement(s_.links[li])) continue;
-        int node = nodeToSplit(s_.links[li]);
-        if (node < 0) continue;
+      for (size_t j = 0; j < work.size(); ++j) {
+        if (!wants[j]) continue;
+        const LinkIndex li = work[j];
+        const int node = nodeToSplit(s_.links[li]);
         if (s_.links.size() + 4 > opt_.maxLinks) {  // the memory bound: stop refining
           s_.linkCapReached = true;
           evaluateNewLinks();  // this generation's links, made before the bound, get F~ and V
@@ -622,10 +633,11 @@ class KeyTimeSolver {
   }
 
   std::vector<LinkIndex> unrefinedLinks() const {
-    std::vector<LinkIndex> work;
-    for (size_t i = 0; i < s_.links.size(); ++i)
-      if (!s_.links[i].refined) work.push_back(LinkIndex(i));
-    return work;
+    // A row order with the refined links last (one scan of the links in parallel parts).
+    RowOrder order =
+        sortByRow(s_.links.size(), 2u, [&](size_t i) { return s_.links[i].refined ? 1u : 0u; });
+    order.order.resize(order.rowStart[1]);
+    return std::move(order.order);
   }
 
   // Accurate pass: the quadrature F (linkFormFactor) of every visible leaf link not yet
@@ -981,18 +993,19 @@ class KeyTimeSolver {
   // Per receiving node, its gathered (unrefined) links in link order: adj_[adjStart_[i] ..
   // adjStart_[i + 1]); per link, whether its shooter emits (shooterEmits_).
   void buildGatherLists() {
-    size_t N = size_t(h_.size());
-    adjStart_.assign(N + 1, 0);
-    for (const SolverLink& l : s_.links)
-      if (!l.refined) ++adjStart_[size_t(l.receiver) + 1];
-    for (size_t i = 0; i < N; ++i) adjStart_[i + 1] += adjStart_[i];
-    adj_.assign(adjStart_[N], 0);
-    std::vector<size_t> fill(adjStart_.begin(), adjStart_.end() - 1);
-    for (size_t li = 0; li < s_.links.size(); ++li)
-      if (!s_.links[li].refined) adj_[fill[size_t(s_.links[li].receiver)]++] = LinkIndex(li);
+    const size_t N = size_t(h_.size());
+    // The refined links go to one more row, left out.
+    RowOrder byReceiver = sortByRow(s_.links.size(), uint32_t(N + 1), [&](size_t li) {
+      const SolverLink& l = s_.links[li];
+      return l.refined ? uint32_t(N) : uint32_t(l.receiver);
+    });
+    adjStart_.assign(byReceiver.rowStart.begin(), byReceiver.rowStart.end() - 1);
+    adj_.swap(byReceiver.order);
+    adj_.resize(adjStart_[N]);
     shooterEmits_.resize(s_.links.size());
-    for (size_t k = 0; k < s_.links.size(); ++k)
+    tbb::parallel_for(size_t(0), s_.links.size(), [&](size_t k) {
       shooterEmits_[k] = surfaces_[h_.node(s_.links[k].shooter).id.top].isEmitter() ? 1 : 0;
+    });
   }
 
   // What a node gives its parent's pull: its exposed area e A and e A B.
@@ -1226,21 +1239,34 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
                         : polygonBounds(prev.world[size_t(r)]);
   };
   const size_t T = size_t(h.topCount());
-  std::vector<std::pair<uint32_t, uint32_t>> keys;
-  std::vector<CachedClusterLink> values;
-  for (const ClusterLink& l : prev.clusterLinkValues) {
-    if (!l.evaluated || !isStatic(l.receiver) || !isStatic(l.shooter)) continue;
+  // Per link, in parallel, whether it is kept; then the kept ones in link order.
+  const std::vector<ClusterLink>& links = prev.clusterLinkValues;
+  std::vector<char> kept(links.size());
+  tbb::parallel_for(size_t(0), links.size(), [&](size_t i) {
+    const ClusterLink& l = links[i];
+    if (!l.evaluated || !isStatic(l.receiver) || !isStatic(l.shooter)) {
+      kept[i] = 0;
+      return;
+    }
     const ClusterBounds a = box(l.receiver), b = box(l.shooter);
     const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
     bool hit = false;
     for (const auto& s : swept)
       hit =
           hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
-    if (!hit) {
+    kept[i] = hit ? 0 : 1;
+  });
+  std::vector<std::pair<uint32_t, uint32_t>> keys;
+  std::vector<CachedClusterLink> values;
+  const size_t count = size_t(std::count(kept.begin(), kept.end(), char(1)));
+  keys.reserve(count);
+  values.reserve(count);
+  for (size_t i = 0; i < links.size(); ++i)
+    if (kept[i]) {
+      const ClusterLink& l = links[i];
       keys.emplace_back(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
       values.push_back(CachedClusterLink{l.direction, l.visibility, l.groupVisibility});
     }
-  }
   return ClusterLinkCache(keys, std::move(values), uint32_t(T + size_t(tree.size())));
 }
 

@@ -25,11 +25,39 @@ template <class RowOf>
 RowOrder sortByRow(size_t n, uint32_t rows, RowOf rowOf) {
   RowOrder out;
   out.rowStart.assign(size_t(rows) + 1, 0);
-  for (size_t i = 0; i < n; ++i) ++out.rowStart[size_t(rowOf(i)) + 1];
-  std::partial_sum(out.rowStart.begin(), out.rowStart.end(), out.rowStart.begin());
   out.order.resize(n);
-  std::vector<uint32_t> fill(out.rowStart.begin(), out.rowStart.end() - 1);
-  for (size_t i = 0; i < n; ++i) out.order[fill[rowOf(i)]++] = uint32_t(i);
+  // In parallel over up to kChunks fixed parts of the items (so the same whatever the thread
+  // count): each counts its rows, and a row's items from part c follow those of the parts
+  // before it, which is the one-pass order. One pass over 1.4 M links had been 3 % of the
+  // 10k-triangle hall's rad-global with the other core idle (its gather lists each round).
+  constexpr size_t kMinPart = size_t(1) << 16, kChunks = 16;
+  const size_t parts = std::min(kChunks, (n + kMinPart - 1) / kMinPart);
+  if (parts <= 1) {
+    for (size_t i = 0; i < n; ++i) ++out.rowStart[size_t(rowOf(i)) + 1];
+    std::partial_sum(out.rowStart.begin(), out.rowStart.end(), out.rowStart.begin());
+    std::vector<uint32_t> fill(out.rowStart.begin(), out.rowStart.end() - 1);
+    for (size_t i = 0; i < n; ++i) out.order[fill[rowOf(i)]++] = uint32_t(i);
+    return out;
+  }
+  const size_t per = (n + parts - 1) / parts;
+  std::vector<std::vector<uint32_t>> fill(parts);  // per part: its counts, then its next slots
+  tbb::parallel_for(size_t(0), parts, [&](size_t c) {
+    fill[c].assign(rows, 0);
+    for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i) ++fill[c][rowOf(i)];
+  });
+  for (uint32_t r = 0; r < rows; ++r) {
+    uint32_t at = out.rowStart[r];
+    for (size_t c = 0; c < parts; ++c) {
+      const uint32_t k = fill[c][r];
+      fill[c][r] = at;
+      at += k;
+    }
+    out.rowStart[size_t(r) + 1] = at;
+  }
+  tbb::parallel_for(size_t(0), parts, [&](size_t c) {
+    for (size_t i = c * per; i < std::min(n, (c + 1) * per); ++i)
+      out.order[fill[c][rowOf(i)]++] = uint32_t(i);
+  });
   return out;
 }
 
