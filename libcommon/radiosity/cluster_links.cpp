@@ -294,19 +294,8 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
         }
       });
       made += next.size();
-      for (size_t i = 0; i < size; ++i) {
-        const ClusterLink l = linkAt(i);
-        current = i;
-        if (!refines(i, l)) {
-          keep(l);
-          continue;
-        }
-        if (firstLevel) changes(l.receiver);
-        ++count;
-      }
-      work.swap(next);
-      return;
     }
+    // The decisions in link order (the children already made when `parallel`).
     Appender append{next, patchPairs, made};
     for (size_t i = 0; i < size; ++i) {
       const ClusterLink l = linkAt(i);
@@ -315,7 +304,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
       // light left inside a cluster link reaches its receivers without shadows (stopped
       // wherever the bound fell, the 30k-triangle hall had lost 92 % of its bad pairs). A refined
       // link is replaced by its children, so it no longer counts (`count` of them this call).
-      if (made + patchPairs.size() > budget + count) overBudget = true;
+      if (!parallel && made + patchPairs.size() > budget + count) overBudget = true;
       if (overBudget && !emits(l.shooter)) {
         keep(l);
         continue;
@@ -324,7 +313,7 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
         keep(l);
         continue;
       }
-      expand(l, append);
+      if (!parallel) expand(l, append);
       if (firstLevel) changes(l.receiver);
       ++count;
     }

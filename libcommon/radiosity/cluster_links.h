@@ -146,7 +146,7 @@ class ClusterLinks {
   struct LinkEnds {
     ClusterRef receiver, shooter;
   };
-  // Whether a link between r and s may carry energy (see link's comment in the .cpp).
+  // Whether a link between r and s may carry energy (see the .cpp).
   bool canExchange(ClusterRef r, ClusterRef s) const;
   // The children of refined link l, in order: links through sink.link(r, s), pairs of
   // top-level patches through sink.pair(r, s).

@@ -26,12 +26,12 @@ RowOrder sortByRow(size_t n, uint32_t rows, RowOf rowOf) {
   RowOrder out;
   out.rowStart.assign(size_t(rows) + 1, 0);
   out.order.resize(n);
-  // In parallel over up to kChunks fixed parts of the items (so the same whatever the thread
+  // In parallel over up to kMaxParts fixed parts of the items (so the same whatever the thread
   // count): each counts its rows, and a row's items from part c follow those of the parts
   // before it, which is the one-pass order. One pass over 1.4 M links had been 3 % of the
   // 10k-triangle hall's rad-global with the other core idle (its gather lists each round).
-  constexpr size_t kMinPart = size_t(1) << 16, kChunks = 16;
-  const size_t parts = std::min(kChunks, (n + kMinPart - 1) / kMinPart);
+  constexpr size_t kMinPart = size_t(1) << 16, kMaxParts = 16;
+  const size_t parts = std::min(kMaxParts, (n + kMinPart - 1) / kMinPart);
   if (parts <= 1) {
     for (size_t i = 0; i < n; ++i) ++out.rowStart[size_t(rowOf(i)) + 1];
     std::partial_sum(out.rowStart.begin(), out.rowStart.end(), out.rowStart.begin());
