@@ -190,8 +190,8 @@ class ClusterLinks {
   std::vector<glm::dvec3> centroid_, normal_;  // per top
   // A link end whose members all face one way (a top; a cluster of a wall's tiles, of a row of
   // desk tops): that normal and the lowest of its members' plane offsets, so that a link to a
-  // cluster or top lying wholly on or behind every member's plane is not made (link), and how
-  // far in front of that plane a box may reach and still count as on it (0 for a top).
+  // cluster or top lying wholly on or behind every member's plane is not made (canExchange), and
+  // how far in front of that plane a box may reach and still count as on it (0 for a top).
   // `parallel` false: the members face several ways.
   struct MemberPlanes {
     glm::dvec3 normal{0.0};

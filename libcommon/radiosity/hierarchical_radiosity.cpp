@@ -605,20 +605,21 @@ class KeyTimeSolver {
     size_t count = 0;
     while (!work.empty()) {
       evaluateNewLinks();
-      // The oracle of every link first, in parallel: a pure function of the link and of B, which
-      // splitting other links of this generation does not change (a new node's B is its
-      // parent's, and an existing node keeps its own), so the decisions below are the same.
-      // Asked one link after the other it had been 2 % of the 10k-triangle hall's rad-global.
-      std::vector<char> wants(work.size());
+      // Per link, the node it splits (-1: none), in parallel first: the oracle and the choice
+      // are pure functions of the link, of B and of the nodes' areas, which splitting other
+      // links of this generation does not change (a new node's B is its parent's, and an
+      // existing node keeps its own), so the decisions below are the same. Asked one link after
+      // the other they had been 2 % of the 10k-triangle hall's rad-global.
+      std::vector<int> splits(work.size());
       tbb::parallel_for(size_t(0), work.size(), [&](size_t j) {
         const SolverLink& l = s_.links[work[j]];
-        wants[j] = !l.refined && oracleWantsRefinement(l) && nodeToSplit(l) >= 0;
+        splits[j] = !l.refined && oracleWantsRefinement(l) ? nodeToSplit(l) : -1;
       });
       std::vector<LinkIndex> next;
       for (size_t j = 0; j < work.size(); ++j) {
-        if (!wants[j]) continue;
+        const int node = splits[j];
+        if (node < 0) continue;
         const LinkIndex li = work[j];
-        const int node = nodeToSplit(s_.links[li]);
         if (s_.links.size() + 4 > opt_.maxLinks) {  // the memory bound: stop refining
           s_.linkCapReached = true;
           evaluateNewLinks();  // this generation's links, made before the bound, get F~ and V
