@@ -25,7 +25,7 @@ uint64_t clusterLinkSeed(ClusterRef r, ClusterRef s) {
 ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
                            const std::vector<double>& area, const std::vector<double>& topEmission,
                            const VisibilityScene* visibility, int rays, double separation,
-                           double lightShare, const ClusterLinkCache* reuse)
+                           double lightShare, int memberRays, const ClusterLinkCache* reuse)
     : tree_(tree),
       world_(world),
       area_(area),
@@ -34,6 +34,7 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
       rays_(std::max(1, rays)),
       separation_(separation),
       lightShare_(lightShare),
+      memberRays_(std::max(0, memberRays)),
       reuse_(reuse) {
   const size_t T = topEmission.size();
   topBounds_.resize(T);
@@ -55,6 +56,8 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
   clusterMaxB_.assign(size_t(tree.size()), 0.0);
   topMaxB_.assign(T, 0.0);
   const std::vector<uint32_t>& m = tree.members();
+  memberPosition_.assign(T, 0);
+  for (size_t i = 0; i < m.size(); ++i) memberPosition_[m[i]] = uint32_t(i);
   memberAreaPrefix_.assign(m.size() + 1, 0.0);
   memberPowerPrefix_.assign(m.size() + 1, 0.0);
   for (size_t i = 0; i < m.size(); ++i) {
@@ -340,13 +343,43 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
 }
 
 void ClusterLinks::evaluate() {
-  bool any = false;
-  for (const ClusterLink& l : links_) any = any || !l.evaluated;
-  if (!any) return;
-  tbb::parallel_for(size_t(0), links_.size(), [&](size_t i) {
-    if (!links_[i].evaluated) evaluateLink(links_[i]);
-  });
+  std::vector<uint32_t> fresh;  // the links not evaluated yet, in link order
+  for (size_t i = 0; i < links_.size(); ++i)
+    if (!links_[i].evaluated) fresh.push_back(uint32_t(i));
+  if (fresh.empty()) return;
+  // Their V at their cluster receivers' members: one byte a member, placed in link order.
+  if (memberRays_ > 0) {
+    size_t at = memberVisibility_.size();
+    for (uint32_t i : fresh) {
+      ClusterLink& l = links_[i];
+      if (!isCluster(l.receiver)) continue;
+      l.memberVisibility = uint32_t(at);
+      at += tree_.node(clusterIndex(l.receiver)).count;
+    }
+    memberVisibility_.resize(at, 255);
+  }
+  tbb::parallel_for(size_t(0), fresh.size(), [&](size_t k) { evaluateLink(links_[fresh[k]]); });
   listsValid_ = false;
+}
+
+template <class U>
+uint32_t ClusterLinks::drawFacingMember(ClusterRef end, const ClusterBounds& other,
+                                        const std::vector<double>& prefix, U u) const {
+  if (!isCluster(end)) return uint32_t(end);
+  const ClusterNode& n = tree_.node(clusterIndex(end));
+  const double lo = prefix[n.first], hi = prefix[n.first + n.count];
+  uint32_t j = 0;
+  for (int t = 0; t < kFacingTries; ++t) {
+    const double target = lo + u(t) * (hi - lo);
+    auto it =
+        std::upper_bound(prefix.begin() + n.first + 1, prefix.begin() + n.first + n.count, target);
+    j = tree_.members()[size_t(it - prefix.begin()) - 1];
+    const glm::dvec3& nj = normal_[j];
+    double farthest = 0.0;  // the largest n . x over the other's box
+    for (int a = 0; a < 3; ++a) farthest += nj[a] * (nj[a] > 0.0 ? other.hi[a] : other.lo[a]);
+    if (farthest > glm::dot(nj, centroid_[j])) break;
+  }
+  return j;
 }
 
 void ClusterLinks::evaluateLink(ClusterLink& l) {
@@ -358,6 +391,14 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
       l.direction = c->direction;
       l.visibility = c->visibility;
       l.groupVisibility = c->groupVisibility;
+      if (l.memberVisibility != ClusterLink::kNoMemberVisibility &&
+          c->memberVisibility != ClusterLink::kNoMemberVisibility) {
+        const auto from = reuse_->memberVisibility.begin() + long(c->memberVisibility);
+        std::copy(from, from + long(tree_.node(clusterIndex(l.receiver)).count),
+                  memberVisibility_.begin() + long(l.memberVisibility));
+      } else {
+        l.memberVisibility = ClusterLink::kNoMemberVisibility;
+      }
       ++reused_;
       return;
     }
@@ -372,15 +413,6 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
   double v = 1.0;
   if (visibility_) {
     const uint64_t seed = clusterLinkSeed(l.receiver, l.shooter);
-    auto pick = [&](ClusterRef ref, double u, const std::vector<double>& prefix) -> uint32_t {
-      if (!isCluster(ref)) return uint32_t(ref);
-      const ClusterNode& n = tree_.node(clusterIndex(ref));
-      const double lo = prefix[n.first], hi = prefix[n.first + n.count];
-      const double target = lo + u * (hi - lo);
-      auto it = std::upper_bound(prefix.begin() + n.first + 1, prefix.begin() + n.first + n.count,
-                                 target);
-      return tree_.members()[size_t(it - prefix.begin()) - 1];
-    };
     // A shooter holding lights is sampled by emitted power: its light comes from them, and the
     // visibility of its area (a ceiling's, the lights a small part of it) had made the
     // 10k-triangle hall's light through cluster links 2.4 % dark at --light-cluster-share 1.
@@ -407,21 +439,12 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
     // pairs.
     auto pickFacing = [&](ClusterRef ref, ClusterRef other, int i, int side,
                           const std::vector<double>& prefix) -> uint32_t {
-      if (!isCluster(ref)) return uint32_t(ref);
-      const ClusterBounds& o = bounds(other);
-      uint32_t j = 0;
-      for (int t = 0; t < kFacingTries; ++t) {
-        const uint64_t c =
-            t == 0
-                ? uint64_t(i) * 6 + uint64_t(side)
-                : uint64_t(k) * 6 + (uint64_t(i) * kFacingTries + uint64_t(t)) * 2 + uint64_t(side);
-        j = pick(ref, uniformOpen01(seed, c), prefix);
-        const glm::dvec3& n = normal_[j];
-        double farthest = 0.0;  // the largest n . x over the other's box
-        for (int a = 0; a < 3; ++a) farthest += n[a] * (n[a] > 0.0 ? o.hi[a] : o.lo[a]);
-        if (farthest > glm::dot(n, centroid_[j])) break;
-      }
-      return j;
+      return drawFacingMember(ref, bounds(other), prefix, [&](int t) {
+        return uniformOpen01(seed, t == 0 ? uint64_t(i) * 6 + uint64_t(side)
+                                          : uint64_t(k) * 6 +
+                                                (uint64_t(i) * kFacingTries + uint64_t(t)) * 2 +
+                                                uint64_t(side));
+      });
     };
     double sumK = 0.0;
     for (int i = 0; i < k; ++i) {
@@ -470,11 +493,52 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
     }
   }
   l.visibility = float(v);
+  if (l.memberVisibility != ClusterLink::kNoMemberVisibility) {
+    const ClusterNode& n = tree_.node(clusterIndex(l.receiver));
+    for (uint32_t m = 0; m < n.count; ++m)
+      memberVisibility_[size_t(l.memberVisibility) + m] =
+          visibilityAtMember(l, tree_.members()[n.first + m]);
+  }
+}
+
+uint8_t ClusterLinks::visibilityAtMember(const ClusterLink& l, uint32_t t) const {
+  const uint8_t groupV = l.groupVisibility[size_t(facingGroupOf(normal_[t]))];
+  if (!visibility_) return groupV;
+  // A member with all of the shooter's box behind its plane sees none of it (F = 0 there).
+  const glm::dvec3& n = normal_[t];
+  const ClusterBounds& S = bounds(l.shooter);
+  double farthest = 0.0;
+  for (int a = 0; a < 3; ++a) farthest += n[a] * (n[a] > 0.0 ? S.hi[a] : S.lo[a]);
+  if (!(farthest > glm::dot(n, centroid_[t]))) return groupV;
+  const uint64_t seed = splitMix64(clusterLinkSeed(l.receiver, l.shooter) ^
+                                   (0x6d656d626572ull + uint64_t(t) * 0x9e3779b97f4a7c15ull));
+  const std::vector<double>& prefix = emits(l.shooter) ? memberPowerPrefix_ : memberAreaPrefix_;
+  constexpr uint64_t kPerPair = 4 + kFacingTries;  // counters a pair draws from
+  double kernel = 0.0, openKernel = 0.0;
+  for (int i = 0; i < memberRays_; ++i) {
+    const uint64_t c = uint64_t(i) * kPerPair;
+    const uint32_t j = drawFacingMember(l.shooter, topBounds_[t], prefix, [&](int k) {
+      return uniformOpen01(seed, c + 4 + uint64_t(k));
+    });
+    const glm::dvec3 x =
+        pointOnPolygon(world_[t], uniformOpen01(seed, c), uniformOpen01(seed, c + 1));
+    const glm::dvec3 y =
+        pointOnPolygon(world_[j], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
+    const glm::dvec3 xy = y - x;
+    const double len2 = glm::dot(xy, xy);
+    if (!(len2 > 0.0)) continue;
+    const double k =
+        std::max(0.0, glm::dot(n, xy)) * std::max(0.0, -glm::dot(normal_[j], xy)) / (len2 * len2);
+    if (!(k > 0.0)) continue;
+    kernel += k;
+    if (!visibility_->occluded(x, y, t, j)) openKernel += k;
+  }
+  return kernel > 0.0 ? quantizedVisibility(openKernel / kernel) : groupV;
 }
 
 // F(top t <- S) of a link at t's centroid: H_i / B_S of the transfer at the top of
 // cluster_links.h, summed over S's facing groups (a top-level patch shooter is its own group).
-double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
+double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t, double exposure) const {
   const double radius = isCluster(l.shooter) ? clusterRadius_[size_t(clusterIndex(l.shooter))]
                                              : topRadius_[size_t(l.shooter)];
   const glm::dvec3 x = centroid_[t], n = normal_[t];
@@ -498,10 +562,17 @@ double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t) const {
     const size_t s = size_t(l.shooter);
     sum = group(area_[s] * normal_[s], centroid_[s]);
   }
-  // A receiver cluster's member takes the V of its facing group (evaluateLink).
-  const double v = isCluster(l.receiver)
-                       ? double(l.groupVisibility[size_t(facingGroupOf(n))]) / 255.0
-                       : double(l.visibility);
+  // A receiver cluster's member takes its own V where it is wholly exposed, else the V of its
+  // facing group (evaluateLink): its own rays start all over it, the covered part included,
+  // while the gather takes a link at an ancestor cluster as the exposed part's (gather).
+  double v = double(l.visibility);
+  if (isCluster(l.receiver)) {
+    const uint32_t first = tree_.node(clusterIndex(l.receiver)).first;
+    v = (l.memberVisibility != ClusterLink::kNoMemberVisibility && exposure >= 1.0
+             ? double(memberVisibility_[size_t(l.memberVisibility) + memberPosition_[t] - first])
+             : double(l.groupVisibility[size_t(facingGroupOf(n))])) /
+        255.0;
+  }
   return v / M_PI * sum;
 }
 
@@ -526,7 +597,7 @@ Sum ClusterLinks::overExposedPart(size_t t, const std::vector<double>& exposure,
   return own / e + above;
 }
 
-void ClusterLinks::buildReceiverLists() {
+void ClusterLinks::buildReceiverLists(const std::vector<double>& exposure) {
   if (listsValid_) return;
   const size_t T = emission_.size(), C = size_t(tree_.size());
   // The lists of the links before the last refinement round, where it left them (movedTo_):
@@ -569,7 +640,7 @@ void ClusterLinks::buildReceiverLists() {
       auto add = [&](size_t r) {
         for (uint32_t k = byReceiver.rowStart[r]; k < byReceiver.rowStart[r + 1]; ++k) {
           const uint32_t i = byReceiver.order[k];
-          const double f = formFactor(links_[i], uint32_t(t));
+          const double f = formFactor(links_[i], uint32_t(t), exposure.empty() ? 1.0 : exposure[t]);
           if (f > 0.0) entries.push_back({i, float(f)});
         }
       };
@@ -599,7 +670,7 @@ void ClusterLinks::buildReceiverLists() {
 // with the groups 0.998-1.002 and 0.989.
 void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
                           std::vector<glm::dvec3>& out) {
-  buildReceiverLists();
+  buildReceiverLists(exposure);
   const size_t T = emission_.size();
   struct GroupRadiosity {
     std::array<glm::dvec3, 6> power;  // P_g by facingGroupOf
@@ -661,7 +732,7 @@ std::vector<double> ClusterLinks::rowSums(const std::vector<double>& exposure) {
   // From the gather's lists, so that the row sums are of the very form factors the gather
   // multiplies (in parallel; the serial pass over every link and member top it replaces was
   // 6 % of the 10k-triangle hall's rad-global).
-  buildReceiverLists();
+  buildReceiverLists(exposure);
   const size_t T = emission_.size();
   std::vector<double> out(T, 0.0);
   tbb::parallel_for(size_t(0), T, [&](size_t t) {

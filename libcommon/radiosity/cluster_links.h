@@ -38,9 +38,13 @@
 // link's direction (gather), as the transfer above weighs the groups; and V_RS the
 // kernel-weighted share of k shadow-ray pairs between points of R's and S's patches that are
 // unoccluded, each end's patch drawn by area among those that may face the other end
-// (evaluateLink), taken at member i over the pairs whose R end lies in i's own facing group,
-// with the link's V as a prior (a group holds few of the k pairs). The irradiance is pushed
-// down to every member top of R, so the gather goes through the clusters.
+// (evaluateLink). At a member i of a cluster R, V is i's own: the kernel-weighted open share of
+// a few more pairs from points of i to S's tops (visibilityAtMember; one V for a wall's tiles
+// had given its upper tiles, open to the seats' clusters, the V of its lower ones, hidden
+// behind the seats); where i is partly covered (its rays would start under the cover too) or
+// none of its pairs has a kernel, the V of the pairs whose R end lies in i's facing group, with
+// the link's V as a prior (a group holds few of the k pairs). The irradiance is pushed down to
+// every member top of R, so the gather goes through the clusters.
 #pragma once
 
 #include <algorithm>
@@ -76,6 +80,11 @@ struct ClusterLink {
   // receiver (evaluateLink); the transfer takes each member's group's.
   GroupVisibility groupVisibility{255, 255, 255, 255, 255, 255};
   bool evaluated = false;
+  // For a cluster receiver: where V at each of its member tops (in the tree's member order, in
+  // 1/255ths) starts in the ClusterLinks' member visibility (ClusterLinks::visibilityAtMember);
+  // kNoMemberVisibility: the members take their facing group's V.
+  uint32_t memberVisibility = kNoMemberVisibility;
+  static constexpr uint32_t kNoMemberVisibility = ~0u;
 };
 
 // A cluster link's values that the next key time may take over (coherence, paper §4.2), keyed
@@ -85,8 +94,15 @@ struct CachedClusterLink {
   glm::vec3 direction{0.0f};
   float visibility = 1;
   GroupVisibility groupVisibility{255, 255, 255, 255, 255, 255};
+  uint32_t memberVisibility = ClusterLink::kNoMemberVisibility;  // in ClusterLinkCache's
 };
-using ClusterLinkCache = PairTable<CachedClusterLink>;
+struct ClusterLinkCache {
+  PairTable<CachedClusterLink> links;
+  std::vector<uint8_t> memberVisibility;  // each cached link's, as ClusterLink::memberVisibility
+  const CachedClusterLink* find(uint32_t row, uint32_t column) const {
+    return links.find(row, column);
+  }
+};
 // A cluster link end as a ClusterLinkCache row or column: top-level patch t as t, cluster c as
 // topCount + c (topCount + the tree's size rows in all).
 inline uint32_t clusterLinkEnd(ClusterRef r, size_t topCount) {
@@ -100,7 +116,7 @@ class ClusterLinks {
   ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
                const std::vector<double>& area, const std::vector<double>& topEmission,
                const VisibilityScene* visibility, int rays, double separation, double lightShare,
-               const ClusterLinkCache* reuse = nullptr);
+               int memberRays, const ClusterLinkCache* reuse = nullptr);
 
   // One round of refinement (see the top of this file) with eps Phi = epsAbs (refineAll: every
   // link is refined down to patch pairs, the all-pairs linking). The pairs of top-level
@@ -138,6 +154,8 @@ class ClusterLinks {
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
   const std::vector<ClusterLink>& links() const { return links_; }
   std::vector<ClusterLink> takeLinks() && { return std::move(links_); }
+  // The links' V at their receivers' members (ClusterLink::memberVisibility), after takeLinks.
+  std::vector<uint8_t> takeMemberVisibility() && { return std::move(memberVisibility_); }
   // Links evaluated from now on are computed, not taken over (the cache is about to go).
   void forgetReuse() { reuse_ = nullptr; }
   bool reusing() const { return reuse_ != nullptr; }
@@ -174,8 +192,20 @@ class ClusterLinks {
   // take 0 or 1 from them (10k-triangle hall, frame 48 against all pairs: 1.16 % with p = 0,
   // 1.09 % with 0.5, 1.09 % with 2, 1.12 % with one V per link).
   static constexpr double kGroupPrior = 0.5;
-  double formFactor(const ClusterLink& l, uint32_t top) const;
-  void buildReceiverLists();
+  // F V of link l at member top `top` of its receiver, whose exposure is `exposure`.
+  double formFactor(const ClusterLink& l, uint32_t top, double exposure) const;
+  // V of link l at member top t of its cluster receiver: the kernel-weighted open share of
+  // memberRays_ ray pairs from points of t to points of the shooter's tops that may face t, in
+  // 1/255ths; the member's facing group's V where no pair has a kernel (see the top of this
+  // file).
+  uint8_t visibilityAtMember(const ClusterLink& l, uint32_t t) const;
+  // A member top of `end` (itself for a top) drawn by `prefix` (area, or emitted power) among
+  // those whose plane has some of `other` in front: up to kFacingTries draws, the t-th with
+  // uniform u(t) (the last one drawn when none faces).
+  template <class U>
+  uint32_t drawFacingMember(ClusterRef end, const ClusterBounds& other,
+                            const std::vector<double>& prefix, U u) const;
+  void buildReceiverLists(const std::vector<double>& exposure);
 
   const ClusterTree& tree_;
   const std::vector<Polygon>& world_;
@@ -185,6 +215,7 @@ class ClusterLinks {
   int rays_;
   double separation_;
   double lightShare_;
+  int memberRays_;
   const ClusterLinkCache* reuse_;
   std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
@@ -222,6 +253,10 @@ class ClusterLinks {
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;
+  // The links' V at their receivers' members (ClusterLink::memberVisibility); a refined link's
+  // stay until the key's end.
+  std::vector<uint8_t> memberVisibility_;
+  std::vector<uint32_t> memberPosition_;  // per top: its index in tree_.members()
   size_t expectedLinks_ = 0;
   // Per link: its shooter's B towards its receiver (gather). This and the gather's form
   // factors in single precision: 1.2 M links and 2.5 M entries on the 10k-triangle hall.

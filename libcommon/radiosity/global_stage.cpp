@@ -29,6 +29,7 @@ nlohmann::json GlobalOptions::toJson() const {
           {"no-clustering", !r.clustering},
           {"cluster-separation", r.clusterSeparation},
           {"light-cluster-share", r.lightClusterShare},
+          {"cluster-member-rays", r.clusterMemberRays},
           {"no-shooter-shape", !r.shooterShape},
           {"no-coherence", !spaceTime.coherence}};
 }

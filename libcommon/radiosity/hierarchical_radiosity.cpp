@@ -203,9 +203,10 @@ class KeyTimeSolver {
       topEmission_.resize(size_t(h_.topCount()));
       for (int t = 0; t < h_.topCount(); ++t)
         topEmission_[size_t(t)] = maxComponent(surfaces_[size_t(t)].emission);
-      clusters_ = std::make_unique<ClusterLinks>(
-          *input_.clusters, s_.world, s_.area, topEmission_, input_.visibility, opt_.rays,
-          opt_.clusterSeparation, opt_.lightClusterShare, input_.reuseClusterLinks);
+      clusters_ = std::make_unique<ClusterLinks>(*input_.clusters, s_.world, s_.area, topEmission_,
+                                                 input_.visibility, opt_.rays,
+                                                 opt_.clusterSeparation, opt_.lightClusterShare,
+                                                 opt_.clusterMemberRays, input_.reuseClusterLinks);
       if (input_.expectedClusterLinks > 0)
         clusters_->expectLinks(withMargin(input_.expectedClusterLinks));
     } else {
@@ -1138,6 +1139,7 @@ class KeyTimeSolver {
       // the solver goes: a copy beside them had made rad-global's peak on the 10k-triangle
       // hall (+47 MB at the end of each key's solve).
       s_.clusterLinkValues = std::move(*clusters_).takeLinks();
+      s_.clusterMemberVisibility = std::move(*clusters_).takeMemberVisibility();
       clusters_.reset();
     }
     s_.radiosity = std::move(B_);
@@ -1262,13 +1264,22 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
   const size_t count = size_t(std::count(kept.begin(), kept.end(), char(1)));
   keys.reserve(count);
   values.reserve(count);
+  ClusterLinkCache cache;
   for (size_t i = 0; i < links.size(); ++i)
     if (kept[i]) {
       const ClusterLink& l = links[i];
       keys.emplace_back(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
       values.push_back(CachedClusterLink{l.direction, l.visibility, l.groupVisibility});
+      if (l.memberVisibility != ClusterLink::kNoMemberVisibility) {
+        values.back().memberVisibility = uint32_t(cache.memberVisibility.size());
+        const auto from = prev.clusterMemberVisibility.begin() + long(l.memberVisibility);
+        cache.memberVisibility.insert(cache.memberVisibility.end(), from,
+                                      from + long(tree.node(clusterIndex(l.receiver)).count));
+      }
     }
-  return ClusterLinkCache(keys, std::move(values), uint32_t(T + size_t(tree.size())));
+  cache.links =
+      PairTable<CachedClusterLink>(keys, std::move(values), uint32_t(T + size_t(tree.size())));
+  return cache;
 }
 
 ClusterTree clusterTreeOf(const Scene& scene, const PatchHierarchy& h, double t0, double t1) {

@@ -485,6 +485,7 @@ class KeyTimePass {
         in.reuseClusterLinks = &clusterCache;
       }
       std::vector<ClusterLink>().swap(prev.clusterLinkValues);
+      std::vector<uint8_t>().swap(prev.clusterMemberVisibility);
       // The closure integrates only pairs of patches that never move (KeySolveInput::
       // movingTops), so every leaf-to-top form factor prev kept stays valid; the union
       // hierarchy's dense node numbering is the same at every key. The solve takes them over.

@@ -110,6 +110,11 @@ void addOptions(CLI::App& app, Options& o) {
                  "every light's links to patch pairs")
       ->capture_default_str()
       ->check(rad::finiteRange(0.0, 1e6));
+  app.add_option("--cluster-member-rays", r.clusterMemberRays,
+                 "shadow-ray pairs per member top of a cluster link's receiver, for that top's "
+                 "own visibility; 0: each member takes its facing group's visibility")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
   app.add_flag_callback(
       "--no-clustering", [&r] { r.clustering = false; },
       "link every pair of top-level patches (the baseline) instead of starting from the root "
