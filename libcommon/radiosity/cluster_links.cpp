@@ -347,14 +347,17 @@ void ClusterLinks::evaluate() {
   for (size_t i = 0; i < links_.size(); ++i)
     if (!links_[i].evaluated) fresh.push_back(uint32_t(i));
   if (fresh.empty()) return;
-  // Their V at their cluster receivers' members: one byte a member, placed in link order.
+  // Their V at their cluster receivers' members: one byte a member, placed in link order (past
+  // 4 GiB of them, which no scene here comes near, the members take their group's V).
   if (memberRays_ > 0) {
     size_t at = memberVisibility_.size();
     for (uint32_t i : fresh) {
       ClusterLink& l = links_[i];
       if (!isCluster(l.receiver)) continue;
+      const size_t count = tree_.node(clusterIndex(l.receiver)).count;
+      if (at + count >= size_t(ClusterLink::kNoMemberVisibility)) break;
       l.memberVisibility = uint32_t(at);
-      at += tree_.node(clusterIndex(l.receiver)).count;
+      at += count;
     }
     memberVisibility_.resize(at, 255);
   }

@@ -69,9 +69,10 @@ inline uint8_t quantizedVisibility(double v) {
   return uint8_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
 }
 
-// 32 bytes: the direction and V in single precision, V per receiver facing group in bytes
-// (1.2 M links per key on the 10k-triangle hall, held with the next key's cache of them; 56
-// bytes had been 20 MB more of each, and the group V in floats 46 MB more of rad-global's peak).
+// 36 bytes: the direction and V in single precision, V per receiver facing group in bytes, and
+// where its members' own V start (1.2 M links per key on the 10k-triangle hall, held with the
+// next key's cache of them; 56 bytes had been 20 MB more of each, and the group V in floats 46
+// MB more of rad-global's peak).
 struct ClusterLink {
   ClusterRef receiver = 0, shooter = 0;
   glm::vec3 direction{0.0f};  // unit, from the receiver's centre towards the shooter's
@@ -96,6 +97,8 @@ struct CachedClusterLink {
   GroupVisibility groupVisibility{255, 255, 255, 255, 255, 255};
   uint32_t memberVisibility = ClusterLink::kNoMemberVisibility;  // in ClusterLinkCache's
 };
+// The cluster links the next key time may take over, and their members' own V (one byte a
+// member of a cluster receiver, as ClusterLinks keeps them).
 struct ClusterLinkCache {
   PairTable<CachedClusterLink> links;
   std::vector<uint8_t> memberVisibility;  // each cached link's, as ClusterLink::memberVisibility
