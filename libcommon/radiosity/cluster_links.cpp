@@ -25,7 +25,8 @@ uint64_t clusterLinkSeed(ClusterRef r, ClusterRef s) {
 ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
                            const std::vector<double>& area, const std::vector<double>& topEmission,
                            const VisibilityScene* visibility, int rays, double separation,
-                           double lightShare, int memberRays, const ClusterLinkCache* reuse)
+                           double lightShare, int memberRays, bool isotropic,
+                           const ClusterLinkCache* reuse)
     : tree_(tree),
       world_(world),
       area_(area),
@@ -35,6 +36,7 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
       separation_(separation),
       lightShare_(lightShare),
       memberRays_(std::max(0, memberRays)),
+      isotropic_(isotropic),
       reuse_(reuse) {
   const size_t T = topEmission.size();
   topBounds_.resize(T);
@@ -81,7 +83,7 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
     for (size_t g = 0; g < 6; ++g)
       if (groupArea[g] > 0.0)
         f.group[size_t(f.count++)] = {glm::vec3(normalArea[g]), glm::vec3(moment[g] / groupArea[g]),
-                                      int(g)};
+                                      int(g), float(groupArea[g])};
   }
   // Every top's plane; a cluster's when its members are parallel (MemberPlanes): normals within
   // about a milliradian of the first's, which with rounding is the tolerance of a box on it.
@@ -548,22 +550,29 @@ double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t, double exposur
   // One facing group: max(0, -N_g . d) max(0, n_i . d) / |d|^4. A link kept at the link bound
   // may have receivers within S's reach; S's patches are spread over its bounding sphere, so
   // the distance is taken as at least its radius.
-  auto group = [&](const glm::dvec3& normalArea, const glm::dvec3& centre) {
+  // Isotropic (see the top of this file): a shooter cluster's group shows A_g / 4 in every
+  // direction, a receiver cluster's member takes 1/4 for its cosine.
+  const bool isotropicShooter = isotropic_ && isCluster(l.shooter);
+  const bool isotropicReceiver = isotropic_ && isCluster(l.receiver);
+  auto group = [&](const glm::dvec3& normalArea, double area, const glm::dvec3& centre) {
     const glm::dvec3 d = centre - x;
-    const double cosines = std::max(0.0, -glm::dot(normalArea, d)) * std::max(0.0, glm::dot(n, d));
+    const double r2 = glm::dot(d, d), length = std::sqrt(r2);
+    const double shown = isotropicShooter ? 0.25 * area * length : -glm::dot(normalArea, d);
+    const double seen = isotropicReceiver ? 0.25 * length : glm::dot(n, d);
+    const double cosines = std::max(0.0, shown) * std::max(0.0, seen);
     if (!(cosines > 0.0)) return 0.0;
-    const double r2 = glm::dot(d, d), rs2 = std::max(r2, radius * radius);
+    const double rs2 = std::max(r2, radius * radius);
     return cosines / (r2 * rs2);
   };
   double sum = 0.0;
   if (isCluster(l.shooter)) {
     const FacingGroups& f = clusterFacing_[size_t(clusterIndex(l.shooter))];
     for (int g = 0; g < f.count; ++g)
-      sum +=
-          group(glm::dvec3(f.group[size_t(g)].normalArea), glm::dvec3(f.group[size_t(g)].centre));
+      sum += group(glm::dvec3(f.group[size_t(g)].normalArea), double(f.group[size_t(g)].area),
+                   glm::dvec3(f.group[size_t(g)].centre));
   } else {
     const size_t s = size_t(l.shooter);
-    sum = group(area_[s] * normal_[s], centroid_[s]);
+    sum = group(area_[s] * normal_[s], area_[s], centroid_[s]);
   }
   // A receiver cluster's member takes its own V where it is wholly exposed, else the V of its
   // facing group (evaluateLink): its own rays start all over it, the covered part included,
@@ -715,7 +724,9 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector
     double den = 0.0;
     for (int k = 0; k < f.count; ++k) {
       const FacingGroup& fg = f.group[size_t(k)];
-      const double w = std::max(0.0, -glm::dot(glm::dvec3(fg.normalArea), glm::dvec3(l.direction)));
+      const double w =
+          isotropic_ ? double(fg.area)
+                     : std::max(0.0, -glm::dot(glm::dvec3(fg.normalArea), glm::dvec3(l.direction)));
       const size_t a = size_t(fg.axisSign);
       if (!(w > 0.0 && g.area[a] > 0.0)) continue;
       num += w / g.area[a] * g.power[a];

@@ -45,6 +45,13 @@
 // none of its pairs has a kernel, the V of the pairs whose R end lies in i's facing group, with
 // the link's V as a prior (a group holds few of the k pairs). The irradiance is pushed down to
 // every member top of R, so the gather goes through the clusters.
+//
+// Isotropic clusters (the option; Smits, Arvo, Greenberg 1994 §3): a cluster end is taken as
+// emitting and receiving alike in every direction, as if its members' orientations were
+// unknown: a shooter cluster's group g shows its area A_g / 4 (the mean projected area of a
+// surface over all directions) instead of max(0, -N_g . d) / |d|, B_S is its groups' area
+// average, and a member of a receiver cluster takes 1/4 (the mean of max(0, cos) over the
+// sphere) instead of its own cosine. A top-level patch end stays oriented.
 #pragma once
 
 #include <algorithm>
@@ -119,7 +126,7 @@ class ClusterLinks {
   ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
                const std::vector<double>& area, const std::vector<double>& topEmission,
                const VisibilityScene* visibility, int rays, double separation, double lightShare,
-               int memberRays, const ClusterLinkCache* reuse = nullptr);
+               int memberRays, bool isotropic, const ClusterLinkCache* reuse = nullptr);
 
   // One round of refinement (see the top of this file) with eps Phi = epsAbs (refineAll: every
   // link is refined down to patch pairs, the all-pairs linking). The pairs of top-level
@@ -219,6 +226,7 @@ class ClusterLinks {
   double separation_;
   double lightShare_;
   int memberRays_;
+  bool isotropic_;
   const ClusterLinkCache* reuse_;
   std::atomic<size_t> reused_{0};
   std::vector<glm::dvec3> centroid_, normal_;  // per top
@@ -243,6 +251,7 @@ class ClusterLinks {
     glm::vec3 normalArea{0.0f};  // N_g
     glm::vec3 centre{0.0f};      // c_g
     int axisSign = 0;            // facingGroupOf its members' normals
+    float area = 0.0f;           // A_g, the sum of its members' areas
   };
   // A top's facing group by its normal: the dominant axis and its sign, 2 axis + (n < 0).
   static int facingGroupOf(const glm::dvec3& n);

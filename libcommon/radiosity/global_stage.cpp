@@ -30,6 +30,7 @@ nlohmann::json GlobalOptions::toJson() const {
           {"cluster-separation", r.clusterSeparation},
           {"light-cluster-share", r.lightClusterShare},
           {"cluster-member-rays", r.clusterMemberRays},
+          {"isotropic-clusters", r.isotropicClusters},
           {"no-shooter-shape", !r.shooterShape},
           {"no-coherence", !spaceTime.coherence}};
 }

@@ -203,10 +203,10 @@ class KeyTimeSolver {
       topEmission_.resize(size_t(h_.topCount()));
       for (int t = 0; t < h_.topCount(); ++t)
         topEmission_[size_t(t)] = maxComponent(surfaces_[size_t(t)].emission);
-      clusters_ = std::make_unique<ClusterLinks>(*input_.clusters, s_.world, s_.area, topEmission_,
-                                                 input_.visibility, opt_.rays,
-                                                 opt_.clusterSeparation, opt_.lightClusterShare,
-                                                 opt_.clusterMemberRays, input_.reuseClusterLinks);
+      clusters_ = std::make_unique<ClusterLinks>(
+          *input_.clusters, s_.world, s_.area, topEmission_, input_.visibility, opt_.rays,
+          opt_.clusterSeparation, opt_.lightClusterShare, opt_.clusterMemberRays,
+          opt_.isotropicClusters, input_.reuseClusterLinks);
       if (input_.expectedClusterLinks > 0)
         clusters_->expectLinks(withMargin(input_.expectedClusterLinks));
     } else {

@@ -850,7 +850,7 @@ struct SeparatedClusterLinks {
         area(areasOf(polys)),
         emission(polys.size(), 0.0),
         links(tree, polys, area, emission, visibility, rays, 2.0, 0.1,
-              RadiosityOptions{}.clusterMemberRays) {
+              RadiosityOptions{}.clusterMemberRays, false) {
     std::vector<std::pair<int, int>> pairs;
     bool over = false;
     while (links.refine(1.0, false, 1u << 20, pairs, over) > 0) links.evaluate();
@@ -917,7 +917,7 @@ TEST(ClusterLinks, NoLinkJoinsTopsThatCannotSeeEachOther) {
   PatchHierarchy h = hierarchyOf(polys);
   ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
   std::vector<double> area = SeparatedClusterLinks::areasOf(polys), emission(polys.size(), 0.0);
-  ClusterLinks links(tree, polys, area, emission, nullptr, 4, 4.0, 0.1, 4);
+  ClusterLinks links(tree, polys, area, emission, nullptr, 4, 4.0, 0.1, 4, false);
   std::vector<std::pair<int, int>> pairs;
   bool over = false;
   // A tiny threshold: every link is refined until the separation holds.
@@ -1150,7 +1150,7 @@ TEST(ClusterLinks, EachMemberOfAReceiverClusterTakesItsOwnVisibility) {
       exactFV[t] += f * open / 256.0;
     }
   auto meanError = [&](int memberRays) {
-    ClusterLinks links(tree, polys, area, emission, &vis, 16, 2.0, 0.1, memberRays);
+    ClusterLinks links(tree, polys, area, emission, &vis, 16, 2.0, 0.1, memberRays, false);
     std::vector<std::pair<int, int>> pairs;
     bool over = false;
     int clusterReceivers = 0;
@@ -1171,6 +1171,77 @@ TEST(ClusterLinks, EachMemberOfAReceiverClusterTakesItsOwnVisibility) {
   EXPECT_LT(byMember, 0.1);
 }
 
+// Isotropic clusters (--isotropic-clusters): a cluster shows A / 4 in every direction. A sphere
+// does (Cauchy: its projected area is pi r^2 = A / 4); a flat panel seen face-on shows all of
+// A. Seen by a small tile 10 m away, the tile's irradiance through its cluster link against the
+// exact point-to-polygon sum over the shooter's tops: a sphere of 512 triangles (radius 0.5),
+// isotropic 0.993, oriented 1.008; a panel of 8 x 8 tiles (1 m^2) face-on, oriented 0.971 (the
+// point approximation at 10 times its radius), isotropic a quarter of that.
+TEST(ClusterLinks, IsotropicClustersShowAQuarterOfTheirAreaInEveryDirection) {
+  std::vector<Polygon> sphere;
+  const double radius = 0.5;
+  std::function<void(glm::dvec3, glm::dvec3, glm::dvec3, int)> facet =
+      [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, int level) {
+        if (level == 0) {
+          Polygon p;
+          p.count = 3;
+          p.v = {radius * a, radius * b, radius * c, glm::dvec3(0.0)};
+          if (glm::dot(p.normal(), p.centroid()) < 0.0) std::swap(p.v[1], p.v[2]);
+          sphere.push_back(p);
+          return;
+        }
+        const glm::dvec3 ab = glm::normalize(a + b), bc = glm::normalize(b + c),
+                         ca = glm::normalize(c + a);
+        facet(a, ab, ca, level - 1);
+        facet(ab, b, bc, level - 1);
+        facet(ca, bc, c, level - 1);
+        facet(ab, bc, ca, level - 1);
+      };
+  for (int sx : {-1, 1})
+    for (int sy : {-1, 1})
+      for (int sz : {-1, 1}) facet({double(sx), 0, 0}, {0, double(sy), 0}, {0, 0, double(sz)}, 3);
+  ASSERT_EQ(sphere.size(), 512u);
+  std::vector<Polygon> panel;  // x = 0, facing +x
+  addTileGrid(panel, {0, -0.5, -0.5}, {0, 0.125, 0}, {0, 0, 0.125}, 8, 8, false);
+  ASSERT_NEAR(panel[0].normal().x, 1.0, 1e-12);
+  // The tile's irradiance from `shooter` (B = 1) through the cluster links, over the exact sum.
+  auto ratio = [&](std::vector<Polygon> polys, bool isotropic) {
+    const size_t tile = polys.size();
+    addQuad(polys, {10, -0.05, -0.05}, {10, -0.05, 0.05}, {10, 0.05, 0.05}, {10, 0.05, -0.05});
+    EXPECT_NEAR(polys[tile].normal().x, -1.0, 1e-12);
+    PatchHierarchy h = hierarchyOf(polys);
+    ClusterTree tree(h, polys, std::vector<char>(polys.size(), 0));
+    std::vector<double> area, emission(polys.size(), 0.0);
+    for (const Polygon& p : polys) area.push_back(p.area());
+    std::vector<glm::dvec3> B(polys.size(), glm::dvec3(1.0));
+    B[tile] = glm::dvec3(0.0);
+    double exact = 0.0;
+    for (size_t j = 0; j < tile; ++j)
+      exact += pointToPolygonFormFactor(polys[tile].centroid(), polys[tile].normal(), polys[j]);
+    ClusterLinks links(tree, polys, area, emission, nullptr, 4, 4.0, 0.1, 0, isotropic);
+    std::vector<std::pair<int, int>> pairs;
+    bool over = false;
+    while (links.refine(1.0, false, 1u << 20, pairs, over) > 0) links.evaluate();
+    links.evaluate();
+    bool linked = false;
+    for (const ClusterLink& l : links.links())
+      linked = linked || (l.receiver == ClusterRef(tile) && isCluster(l.shooter));
+    EXPECT_TRUE(linked) << "the tile gathers the shooter through no cluster link";
+    std::vector<glm::dvec3> H;
+    links.gather(B, {}, H);
+    return H[tile].x / exact;
+  };
+  const double sphereIsotropic = ratio(sphere, true), sphereOriented = ratio(sphere, false);
+  const double panelIsotropic = ratio(panel, true), panelOriented = ratio(panel, false);
+  std::cout << "over the exact sum: sphere isotropic " << sphereIsotropic << ", oriented "
+            << sphereOriented << "; panel face-on isotropic " << panelIsotropic << ", oriented "
+            << panelOriented << "\n";
+  EXPECT_NEAR(sphereIsotropic, 1.0, 0.02);
+  EXPECT_NEAR(sphereOriented, 1.0, 0.02);
+  EXPECT_NEAR(panelOriented, 1.0, 0.04);
+  EXPECT_NEAR(panelIsotropic / panelOriented, 0.25, 1e-3);  // A / 4 against all of A
+}
+
 // The gather lists after a refinement round take over the entries of the tops whose links did
 // not change (the links renumbered) and make the others anew: the row sums and the gathered
 // irradiance must be the very values of lists made anew for the same links. Rounds at three
@@ -1186,7 +1257,7 @@ TEST(ClusterLinks, ListsTakenOverAfterARoundAreThoseMadeAnew) {
   std::vector<glm::dvec3> B(polys.size());
   for (size_t t = 0; t < polys.size(); ++t) B[t] = glm::dvec3(0.1 + 0.01 * double(t % 7), 0.2, 0.3);
   auto run = [&](bool listsBetweenRounds, size_t& refined) {
-    ClusterLinks links(tree, polys, area, emission, nullptr, 4, 2.0, 0.1, 4);
+    ClusterLinks links(tree, polys, area, emission, nullptr, 4, 2.0, 0.1, 4, false);
     std::vector<std::pair<int, int>> pairs;
     bool over = false;
     std::vector<double> rows;

@@ -116,6 +116,10 @@ void addOptions(CLI::App& app, Options& o) {
       ->capture_default_str()
       ->check(CLI::Range(0, 64));
   app.add_flag_callback(
+      "--isotropic-clusters", [&r] { r.isotropicClusters = true; },
+      "take each cluster as emitting and receiving alike in every direction (area / 4) instead "
+      "of by its members' facing groups");
+  app.add_flag_callback(
       "--no-clustering", [&r] { r.clustering = false; },
       "link every pair of top-level patches (the baseline) instead of starting from the root "
       "cluster's self-link of a cluster hierarchy over them");
