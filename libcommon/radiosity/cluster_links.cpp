@@ -379,12 +379,16 @@ uint32_t ClusterLinks::drawFacingMember(ClusterRef end, const ClusterBounds& oth
     auto it =
         std::upper_bound(prefix.begin() + n.first + 1, prefix.begin() + n.first + n.count, target);
     j = tree_.members()[size_t(it - prefix.begin()) - 1];
-    const glm::dvec3& nj = normal_[j];
-    double farthest = 0.0;  // the largest n . x over the other's box
-    for (int a = 0; a < 3; ++a) farthest += nj[a] * (nj[a] > 0.0 ? other.hi[a] : other.lo[a]);
-    if (farthest > glm::dot(nj, centroid_[j])) break;
+    if (mayFace(j, other)) break;
   }
   return j;
+}
+
+bool ClusterLinks::mayFace(uint32_t t, const ClusterBounds& box) const {
+  const glm::dvec3& n = normal_[t];
+  double farthest = 0.0;  // the largest n . x over the box
+  for (int a = 0; a < 3; ++a) farthest += n[a] * (n[a] > 0.0 ? box.hi[a] : box.lo[a]);
+  return farthest > glm::dot(n, centroid_[t]);
 }
 
 void ClusterLinks::evaluateLink(ClusterLink& l) {
@@ -510,11 +514,8 @@ uint8_t ClusterLinks::visibilityAtMember(const ClusterLink& l, uint32_t t) const
   const uint8_t groupV = l.groupVisibility[size_t(facingGroupOf(normal_[t]))];
   if (!visibility_) return groupV;
   // A member with all of the shooter's box behind its plane sees none of it (F = 0 there).
+  if (!mayFace(t, bounds(l.shooter))) return groupV;
   const glm::dvec3& n = normal_[t];
-  const ClusterBounds& S = bounds(l.shooter);
-  double farthest = 0.0;
-  for (int a = 0; a < 3; ++a) farthest += n[a] * (n[a] > 0.0 ? S.hi[a] : S.lo[a]);
-  if (!(farthest > glm::dot(n, centroid_[t]))) return groupV;
   const uint64_t seed = splitMix64(clusterLinkSeed(l.receiver, l.shooter) ^
                                    (0x6d656d626572ull + uint64_t(t) * 0x9e3779b97f4a7c15ull));
   const std::vector<double>& prefix = emits(l.shooter) ? memberPowerPrefix_ : memberAreaPrefix_;
@@ -556,7 +557,10 @@ double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t, double exposur
   const bool isotropicReceiver = isotropic_ && isCluster(l.receiver);
   auto group = [&](const glm::dvec3& normalArea, double area, const glm::dvec3& centre) {
     const glm::dvec3 d = centre - x;
-    const double r2 = glm::dot(d, d), length = std::sqrt(r2);
+    const double r2 = glm::dot(d, d);
+    // |d| only where a cluster end is isotropic: the oriented gather (every entry of every key's
+    // lists) takes no square root.
+    const double length = isotropic_ ? std::sqrt(r2) : 0.0;
     const double shown = isotropicShooter ? 0.25 * area * length : -glm::dot(normalArea, d);
     const double seen = isotropicReceiver ? 0.25 * length : glm::dot(n, d);
     const double cosines = std::max(0.0, shown) * std::max(0.0, seen);

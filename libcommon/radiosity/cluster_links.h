@@ -212,6 +212,8 @@ class ClusterLinks {
   // A member top of `end` (itself for a top) drawn by `prefix` (area, or emitted power) among
   // those whose plane has some of `other` in front: up to kFacingTries draws, the t-th with
   // uniform u(t) (the last one drawn when none faces).
+  // Whether top t's plane has some of `box` in front (else t sees none of it).
+  bool mayFace(uint32_t t, const ClusterBounds& box) const;
   template <class U>
   uint32_t drawFacingMember(ClusterRef end, const ClusterBounds& other,
                             const std::vector<double>& prefix, U u) const;
