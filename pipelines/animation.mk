@@ -4,13 +4,17 @@
 #
 # The stages, their variables and command lines are in stages.mk (slurm.mk submits the same
 # ones to a Slurm cluster).
-# Each stage's parameters are written to a stamp file (OUT/*.params) that changes only when
-# they change, so Make re-runs exactly the stages a change affects: GLOBAL_FLAGS re-runs
-# global → movies → compose; INTERVALS_FLAGS re-runs intervals → movies → compose;
-# MOVIES_FLAGS re-runs movies → compose; COMPOSE_FLAGS re-runs compose only.
+# Each stage's parameters are kept in a stamp (OUT/STAGE.params), and the content hashes of the
+# scene's files (the glTF, its buffers and images) in OUT/scene.params; a stamp is rewritten only
+# when it changes, so Make re-runs exactly the stages a change affects: a new scene, buffer or
+# texture content re-runs all; GLOBAL_FLAGS re-runs global → movies → compose; INTERVALS_FLAGS
+# re-runs intervals → movies → compose; MOVIES_FLAGS re-runs movies → compose; COMPOSE_FLAGS
+# re-runs compose only. `make -n` writes nothing.
 # Every tool writes atomically, and directory outputs are marked done by a stamp written
 # after the tool succeeded, so a killed stage leaves nothing Make would take as up to date.
-# `make -j` is safe: global and intervals run side by side.
+# `make -j` is safe: global and intervals run side by side. `make clean` removes only the files
+# the pipeline writes, by name (clean.sh). OUT, SCENE and BIN are checked before anything runs
+# (check-variables.sh).
 
 include $(dir $(lastword $(MAKEFILE_LIST)))stages.mk
 .DEFAULT_GOAL := all
@@ -23,21 +27,22 @@ all: $(OUT)/movie.mp4 $(OUT)/contact-sheet.png
 
 frames: $(OUT)/frames/.done
 
-$(OUT)/global.rlh: $(SCENE) $(OUT)/global.params $(BIN)/rad-global
+$(OUT)/global.rlh: $(OUT)/scene.params $(OUT)/global.params $(BIN)/rad-global
 	$(GLOBAL_CMD)
 
-$(OUT)/intervals.rti: $(SCENE) $(OUT)/intervals.params $(BIN)/rad-intervals
+$(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-intervals
 	$(INTERVALS_CMD)
 
-# The folder is emptied first: movies of an earlier run (another intervals.rti) must not linger.
-$(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
-	@rm -rf $(OUT)/movies
+# The folder is emptied first (of the pipeline's own files, clean.sh): movies of an earlier run
+# (another intervals.rti) must not linger.
+$(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
+	@$(PIPELINES)clean.sh $(OUT) movies
 	$(MOVIES_CMD)
 	@touch $@
 
-$(OUT)/frames/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
+$(OUT)/frames/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
-	@rm -rf $(OUT)/frames
+	@$(PIPELINES)clean.sh $(OUT) frames
 	$(COMPOSE_CMD)
 	@touch $@
 

@@ -2,8 +2,8 @@
 # slurm.mk: which pieces of a split stage (movie shards, frame chunks) must run. A piece is done
 # when its stamp DIR/.KIND-I-of-N exists, is newer than every prerequisite of the stage, and no
 # stage upstream of it was submitted in this make run (its inputs are about to change). If any
-# stamp is stale or of another split, the whole folder is emptied: its files came from other
-# inputs. Prints the indices to run, comma-separated (empty: every piece is done).
+# stamp is stale or of another split, the folder is emptied of the pipeline's files (clean.sh):
+# they came from other inputs. Prints the indices to run, comma-separated (empty: every piece is done).
 #
 #   pipelines/slurm-pieces.sh DIR KIND N SUBMITTED "UPSTREAM STAGES" PREREQUISITE...
 set -euo pipefail
@@ -24,7 +24,7 @@ for stamp in "$dir/.$kind-"*; do
     if [ -e "$p" ] && ! [ "$stamp" -nt "$p" ]; then stale=1; fi
   done
 done
-if [ "$stale" = 1 ] || [ "$have" = 0 ]; then rm -rf "$dir"; fi
+if [ "$stale" = 1 ] || [ "$have" = 0 ]; then "$(dirname "$0")/clean.sh" "$(dirname "$dir")" "$(basename "$dir")"; fi
 mkdir -p "$dir"
 
 missing=()

@@ -65,8 +65,6 @@ endif
 WINDOW_COUNT := $(words $(WINDOWS))
 WINDOW_FILES := $(foreach i,$(shell seq 0 $$(($(WINDOW_COUNT) - 1))),$(OUT)/global-windows/w$(i).rkw)
 
-quote = '$(subst ','\'',$(1))'
-
 # Submits stage $(1): array indices $(2) (a shell word; empty: one task, numbered 0), after the
 # jobs this run submitted for the stages $(3), running the command $(4).
 submit = mkdir -p $(LOGS) && \
@@ -93,7 +91,7 @@ endif
 frames: $(OUT)/frames/.done
 
 # One job, or GLOBAL_WINDOWS time windows side by side and their merge (the same bytes).
-$(OUT)/global.rlh: $(SCENE) $(OUT)/global.params $(BIN)/rad-global
+$(OUT)/global.rlh: $(OUT)/scene.params $(OUT)/global.params $(BIN)/rad-global
 ifeq ($(WINDOW_COUNT),1)
 	@$(call submit,global,,,$(GLOBAL_CMD))
 else
@@ -106,10 +104,10 @@ else
 	$(call submit,global-merge,,global,$(call GLOBAL_MERGE_CMD,$(WINDOW_FILES)))
 endif
 
-$(OUT)/intervals.rti: $(SCENE) $(OUT)/intervals.params $(BIN)/rad-intervals
+$(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-intervals
 	@$(call submit,intervals,,,$(INTERVALS_CMD))
 
-$(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
+$(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
 	@rm -f $@ && \
 	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies shard $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
 	if [ -n "$$missing" ]; then \
@@ -118,7 +116,7 @@ $(OUT)/movies/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movi
 	  $(call submit,movies-done,,movies,touch $@); \
 	else touch $@; fi
 
-$(OUT)/frames/.done: $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
+$(OUT)/frames/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
 	@rm -f $@ && \
 	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals movies" $^) && \

@@ -18,12 +18,32 @@ INTERVALS_FLAGS ?=
 MOVIES_FLAGS    ?=
 COMPOSE_FLAGS   ?=
 
+PIPELINES := $(dir $(lastword $(MAKEFILE_LIST)))
+# The calling Makefile's name, for its messages.
+MAKEFILE_NAME := $(notdir $(firstword $(MAKEFILE_LIST)))
+# $(1) as one shell word, whatever it holds.
+quote = '$(subst ','\'',$(1))'
+
+# The variables are checked before anything runs or is written (check-variables.sh says what
+# it allows and why): a path Make or a shell would split or read as syntax, and an OUT that a
+# run or `make clean` could harm (the root, the home folder, the repository), stop the run here
+# with one line.
+VARIABLES_PROBLEM := $(shell $(PIPELINES)check-variables.sh $(call quote,$(abspath $(PIPELINES)..)) \
+  $(call quote,$(SCENE)) $(call quote,$(OUT)) $(call quote,$(BIN)) $(call quote,$(FRAMES)) \
+  $(call quote,$(SIZE)) $(call quote,$(FPS)))
+ifneq ($(VARIABLES_PROBLEM),)
+$(error $(MAKEFILE_NAME): $(VARIABLES_PROBLEM))
+endif
+# A path that starts with `-` would read as an option to the tools.
+dash-safe = $(if $(filter -%,$(1)),./$(1),$(1))
+override SCENE := $(call dash-safe,$(SCENE))
+override OUT   := $(call dash-safe,$(OUT))
+override BIN   := $(call dash-safe,$(BIN))
+
 GLOBAL_ARGS    = --frames $(FRAMES) --fps $(FPS) $(GLOBAL_FLAGS)
 INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) $(INTERVALS_FLAGS)
 MOVIES_ARGS    = $(MOVIES_FLAGS)
 COMPOSE_ARGS   = --frames $(FRAMES) $(COMPOSE_FLAGS)
-
-FIRST_FRAME = $(firstword $(subst -, ,$(FRAMES)))
 
 # The stage command lines, written once: the rules run them, `make -f animation.mk
 # stage-commands` prints them (one `STAGE<TAB>command` line each) for bench.py and tradeoff.py,
@@ -45,38 +65,57 @@ MOVIES_RUN  = $(strip $(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/interv
                 $(MOVIES_ARGS) --report $(1))
 COMPOSE_RUN = $(strip $(BIN)/rad-compose $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies \
                 -o $(OUT)/frames $(1) --report $(2))
-# The mp4, and every 12th frame 4 across. Written to $@.tmp, then moved.
-MP4_CMD     = ffmpeg -loglevel error -y -framerate $(FPS) -start_number $(FIRST_FRAME) \
-                -i $(OUT)/frames/%04d.png -c:v libx264 -pix_fmt yuv420p -crf 18 -f mp4 $(OUT)/movie.mp4.tmp && \
-              mv -f $(OUT)/movie.mp4.tmp $(OUT)/movie.mp4
-CONTACT_CMD = ffmpeg -loglevel error -y -start_number $(FIRST_FRAME) -i $(OUT)/frames/%04d.png \
-                -vf "select=not(mod(n\,12)),tile=4x2:padding=4:color=white" -frames:v 1 -update 1 -f image2 \
-                $(OUT)/contact-sheet.png.tmp && mv -f $(OUT)/contact-sheet.png.tmp $(OUT)/contact-sheet.png
+# The mp4 and the contact sheet (encode.sh: exactly the frames FRAMES names, odd sizes padded).
+MP4_CMD     = $(PIPELINES)encode.sh mp4 $(OUT)/frames $(FRAMES) $(FPS) $(OUT)/movie.mp4
+CONTACT_CMD = $(PIPELINES)encode.sh contact $(OUT)/frames $(FRAMES) $(FPS) $(OUT)/contact-sheet.png
 
-# A stamp's content is the stage's parameters; it is rewritten only when they change. It is
-# updated while the Makefile is read (not by a rule), so `make -n` already knows which stages
-# a change of parameters affects.
-update-params = $(shell mkdir -p $(OUT) && printf '%s\n' '$(2)' > $(OUT)/$(1).params.new && \
-  { cmp -s $(OUT)/$(1).params.new $(OUT)/$(1).params && rm -f $(OUT)/$(1).params.new || \
-    mv -f $(OUT)/$(1).params.new $(OUT)/$(1).params; })
-ifeq ($(filter clean stage-commands,$(MAKECMDGOALS)),)
-$(call update-params,global,$(GLOBAL_ARGS))
-$(call update-params,intervals,$(INTERVALS_ARGS))
-$(call update-params,movies,$(MOVIES_ARGS))
-$(call update-params,compose,$(COMPOSE_ARGS))
+# The stamps, one file each, OUT/NAME.params: a stage's parameters, and for `scene` the content
+# hash of every file the scene is made of (rad-inspect --inputs: the glTF, its buffers and
+# images). The stages depend on their stamps, not on the scene's file times, so Make re-runs
+# exactly the stages a change of content or parameters affects (an older scene copied over, a
+# moved vertex in a .bin, a recoloured texture included). The stamps are compared while the
+# Makefile is read, and nothing is written then: a stamp that differs is made to depend on FORCE,
+# so its rule writes it before the stages run, `make -n` lists the stages the change affects
+# and writes nothing, and a stamp that cannot be written fails the run with one line.
+STAMP_global    = $(GLOBAL_ARGS)
+STAMP_intervals = $(INTERVALS_ARGS)
+STAMP_movies    = $(MOVIES_ARGS)
+STAMP_compose   = $(COMPOSE_ARGS)
+STAMPS := scene global intervals movies compose
+same-text     = $(and $(findstring x$(1)x,x$(2)x),$(findstring x$(2)x,x$(1)x))
+stamp-differs = $(if $(call same-text,$(file <$(OUT)/$(1).params),$(STAMP_$(1))),,differs)
+
+# Only the goals that run stages read the scene (clean and stage-commands need no built tools).
+ifneq ($(filter-out clean stage-commands,$(or $(MAKECMDGOALS),all)),)
+ifeq ($(wildcard $(BIN)/rad-inspect),)
+$(error $(MAKEFILE_NAME): $(BIN)/rad-inspect is not built; run pipelines/bootstrap.sh first)
 endif
+STAMP_scene := $(shell $(BIN)/rad-inspect --inputs $(SCENE) 2>&1)
+ifneq ($(.SHELLSTATUS),0)
+$(error $(STAMP_scene))
+endif
+$(foreach s,$(STAMPS),$(if $(call stamp-differs,$(s)),$(eval $(OUT)/$(s).params: FORCE)))
+endif
+
+$(OUT)/%.params:
+	@err=$$( { mkdir -p $(@D) && printf '%s\n' $(call quote,$(STAMP_$*)) > $@.tmp.$$$$ && \
+	  mv -f $@.tmp.$$$$ $@; } 2>&1 ) || { rm -f $@.tmp.$$$$ 2>/dev/null; \
+	  echo "$(MAKEFILE_NAME): $@: cannot write the stamp: $${err##*: }" >&2; exit 1; }
+
+.PHONY: FORCE
+FORCE:
 
 # A stage binary that is not built is an error, not a stage quietly left out.
 $(BIN)/rad-%:
-	@echo "$(notdir $(firstword $(MAKEFILE_LIST))): $@ is not built; run pipelines/bootstrap.sh first" >&2; exit 1
+	@echo "$(MAKEFILE_NAME): $@ is not built; run pipelines/bootstrap.sh first" >&2; exit 1
 
 # What the toolchain sees in the scene (patches, emitters, dynamic nodes, camera, time range).
-$(OUT)/scene.json: $(SCENE) $(BIN)/rad-inspect
-	@mkdir -p $(@D)
-	$(BIN)/rad-inspect --json $(SCENE) > $@.tmp && mv -f $@.tmp $@
+$(OUT)/scene.json: $(OUT)/scene.params $(BIN)/rad-inspect
+	$(BIN)/rad-inspect --json $(SCENE) > $@.tmp.$$$$ && mv -f $@.tmp.$$$$ $@ || { rm -f $@.tmp.$$$$; exit 1; }
 
+# Only what the pipeline wrote, by name (clean.sh); OUT was checked above.
 clean:
-	rm -rf $(OUT)
+	@$(PIPELINES)clean.sh $(OUT)
 
 # $(info) prints the text as Make expanded it, with no shell in between to eat quotes.
 stage-commands:

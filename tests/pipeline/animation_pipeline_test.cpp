@@ -14,49 +14,15 @@
 #include "formats/exr_image.h"
 #include "libcommon/reference/image_difference.h"
 #include "tests/cli/cli_util.h"
+#include "tests/pipeline/pipeline_util.h"
 
 namespace rad::test {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kStages = {"rad-global", "rad-intervals", "rad-movies",
-                                          "rad-compose"};
-
-// The stages that are not built: the pipeline tests fail on them, they do not skip.
-std::vector<std::string> missingStages() {
-  std::vector<std::string> missing;
-  for (const std::string& s : kStages)
-    if (!fs::exists(tool(s))) missing.push_back(s);
-  return missing;
-}
-
-// Small, fast settings; the Makefile is the one the README runs.
-std::string makeCommand(const fs::path& out, const std::string& bin = RAD_BIN_DIR,
-                        const std::string& extra = "") {
-  return "make --no-print-directory -C " RAD_SOURCE_DIR " -f pipelines/animation.mk BIN=" + bin +
-         " OUT=" + out.string() + " FRAMES=0-7 SIZE=88x60 " + extra;
-}
-
-fs::path freshDir(const std::string& name) {
-  fs::path d =
-      fs::temp_directory_path() / ("rad_pipeline_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 FloatImage readImage(const fs::path& path) {
   return readExrImage(path.string(), {"R", "G", "B"});
-}
-
-// Which stages `make -n` would run.
-std::vector<std::string> stagesMakeWouldRun(const std::string& command) {
-  CommandResult r = runCommand(command + " -n");
-  std::vector<std::string> run;
-  for (const std::string& s : kStages)
-    if (r.out.find("/" + s + " ") != std::string::npos) run.push_back(s);
-  return run;
 }
 
 class AnimationPipeline : public ::testing::Test {
@@ -115,9 +81,9 @@ TEST_F(AnimationPipeline, ProducesFiniteFramesMovieAndContactSheet) {
 
   // Nothing to do on a second run.
   EXPECT_TRUE(stagesMakeWouldRun(makeCommand(out)).empty());
-  // A change of one stage's parameters re-runs exactly that stage and what depends on it. The
-  // stamps are updated as the Makefile is read, so each check is followed by a real run with
-  // the default parameters, which puts the stamps back.
+  // A change of one stage's parameters re-runs exactly that stage and what depends on it.
+  // `make -n` writes no stamp; each check is followed by a real run with the default
+  // parameters all the same, which must find nothing to do.
   auto expectRerun = [&](const std::string& change, std::vector<std::string> expected) {
     EXPECT_EQ(stagesMakeWouldRun(makeCommand(out, RAD_BIN_DIR, change)), expected) << change;
     ASSERT_EQ(runCommand(makeCommand(out)).exitCode, 0);
