@@ -8,7 +8,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 
+#include "formats/temp_file_registry.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -39,10 +41,12 @@ AtomicFile::AtomicFile(std::string path, Durability durability)
   const std::string ext = hasExt ? name.substr(dot) : "";
   tempPath_ = dir + "." + stem + ".tmp." + std::to_string(::getpid()) + "." +
               std::to_string(gTempCounter.fetch_add(1)) + ext;
+  registrySlot_ = registerTempFile(tempPath_);
 }
 
 AtomicFile::~AtomicFile() {
   if (!committed_) ::unlink(tempPath_.c_str());  // ENOENT is fine: nothing was written
+  unregisterTempFile(registrySlot_);
 }
 
 void AtomicFile::commit() {
@@ -53,6 +57,7 @@ void AtomicFile::commit() {
           path_, std::string("cannot rename temporary file into place: ") + std::strerror(errno));
     }
     committed_ = true;
+    unregisterTempFile(std::exchange(registrySlot_, -1));
     return;
   }
   // Flush the data before the rename makes it visible, so a crash cannot leave a complete
@@ -73,6 +78,7 @@ void AtomicFile::commit() {
         path_, std::string("cannot rename temporary file into place: ") + std::strerror(errno));
   }
   committed_ = true;
+  unregisterTempFile(std::exchange(registrySlot_, -1));
   // Make the rename itself durable; failure here is not worth failing the stage for.
   int dirFd = ::open(directoryOf(path_).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dirFd >= 0) {

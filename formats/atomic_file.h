@@ -13,8 +13,10 @@ namespace rad {
 // The temporary lives in the same directory as `path` (rename is atomic only within one file
 // system) and is a hidden file, ".<stem>.tmp.<pid>.<n><ext>": Make's wildcards skip it, no
 // rule names it, and it keeps the extension so writers that pick a format by extension (OIIO)
-// still work. A process killed with SIGKILL can leave one behind; it is never mistaken for
-// output. Not thread-safe per object; distinct objects may be used from distinct threads.
+// still work. While it may exist it is registered (formats/temp_file_registry.h): SIGINT,
+// SIGTERM and SIGHUP remove it before the process dies of the signal. A process killed with
+// SIGKILL can leave one behind; it is never mistaken for output. Not thread-safe per object;
+// distinct objects may be used from distinct threads.
 class AtomicFile {
  public:
   // How commit() makes the file durable (survive a power loss, not only a crash of the process;
@@ -45,6 +47,7 @@ class AtomicFile {
   std::string tempPath_;
   Durability durability_;
   bool committed_ = false;
+  int registrySlot_ = -1;  // registerTempFile's slot for tempPath_
 };
 
 // Flushes the whole file system holding `path` (syncfs(2)): the one sync that makes files

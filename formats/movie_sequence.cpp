@@ -148,20 +148,27 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     }
   };
   std::vector<std::thread> threads;
-  for (size_t k = 1; k < workers; ++k)
-    threads.emplace_back([&, k] {
-      Worker& w = done[k];
-      try {
-        std::unique_ptr<TextureMovieBaker> sibling = baker.sibling();
-        work(*sibling, w);
-        w.stats = sibling->stats();
-        w.rendererName = sibling->rendererName();
-      } catch (...) {  // the sibling's construction or teardown, or a failed progress report
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-      }
-    });
+  for (size_t k = 1; k < workers && !stop; ++k) try {
+      threads.emplace_back([&, k] {
+        Worker& w = done[k];
+        try {
+          std::unique_ptr<TextureMovieBaker> sibling = baker.sibling();
+          work(*sibling, w);
+          w.stats = sibling->stats();
+          w.rendererName = sibling->rendererName();
+        } catch (...) {  // the sibling's construction or teardown, or a failed progress report
+          std::lock_guard<std::mutex> lock(mutex);
+          if (!failure) failure = std::current_exception();
+          stop = true;
+        }
+      });
+    } catch (...) {
+      // A thread that did not start (std::system_error): the started ones stop and are joined
+      // below (a joinable std::thread destroyed unjoined aborts), and the error is reported.
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!failure) failure = std::current_exception();
+      stop = true;
+    }
   try {
     work(baker, done[0]);
   } catch (...) {  // a failed progress report: the other workers still have to be joined

@@ -11,7 +11,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -153,6 +155,41 @@ std::string probeContextInChild() {
   return "cannot create an OpenGL 4.5 core context" + driverChoice();
 }
 
+// Address space a context needs beyond what the process has mapped when it is made: llvmpipe
+// starts a rasteriser thread per core (each with its stack) and LLVM's JIT maps its code and
+// heaps when the first shaders compile. Mesa does not fail cleanly when an allocation fails:
+// under `ulimit -v` the stages died of SIGSEGV in the shader compile or of LLVM's abort, after
+// a context had been made. So under an address-space limit a context is refused up front
+// (exit 4) unless this much is left: the base (LLVM, the shaders) for the process's first
+// context only, the per-core part (the rasteriser threads) for each. Without a limit nothing
+// is checked.
+constexpr size_t kMiB = size_t(1) << 20;
+constexpr size_t kGlAddressSpaceBase = 512 * kMiB;
+constexpr size_t kGlAddressSpacePerCore = 64 * kMiB;
+
+// "" when RLIMIT_AS leaves room for a context, else why not (one line).
+std::string addressSpaceShortage() {
+  static std::atomic<bool> first{true};
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return "";
+  size_t pages = 0;
+  if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(statm, "%zu", &pages) != 1) pages = 0;
+    std::fclose(statm);
+  }
+  const size_t mapped = pages * size_t(sysconf(_SC_PAGESIZE));
+  const long cores = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
+  const size_t need =
+      (first.exchange(false) ? kGlAddressSpaceBase : 0) + size_t(cores) * kGlAddressSpacePerCore;
+  const size_t cap = size_t(limit.rlim_cur);
+  if (mapped < cap && cap - mapped >= need) return "";
+  const size_t left = mapped < cap ? cap - mapped : 0;
+  return "the address-space limit (ulimit -v " + std::to_string(cap / 1024) + ") leaves " +
+         std::to_string(left / kMiB) + " MiB; an OpenGL context (Mesa llvmpipe, " +
+         std::to_string(cores) + " cores) needs " + std::to_string(need / kMiB) +
+         " MiB more: raise the limit";
+}
+
 // The probe's verdict, taken once per process before its first context.
 const std::string& contextProbe() {
   static const std::string verdict = probeContextInChild();
@@ -166,6 +203,8 @@ GlContext::GlContext() {
                                  ? "; unset GALLIUM_DRIVER or set it to llvmpipe"
                                  : " (OSMesaCreateContextAttribs failed; is libosmesa6 with "
                                    "llvmpipe installed?)";
+  if (const std::string shortage = addressSpaceShortage(); !shortage.empty())
+    throw environmentError(shortage);
   if (const std::string& failed = contextProbe(); !failed.empty())
     throw environmentError(failed + remedy);
   OSMesaContext ctx = createCoreContext();

@@ -425,21 +425,21 @@ class ItemBufferPipeline {
   ItemBufferPipeline(size_t workers, ImageSize size, const std::vector<ItemObject>& objects,
                      std::vector<int> frames, View view)
       : frames_(std::move(frames)), view_(std::move(view)), slots_(workers) {
-    for (size_t k = 0; k < workers; ++k)
-      threads_.emplace_back([this, k, size, &objects] { work(k, size, objects); });
+    try {
+      for (size_t k = 0; k < workers; ++k)
+        threads_.emplace_back([this, k, size, &objects] { work(k, size, objects); });
+    } catch (...) {
+      // A thread that did not start (std::system_error): no destructor runs for a constructor
+      // that throws, and a joinable std::thread destroyed unjoined aborts the process.
+      stopAndJoin();
+      throw;
+    }
     // The objects are the caller's: every worker has uploaded them before this returns.
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [&] { return uploaded_ == threads_.size(); });
   }
 
-  ~ItemBufferPipeline() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    changed_.notify_all();
-    for (std::thread& t : threads_) t.join();
-  }
+  ~ItemBufferPipeline() { stopAndJoin(); }
 
   // Frame i's slot once rendered (rethrows a worker's error); release(i) hands it back.
   Slot& take(size_t i) {
@@ -458,6 +458,15 @@ class ItemBufferPipeline {
   }
 
  private:
+  void stopAndJoin() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    changed_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+
   void work(size_t k, ImageSize size, const std::vector<ItemObject>& objects) {
     Slot& s = slots_[k];
     std::unique_ptr<ItemBufferRenderer> renderer;

@@ -19,6 +19,7 @@ used and the output is deterministic, so regenerated files are byte-identical.
 
 usage: make_paper_scenes.py OUTDIR [NAME ...]     (no NAME: every scene)
 """
+import argparse
 import base64
 import json
 import math
@@ -404,10 +405,28 @@ def all_scenes():
     yield "cubic", lambda: (cubic_scene(), 30.0)
 
 
+def parse_args(argv):
+    """OUTDIR and the wanted scene names; exits 2 with one line on a usage error, 0 after
+    --help (which writes nothing)."""
+    names = [name for name, _ in all_scenes()]
+    parser = argparse.ArgumentParser(
+        prog="make_paper_scenes.py", description=__doc__.split("\n\n")[0],
+        epilog="scenes: " + " ".join(names),
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("outdir", metavar="OUTDIR", help="folder to write NAME.gltf into")
+    parser.add_argument("names", metavar="NAME", nargs="*", help="scenes to write (default: all)")
+    args = parser.parse_args(argv)
+    # A folder named like an option is a typo for one (`--help` once became a folder).
+    if args.outdir.startswith("-"):
+        parser.error(f"OUTDIR {args.outdir!r} starts with '-'; write ./{args.outdir} to mean it")
+    unknown = [n for n in args.names if n not in names]
+    if unknown:
+        parser.error("unknown scene " + ", ".join(unknown) + "; scenes: " + " ".join(names))
+    return args.outdir, set(args.names)
+
+
 def main():
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    outdir, wanted = sys.argv[1], set(sys.argv[2:])
+    outdir, wanted = parse_args(sys.argv[1:])
     os.makedirs(outdir, exist_ok=True)
     for name, make in all_scenes():
         if wanted and name not in wanted:

@@ -19,12 +19,19 @@
 #include <tbb/global_control.h>
 
 #include "formats/build_info.h"
+#include "libcommon/core/failure.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {
 
 namespace {
 int gThreads = 0;  // --threads; 0: every core this process may use (TBB's default)
+// The largest --threads. A fixed number, not one derived from this machine's cores, so a
+// command line (a Makefile's, a farm job's) means the same on every node; above the largest
+// machines' hardware threads, and low enough that the threads' stacks and rad-movies' GL
+// contexts (one per worker) stay within a machine's memory, where 10^8 threads aborted
+// (SIGABRT) or grew without bound.
+constexpr long long kMaxThreads = 1024;
 std::unique_ptr<tbb::global_control> gThreadLimit;
 
 constexpr const char* kPrintDefaults = "--print-defaults";
@@ -84,7 +91,7 @@ void setUpApp(CLI::App& app, const std::string& tool, const std::string& example
   // comes from ids): it only bounds the cores used, e.g. for make -j or a shared machine.
   app.add_option("--threads", gThreads, "worker threads; 0: all cores")
       ->capture_default_str()
-      ->check(nonNegativeInteger());
+      ->check(integerRange(0, kMaxThreads));
   app.add_flag_callback(
       kPrintDefaults, [] { throw CallForDefaults(); },
       "print every option's default as one JSON object on stdout and exit");
@@ -137,15 +144,10 @@ int runTool(const std::string& tool, const std::function<int()>& body) {
   int rc = 0;
   try {
     rc = body();
-  } catch (const Error& e) {
-    std::cerr << tool << ": " << oneLine(e.what()) << "\n";
-    rc = int(e.code());
-  } catch (const std::bad_alloc&) {
-    std::cerr << tool << ": out of memory\n";
-    rc = int(ExitCode::kEnvironment);
-  } catch (const std::exception& e) {
-    std::cerr << tool << ": internal error: " << oneLine(e.what()) << "\n";
-    rc = int(ExitCode::kInternal);
+  } catch (...) {
+    const Failure failure = failureOf(std::current_exception());
+    std::cerr << tool << ": " << oneLine(failure.message) << "\n";
+    rc = int(failure.code);
   }
   return finishStdout(tool, rc);
 }

@@ -21,6 +21,7 @@
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
 #include "libcommon/compose/compose_options.h"
+#include "tools/common/made_from_scene.h"
 #include "tools/common/tool_main.h"
 
 namespace {
@@ -103,10 +104,13 @@ int run(const rad::ComposeOptions& given, int argc, char** argv) {
   rad::InputRecord globalInput;  // taken while the file's bytes are held
   {
     rad::ContainerReader globalReader = rad::ContainerReader::open(o.global);
+    rad::requireMadeFrom(globalReader, rad::kLinkHierarchyKind, rad::kLinkHierarchyMajor, scene);
     solution = rad::readLinkHierarchyRadiosity(globalReader, scene);
     globalInput = rad::inputRecordOf(globalReader);
   }
   rad::ContainerReader intervalsReader = rad::ContainerReader::open(o.intervals);
+  rad::requireMadeFrom(intervalsReader, rad::kTextureIntervalsKind, rad::kTextureIntervalsMajor,
+                       scene);
   rad::TextureIntervals intervals = rad::readTextureIntervals(intervalsReader);
   rad::requireGlobalCoversIntervals(o.global, solution, o.intervals, intervals);
 
@@ -116,6 +120,7 @@ int run(const rad::ComposeOptions& given, int argc, char** argv) {
   provenance.inputs.push_back(std::move(globalInput));
   rad::addInput(provenance, intervalsReader);
   rad::addMoviesInput(provenance, intervals, o.movies, c.frames);
+  rad::requireMoviesMadeFrom(provenance.inputs.back(), scene);
   warnAboutDifferences(c, given.camera, o.intervals, intervalsReader, intervals);
 
   rad::Progress progress(kTool, long(c.frames.size()));

@@ -19,6 +19,7 @@
 #include "formats/provenance.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/global_stage.h"
+#include "libcommon/scene/scene_digest.h"
 #include "tools/common/tool_main.h"
 
 namespace {
@@ -156,6 +157,16 @@ void addOptions(CLI::App& app, Options& o) {
       ->excludes(window);
 }
 
+// The parameters both outputs' provenance records: the options and the digests of the scene's
+// parts the solution depends on (the camera is not one of them).
+nlohmann::json provenanceParameters(const rad::GlobalOptions& g, const rad::Scene& scene) {
+  nlohmann::json params = g.toJson();
+  params[rad::kSceneDigestsKey] =
+      rad::sceneDigests(scene, {rad::ScenePart::kGeometry, rad::ScenePart::kMaterials,
+                                rad::ScenePart::kLights, rad::ScenePart::kAnimation});
+  return params;
+}
+
 // The metadata of both outputs: what ran.
 nlohmann::json runMetadata(const rad::GlobalOptions& g, const rad::FrameRange& frames) {
   return {{"parameters", g.toJson()},
@@ -171,7 +182,7 @@ void writeWindow(const Options& o, const rad::Scene& scene, const rad::FrameRang
   const rad::GlobalOptions& g = o.global;
   rad::KeyWindow window =
       rad::solveKeyWindow(scene, keyTimes, keys.first, keys.last, g.spaceTime, &report.solve);
-  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, g.toJson());
+  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, provenanceParameters(g, scene));
   rad::addInput(prov, o.scene);
   nlohmann::json metadata = runMetadata(g, frames);
   metadata["window"] = g.window;
@@ -202,7 +213,8 @@ void writeHierarchy(const Options& o, const rad::Scene& scene, const rad::FrameR
   }
   std::vector<const char*> args;
   for (const std::string& w : words) args.push_back(w.c_str());
-  rad::Provenance prov = rad::makeProvenance(kTool, int(args.size()), args.data(), params);
+  rad::Provenance prov =
+      rad::makeProvenance(kTool, int(args.size()), args.data(), provenanceParameters(g, scene));
   rad::addInput(prov, o.scene);
   auto tWrite = std::chrono::steady_clock::now();
   rad::writeLinkHierarchy(o.output, solution, prov, runMetadata(g, frames));

@@ -13,6 +13,7 @@
 #include "formats/texture_intervals.h"
 #include "libcommon/intervals/intervals_options.h"
 #include "libcommon/scene/frame_range.h"
+#include "libcommon/scene/scene_digest.h"
 #include "tools/common/tool_main.h"
 
 namespace {
@@ -52,7 +53,11 @@ int run(const rad::IntervalsOptions& given, int argc, char** argv) {
   if (o.frames.empty()) o.frames = rad::animationFrames(scene, o.build.fps).toString();
   const std::vector<int> frames = increasingFrames(o.frames);
 
-  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, o.toJson());
+  // The item buffers see the patches where the camera sees them: geometry, motion, camera.
+  nlohmann::json parameters = o.toJson();
+  parameters[rad::kSceneDigestsKey] = rad::sceneDigests(
+      scene, {rad::ScenePart::kGeometry, rad::ScenePart::kAnimation, rad::ScenePart::kCamera});
+  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
   rad::addInput(provenance, o.scene);
   rad::Progress progress(kTool, long(frames.size()));
   rad::IntervalSequence sequence =

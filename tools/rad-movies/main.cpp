@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "formats/atomic_file.h"
+#include "formats/container.h"
 #include "formats/form_factor_scratch_file.h"
 #include "formats/frame_window.h"
 #include "formats/gltf_scene.h"
@@ -15,6 +16,8 @@
 #include "formats/texture_intervals.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/movies/texture_movie_baker.h"
+#include "libcommon/scene/scene_digest.h"
+#include "tools/common/made_from_scene.h"
 #include "tools/common/tool_main.h"
 
 namespace {
@@ -36,18 +39,34 @@ int run(Options o, int argc, char** argv) {
   o.baker.merge = rad::parseMergeMode(o.merge);
   o.baker.goodLayer = rad::parseGoodLayer(o.goodLayer);
   rad::Scene scene = rad::readGltfScene(o.scene);
-  rad::GlobalSolution solution = rad::readLinkHierarchy(o.global, scene);
-  rad::TextureIntervals intervals = rad::readTextureIntervals(o.intervals);
+  rad::GlobalSolution solution;
+  rad::InputRecord globalInput, intervalsInput;  // taken while the files' bytes are held
+  {
+    const rad::ContainerReader reader = rad::ContainerReader::open(o.global);
+    rad::requireMadeFrom(reader, rad::kLinkHierarchyKind, rad::kLinkHierarchyMajor, scene);
+    solution = rad::readLinkHierarchy(reader, scene);
+    globalInput = rad::inputRecordOf(reader);
+  }
+  rad::TextureIntervals intervals;
+  {
+    const rad::ContainerReader reader = rad::ContainerReader::open(o.intervals);
+    rad::requireMadeFrom(reader, rad::kTextureIntervalsKind, rad::kTextureIntervalsMajor, scene);
+    intervals = rad::readTextureIntervals(reader);
+    intervalsInput = rad::inputRecordOf(reader);
+  }
   rad::requireGlobalCoversIntervals(o.global, solution, o.intervals, intervals);
   const double secondsRead = rad::secondsSince(start);
 
   nlohmann::json parameters = o.baker.toJson();
   parameters["shard"] = o.shard;
   parameters["output"] = o.outDir;
+  parameters[rad::kSceneDigestsKey] =
+      rad::sceneDigests(scene, {rad::ScenePart::kGeometry, rad::ScenePart::kMaterials,
+                                rad::ScenePart::kLights, rad::ScenePart::kAnimation});
   rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
   rad::addInput(provenance, o.scene);
-  rad::addInput(provenance, o.global);
-  rad::addInput(provenance, o.intervals);
+  provenance.inputs.push_back(std::move(globalInput));
+  provenance.inputs.push_back(std::move(intervalsInput));
 
   rad::TextureMovieBakerBackends backends;
   backends.formFactorSpill = rad::formFactorScratchFiles();
