@@ -12,16 +12,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <functional>
-#include <iterator>
 #include <limits>
 #include <map>
+#include <new>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
+#include "formats/gltf_scene_file.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -30,8 +26,9 @@ namespace {
 
 class Reader {
  public:
-  Reader(const std::string& path, const tinygltf::Model& model, const GltfReadOptions& options)
-      : path_(path), m_(model), options_(options) {}
+  Reader(const std::string& path, const tinygltf::Model& model, const GltfReadOptions& options,
+         const GltfLoaderHooks& hooks)
+      : path_(path), m_(model), options_(options), hooks_(hooks) {}
   Scene read();
 
  private:
@@ -54,6 +51,7 @@ class Reader {
   std::string path_;
   const tinygltf::Model& m_;
   GltfReadOptions options_;
+  const GltfLoaderHooks& hooks_;    // why an image has no pixels
   std::map<int, int> materialMap_;  // glTF material -> Scene::materials
   std::map<int, int> textureMap_;   // glTF texture -> Scene::textures
   size_t droppedTriangles_ = 0;
@@ -189,6 +187,14 @@ int typeComponents(int type) {
       return -1;
   }
 }
+
+// The narrowest perspective yfov. The rasterising stages round projection x view x model to
+// float once (rasterClipFromLocal): the x, y rows scale with 1 / tan(yfov / 2), so the rounding
+// of their translation part, 2^-24 |eye| / tan(yfov / 2), must stay below a pixel of the
+// largest image (2 / 16384 in NDC) for a camera about as far from the origin as from what it
+// sees: tan(yfov / 2) > 5e-4. A yfov of 1e-9 left most pixels without a surface (black). Real
+// lenses stay far above it (a 1200 mm telephoto on 35 mm film: 0.02 rad).
+constexpr double kMinYfov = 1e-3;
 
 // Elements of an accessor without a bufferView (zeros but for sparse substitutions).
 constexpr size_t kMaxZeroElements = size_t(1) << 20;
@@ -631,8 +637,13 @@ int Reader::texture(int index, Scene& scene) {
   const size_t bytes = bits == 16 ? 2 : 1;
   if (w <= 0 || h <= 0 || comp < 1 || comp > 4 || (bits != 8 && bits != 16) ||
       img.image.size() < size_t(w) * size_t(h) * size_t(comp) * bytes) {
-    scene.warnings.push_back(where + ": image '" + clipInput(img.name) +
-                             "' not decoded; base colour texture ignored");
+    // One rule for every image without pixels (formats/gltf_scene.md "Materials").
+    std::string why = hooks_.imageProblem(size_t(gt.source));
+    const std::string name = !img.name.empty() ? img.name : img.uri;
+    scene.warnings.push_back(where + ": image " + std::to_string(gt.source) +
+                             (name.empty() ? std::string() : " '" + clipInput(name) + "'") + ": " +
+                             (why.empty() ? std::string("not decoded") : why) +
+                             "; texture ignored, reflectance = baseColorFactor only");
     return textureMap_[index] = -1;
   }
   Texture tex;
@@ -681,6 +692,9 @@ void Reader::readCameras(Scene& scene) {
       c.znear = g.perspective.znear;
       c.zfar = g.perspective.zfar;
       if (!(c.yfov > 0.0 && c.yfov < M_PI)) fail(where + ": yfov must be in (0, pi)");
+      if (c.yfov < kMinYfov)
+        fail(where + ": yfov " + number(c.yfov) + " is below the limit " + number(kMinYfov) +
+             " rad (0.057 degrees): the rasterising stages' float projection cannot place it");
       if (!(c.aspectRatio >= 0.0) || !std::isfinite(c.aspectRatio))
         fail(where + ": bad aspectRatio");
       if (!(c.znear > 0.0) || !std::isfinite(c.znear)) fail(where + ": znear must be > 0");
@@ -886,78 +900,6 @@ void Reader::requireWorldArea(const Scene& scene, int node, double t) const {
 
 namespace {
 
-// Deeper nesting is refused before parsing: tinygltf's JSON parser (nlohmann) recurses once per
-// level and overflows the stack (SIGSEGV) near 100,000 levels. glTF itself nests < 10 levels;
-// extras rarely reach 20.
-constexpr int kMaxJsonDepth = 256;
-
-// The deepest nesting of objects and arrays in the JSON text (strings and their escapes skipped),
-// without recursion; counting stops above `limit`.
-int jsonNestingDepth(const char* text, size_t size, int limit) {
-  int depth = 0, deepest = 0;
-  bool inString = false;
-  for (size_t i = 0; i < size; ++i) {
-    const char c = text[i];
-    if (inString) {
-      if (c == '\\')
-        ++i;  // the escaped character, a quote included, is part of the string
-      else if (c == '"')
-        inString = false;
-    } else if (c == '"') {
-      inString = true;
-    } else if (c == '{' || c == '[') {
-      deepest = std::max(deepest, ++depth);
-      if (deepest > limit) break;
-    } else if (c == '}' || c == ']') {
-      --depth;
-    }
-  }
-  return deepest;
-}
-
-void checkJsonDepth(const std::string& path, const char* text, size_t size) {
-  if (jsonNestingDepth(text, size, kMaxJsonDepth) > kMaxJsonDepth)
-    throw inputError(
-        path, "invalid gltf: JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
-}
-
-// tinygltf reads these with ParseUnsignedProperty, which keeps the default 0 without an error
-// when the value is negative, fractional or not a number: a negative byteOffset silently read
-// from the buffer's start (other meshes' data, hence garbage geometry and slow runs). Checked
-// here on the same JSON text (its depth already bounded).
-void checkUnsignedFields(const std::string& path, const char* text, size_t size) {
-  const nlohmann::json j = nlohmann::json::parse(text, text + size, nullptr, false);
-  if (!j.is_object()) return;  // tinygltf reports the syntax error
-  auto check = [&](const nlohmann::json& o, const char* key, const std::string& where) {
-    if (!o.is_object() || !o.contains(key)) return;
-    if (!o[key].is_number_unsigned())
-      throw inputError(path, where + ": " + key + " " + clipInput(o[key].dump()) +
-                                 " is not a non-negative integer");
-  };
-  auto each = [&](const char* array,
-                  const std::function<void(const nlohmann::json&, const std::string&)>& f) {
-    auto it = j.find(array);
-    if (it == j.end() || !it->is_array()) return;
-    std::string name(array);
-    name.pop_back();  // "bufferViews" -> "bufferView"
-    for (size_t i = 0; i < it->size(); ++i) f((*it)[i], name + " " + std::to_string(i));
-  };
-  each("buffers",
-       [&](const nlohmann::json& o, const std::string& w) { check(o, "byteLength", w); });
-  each("bufferViews", [&](const nlohmann::json& o, const std::string& w) {
-    for (const char* key : {"byteOffset", "byteLength", "byteStride"}) check(o, key, w);
-  });
-  each("accessors", [&](const nlohmann::json& o, const std::string& w) {
-    check(o, "byteOffset", w);
-    check(o, "count", w);
-    if (!o.is_object() || !o.contains("sparse") || !o["sparse"].is_object()) return;
-    const nlohmann::json& sparse = o["sparse"];
-    check(sparse, "count", w + " sparse");
-    for (const char* part : {"indices", "values"})
-      if (sparse.contains(part)) check(sparse[part], "byteOffset", w + " sparse " + part);
-  });
-}
-
 // KHR_lights_punctual lights in the file (not supported; counted to say why a scene is dark).
 int punctualLightCount(const tinygltf::Model& model) {
   auto ext = model.extensions.find("KHR_lights_punctual");
@@ -967,83 +909,90 @@ int punctualLightCount(const tinygltf::Model& model) {
   return int(model.lights.size());
 }
 
-std::string readWholeFile(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw inputError(path, "cannot open file");
-  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (file.bad()) throw inputError(path, "cannot read file");
-  return bytes;
-}
-
-uint32_t readU32(const std::string& bytes, size_t at) {
-  uint32_t v;
-  std::memcpy(&v, bytes.data() + at, 4);
-  return v;
-}
-
-// GLB (glTF section 4.4): 12-byte header (magic, version 2, total length), then the JSON chunk
-// (length, type "JSON", text). Checked here before tinygltf sees the file; returns the JSON text.
-std::pair<const char*, size_t> glbJsonChunk(const std::string& path, const std::string& bytes) {
-  const uint64_t fileSize = bytes.size();
-  if (fileSize < 12)
-    throw inputError(path, "truncated glb: " + std::to_string(fileSize) + " bytes");
-  const uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8);
-  if (version != 2)
-    throw inputError(path, "glb version " + std::to_string(version) + ", expected 2");
-  if (length > fileSize)
-    throw inputError(path, "truncated glb: header declares " + std::to_string(length) +
-                               " bytes, file has " + std::to_string(fileSize));
-  if (length < 20) throw inputError(path, "truncated glb: no JSON chunk");
-  const uint32_t chunkLength = readU32(bytes, 12), chunkType = readU32(bytes, 16);
-  if (chunkType != 0x4E4F534Au) throw inputError(path, "invalid glb: the first chunk is not JSON");
-  if (chunkLength > length - 20)
-    throw inputError(path, "invalid glb: JSON chunk of " + std::to_string(chunkLength) +
-                               " bytes exceeds the file's " + std::to_string(length));
-  return {bytes.data() + 20, chunkLength};
-}
-
 }  // namespace
 
-Scene readGltfScene(const std::string& path, const GltfReadOptions& options) {
-  const std::string bytes = readWholeFile(path);
-  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-  const auto [json, jsonSize] = binary ? glbJsonChunk(path, bytes)
-                                       : std::pair<const char*, size_t>{bytes.data(), bytes.size()};
-  if (!binary && bytes.size() > std::numeric_limits<unsigned int>::max())
-    throw inputError(path, "invalid gltf: JSON text over 4 GB");
-  checkJsonDepth(path, json, jsonSize);
-  checkUnsignedFields(path, json, jsonSize);
-  const std::string baseDir = std::filesystem::path(path).parent_path().string();
+GltfReadOptions& defaultGltfReadOptions() {
+  static GltfReadOptions options;
+  return options;
+}
+
+namespace {
+GltfWarningHandler& warningHandler() {
+  static GltfWarningHandler handler;
+  return handler;
+}
+
+// tinygltf's warnings about external images (not found, unreadable, empty): the reader's own
+// warning for the texture says the same with the reason, once.
+std::string withoutImageFileWarnings(const std::string& warn) {
+  std::istringstream lines(warn);
+  std::string line, kept;
+  while (std::getline(lines, line)) {
+    bool fileLine = false;
+    for (const char* prefix : {"File not found : ", "File read error : ", "File is empty : ",
+                               "Failed to load external 'uri' for image["})
+      fileLine = fileLine || line.rfind(prefix, 0) == 0;
+    if (!fileLine) kept += line + "\n";
+  }
+  return kept;
+}
+
+Scene parseAndRead(const std::string& path, const GltfReadOptions& options) {
+  const GltfSceneFile file = readGltfSceneFile(path);
+  GltfLoaderHooks hooks(file.externalFiles, options.maxTexturePixels);
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
+  hooks.install(loader);
   std::string err, warn;
   bool ok = false;
   try {
-    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-    ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data,
-                                              static_cast<unsigned int>(bytes.size()), baseDir)
-                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
-                                             static_cast<unsigned int>(bytes.size()), baseDir);
+    const auto* data = reinterpret_cast<const unsigned char*>(file.bytes.data());
+    const auto size = static_cast<unsigned int>(file.bytes.size());  // <= kMaxSceneFileBytes
+    ok = file.binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, size, file.baseDir)
+                     : loader.LoadASCIIFromString(&model, &err, &warn, file.bytes.data(), size,
+                                                  file.baseDir);
   } catch (const std::bad_alloc&) {
-    throw inputError(path, "invalid gltf: out of memory while parsing");
+    throw;
   } catch (const std::exception& e) {
     throw inputError(path, std::string("invalid gltf: ") + oneLine(e.what()));
   }
   if (!ok) {
+    const std::string buffer = hooks.bufferProblem();
+    if (!buffer.empty()) throw inputError(path, buffer);
     std::string what = oneLine(err.empty() ? warn : err);
     throw inputError(path, "invalid gltf: " + (what.empty() ? std::string("unknown error") : what));
   }
+  Reader reader(path, model, options, hooks);
+  Scene scene = reader.read();
+  scene.punctualLights = punctualLightCount(model);
+  warn = withoutImageFileWarnings(warn);
+  if (!warn.empty()) scene.warnings.push_back("tinygltf: " + oneLine(warn));
+  return scene;
+}
+}  // namespace
+
+void setGltfWarningHandler(GltfWarningHandler handler) {
+  warningHandler() = std::move(handler);
+}
+
+Scene readGltfScene(const std::string& path) {
+  return readGltfScene(path, defaultGltfReadOptions());
+}
+
+Scene readGltfScene(const std::string& path, const GltfReadOptions& options) {
+  Scene scene;
   try {
-    Reader reader(path, model, options);
-    Scene scene = reader.read();
-    scene.punctualLights = punctualLightCount(model);
-    if (!warn.empty()) scene.warnings.push_back("tinygltf: " + oneLine(warn));
-    return scene;
+    scene = parseAndRead(path, options);
   } catch (const Error&) {
     throw;
-  } catch (const std::exception& e) {  // e.g. bad_alloc on absurd sizes: still bad input
+  } catch (const std::bad_alloc&) {  // exit 4 as documented, not bad input
+    throw Error(ExitCode::kEnvironment, path, "out of memory while reading the scene");
+  } catch (const std::exception& e) {  // a library's failure on absurd input: still bad input
     throw inputError(path, std::string("cannot read: ") + oneLine(e.what()));
   }
+  if (warningHandler())
+    for (const std::string& w : scene.warnings) warningHandler()(path, w);
+  return scene;
 }
 
 }  // namespace rad

@@ -21,6 +21,7 @@
 #include "formats/build_info.h"
 #include "libcommon/core/failure.h"
 #include "libcommon/scene/scene.h"
+#include "tools/common/scene_read_options.h"
 
 namespace rad {
 
@@ -95,6 +96,7 @@ void setUpApp(CLI::App& app, const std::string& tool, const std::string& example
   app.add_flag_callback(
       kPrintDefaults, [] { throw CallForDefaults(); },
       "print every option's default as one JSON object on stdout and exit");
+  addSceneReadOptions(app, tool);  // --max-texture-pixels; scene warnings on stderr
 }
 
 int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** argv) {

@@ -9,6 +9,8 @@
 #include "formats/container.h"
 #include "formats/exr_info.h"
 #include "formats/file_kind.h"
+#include "formats/gltf_file_access.h"
+#include "formats/gltf_inputs.h"
 #include "formats/gltf_scene.h"
 #include "formats/inspect_kinds.h"
 #include "formats/pixel_checksum.h"
@@ -25,7 +27,8 @@ struct Options {
   std::vector<std::string> files;
   bool json = false;
   bool check = false;
-  std::string array;  // dump one array of a container
+  std::string array;   // dump one array of a container
+  std::string inputs;  // --inputs: the files a scene is made of, with hashes
 };
 
 // count, min, max and non-finite count of one array, whatever its dtype.
@@ -164,6 +167,9 @@ nlohmann::json inspectOne(const std::string& path, const Options& o, std::string
     text = os.str();
     return s;
   }
+  // A FIFO or device is refused before detectFileKind opens it (a FIFO would block).
+  if (const std::string why = rad::regularFileProblem(path); !why.empty() && why != "no such file")
+    throw rad::inputError(path, why);
   rad::FileKind kind = rad::detectFileKind(path);
   switch (kind) {
     case rad::FileKind::kMissing:
@@ -210,11 +216,29 @@ int main(int argc, char** argv) {
       "Shows what is inside a rad file (container, glTF scene, OpenEXR, texture-movie folder)."};
   Options o;
   rad::setUpApp(app, kTool, "rad-inspect out/global.rlh --array radiosity");
-  app.add_option("FILE", o.files, "files to inspect")->required();
+  CLI::Option* files =
+      app.add_option("FILE", o.files, "files to inspect (required unless --inputs)");
   app.add_flag("--json", o.json, "print JSON on stdout instead of text");
   app.add_flag("--check", o.check, "validate only: print 'FILE: ok' or the error");
   app.add_option("--array", o.array, "dump one array of a container file");
+  app.add_option("--inputs", o.inputs,
+                 "instead: print 'HASH<TAB>PATH' for SCENE and each external buffer and image it "
+                 "references (a missing image: 'missing'), for make's dependencies; decodes "
+                 "nothing")
+      ->option_text("SCENE")
+      ->excludes(files);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
+  // The summary shows a scene's warnings; stderr need not repeat them.
+  rad::setGltfWarningHandler(nullptr);
+  if (!o.inputs.empty())
+    return rad::runTool(kTool, [&]() {
+      std::cout << rad::gltfInputsText(rad::gltfInputs(o.inputs));
+      return 0;
+    });
+  if (o.files.empty()) {
+    std::cerr << kTool << ": FILE is required (try --help)\n";
+    return int(rad::ExitCode::kUsage);
+  }
 
   int worst = 0;
   nlohmann::json all = nlohmann::json::array();

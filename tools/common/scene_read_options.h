@@ -1,0 +1,16 @@
+// What every tool that reads a glTF scene shares (formats/gltf_scene.md): the texture bound and
+// the scene's warnings on stderr.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace rad {
+
+// Adds --max-texture-pixels (bound to defaultGltfReadOptions(), which readGltfScene(path) uses)
+// and installs a warning handler that prints each warning of each scene read, once per run, as
+// `tool: SCENE: warning: TEXT` on stderr. Called by setUpApp, so every tool has both.
+void addSceneReadOptions(CLI::App& app, const std::string& tool);
+
+}  // namespace rad
