@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what the toolchain needs from Debian 12's packages (only when something is
-# missing, so re-running is cheap) and builds it into build/ (Release).
-# Used by the README's two commands; safe to run again at any time.
+# missing, so re-running is cheap) and builds the tools into build/bin (Release); the tests are
+# built by tests/run.sh. Used by the README's two commands; safe to run again at any time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -16,4 +16,4 @@ pipelines/apt_install.sh "${packages[@]}"
 
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j"$jobs"
+cmake --build build -j"$jobs" --target tools

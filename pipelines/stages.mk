@@ -5,9 +5,15 @@
 #   scene.gltf ─► rad-global ────► global.rlh ──────┐
 #        └──────► rad-intervals ─► intervals.rti ─► rad-movies ─► movies/ ─► rad-compose ─► frames/ ─► movie.mp4
 
-SCENE ?= pipelines/scenes/cornell-moving.gltf
+PIPELINES := $(dir $(lastword $(MAKEFILE_LIST)))
+# The repository, and the defaults in it: relative when make runs in the repository's root (as
+# the README does), absolute from anywhere else.
+REPOSITORY := $(abspath $(PIPELINES)..)
+in-repository = $(if $(filter $(CURDIR),$(REPOSITORY)),$(1),$(REPOSITORY)/$(1))
+
+SCENE ?= $(call in-repository,pipelines/scenes/cornell-moving.gltf)
 OUT   ?= out/$(basename $(notdir $(SCENE)))
-BIN   ?= build/bin
+BIN   ?= $(call in-repository,build/bin)
 
 FRAMES ?= 0-95
 FPS    ?= 24
@@ -18,7 +24,6 @@ INTERVALS_FLAGS ?=
 MOVIES_FLAGS    ?=
 COMPOSE_FLAGS   ?=
 
-PIPELINES := $(dir $(lastword $(MAKEFILE_LIST)))
 # The calling Makefile's name, for its messages.
 MAKEFILE_NAME := $(notdir $(firstword $(MAKEFILE_LIST)))
 # $(1) as one shell word, whatever it holds.
@@ -28,7 +33,7 @@ quote = '$(subst ','\'',$(1))'
 # it allows and why): a path Make or a shell would split or read as syntax, and an OUT that a
 # run or `make clean` could harm (the root, the home folder, the repository), stop the run here
 # with one line.
-VARIABLES_PROBLEM := $(shell $(PIPELINES)check-variables.sh $(call quote,$(abspath $(PIPELINES)..)) \
+VARIABLES_PROBLEM := $(shell $(PIPELINES)check-variables.sh $(call quote,$(REPOSITORY)) \
   $(call quote,$(SCENE)) $(call quote,$(OUT)) $(call quote,$(BIN)) $(call quote,$(FRAMES)) \
   $(call quote,$(SIZE)) $(call quote,$(FPS)))
 ifneq ($(VARIABLES_PROBLEM),)

@@ -243,7 +243,8 @@ TEST_F(PipelineSafety, DryRunWritesNothing) {
 }
 
 // FRAMES=0-15x2 gives an mp4 of its 8 frames (ffmpeg's %04d reader had stopped at the first gap:
-// one frame); an odd SIZE is padded to even sides for H.264 instead of failing at the end.
+// one frame); an odd SIZE is padded to even sides for H.264 instead of failing at the end; the
+// contact sheet is a PNG.
 TEST_F(PipelineSafety, ASteppedRangeAndAnOddSizeMakeAWholeMovie) {
   fs::path dir = freshDir("stepped");
   fs::path out = dir / "out";
@@ -254,7 +255,9 @@ TEST_F(PipelineSafety, ASteppedRangeAndAnOddSizeMakeAWholeMovie) {
       "stream=nb_read_frames,width,height -of csv=p=0 " +
       (out / "movie.mp4").string());
   EXPECT_EQ(probe.out, "88,60,8\n");
-  EXPECT_TRUE(fs::exists(out / "contact-sheet.png"));
+  // A PNG, as its name says (ffmpeg's image2 muxer had taken the codec from a `.tmp` name: JPEG).
+  EXPECT_EQ(readWholeFile((out / "contact-sheet.png").string()).substr(0, 8),
+            std::string("\x89PNG\r\n\x1a\n", 8));
   fs::remove_all(dir);
 }
 
@@ -293,6 +296,20 @@ TEST_F(PipelineSafety, APathStartingWithADashIsAPath) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("rad-global ./-scene.gltf -o /tmp/-out/global.rlh"), std::string::npos)
       << r.out;
+}
+
+// Run from another folder, the defaults (BIN, SCENE) are the repository's, not the folder's.
+TEST_F(PipelineSafety, RunFromAnotherFolderTheDefaultsAreTheRepositorys) {
+  fs::path dir = freshDir("elsewhere");
+  CommandResult r =
+      runCommand("cd " + dir.string() +
+                 " && make -s -f " RAD_SOURCE_DIR "/pipelines/animation.mk stage-commands");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find(RAD_SOURCE_DIR "/build/bin/rad-global " RAD_SOURCE_DIR
+                                      "/pipelines/scenes/cornell-moving.gltf -o out/"),
+            std::string::npos)
+      << r.out;
+  fs::remove_all(dir);
 }
 
 }  // namespace
