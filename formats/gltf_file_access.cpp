@@ -268,7 +268,8 @@ std::string GltfLoaderHooks::imageProblem(size_t index) const {
     auto read = fileProblem_.find(f.path);
     const std::string why = read != fileProblem_.end() ? read->second : "cannot be read";
     // An absolute or "../" URI is joined to the scene's folder like any other (as tinygltf does).
-    return why == "no such file" ? why + " (looked for " + quoted(f.path) + ")" : why;
+    return why == "no such file" && f.path != f.uri ? why + " (looked for " + quoted(f.path) + ")"
+                                                    : why;
   }
   return "";
 }
