@@ -2,7 +2,7 @@
 // Tost, "Frame rate independent texture movies for animated radiosity", §4.1 and §4.3; the
 // item buffer itself goes back to Weghorst, Hooper, Greenberg 1984, "Improved computational
 // methods for ray tracing"). rad-intervals renders one per frame to find which patches are
-// visible, at what level and resolution (DESIGN.md §6).
+// visible, at what level and resolution (docs/design.md §6.2).
 //
 // Rendered with OpenGL through OSMesa into an integer GL_R32UI target (ids are exact, no
 // colour encoding) plus an R32F target carrying eye-space depth, with a reversed-Z
