@@ -11,8 +11,8 @@
 // centre's point on the receiver plane crosses the blocker between s and the plane. Instead of
 // counting covered samples (the paper increments a counter) each sample writes its own bit
 // into an integer render target with glLogicOp(GL_OR): one 64-bit mask per texel. Occlusion
-// masks of disjoint blocker sets then merge exactly by OR (DESIGN.md §6 "rad-movies"), so the
-// coherent result (static blockers once per movie, dynamic ones per key) equals rendering all
+// masks of disjoint blocker sets then merge exactly by OR (docs/design.md §6.3 "rad-movies"), so
+// the coherent result (static blockers once per movie, dynamic ones per key) equals rendering all
 // blockers at every key bit for bit.
 //
 // Texture map of the receiver: texel (i, j) has its centre at (u,v) = ((i+.5)/w, (j+.5)/h) and
