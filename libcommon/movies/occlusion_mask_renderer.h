@@ -1,5 +1,5 @@
 // The door for shadow methods in the texture-movie bake (paper §3.1 "Transmittance Texture
-// Computation", §5; DESIGN.md §6 "rad-movies").
+// Computation", §5; docs/design.md §6.3 "rad-movies").
 //
 // The baker (texture_movie_baker.h) asks one question per bad pair and key: which shooter
 // samples does a set of blocker triangles hide from each texel of the receiver? The answer is
