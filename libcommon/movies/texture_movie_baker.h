@@ -1,6 +1,6 @@
 // Texture-movie baking, the second pass of Martín, Pueyo, Tost, "Frame-to-frame coherent
 // animation with two-pass radiosity" (§3.1 texture computation, §5 frame-to-frame coherence;
-// DESIGN.md §6 "rad-movies").
+// docs/design.md §6.3 "rad-movies").
 //
 // Per movie (patch node P of top-level patch R, frames [f0, f1], texture w x h) and key time
 // t, the irradiance at texel centre x is
