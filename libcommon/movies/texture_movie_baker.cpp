@@ -633,7 +633,7 @@ class MovieBake {
     for (size_t x = 0; x < texels_; ++x)
       for (int c = 0; c < 3; ++c) {
         double v = acc_[x][c];
-        // Irradiance is never negative or NaN (DESIGN.md §9); clamp rounding only.
+        // Irradiance is never negative or NaN (docs/design.md §9); clamp rounding only.
         texture_[3 * x + size_t(c)] = std::isfinite(v) ? float(std::max(v, 0.0)) : 0.0f;
       }
     stats_.secondsCombine += secondsSince(clock);
