@@ -1,4 +1,4 @@
-// The scene model: glTF 2.0 animation evaluation, input polygons, cameras (DESIGN.md §4).
+// The scene model: glTF 2.0 animation evaluation, input polygons, cameras (docs/design.md §4).
 //
 // Animation semantics follow the glTF 2.0 specification, §3.11 "Animations" and
 // Appendix C "Animation Sampler Interpolation Modes" (Khronos, glTF 2.0.1).
