@@ -1,5 +1,5 @@
 // Frames of an animation and the key frames inside them: the one rule every stage shares
-// (DESIGN.md §1 "Defaults: frames = the scene's whole animation", §4 "frame f is at f / fps").
+// (docs/design.md §1 "Defaults: frames = the scene's whole animation", §4 "frame f is at f / fps").
 //
 // rad-global's key times (paper §4.2) and rad-movies' key textures (paper §5) are both
 // `keyFrames(first, last, step)`; every tool without --frames covers `animationFrames`.
