@@ -1,4 +1,4 @@
-// The scene model: what the toolchain sees of an animated glTF 2.0 scene (DESIGN.md §4).
+// The scene model: what the toolchain sees of an animated glTF 2.0 scene (docs/design.md §4).
 //
 // Units are metres and seconds; time is double everywhere. Geometry is kept in each mesh
 // node's local frame so rigid motion never changes a patch's shape or id; world positions at
@@ -29,7 +29,7 @@ constexpr double kMaxCoordinate = 1e15;
 // pi L_e A and the radiosity B_e / (1 - rho) stay finite, also in float32 outputs.
 constexpr double kMaxEmission = 1e12;
 // Diffuse reflectance per channel: the radiosity solve converges like rho^n, so rho = 1 with any
-// emission diverges; 0.999 is the furnace's highest (DESIGN.md section 8).
+// emission diverges; 0.999 is the furnace's highest (docs/design.md §8).
 constexpr double kMaxReflectance = 0.999;
 
 struct Texture {
