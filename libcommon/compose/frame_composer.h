@@ -1,4 +1,4 @@
-// Final frames from texture movies (paper §3.1, last step of the second pass; DESIGN.md §6
+// Final frames from texture movies (paper §3.1, last step of the second pass; docs/design.md §6.4
 // "rad-compose"): rasterise the scene from the camera, texture each visible patch with its
 // movie's irradiance H at time t and turn it into exitant radiance
 //   $L(x) = L_e + \frac{\rho(x)}{\pi} H(x)$,
