@@ -1,7 +1,7 @@
-// rad-compose's options (paper §3.1 last step; DESIGN.md §6 "rad-compose"): the command line
+// rad-compose's options (paper §3.1 last step; docs/design.md §6.4 "rad-compose"): the command line
 // binds each flag to a field here, and toJson() is the provenance parameters of every frame,
-// so a flag's name is written once (CONVENTIONS.md "Stages with one shape"). The defaults that
-// come from the inputs (the intervals' window, fps and size, the scene's first camera) are
+// so a flag's name is written once (docs/conventions.md §7 "Stages with one shape"). The defaults
+// that come from the inputs (the intervals' window, fps and size, the scene's first camera) are
 // filled in by the tool once the inputs are read, before toJson(), so the provenance records
 // every value in effect. The frame loop is formats/frame_sequence.h.
 #pragma once
