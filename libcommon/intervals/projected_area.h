@@ -1,6 +1,7 @@
 // Projected area of a patch in pixels, clipped to the view frustum, ignoring occlusion: the
 // denominator of a patch's visible fraction in rad-intervals (Martín, Pueyo, Tost, "Frame
-// rate independent texture movies for animated radiosity", §4.3; DESIGN.md §6 rad-intervals).
+// rate independent texture movies for animated radiosity", §4.3; docs/design.md §6.2
+// rad-intervals).
 //
 // Computed analytically on the CPU, so it is exact up to rounding and costs a few hundred
 // flops per polygon: clip the polygon in homogeneous clip space against the six frustum planes
