@@ -1,6 +1,6 @@
 // Texture-movie extents from per-frame item buffers (Martín, Pueyo, Tost, "Frame rate
 // independent texture movies for animated radiosity", §4.1 "texture movies" and §4.3 "item
-// buffer"; DESIGN.md §6 rad-intervals).
+// buffer"; docs/design.md §6.2 rad-intervals).
 //
 // Each top-level patch is subdivided regularly down to maxLevel; every leaf is rendered into
 // an item buffer with its own id. Per frame:
