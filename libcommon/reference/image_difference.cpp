@@ -1,4 +1,4 @@
-// DESIGN.md §10 ("How error is measured"): RMSE / mean and bias over non-emitters, the
+// docs/design.md §10 ("How error is measured"): RMSE / mean and bias over non-emitters, the
 // references' noise removed with two references of independent seeds.
 #include "libcommon/reference/image_difference.h"
 
@@ -104,7 +104,8 @@ DifferenceStats compareImages(const FloatImage& test, const FloatImage& referenc
   return s;
 }
 
-// ---- DESIGN.md §10 ---------------------------------------------------------------------------
+// ---- docs/design.md §10
+// ---------------------------------------------------------------------------
 
 std::vector<double> luminanceWeights(const std::vector<std::string>& channels) {
   std::vector<double> w(channels.size(), 0.0);
