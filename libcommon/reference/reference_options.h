@@ -1,6 +1,6 @@
-// rad-reference's options (DESIGN.md §8 "error vs converged reference"): the command line binds
-// each flag to a field here, and toJson() is the provenance parameters of every frame it
-// writes, so a flag's name and default are written once (CONVENTIONS.md "Stages with one
+// rad-reference's options (docs/design.md §8 "error vs converged reference"): the command line
+// binds each flag to a field here, and toJson() is the provenance parameters of every frame it
+// writes, so a flag's name and default are written once (docs/conventions.md §7 "Stages with one
 // shape").
 #pragma once
 
