@@ -399,7 +399,7 @@ struct PathTracer::Impl {
       if (glm::dot(dir, n) >= 0.0) {
         if (!s.doubleSided && bounce == 0 && culledPasses < kMaxCulledPasses) {
           // The camera does not see the back of a one-sided polygon: glTF culls back faces
-          // (doubleSided false), and so does rad-compose's item buffer (DESIGN.md §4:
+          // (doubleSided false), and so does rad-compose's item buffer (docs/design.md §4:
           // one-sided by winding). The primary ray goes on past it. Light paths still treat
           // the polygon as opaque, as the radiosity stages' visibility does.
           // The search restarts from the same origin just short of this hit, with this
