@@ -1,8 +1,8 @@
-// Image and frame-sequence error figures (DESIGN.md §8, §10): error against a converged
+// Image and frame-sequence error figures (docs/design.md §8, §10): error against a converged
 // path-traced reference and temporal flicker (mean |Δ| between consecutive frames where nothing
 // changes). No file I/O: callers load the images (formats/exr_image.h).
 //
-// The figure that judges a renderer is ErrorFigures (DESIGN.md §10): RMSE / mean and bias over
+// The figure that judges a renderer is ErrorFigures (docs/design.md §10): RMSE / mean and bias over
 // the pixels that are not emitters, with the references' own noise removed when a second
 // reference is given. DifferenceStats (RMSE, relative L2, max, PSNR over every sample) is kept
 // for what it is good at (two renders of the same method, a stored frame), but its relative L2
@@ -70,7 +70,8 @@ void requireSameShape(const FloatImage& test, const FloatImage& reference,
 DifferenceStats compareImages(const FloatImage& test, const FloatImage& reference,
                               const std::string& testWhere = "test image");
 
-// ---- The error figure of DESIGN.md §10 -------------------------------------------------------
+// ---- The error figure of docs/design.md §10
+// -------------------------------------------------------
 
 // Luminance weights for an image's channels: Rec. 709, $Y = 0.2126 R + 0.7152 G + 0.0722 B$,
 // when channels named R, G and B are all present (other channels weigh 0); otherwise every
@@ -121,7 +122,7 @@ struct PixelSetStats {
   // The references' noise: $\sigma^2 = \mathrm{mean}((r_1 - r_2)^2) / 2$; 0 with one reference.
   double noise() const;
   // $\sqrt{\max(0, \mathrm{raw}^2 - \sigma^2)}$: as $E\,(t - r_i)^2 = d^2 + \sigma^2$ and
-  // $E\,(r_1 - r_2)^2 = 2\sigma^2$ for independent reference noise (DESIGN.md §10).
+  // $E\,(r_1 - r_2)^2 = 2\sigma^2$ for independent reference noise (docs/design.md §10).
   double rmse() const;
   // The figures divided by $\bar r$: 0 when the error is 0 (or nothing was compared); +inf
   // (bias: -inf or +inf) when $\bar r \le 0$ and the error is not 0.
@@ -131,7 +132,7 @@ struct PixelSetStats {
   double bias() const;  // $\mathrm{mean}(t - r) / \bar r$
 };
 
-// DESIGN.md §10 over one frame or a pooled sequence: non-emitter pixels (`surfaces`, the
+// docs/design.md §10 over one frame or a pooled sequence: non-emitter pixels (`surfaces`, the
 // figure) and emitter pixels (`emitters`, reported apart). A pixel with a non-finite value in
 // any channel of any image is in neither (DifferenceStats counts it in nonFinite).
 struct ErrorFigures {
@@ -168,7 +169,7 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
 struct FrameDifference {
   int frame = 0;
   DifferenceStats stats;  // test against the (first) reference, every sample
-  ErrorFigures error;     // DESIGN.md §10
+  ErrorFigures error;     // docs/design.md §10
 };
 
 struct SequenceDifference {
