@@ -1,5 +1,5 @@
 // Reference renderer: an independent Monte Carlo path tracer for the same scenes (issue 7), used
-// to measure the radiosity pipeline's error (DESIGN.md §8 "error vs converged reference").
+// to measure the radiosity pipeline's error (docs/design.md §8 "error vs converged reference").
 //
 // It shares only the scene model (Scene: worldTransform, inputPolygons, materials) and the
 // camera (camera_projection.h primaryRay) with the pipeline; ray casting is its own Embree 3
