@@ -1,4 +1,4 @@
-// Space-time hierarchical radiosity (paper §3.1, §4.2; DESIGN.md §6 "rad-global"): one
+// Space-time hierarchical radiosity (paper §3.1, §4.2; docs/design.md §6.1 "rad-global"): one
 // hierarchical solve per key time on a shared (union) patch hierarchy, with temporal
 // coherence between consecutive key times, merged into a GlobalSolution.
 //
