@@ -2,7 +2,7 @@
 // determined form-factors" (point-to-polygon contour formula); area quadrature after Cohen &
 // Wallace, "Radiosity and Realistic Image Synthesis", ch. 4.
 //
-// Unoccluded diffuse form factors between planar polygons. Conventions (shared/reference):
+// Unoccluded diffuse form factors between planar polygons. Conventions (tests/data/reference):
 //  * Every polygon lists its vertices counter-clockwise about its front normal.
 //  * Polygons are one-sided: an emitter leaves (and a receiver accepts) energy through its
 //    front only. F is 0 when the receiving element lies on or behind the polygon's plane, and
