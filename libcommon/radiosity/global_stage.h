@@ -1,6 +1,6 @@
-// rad-global as a stage (paper §3.1, §4.2; DESIGN.md §6 "rad-global"): the options its command
-// line binds and records as provenance, the key-time schedule and the min-area default derived
-// from them, and the run report. The algorithm itself is solveSpaceTime
+// rad-global as a stage (paper §3.1, §4.2; docs/design.md §6.1 "rad-global"): the options its
+// command line binds and records as provenance, the key-time schedule and the min-area default
+// derived from them, and the run report. The algorithm itself is solveSpaceTime
 // (space_time_radiosity.h); the tool parses, calls the functions here and writes global.rlh.
 #pragma once
 
