@@ -1,6 +1,6 @@
 // Hierarchical radiosity at one time (Hanrahan, Salzman, Aupperle 1991, "A rapid hierarchical
 // radiosity algorithm") and the pieces rad-global's space-time solve is made of (paper §3.1,
-// §4.2; DESIGN.md §6).
+// §4.2; docs/design.md §6.1).
 //
 // One key-time solve, as named passes (solveKeyTime runs them in this order):
 //  * link top level: with a cluster hierarchy (KeySolveInput::clusters), cluster links from the
