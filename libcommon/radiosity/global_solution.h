@@ -1,5 +1,5 @@
 // The space-time global solution rad-global computes and the second pass reads (paper §3.1,
-// §4.2; DESIGN.md §6): the union over all key times of the patch hierarchy, the links with
+// §4.2; docs/design.md §6.1): the union over all key times of the patch hierarchy, the links with
 // their activity intervals and F·V samples, the radiosity of every node at every key time, and
 // what rad-movies needs per receiver: the good-link irradiance as vertex values over the union
 // leaves (Gouraud) and the bad (receiver top, shooter top) pairs.
