@@ -1,4 +1,4 @@
-// Errors and exit codes shared by every tool (CONVENTIONS.md "Small tools", "Errors").
+// Errors and exit codes shared by every tool (docs/conventions.md §3 "Small tools", §4 "Errors").
 //
 // Library code throws rad::Error; only a tool's main catches it and prints
 // `rad-tool: path: what is wrong` on one line, then exits with the error's code.
