@@ -1,4 +1,4 @@
-# Measurement targets (issue 7; DESIGN.md §8). Both print their figures and write CSV.
+# Measurement targets (issue 7; docs/design.md §8). Both print their figures and write CSV.
 #
 #   make -f pipelines/bench.mk tables   [BENCH_FRAMES=400] [BENCH_SIZE=352x240] [BENCH_ONLY=cubes-1,cubes-32] [BENCH_REFERENCE_SPP=128]
 #       (BENCH_ONLY=cornell-moving BENCH_FRAMES=96: the bundled scene, per stage)
