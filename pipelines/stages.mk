@@ -1,4 +1,4 @@
-# The pipeline's stages, defined once (DESIGN.md §1, §7): their variables, their parameter
+# The pipeline's stages, defined once (docs/design.md §1, §7): their variables, their parameter
 # stamps and their command lines. animation.mk runs them on this machine, slurm.mk submits them
 # to a Slurm cluster; both include this file, so a stage runs the same command either way.
 #
