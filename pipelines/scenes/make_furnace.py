@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the furnace: a closed cube, 2 m on a side, whose six walls all emit L_e and reflect rho
-(DESIGN.md §8 "furnace through the whole pipeline"; the closed form is in
+(docs/design.md §8 "furnace through the whole pipeline"; the closed form is in
 tests/data/reference/furnace.json). Every wall's radiance is then exactly
 
     L = L_e / (1 - rho)
