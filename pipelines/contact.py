@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Near-contact geometry against converged references (issue 15, DESIGN.md §10), at the
+"""Near-contact geometry against converged references (issue 15, docs/design.md §10), at the
 default settings: the configurations where light leaks through, or darkness creeps out of,
 geometry that touches or nearly touches.
 
