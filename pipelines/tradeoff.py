@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Speed/accuracy curve (issue 7 item 5; DESIGN.md §8 "error vs converged reference").
+"""Speed/accuracy curve (issue 7 item 5; docs/design.md §8 "error vs converged reference").
 
 Sweeps each accuracy knob on its own, every other one at its default, on one scene: for every
 setting the whole pipeline runs and its frames are compared with a converged path-traced
-reference (rad-reference). The error is DESIGN.md §10's: RMSE / mean over the pixels that are
+reference (rad-reference). The error is docs/design.md §10's: RMSE / mean over the pixels that are
 not emitters, with the bias beside it (rad-diff). Writes OUT/tradeoff.csv (knob, value, seconds
 per frame, RMSE / mean, bias, the older relative L2), OUT/tradeoff.gp and, when gnuplot is installed, OUT/tradeoff.png with the Pareto
 front (the settings no other setting beats in both time and error) marked.
@@ -283,7 +283,7 @@ def report(out, rows, defaults):
                                           "pareto"], extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
-    # RMSE/mean and bias over non-emitters (DESIGN.md §10); "raw" keeps the references' noise;
+    # RMSE/mean and bias over non-emitters (docs/design.md §10); "raw" keeps the references' noise;
     # the relative L2 is the older figure, normalised by the reference's RMS (lights dominate it).
     print("%-14s %-8s %10s %8s %10s %8s %9s %9s %s" % (
         "knob", "value", "CPU s/fr", "spread", "RMSE/mean", "bias", "raw", "rel. L2", "pareto"))
