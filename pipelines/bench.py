@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Reproduces the paper's §6 tables with this toolchain (issue 7; DESIGN.md §8).
+"""Reproduces the paper's §6 tables with this toolchain (issue 7; docs/design.md §8).
 
 Every configuration runs the whole pipeline twice with the same binaries, one after the
 other on this machine:
@@ -16,7 +16,7 @@ as a ratio in one run. The coherent and scratch frames are compared with rad-dif
 
 Both are compared with rad-reference at one frame (midway between two key times near the
 middle; --reference-spp, 0 skips it): two independent path-traced references A and B (seeds 0
-and 1) give the error of a frame T as DESIGN.md §10 defines it, computed by `rad-diff T A --ref2
+and 1) give the error of a frame T as docs/design.md §10 defines it, computed by `rad-diff T A --ref2
 B`: RMSE / mean and bias over the pixels that are not emitters, the references' own noise
 removed (d^2 = (rmse(T,A)^2 + rmse(T,B)^2)/2 - noise^2, noise^2 = mean((A-B)^2)/2). The older
 relative L2 (normalised by the reference's RMS, which a visible light dominates) is kept beside
@@ -229,7 +229,7 @@ def rad_diff(bin_dir, test, reference, reference2=None):
 
 
 class ReferenceNoise:
-    """The error figure of DESIGN.md §10 against two path-traced references A, B (files or frame
+    """The error figure of docs/design.md §10 against two path-traced references A, B (files or frame
     directories) with independent noise, as rad-diff computes it (`rad-diff T A --ref2 B`):
     RMSE / mean and bias over non-emitting pixels with the references' noise removed, the
     emitters' own figure, and the older relative L2 against A (labelled as such)."""
