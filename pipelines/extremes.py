@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Numerical extremes through the real tools (DESIGN.md §9, issue 15), at the default settings.
+"""Numerical extremes through the real tools (docs/design.md §9, issue 15), at the default settings.
 
 Variants of the bundled Cornell scene (one frame, 88x60), each run through the four stages of
 animation.mk (bench.stage_commands: the same command lines):
