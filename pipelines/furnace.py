@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The furnace through the whole pipeline, at the default settings (DESIGN.md §8, issue 15).
+"""The furnace through the whole pipeline, at the default settings (docs/design.md §8, issue 15).
 
 A closed cube whose walls all emit L_e = 0.5 and reflect rho (pipelines/scenes/make_furnace.py)
 has the exact radiance L_e / (1 - rho) everywhere. Each rho runs the four stages of animation.mk
@@ -11,7 +11,7 @@ usage: furnace.py [--rho 0.5,0.9,0.99,0.999] [--size 88x60] [--bin DIR] [--out D
                   [--flags STAGE=ARGS ...] [--check] [--goals]
   --check   exit 1 unless every run ends with finite, non-negative frames or a one-line
             error
-  --goals   exit 1 unless every frame mean is within DESIGN.md §8's goal (0.5 % at rho <= 0.9,
+  --goals   exit 1 unless every frame mean is within docs/design.md §8's goal (0.5 % at rho <= 0.9,
             2 % at 0.99, 5 % at 0.999); the ctest `pipeline_furnace_meets_goals` runs both
 """
 import argparse
@@ -49,7 +49,7 @@ def run_one(bin_dir, out_root, rho, size, flags, scene_args=()):
 
 
 def goal_of(rho):
-    """DESIGN.md §8: 0.5 % up to rho 0.9, 2 % at 0.99, 5 % at 0.999."""
+    """docs/design.md §8: 0.5 % up to rho 0.9, 2 % at 0.99, 5 % at 0.999."""
     return 0.005 if rho <= 0.9 else 0.02 if rho <= 0.99 else 0.05
 
 
