@@ -1,4 +1,4 @@
-# The production pipeline on this machine (DESIGN.md §1, §7):
+# The production pipeline on this machine (docs/design.md §1, §7):
 #
 #   make -f pipelines/animation.mk [SCENE=...] [FRAMES=0-95] [SIZE=352x240] [GLOBAL_FLAGS=...] ...
 #
