@@ -1,5 +1,5 @@
 // Write-to-temporary-then-rename, so an interrupted or failing stage never leaves a half file
-// that Make would take as up to date (DESIGN.md §5).
+// that Make would take as up to date (docs/design.md §5).
 #pragma once
 
 #include <string>
