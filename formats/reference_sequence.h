@@ -1,5 +1,5 @@
-// rad-reference's frame loop (DESIGN.md §8): path-traces each frame of a range and writes it as
-// OUTDIR/NNNN.exr (linear radiance, the provenance as attributes), next to frame_sequence (the
+// rad-reference's frame loop (docs/design.md §8): path-traces each frame of a range and writes it
+// as OUTDIR/NNNN.exr (linear radiance, the provenance as attributes), next to frame_sequence (the
 // same for rad-compose). The renderer is libcommon/reference/path_tracer.h.
 #pragma once
 
