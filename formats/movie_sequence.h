@@ -1,4 +1,4 @@
-// rad-movies' movie loop (DESIGN.md §6 "rad-movies"; paper §3.1, §5), next to rad-compose's
+// rad-movies' movie loop (docs/design.md §6.3 "rad-movies"; paper §3.1, §5), next to rad-compose's
 // (frame_sequence.h): the movies of one shard of intervals.rti are baked by one worker per
 // thread, each taking the next movie and baking it whole with its own baker
 // (libcommon/movies/texture_movie_baker.h), and each is streamed key by key into
