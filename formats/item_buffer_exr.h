@@ -1,4 +1,4 @@
-// Item buffers as OpenEXR files (DESIGN.md §5 `itembuffers/NNNN.exr`): what rad-intervals
+// Item buffers as OpenEXR files (docs/design.md §5 `itembuffers/NNNN.exr`): what rad-intervals
 // saw at one frame, for inspection with rad-inspect, exrheader or oiiotool.
 //
 // One scanline part, data window (0,0)-(width-1,height-1), row 0 = top of the image (EXR's
