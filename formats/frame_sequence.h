@@ -1,4 +1,4 @@
-// rad-compose's frame loop (DESIGN.md §6 "rad-compose"): for each frame, the texture movies
+// rad-compose's frame loop (docs/design.md §6.4 "rad-compose"): for each frame, the texture movies
 // active at it are read lazily from MOVIES_DIR (movies/MMMMMM.exr) and dropped after their last
 // frame, so memory stays flat in the animation's length; each frame is composed
 // (libcommon/compose/frame_composer.h) and written as FRAMES_DIR/NNNN.exr (+ .png), atomically.
