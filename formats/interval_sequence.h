@@ -1,4 +1,4 @@
-// rad-intervals' frame loop (paper §4.1, §4.3; DESIGN.md §6 rad-intervals), next to
+// rad-intervals' frame loop (paper §4.1, §4.3; docs/design.md §6.2 rad-intervals), next to
 // frame_sequence (rad-compose's): every frame through one TextureIntervalsBuilder
 // (libcommon/intervals/texture_intervals_builder.h), optionally writing each frame's item
 // buffer as DIR/NNNN.exr, then the extents as the intervals.rti record.
