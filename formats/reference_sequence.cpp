@@ -21,7 +21,7 @@ void renderReferenceSequence(const Scene& scene, int cameraNode, ImageSize size,
   PathTracer tracer(scene, frames.empty() ? 0.0 : frames.front() / options.fps);
   for (int frame : frames) {
     const auto start = std::chrono::steady_clock::now();
-    const double t = frame / options.fps;  // DESIGN.md §4: frame f is at f / fps
+    const double t = frame / options.fps;  // docs/design.md §4: frame f is at f / fps
     tracer.setTime(t);
     const CameraView view = scene.cameraAt(cameraNode, t);
     FloatImage image = tracer.render(view, size, tracing, frame);
