@@ -1,4 +1,4 @@
-// frames/NNNN.exr and frames/NNNN.png: rad-compose's final frames (DESIGN.md §5).
+// frames/NNNN.exr and frames/NNNN.png: rad-compose's final frames (docs/design.md §5).
 //
 // EXR: one scanline part, channels R, G, B of linear exitant radiance W/(m^2 sr), FLOAT (or
 // HALF with --half; values above 65504 are clamped there), row 0 = top; uncompressed unless
