@@ -1,6 +1,6 @@
-// What build made this binary, for provenance and --version (CONVENTIONS.md "Files that say what
-// made them"). The revision is read when the binary is built, not when CMake is configured: the
-// generated build_info.cpp is rewritten by formats/build_info.cmake on every build, and only
+// What build made this binary, for provenance and --version (docs/conventions.md §1 "Files that say
+// what made them"). The revision is read when the binary is built, not when CMake is configured:
+// the generated build_info.cpp is rewritten by formats/build_info.cmake on every build, and only
 // when the revision changed, so an unchanged checkout rebuilds nothing.
 #pragma once
 
