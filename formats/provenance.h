@@ -1,7 +1,7 @@
-// Provenance: what made a file and from what (DESIGN.md §5, CONVENTIONS.md "Files that say what
-// made them"). Every rad file records the tool, its version and git revision, the full command
-// line, every parameter in effect (defaults included) and each input's content hash followed by
-// that input's own provenance, so the whole chain back to the scene can be printed like
+// Provenance: what made a file and from what (docs/design.md §5, docs/conventions.md §1 "Files that
+// say what made them"). Every rad file records the tool, its version and git revision, the full
+// command line, every parameter in effect (defaults included) and each input's content hash
+// followed by that input's own provenance, so the whole chain back to the scene can be printed like
 // Radiance's getinfo.
 #pragma once
 
