@@ -69,7 +69,7 @@ void writeFrameExr(const std::string& path, const ComposedFrame& frame, const Fr
   size_t elem = sizeof(float);
   uint64_t checksum = 0;
   if (half) {
-    // Half overflows at 65504: clamp rather than write inf (DESIGN.md §5).
+    // Half overflows at 65504: clamp rather than write inf (docs/design.md §5).
     halves.resize(frame.rgb.size());
     std::vector<float> stored(frame.rgb.size());  // what a reader decodes
     for (size_t i = 0; i < frame.rgb.size(); ++i) {
