@@ -1,6 +1,6 @@
 // Container and provenance format tests: round trips; truncated, corrupted, future-version and
 // wrong-kind files give the documented one-line error naming the file; adversarial input never
-// crashes (CONVENTIONS.md "Tests").
+// crashes (docs/conventions.md §6 "Tests").
 #include <gtest/gtest.h>
 #include <unistd.h>
 
