@@ -1,4 +1,4 @@
-// The whole pipeline through the real Makefile (issue 6, DESIGN.md §7): the bundled scene at a
+// The whole pipeline through the real Makefile (issue 6, docs/design.md §7): the bundled scene at a
 // small size and a few frames; frames are finite and close to a stored reference; a change of
 // one stage's parameters re-runs exactly the stages downstream of it; a killed stage leaves
 // nothing Make would take as done.
