@@ -484,7 +484,7 @@ TEST(HierarchicalRadiosity, LinkBoundStopsRefiningAndSaysSo) {
   EXPECT_GT(unbounded.links.size(), size_t(200));
 }
 
-// Energy conservation with refinement on (DESIGN.md §6 "Energy"): the closed furnaces at the
+// Energy conservation with refinement on (docs/design.md §6.1 "Energy"): the closed furnaces at the
 // default settings, every leaf at E / (1 - rho) to 1e-3 up to rho = 0.999, with as many links at
 // rho = 0.999 as at 0.5 (the oracle relative to the power carried). Without the closure factor
 // the refined row sums range over 0.86 .. 1.23 and B is several per cent off at rho = 0.9.
