@@ -119,7 +119,7 @@ TEST(ImageDifference, FlickerCountsOnlyPixelsWhereTheReferenceIsStatic) {
   EXPECT_EQ(gaps.flicker.framePairs, 1);
 }
 
-// DESIGN.md §10's case: walls of radiance 1 (grey), a 4x4 light of radiance 200 in a 20x20
+// docs/design.md §10's case: walls of radiance 1 (grey), a 4x4 light of radiance 200 in a 20x20
 // frame, and a test whose walls are 9 % too dark and whose light is right. The relative L2,
 // normalised by the reference RMS that the light dominates, reads about 0.2 %; the figure over
 // the non-emitters reads 9 % and the bias -9 %, exactly.
