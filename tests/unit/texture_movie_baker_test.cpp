@@ -461,7 +461,7 @@ TEST(TextureMovieBaker, MovingLightOrReceiverRendersEveryBlockerPerKey) {
 }
 
 TEST(TextureMovieBaker, SceneScaleFromMillimetresToTenKilometresGivesTheSameIrradiance) {
-  // F and T are scale invariant: scaling every node by k leaves H unchanged (DESIGN.md §9).
+  // F and T are scale invariant: scaling every node by k leaves H unchanged (docs/design.md §9).
   TestScene ref = makeScene(true, false);
   BakedMovie a =
       TextureMovieBaker(ref.scene, ref.solution, kFps, gouraud()).bake(request(ref, 16, 16, 0, 0));
