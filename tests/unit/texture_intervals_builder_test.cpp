@@ -911,7 +911,7 @@ TEST(ItemBufferExr, RoundTripKeepsIdsAndDepth) {
 namespace rad {
 namespace {
 
-// DESIGN.md §9 scene scale: the Cornell box in millimetres under a 0.001 root scale gives the
+// docs/design.md §9 scene scale: the Cornell box in millimetres under a 0.001 root scale gives the
 // same movies as the same box in metres.
 TEST(TextureIntervalsBuilder, SameMoviesAtMillimetreScale) {
   Scene m = readGltfScene(RAD_TEST_DATA "/external/cornell_box/cornell_box.gltf");
