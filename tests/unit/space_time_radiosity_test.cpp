@@ -292,8 +292,8 @@ TEST(SpaceTimeRadiosity, LinkRowsEqualThePlainMergeOfTheKeySolves) {
 // A floor of two coplanar tiles side by side, under a ceiling, with a small light over the
 // first tile only, so the tiles (and the leaves inside each) are refined differently. The
 // good-link irradiance the second pass interpolates must be continuous across every leaf edge
-// and across the tiles' shared edge (DESIGN.md: no visible facets): within 1 % on both sides
-// of every boundary, where T-vertices and per-tile vertex averaging made steps of several %.
+// and across the tiles' shared edge (docs/design.md §8: no visible facets): within 1 % on both
+// sides of every boundary, where T-vertices and per-tile vertex averaging made steps of several %.
 TEST(SpaceTimeRadiosity, GoodIrradianceIsContinuousAcrossLeavesAndTiles) {
   Scene scene;
   scene.path = "tiles";
