@@ -140,7 +140,7 @@ FloatImage room(float wall, float noise, bool useB) {
   return im;
 }
 
-// DESIGN.md §10 figures in --json, with values in closed form (binary fractions, exact in
+// docs/design.md §10 figures in --json, with values in closed form (binary fractions, exact in
 // float): the walls 12.5 % too dark, the light right.
 TEST(RadDiff, JsonLeadsWithTheNonEmitterFigure) {
   fs::path d = freshDir("honest");
