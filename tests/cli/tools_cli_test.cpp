@@ -1,5 +1,5 @@
-// CONVENTIONS.md "Small tools": --help, --version, an unknown flag and a missing file give the
-// documented output and exit code, for every tool that is built.
+// docs/conventions.md §3 "Small tools": --help, --version, an unknown flag and a missing file give
+// the documented output and exit code, for every tool that is built.
 #include <algorithm>
 #include <map>
 
