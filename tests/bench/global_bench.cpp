@@ -1,4 +1,4 @@
-// rad-global's accuracy knob and coherence, measured (issue 3 item 10; DESIGN.md §8): on a
+// rad-global's accuracy knob and coherence, measured (issue 3 item 10; docs/design.md §8): on a
 // scene (default: the bundled moving Cornell box, 96 frames, a key every 4), for --eps over a
 // decade and a half (1e-2 .. 1e-4, the last the "finest" reference), the time, the link count
 // and the error of every top-level patch's radiosity at every key against the finest setting;
