@@ -1,4 +1,4 @@
-// Time per composed frame (DESIGN.md §8: <= 0.2 s at 352x240, ~400 polygons): the pipeline's
+// Time per composed frame (docs/design.md §8: <= 0.2 s at 352x240, ~400 polygons): the pipeline's
 // Cornell scene, every top-level patch split twice in the global solution, and one 16x16
 // texture movie per level-1 node (or none: every pixel falls back).
 // Usage: compose_bench [SCENE.gltf] [FRAMES]
