@@ -1,4 +1,4 @@
-// Coherent vs per-key texture-movie baking (DESIGN.md §8 "speed-up of coherent over
+// Coherent vs per-key texture-movie baking (docs/design.md §8 "speed-up of coherent over
 // from-scratch"): a tiled floor under an area light, static boxes ("chairs") and M cubes
 // moving across the room. Prints the time of both, the render passes and the max relative
 // texel difference between them (exact merge: expected 0).
