@@ -1,11 +1,12 @@
-// rad-intervals figures on the bundled scene (DESIGN.md §8): item-buffer pass time per frame
+// rad-intervals figures on the bundled scene (docs/design.md §8): item-buffer pass time per frame
 // at 352x240, whole-frame time (render + counting + projected areas + events), and the
 // movies it produces: count, mean length, texels per frame, per level and close reason.
 //
 // Usage: intervals_bench [SCENE.gltf | synthetic:N] [FRAMES, default 0-95] [WxH, default 352x240]
 //                        [LEVEL_HYSTERESIS, default 0]
 // synthetic:N builds N unit cubes (6 faces each, every third one moving) on a 2-D grid over a
-// floor, seen by a camera that pans and dollies: N = 66 gives the ~400 polygons of DESIGN.md §8.
+// floor, seen by a camera that pans and dollies: N = 66 gives the ~400 polygons of docs/design.md
+// §8.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
