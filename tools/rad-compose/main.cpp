@@ -1,4 +1,4 @@
-// rad-compose: final frames from the texture movies (paper §3.1 last step; DESIGN.md §6
+// rad-compose: final frames from the texture movies (paper §3.1 last step; docs/design.md §6.4
 // "rad-compose"). Reads the scene, the global solution, the intervals and the movies; writes
 // FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The options are
 // libcommon/compose/compose_options.h; the work is in libcommon/compose/frame_composer.h and
