@@ -1,4 +1,4 @@
-// rad-global: the first pass (paper §3.1, §4.2; DESIGN.md §6 "rad-global"): space-time
+// rad-global: the first pass (paper §3.1, §4.2; docs/design.md §6.1 "rad-global"): space-time
 // hierarchical radiosity over the key times of a frame range, written as global.rlh. The
 // options, key times, min-area default and report are libcommon/radiosity/global_stage.h, the
 // algorithm solveSpaceTime; this main parses, calls and reports. For a render farm (issue 17)
