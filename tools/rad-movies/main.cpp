@@ -1,5 +1,5 @@
 // rad-movies: bakes the texture movies of intervals.rti from the global solution (paper §3.1
-// transmittance textures, §5 frame-to-frame coherence; DESIGN.md §6 "rad-movies"). The baker
+// transmittance textures, §5 frame-to-frame coherence; docs/design.md §6.3 "rad-movies"). The baker
 // is libcommon/movies/texture_movie_baker.h, the shard loop and the movie files
 // formats/movie_sequence.h; this main parses, reads and checks the inputs, calls, reports.
 #include <chrono>
