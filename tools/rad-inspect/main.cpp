@@ -1,4 +1,4 @@
-// rad-inspect: shows what is inside any file of the toolchain (DESIGN.md §6 "rad-inspect"),
+// rad-inspect: shows what is inside any file of the toolchain (docs/design.md §6.5 "rad-inspect"),
 // like Radiance's getinfo: a container's header, provenance and arrays; what the toolchain
 // sees in a glTF scene; an OpenEXR file's parts and attributes.
 #include <cmath>
