@@ -1,5 +1,5 @@
 // What every tool's main shares: exit codes, the one-line error format and CLI11 set-up
-// (CONVENTIONS.md "Small tools with thin mains", "Errors").
+// (docs/conventions.md §3 "Small tools with thin mains", §4 "Errors").
 #pragma once
 
 #include <chrono>
