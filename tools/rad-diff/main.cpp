@@ -1,4 +1,4 @@
-// rad-diff: how far a rendered image or frame sequence is from a reference (DESIGN.md §8,
+// rad-diff: how far a rendered image or frame sequence is from a reference (docs/design.md §8,
 // "error vs converged reference" and "temporal flicker"; §10, "How error is measured"):
 // RMSE / mean and bias over the non-emitter pixels (emitters apart, a second reference's noise
 // removed with --ref2), then RMSE, relative L2, max abs difference and PSNR over every sample,
@@ -71,7 +71,7 @@ std::string text(double x) {
   return os.str();
 }
 
-// One "difference" object: the DESIGN.md §10 figures first (over non-emitter pixels, emitters
+// One "difference" object: the docs/design.md §10 figures first (over non-emitter pixels, emitters
 // apart), then the figures over every sample that bench.py and tradeoff.py read (rmse,
 // relative_l2 normalised by the reference RMS, max_abs, psnr_db), with their meaning unchanged.
 nlohmann::json statsJson(const rad::DifferenceStats& s, const rad::ErrorFigures& e, bool oneFrame) {
