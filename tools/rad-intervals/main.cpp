@@ -1,5 +1,5 @@
 // rad-intervals: texture-movie extents from per-frame item buffers (paper §4.1, §4.3;
-// DESIGN.md §6 rad-intervals). The options are libcommon/intervals/intervals_options.h, the
+// docs/design.md §6.2 rad-intervals). The options are libcommon/intervals/intervals_options.h, the
 // algorithm libcommon/intervals/texture_intervals_builder.h, the frame loop
 // formats/interval_sequence.h; this main parses, calls them, writes intervals.rti and reports.
 #include <cstdio>
