@@ -1,5 +1,5 @@
 // rad-reference: independent Monte Carlo path-traced frames of a scene (issue 7), the
-// "converged reference" of DESIGN.md §8 that rad-diff compares the pipeline's frames with.
+// "converged reference" of docs/design.md §8 that rad-diff compares the pipeline's frames with.
 // Shares only the scene loader and the camera with the pipeline (see
 // libcommon/reference/path_tracer.h). The options are libcommon/reference/reference_options.h,
 // the frame loop formats/reference_sequence.h; this main parses, calls it and reports.
