@@ -73,7 +73,7 @@ def main():
                     help="a slab inside the cube (make_furnace.py --partition)")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--goals", action="store_true",
-                    help="exit 1 unless every frame mean is within DESIGN.md §8's goal")
+                    help="exit 1 unless every frame mean is within docs/design.md §8's goal")
     a = ap.parse_args()
     flags = {}
     for f in a.flags:

@@ -220,7 +220,7 @@ std::string surfacesText(const rad::ErrorFigures& e, const SurfaceGroups& sg) {
 
 std::string legend(const Options& o) {
   return std::string(
-             "  rmse/mean and bias over the pixels that are not emitters (DESIGN.md "
+             "  rmse/mean and bias over the pixels that are not emitters (docs/design.md "
              "§10)") +
          (o.reference2.empty() ? "" : ", the references' noise removed") +
          "; emitters: " + emitterRuleText(o) + "\n";
@@ -392,7 +392,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Compares a test image or frame directory (NNNN.exr) with a reference.\n"
       "\n"
-      "First, the error figure of DESIGN.md §10, over the pixels that are not emitters,\n"
+      "First, the error figure of docs/design.md §10, over the pixels that are not emitters,\n"
       "channels pooled (JSON: rmse_over_mean, bias):\n"
       "  rmse/mean = sqrt(mean((test - ref)^2)) / mean(ref);  bias = mean(test - ref) / "
       "mean(ref).\n"
