@@ -65,7 +65,7 @@ std::string regularFileProblem(const std::string& path) {
 }
 
 bool readRegularFile(const std::string& path, uint64_t limit, std::vector<unsigned char>& out,
-                     uint64_t& fileSize, std::string& why) {
+                     uint64_t& fileSize, std::string& why, uint64_t refuseAbove) {
   out.clear();
   fileSize = 0;
   why = regularFileProblem(path);  // before open(): opening a FIFO or a device has effects
@@ -83,6 +83,12 @@ bool readRegularFile(const std::string& path, uint64_t limit, std::vector<unsign
     return false;
   }
   fileSize = uint64_t(st.st_size);
+  if (fileSize > refuseAbove) {
+    why = "file of " + std::to_string(fileSize) + " bytes, beyond the limit of " +
+          std::to_string(refuseAbove);
+    ::close(fd);
+    return false;
+  }
   out.resize(size_t(std::min(fileSize, limit)));
   size_t done = 0;
   while (done < out.size()) {
@@ -183,15 +189,13 @@ bool GltfLoaderHooks::readWholeFile(std::vector<unsigned char>* out, std::string
   auto limit = self->readLimit_.find(path);
   std::string why = "not a file this scene references";
   uint64_t size = 0;
-  if (limit != self->readLimit_.end() && readRegularFile(path, limit->second, *out, size, why)) {
-    const bool image = std::any_of(self->files_.begin(), self->files_.end(), [&](const auto& f) {
-      return f.path == path && f.kind == GltfExternalFile::Kind::kImage;
-    });
+  const bool image = std::any_of(self->files_.begin(), self->files_.end(), [&](const auto& f) {
+    return f.path == path && f.kind == GltfExternalFile::Kind::kImage;
+  });
+  if (limit != self->readLimit_.end() && readRegularFile(path, limit->second, *out, size, why,
+                                                         image ? kMaxImageFileBytes : UINT64_MAX)) {
     if (size == 0) {
       why = "empty file";
-    } else if (image && size > kMaxImageFileBytes) {
-      why = "file of " + std::to_string(size) + " bytes, beyond the limit of " +
-            std::to_string(kMaxImageFileBytes) + " for an image";
     } else if (!image && size < limit->second) {
       why = "file has " + std::to_string(size) + " bytes, byteLength declares " +
             std::to_string(limit->second);

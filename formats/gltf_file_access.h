@@ -33,10 +33,11 @@ std::string regularFileProblem(const std::string& path);
 
 // Reads `path` if it is a regular file: stat before opening, opened non-blocking, checked again
 // with fstat (a file swapped for a FIFO in between is refused, not waited on). Reads at most
-// `limit` bytes into `out`; `fileSize` gets the file's size. Returns false with `why` set (as
+// `limit` bytes into `out`; `fileSize` gets the file's size. A file larger than `refuseAbove` is
+// not read ("file of N bytes, beyond the limit of M"). Returns false with `why` set (as
 // regularFileProblem, or "cannot read: strerror").
 bool readRegularFile(const std::string& path, uint64_t limit, std::vector<unsigned char>& out,
-                     uint64_t& fileSize, std::string& why);
+                     uint64_t& fileSize, std::string& why, uint64_t refuseAbove = UINT64_MAX);
 
 // tinygltf's percent-decoding of a URI (dlib::urldecode: "%XX" -> byte, '+' -> space), which it
 // applies before joining a URI to the scene's folder.

@@ -179,14 +179,10 @@ std::string readSceneBytes(const std::string& path) {
   std::vector<unsigned char> data;
   uint64_t size = 0;
   std::string why;
-  // One byte past the limit tells a file over it from one at it without reading the rest.
-  if (!readRegularFile(path, kMaxSceneFileBytes + 1, data, size, why)) {
+  if (!readRegularFile(path, kMaxSceneFileBytes, data, size, why, kMaxSceneFileBytes)) {
     if (why == "no such file") why = "cannot open file (no such file)";
     throw inputError(path, why);
   }
-  if (size > kMaxSceneFileBytes)
-    throw inputError(path, "file of " + std::to_string(size) + " bytes, beyond the limit of " +
-                               std::to_string(kMaxSceneFileBytes) + " bytes for a scene");
   return std::string(data.begin(), data.end());
 }
 

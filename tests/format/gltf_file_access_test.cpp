@@ -139,6 +139,16 @@ TEST_F(GltfFileAccess, SceneMustBeARegularFile) {
   expectRefused(at("none.gltf"), "cannot open file");
 }
 
+// Sparse files: refused from their size, nothing read.
+TEST_F(GltfFileAccess, FilesOverTheSizeLimitsAreNotRead) {
+  writeFile(at("big.gltf"), "{");
+  fs::resize_file(at("big.gltf"), kMaxSceneFileBytes + 1);
+  expectRefused(at("big.gltf"), "file of 1073741825 bytes, beyond the limit of 1073741824");
+  writeFile(at("big.png"), "");
+  fs::resize_file(at("big.png"), kMaxImageFileBytes + 1);
+  expectTextureIgnored("big.png", "file of 1073741825 bytes, beyond the limit of 1073741824");
+}
+
 TEST_F(GltfFileAccess, BufferMustBeARegularFileOfItsByteLength) {
   ASSERT_EQ(::mkfifo(at("pipe.bin").c_str(), 0600), 0);
   writeFile(at("scene.gltf"), texturedTriangleGltf("", 0.8, "pipe.bin"));
