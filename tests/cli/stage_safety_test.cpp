@@ -89,7 +89,9 @@ TEST_F(StageSafety, GlStagesUnderAnAddressSpaceLimitEndWithExit4NotASignal) {
       EXPECT_TRUE(r.exitCode == 0 || r.exitCode == 4)
           << mb << " MB: " << cmd << ": " << r.exitCode << "\n"
           << r.err;
-      if (r.exitCode == 4) EXPECT_EQ(rad::test::countLines(r.err), 1) << mb << " MB: " << r.err;
+      if (r.exitCode == 4) {
+        EXPECT_EQ(rad::test::countLines(r.err), 1) << mb << " MB: " << r.err;
+      }
     }
   }
 }

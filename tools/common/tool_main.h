@@ -19,7 +19,8 @@ struct Camera;
 // The exit-code table every --help ends with.
 inline const char* exitCodeHelp() {
   return "Exit codes: 0 ok; 1 bad or incompatible input; 2 usage; 3 could not write output;\n"
-         "            4 environment (no GL context, out of memory); 5 internal error.";
+         "            4 environment (no GL context, out of memory, a thread that cannot start);\n"
+         "            5 internal error.";
 }
 
 // Creates the CLI11 app with --version, --threads, --print-defaults and the exit-code footer.
