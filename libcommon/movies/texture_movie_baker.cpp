@@ -28,6 +28,7 @@
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/movies/ray_cast_masks.h"
+#include "libcommon/movies/solid_contact.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/scene/box_tree.h"
 #include "libcommon/scene/frame_range.h"
@@ -35,22 +36,15 @@
 namespace rad {
 namespace {
 
-struct Box {
-  glm::dvec3 lo{std::numeric_limits<double>::infinity()};
-  glm::dvec3 hi{-std::numeric_limits<double>::infinity()};
-  void grow(const glm::dvec3& p) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  void grow(const Polygon& p) {
-    for (int k = 0; k < p.count; ++k) grow(p.v[k]);
-  }
-  bool overlaps(const Box& o) const {
-    return lo.x <= o.hi.x && o.lo.x <= hi.x && lo.y <= o.hi.y && o.lo.y <= hi.y && lo.z <= o.hi.z &&
-           o.lo.z <= hi.z;
-  }
-  bool contains(const glm::dvec3& p) const { return overlaps(Box{p, p}); }
-};
+// Grows b to hold polygon p's corners.
+void growBoxTo(AxisBox& b, const Polygon& p) {
+  for (int k = 0; k < p.count; ++k) growBox(b, p.v[k]);
+}
+AxisBox boxOf(const Polygon& p) {
+  AxisBox b = emptyAxisBox();
+  growBoxTo(b, p);
+  return b;
+}
 
 // The reversed copy a doubleSided material adds is the same surface: never its own blocker.
 bool sameSurface(const InputPolygon& a, const InputPolygon& b) {
@@ -299,10 +293,10 @@ class MovieGeometry {
       s[size_t(i)] = samplePointOnPolygon(p.shooterWorld[size_t(k)], p.unitSamples[size_t(i)]);
     return s;
   }
-  Box shaftAt(const Pair& p, int k) const {
-    Box box;
-    box.grow(receiverWorld_[size_t(k)]);
-    box.grow(p.shooterWorld[size_t(k)]);
+  AxisBox shaftAt(const Pair& p, int k) const {
+    AxisBox box = emptyAxisBox();
+    growBoxTo(box, receiverWorld_[size_t(k)]);
+    growBoxTo(box, p.shooterWorld[size_t(k)]);
     return box;
   }
   // The convex hull of the shooter and the receiver's texture domain (a triangle's (u,v) square
@@ -332,14 +326,13 @@ class MovieGeometry {
   }
   // Blockers of candidate list `list` in the pair's shaft at key k, as world triangles.
   std::vector<BlockerTriangle> blockersAt(const Pair& p, const std::vector<int>& list, int k) {
-    Box shaft = shaftAt(p, k);
+    const AxisBox shaft = shaftAt(p, k);
     const Shaft hull = hullAt(p, k);
     std::vector<BlockerTriangle> tris;
     for (int b : list) {
       Polygon poly = worldPolygon(b, k);
-      Box pb;
-      pb.grow(poly);
-      if (pb.overlaps(shaft) && hull.meets(pb.lo, pb.hi)) appendTriangles(poly, tris);
+      const AxisBox pb = boxOf(poly);
+      if (boxesMeet(pb, shaft) && hull.meets(pb[0], pb[1])) appendTriangles(poly, tris);
     }
     return tris;
   }
@@ -423,9 +416,7 @@ struct BlockerIndex {
       auto it = world.find(node);
       if (it == world.end())
         it = world.emplace(node, scene.worldTransform(node, scene.startTime())).first;
-      Box box;
-      box.grow(tops[b].local.transformed(it->second));
-      boxes[b] = {box.lo, box.hi};
+      boxes[b] = boxOf(tops[b].local.transformed(it->second));
     }
     fixedTops = BoxTree(boxes);
   }
@@ -467,114 +458,122 @@ class MovieBake {
         transmittance_(texels_),
         texture_(texels_ * 3) {}
 
-  // Texels under a touching solid at key k (a box's foot on the floor, coveredBySolid) are never
-  // seen, and gather nothing: ~0. A pixel between such a texel's centre and an exposed one's
-  // (the floor just beside the box) interpolated the two, and came out up to 4x too dark: the
-  // largest single errors of the Cornell box's frame. Each covered texel next to an exposed one
-  // takes the mean of its exposed 8-neighbours, twice outwards (lightmap dilation), so that
-  // the bilinear lookup meets exposed values only. Static blockers are tested once per movie,
-  // moving ones at each key where their swept bounds meet the receiver.
+  // Texels under a touching solid at key k (a box's foot on the floor, solid_contact.h) are
+  // never seen, and gather nothing: ~0. A pixel between such a texel's centre and an exposed
+  // one's (the floor just beside the box) interpolates the two and comes out far too dark. Each
+  // covered texel next to an exposed one takes the mean of its exposed 8-neighbours, twice
+  // outwards (lightmap dilation), so that the bilinear lookup meets exposed values only. Static
+  // blockers are tested once per movie, moving ones at each key where their swept bounds meet
+  // the receiver.
   void fillCoveredTexels(int k, double t) {
     auto clock = SteadyClock::now();
-    const int w = geo_.width(), h = geo_.height();
-    const PatchHierarchy& hierarchy = solution_.hierarchy;
-    const uint32_t top = req_.patch.top;
-    const Polygon& receiver = geo_.receiverWorld(k);
-    const double size = polygonSize(receiver);
-    // Inside a solid every way: the four rays tilted 88 degrees from the normal (nearly along
-    // the surface) meet backs. The normal ray alone took the ceiling above a lamp panel hung
-    // 1 mm under it, which the camera sees, dark, through the gap; rays 88 degrees from the
-    // normal leave through a gap g from every point within g / tan(2 deg) = 28.6 g of the
-    // panel's edge, and under a box they meet its sides from inside. The normal ray is not
-    // asked: under an open tube closed by a top (the table scene's legs under the table top)
-    // it meets the top's underside, a front, and the leg's footprint gathered as if exposed
-    // (0.5-0.8 against 1.1-1.6 beside it; a floor point inside an open chimney is taken as
-    // covered the same way, and shows its neighbours' light).
-    auto solidAt = [&](const VisibilityScene& blockers, double at, const glm::dvec3& p,
-                       const glm::dvec3& n) {
-      return insideSolid(blockers, geo_.scene(), hierarchy, top, p, n, size, at);
-    };
-    // A texel whose centre lies within a quarter texel outside a solid's foot (a partition
-    // standing on a texel row: the cubic scene's walls are 5 cm from the floor tiles' edges, a
-    // texel centre 0.2 mm from the wall) is covered too: its own gather meets the foot's edge,
-    // where the occlusion masks' rasterization decides the light either way (the row came out at
-    // 24 % of its neighbours, a dashed dark line along the wall in the frame), while its
-    // exposed neighbours' mean is its value to a quarter texel. Tested where a 4-neighbour was
-    // covered by this pass: the centre moved a quarter of the way towards that neighbour.
-    auto coverNearEdges = [&](const VisibilityScene& blockers, double at,
-                              std::vector<char>& covered, const std::vector<char>& before) {
-      std::vector<char> add(texels_, 0);
-      tbb::parallel_for(0, h, [&](int j) {
-        for (int i = 0; i < w; ++i) {
-          const size_t x = size_t(j) * w + i;
-          if (covered[x]) continue;
-          const int di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
-          for (int e = 0; e < 4; ++e) {
-            const int a = i + di[e], b = j + dj[e];
-            if (a < 0 || b < 0 || a >= w || b >= h) continue;
-            const size_t y = size_t(b) * w + a;
-            if (!covered[y] || before[y]) continue;
-            const glm::dvec3 p = geo_.texelPoint(k, x);
-            if (solidAt(blockers, at, p + 0.25 * (geo_.texelPoint(k, y) - p),
-                        geo_.texelNormal(k, x))) {
-              add[x] = 1;
-              break;
-            }
-          }
-        }
-      });
-      for (size_t x = 0; x < texels_; ++x) covered[x] |= add[x];
-    };
-    // `inside`: when given, only texels inside one of these boxes can be covered (the moving
-    // nodes' bounds at t: a texel under a moving box lies in the box's bounds).
-    auto test = [&](const VisibilityScene& blockers, double at, std::vector<char>& covered,
-                    const std::vector<Box>* inside) {
-      const std::vector<char> before = covered;
-      tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
-        if (covered[x]) return;
-        if (inside && std::none_of(inside->begin(), inside->end(),
-                                   [&](const Box& b) { return b.contains(geo_.texelPoint(k, x)); }))
-          return;
-        const glm::dvec3 p = geo_.texelPoint(k, x), n = geo_.texelNormal(k, x);
-        if (solidAt(blockers, at, p, n)) covered[x] = 1;
-      });
-      coverNearEdges(blockers, at, covered, before);
-    };
-    const bool receiverMoves = geo_.receiverDynamic();
-    if (staticCovered_.empty() || receiverMoves) {
-      staticCovered_.assign(texels_, 0);
-      test(visibility_->staticPart(), t, staticCovered_, nullptr);
-      // A triangle's texture is the half square u + v <= 1 of its (u,v) map; the texels beyond
-      // its long edge lie outside the patch, and those on it (a square texture puts a diagonal of
-      // texel centres exactly on the edge) are half-shadowed by whatever touches the edge there.
-      // A pixel inside near the edge interpolated them: the Cornell box's left wall (two
-      // triangles) showed a dark line along its seam with the back wall, the texels on the edge
-      // at 15 % of their inside neighbours. Both are filled as the covered ones are.
-      if (tops_[top].local.count == 3)
-        for (int j = 0; j < h; ++j)
-          for (int i = 0; i < w; ++i)
-            if ((i + 0.5) / w + (j + 0.5) / h >= 1.0 - 1e-9) staticCovered_[size_t(j) * w + i] = 1;
-      Box box;
-      box.grow(receiver);
-      movingNear_.clear();
-      for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
-                                    solution_.keyTimes.back())) {
-        const auto b =
-            geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
-        if (box.overlaps(Box{b[0], b[1]})) movingNear_.push_back(node);
-      }
-    }
+    const double size = polygonSize(geo_.receiverWorld(k));
+    if (staticCovered_.empty() || geo_.receiverDynamic()) coverStaticTexels(k, t, size);
     covered_ = staticCovered_;
     if (!movingNear_.empty() && visibility_->dynamicNodeCount() > 0) {
-      std::vector<Box> now;
+      std::vector<AxisBox> now;
       for (int node : movingNear_) {
         const auto b = geo_.scene().sweptBounds(node, t, t);
         const glm::dvec3 pad(1e-9 * std::max(size, glm::length(b[1] - b[0])));
-        now.push_back(Box{b[0] - pad, b[1] + pad});
+        now.push_back(AxisBox{b[0] - pad, b[1] + pad});
       }
       visibility_->setTime(t);
-      test(visibility_->movingPart(), t, covered_, &now);
+      coverTexels(visibility_->movingPart(), k, t, size, covered_, &now);
     }
+    stats_.coveredTexelsFilled += fillFromExposedNeighbours();
+    stats_.secondsCombine += secondsSince(clock);
+  }
+
+ private:
+  // Whether texel point p (normal n) of the receiver lies inside a solid of `blockers` at time
+  // `at` (insideSolid: the four rays 88 degrees from the normal, so that a gap between the
+  // solid and the surface lets them out, and the texels under an open tube closed by a top
+  // are covered as those under a box are).
+  bool solidAt(const VisibilityScene& blockers, double at, double size, const glm::dvec3& p,
+               const glm::dvec3& n) const {
+    return insideSolid(blockers, geo_.scene(), solution_.hierarchy, req_.patch.top, p, n, size, at);
+  }
+
+  // Marks in `covered` the texels at key k inside a solid of `blockers` at time `at`, then those
+  // near a solid's edge (coverNearEdges). `inside`: when given, only texels inside one of these
+  // boxes can be covered (the moving nodes' bounds at t: a texel under a moving box lies in the
+  // box's bounds).
+  void coverTexels(const VisibilityScene& blockers, int k, double at, double size,
+                   std::vector<char>& covered, const std::vector<AxisBox>* inside) {
+    const std::vector<char> before = covered;
+    tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
+      if (covered[x]) return;
+      if (inside && std::none_of(inside->begin(), inside->end(), [&](const AxisBox& b) {
+            return boxHolds(b, geo_.texelPoint(k, x));
+          }))
+        return;
+      const glm::dvec3 p = geo_.texelPoint(k, x), n = geo_.texelNormal(k, x);
+      if (solidAt(blockers, at, size, p, n)) covered[x] = 1;
+    });
+    coverNearEdges(blockers, k, at, size, covered, before);
+  }
+
+  // A texel whose centre lies within a quarter texel outside a solid's foot (a partition
+  // standing on a texel row, a texel centre a fraction of a millimetre from the wall) is covered
+  // too: its own gather meets the foot's edge, where the occlusion masks' rasterization decides
+  // the light either way (a dashed dark line along the wall), while its exposed neighbours'
+  // mean is its value to a quarter texel. Tested where a 4-neighbour was covered by this pass
+  // (covered and not `before`): the centre moved a quarter of the way towards that neighbour.
+  void coverNearEdges(const VisibilityScene& blockers, int k, double at, double size,
+                      std::vector<char>& covered, const std::vector<char>& before) {
+    const int w = geo_.width(), h = geo_.height();
+    std::vector<char> add(texels_, 0);
+    tbb::parallel_for(0, h, [&](int j) {
+      for (int i = 0; i < w; ++i) {
+        const size_t x = size_t(j) * w + i;
+        if (covered[x]) continue;
+        const int di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
+        for (int e = 0; e < 4; ++e) {
+          const int a = i + di[e], b = j + dj[e];
+          if (a < 0 || b < 0 || a >= w || b >= h) continue;
+          const size_t y = size_t(b) * w + a;
+          if (!covered[y] || before[y]) continue;
+          const glm::dvec3 p = geo_.texelPoint(k, x);
+          if (solidAt(blockers, at, size, p + 0.25 * (geo_.texelPoint(k, y) - p),
+                      geo_.texelNormal(k, x))) {
+            add[x] = 1;
+            break;
+          }
+        }
+      }
+    });
+    for (size_t x = 0; x < texels_; ++x) covered[x] |= add[x];
+  }
+
+  // The texels covered by static solids (staticCovered_; once per movie unless the receiver
+  // moves) and the moving nodes whose bounds over the movie meet the receiver (movingNear_).
+  void coverStaticTexels(int k, double t, double size) {
+    const int w = geo_.width(), h = geo_.height();
+    staticCovered_.assign(texels_, 0);
+    coverTexels(visibility_->staticPart(), k, t, size, staticCovered_, nullptr);
+    // A triangle's texture is the half square u + v <= 1 of its (u,v) map; the texels beyond
+    // its long edge lie outside the patch, and those on it (a square texture puts a diagonal of
+    // texel centres exactly on the edge) are half-shadowed by whatever touches the edge there.
+    // A pixel inside near the edge interpolated them (a dark line along the seam of two
+    // triangles). Both are filled as the covered ones are.
+    if (tops_[req_.patch.top].local.count == 3)
+      for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i)
+          if ((i + 0.5) / w + (j + 0.5) / h >= 1.0 - 1e-9) staticCovered_[size_t(j) * w + i] = 1;
+    const AxisBox box = boxOf(geo_.receiverWorld(k));
+    movingNear_.clear();
+    for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
+                                  solution_.keyTimes.back())) {
+      const auto b =
+          geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
+      if (boxesMeet(box, AxisBox{b[0], b[1]})) movingNear_.push_back(node);
+    }
+  }
+
+  // Each covered texel (covered_) next to an exposed one takes the mean of its exposed
+  // 8-neighbours in texture_, in two rings outwards. Returns how many were filled.
+  long fillFromExposedNeighbours() {
+    const int w = geo_.width(), h = geo_.height();
     std::vector<char> exposed(texels_);
     for (size_t x = 0; x < texels_; ++x) exposed[x] = covered_[x] ? 0 : 1;
     long filled = 0;
@@ -600,9 +599,10 @@ class MovieBake {
         }
       exposed.swap(next);
     }
-    stats_.coveredTexelsFilled += filled;
-    stats_.secondsCombine += secondsSince(clock);
+    return filled;
   }
+
+ public:
 
   // Planning: the per-movie part of every bad pair, in badShooters order.
   void plan(const std::vector<uint32_t>& badShooters) {
@@ -958,15 +958,15 @@ double MovieBake::scanFormFactors(Pair& p) {
 std::vector<int> MovieBake::blockerCandidates(uint32_t S, const Pair& p) {
   const uint32_t R = req_.patch.top;
   const InputPolygon &receiverTop = tops_[R], &shooterTop = tops_[S];
-  Box shaft = geo_.shaftAt(p, 0);
+  AxisBox shaft = geo_.shaftAt(p, 0);
   if (!p.coherent)
     for (int k = 1; k < geo_.keys(); ++k) {
-      Box b = geo_.shaftAt(p, k);
-      shaft.grow(b.lo);
-      shaft.grow(b.hi);
+      const AxisBox b = geo_.shaftAt(p, k);
+      growBox(shaft, b[0]);
+      growBox(shaft, b[1]);
     }
   std::vector<int> candidates;
-  for (int b : blockers_.near(shaft.lo, shaft.hi)) {
+  for (int b : blockers_.near(shaft[0], shaft[1])) {
     if (b == int(R) || b == int(S) || sameSurface(tops_[size_t(b)], receiverTop) ||
         sameSurface(tops_[size_t(b)], shooterTop))
       continue;
@@ -978,19 +978,17 @@ std::vector<int> MovieBake::blockerCandidates(uint32_t S, const Pair& p) {
 // §5: a static pair's shaft blockers split into static ones, rendered here once per movie into
 // the pair's static mask, and dynamic ones (in the shaft swept over the movie), rendered per key.
 void MovieBake::planCoherentBlockers(Pair& p, const std::vector<int>& candidates) {
-  Box shaft = geo_.shaftAt(p, 0);
+  const AxisBox shaft = geo_.shaftAt(p, 0);
   const Shaft hull = geo_.hullAt(p, 0);
   std::vector<int> staticList;
   for (int b : candidates) {
     int node = tops_[size_t(b)].node;
     if (!geo_.movesDuringMovie(node)) {
-      Box pb;
-      pb.grow(geo_.worldPolygon(b, 0));  // t0 is key 0's time
-      if (pb.overlaps(shaft) && hull.meets(pb.lo, pb.hi)) staticList.push_back(b);
+      const AxisBox pb = boxOf(geo_.worldPolygon(b, 0));  // t0 is key 0's time
+      if (boxesMeet(pb, shaft) && hull.meets(pb[0], pb[1])) staticList.push_back(b);
     } else {
       const std::array<glm::dvec3, 2>& sb = geo_.sweptDuringMovie(node);
-      Box swept{sb[0], sb[1]};
-      if (swept.overlaps(shaft)) p.dynamicList.push_back(b);
+      if (boxesMeet(AxisBox{sb[0], sb[1]}, shaft)) p.dynamicList.push_back(b);
     }
   }
   stats_.staticBlockers += long(staticList.size());
@@ -1038,43 +1036,61 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"max-texture-memory", maxTextureMemoryMiB}};
 }
 
+namespace {
+
+// Every counter of TextureMovieBakerStats, once: its group in --report's JSON ("" for the top
+// level), its key there, and the field of each of `stats` (one or two records, so that one list
+// serves toJson and operator+=). The warnings are not counters and are handled apart.
+template <class F, class... Stats>
+void forEachStat(F&& f, Stats&... stats) {
+  f("", "movies", stats.movies...);
+  f("", "constant_movies", stats.constantMovies...);
+  f("", "keys", stats.keys...);
+  f("", "texels", stats.texels...);
+  f("", "bad_pairs", stats.badPairs...);
+  f("", "static_pairs", stats.staticPairs...);
+  f("", "dynamic_pairs", stats.dynamicPairs...);
+  f("", "samples", stats.samples...);
+  f("", "weak_pairs", stats.weakPairs...);
+  f("", "blockers_static", stats.staticBlockers...);
+  f("", "blockers_dynamic", stats.dynamicBlockers...);
+  f("", "render_passes", stats.passes...);
+  f("", "sample_passes", stats.samplePasses...);
+  f("", "ray_cast_passes", stats.rayCastPasses...);
+  f("", "render_passes_saved_by_coherence", stats.passesSavedByCoherence...);
+  f("", "covered_texels_filled", stats.coveredTexelsFilled...);
+  const char* gather = "good_layer_gather";
+  f(gather, "links", stats.gather.links...);
+  f(gather, "entries", stats.gather.entries...);
+  f(gather, "cached_entries", stats.gather.cachedEntries...);
+  f(gather, "tile_entries", stats.gather.tileEntries...);
+  f(gather, "partial_links", stats.gather.partialLinks...);
+  f(gather, "partial_links_moving_blockers", stats.gather.partialLinksMovingBlockers...);
+  f(gather, "partial_links_few_rays", stats.gather.partialLinksFewRays...);
+  f(gather, "partial_tile_links_per_texel", stats.gather.partialTileLinksPerTexel...);
+  f(gather, "near_shooter_leaves", stats.gather.nearShooterLeaves...);
+  f(gather, "near_shooter_seconds", stats.gather.nearShooterSeconds...);
+  f("", "form_factor_texels", stats.formFactorTexels...);
+  f("", "form_factor_texels_interpolated", stats.formFactorTexelsInterpolated...);
+  const char* seconds = "seconds";
+  f(seconds, "good_layer", stats.secondsGood...);
+  f(seconds, "form_factors", stats.secondsFormFactor...);
+  f(seconds, "transmittance", stats.secondsTransmittance...);
+  f(seconds, "combine", stats.secondsCombine...);
+  f(seconds, "form_factor_max_scan", stats.secondsFormFactorScan...);
+}
+
+}  // namespace
+
 nlohmann::json TextureMovieBakerStats::toJson() const {
-  return {{"movies", movies},
-          {"constant_movies", constantMovies},
-          {"keys", keys},
-          {"texels", texels},
-          {"bad_pairs", badPairs},
-          {"static_pairs", staticPairs},
-          {"dynamic_pairs", dynamicPairs},
-          {"samples", samples},
-          {"weak_pairs", weakPairs},
-          {"blockers_static", staticBlockers},
-          {"blockers_dynamic", dynamicBlockers},
-          {"render_passes", passes},
-          {"ray_cast_passes", rayCastPasses},
-          {"sample_passes", samplePasses},
-          {"render_passes_saved_by_coherence", passesSavedByCoherence},
-          {"good_layer_gather",
-           {{"links", gather.links},
-            {"entries", gather.entries},
-            {"cached_entries", gather.cachedEntries},
-            {"tile_entries", gather.tileEntries},
-            {"partial_links", gather.partialLinks},
-            {"partial_links_moving_blockers", gather.partialLinksMovingBlockers},
-            {"partial_links_few_rays", gather.partialLinksFewRays},
-            {"partial_tile_links_per_texel", gather.partialTileLinksPerTexel},
-            {"near_shooter_leaves", gather.nearShooterLeaves},
-            {"near_shooter_seconds", gather.nearShooterSeconds}}},
-          {"covered_texels_filled", coveredTexelsFilled},
-          {"form_factor_texels", formFactorTexels},
-          {"form_factor_texels_interpolated", formFactorTexelsInterpolated},
-          {"seconds",
-           {{"good_layer", secondsGood},
-            {"form_factors", secondsFormFactor},
-            {"form_factor_max_scan", secondsFormFactorScan},
-            {"transmittance", secondsTransmittance},
-            {"combine", secondsCombine}}},
-          {"warnings", warnings}};
+  nlohmann::json j = nlohmann::json::object();
+  forEachStat(
+      [&](const char* group, const char* key, const auto& value) {
+        (*group ? j[group][key] : j[key]) = value;
+      },
+      *this);
+  j["warnings"] = warnings;
+  return j;
 }
 
 Polygon nodePolygonIn(const Polygon& top, PatchId node) {
@@ -1156,39 +1172,8 @@ void TextureMovieBaker::addStats(const TextureMovieBakerStats& stats) {
 }
 
 TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBakerStats& o) {
-  movies += o.movies;
-  constantMovies += o.constantMovies;
-  keys += o.keys;
-  texels += o.texels;
-  badPairs += o.badPairs;
-  staticPairs += o.staticPairs;
-  dynamicPairs += o.dynamicPairs;
-  samples += o.samples;
-  weakPairs += o.weakPairs;
-  staticBlockers += o.staticBlockers;
-  dynamicBlockers += o.dynamicBlockers;
-  passes += o.passes;
-  samplePasses += o.samplePasses;
-  rayCastPasses += o.rayCastPasses;
-  passesSavedByCoherence += o.passesSavedByCoherence;
-  coveredTexelsFilled += o.coveredTexelsFilled;
-  gather.links += o.gather.links;
-  gather.entries += o.gather.entries;
-  gather.cachedEntries += o.gather.cachedEntries;
-  gather.tileEntries += o.gather.tileEntries;
-  gather.partialLinks += o.gather.partialLinks;
-  gather.partialLinksMovingBlockers += o.gather.partialLinksMovingBlockers;
-  gather.partialLinksFewRays += o.gather.partialLinksFewRays;
-  gather.partialTileLinksPerTexel += o.gather.partialTileLinksPerTexel;
-  gather.nearShooterLeaves += o.gather.nearShooterLeaves;
-  gather.nearShooterSeconds += o.gather.nearShooterSeconds;
-  formFactorTexels += o.formFactorTexels;
-  formFactorTexelsInterpolated += o.formFactorTexelsInterpolated;
-  secondsGood += o.secondsGood;
-  secondsFormFactor += o.secondsFormFactor;
-  secondsTransmittance += o.secondsTransmittance;
-  secondsCombine += o.secondsCombine;
-  secondsFormFactorScan += o.secondsFormFactorScan;
+  forEachStat([](const char*, const char*, auto& mine, const auto& theirs) { mine += theirs; }, *this,
+              o);
   for (const std::string& w : o.warnings)
     if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
   return *this;
@@ -1266,15 +1251,14 @@ bool TextureMovieBaker::shadowsMove(const MovieExtent& req,
   for (int node : movingNodesOf(scene_, tops_, t0, t1))
     swept.push_back(scene_.sweptBounds(node, t0, t1));
   if (swept.empty()) return false;
-  Box receiver;
-  receiver.grow(nodeWorldPolygon(scene_, receiverTop, req.patch, t0));
+  const AxisBox receiver = boxOf(nodeWorldPolygon(scene_, receiverTop, req.patch, t0));
   for (uint32_t S : badShooters) {
     if (S >= tops_.size()) continue;
     if (scene_.isDynamic(tops_[S].node, t0, t1)) return true;
-    Box shaft = receiver;
-    shaft.grow(tops_[S].local.transformed(scene_.worldTransform(tops_[S].node, t0)));
+    AxisBox shaft = receiver;
+    growBoxTo(shaft, tops_[S].local.transformed(scene_.worldTransform(tops_[S].node, t0)));
     for (const auto& b : swept)
-      if (shaft.overlaps(Box{b[0], b[1]})) return true;
+      if (boxesMeet(shaft, AxisBox{b[0], b[1]})) return true;
   }
   return false;
 }
