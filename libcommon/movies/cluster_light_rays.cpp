@@ -48,8 +48,8 @@ const ClusterLightStore::Rays& GoodLinkGather::clusterLightRays(int key) {
   const PatchHierarchy& h = solution_.hierarchy;
   const uint32_t R = uint32_t(receiverTop_), T = uint32_t(h.topCount());
   ClusterLightStore& store = byReceiver_.clusterLight;
-  auto [at, fresh] = store.rays.try_emplace(
-      uint64_t(R) * uint64_t(solution_.keyCount()) + uint64_t(key));
+  auto [at, fresh] =
+      store.rays.try_emplace(uint64_t(R) * uint64_t(solution_.keyCount()) + uint64_t(key));
   ClusterLightStore::Rays& out = at->second;
   if (!fresh) return out;
   const std::vector<Polygon>& world = store.staticTopWorld;
@@ -127,8 +127,8 @@ void GoodLinkGather::planClusterVisibility() {
     store.staticTopWorld.resize(T);
     store.topMoves.assign(T, 0);
     for (uint32_t s = 0; s < T; ++s) {
-      store.topMoves[s] = std::find(movingNodes_.begin(), movingNodes_.end(),
-                                          h.top(int(s)).node) != movingNodes_.end();
+      store.topMoves[s] = std::find(movingNodes_.begin(), movingNodes_.end(), h.top(int(s)).node) !=
+                          movingNodes_.end();
       if (!store.topMoves[s]) store.staticTopWorld[s] = nodeWorld(s, t0);
     }
   }

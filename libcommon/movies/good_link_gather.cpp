@@ -298,8 +298,7 @@ void GoodLinkGather::planWeights(const std::vector<char>& needed) {
   for (size_t j = 0; j < links_.size(); ++j)
     if (newHidden[j] >= 0.0)
       byReceiver_.hiddenFormFactor.emplace(
-          HiddenLink{links_[j].row, links_[j].shooter, links_[j].cell},
-          newHidden[j]);
+          HiddenLink{links_[j].row, links_[j].shooter, links_[j].cell}, newHidden[j]);
   if (!visibility_) return;
   selectPartialLinks(risk, carried);
   tbb::parallel_for(size_t(0), links_.size(), [&](size_t j) {
@@ -553,8 +552,7 @@ std::vector<double> GoodLinkGather::farLinksAtCorners(const KeyTerms& key,
       const uint32_t j = cornerLink_[e];
       const Link& l = links_[j];
       if (key.weight[j] == glm::dvec3(0.0)) continue;
-      double f =
-          l.moves ? pointToPolygonFormFactor(p, nx, key.shooter[j]) : cornerFormFactor_[e];
+      double f = l.moves ? pointToPolygonFormFactor(p, nx, key.shooter[j]) : cornerFormFactor_[e];
       if (l.partial && f > 0.0)
         f *= visibilityAt(p, nx, l, pointsOf(key, j), key.shooterNormal[j],
                           l.moves ? nullptr : &cornerOpen_[e], &key.pointWeight[j * rays],
@@ -614,8 +612,9 @@ void GoodLinkGather::gatherTile(const Tile& tile, const KeyTerms& key,
                                 : nullptr);
         H += f * key.weight[l];
       }
-      acc[x] = H + (clusterVisibility_.empty() ? clusterAt(cluster, x)
-                                               : double(clusterVisibility_[x]) * clusterAt(cluster, x));
+      acc[x] =
+          H + (clusterVisibility_.empty() ? clusterAt(cluster, x)
+                                          : double(clusterVisibility_[x]) * clusterAt(cluster, x));
     }
 }
 

@@ -284,16 +284,15 @@ class GoodLinkGather {
                       const std::vector<std::vector<std::pair<uint64_t, uint32_t>>>& nearBelow);
   void cacheTexelTerms(const TexelFrame& frame, const std::vector<Polygon>& shooter,
                        double cacheBytes);
-  void cacheTexelKernels(const TexelFrame& frame, const std::vector<Polygon>& shooter,
-                         double left);
+  void cacheTexelKernels(const TexelFrame& frame, const std::vector<Polygon>& shooter, double left);
   // gather's steps: what every texel shares at one time, then the tiles.
   struct KeyTerms {
-    std::vector<glm::dvec3> weight;                 // per link: B_q \bar V at t; 0 when inactive
-    std::vector<Polygon> shooter;                   // per link: its part at t (when needed)
-    std::vector<glm::dvec3> shooterNormal;          // partial links
-    std::vector<std::vector<glm::dvec3>> points;    // moving partial links: points at t
-    std::vector<double> pointWeight;                // [link * visibilityRays_ + i]
-    std::vector<char> movingNow;                    // a moving node meets the shaft at t
+    std::vector<glm::dvec3> weight;               // per link: B_q \bar V at t; 0 when inactive
+    std::vector<Polygon> shooter;                 // per link: its part at t (when needed)
+    std::vector<glm::dvec3> shooterNormal;        // partial links
+    std::vector<std::vector<glm::dvec3>> points;  // moving partial links: points at t
+    std::vector<double> pointWeight;              // [link * visibilityRays_ + i]
+    std::vector<char> movingNow;                  // a moving node meets the shaft at t
   };
   KeyTerms keyTerms(double t) const;
   const std::vector<glm::dvec3>& pointsOf(const KeyTerms& key, uint32_t link) const;

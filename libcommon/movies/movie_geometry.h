@@ -12,8 +12,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include <glm/glm.hpp>
 #include <tbb/parallel_for.h>
+#include <glm/glm.hpp>
 
 #include "libcommon/intervals/movie_extent.h"
 #include "libcommon/movies/good_link_gather.h"
@@ -37,11 +37,9 @@ inline AxisBox boxOf(const Polygon& p) {
   return b;
 }
 
-
 inline void appendTriangles(const Polygon& p, std::vector<BlockerTriangle>& out) {
   for (int i = 1; i + 1 < p.count; ++i) out.push_back({p.v[0], p.v[i], p.v[i + 1]});
 }
-
 
 // Bad pairs' unoccluded form factors over tiles (MovieGeometry::formFactorsAt). At 4, twice
 // the good layer's ratio for a tile's own links: these are mostly the lights' direct light.

@@ -257,8 +257,7 @@ class MovieBake {
     movingNear_.clear();
     for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
                                   solution_.keyTimes.back())) {
-      const auto b =
-          geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
+      const auto b = geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
       if (boxesMeet(box, AxisBox{b[0], b[1]})) movingNear_.push_back(node);
     }
   }
@@ -296,7 +295,6 @@ class MovieBake {
   }
 
  public:
-
   // Planning: the per-movie part of every bad pair, in badShooters order.
   void plan(const std::vector<uint32_t>& badShooters) {
     saturatedSamples_ = transmittanceSampleCount(std::numeric_limits<double>::infinity(),
@@ -408,7 +406,8 @@ class MovieBake {
 
   // A moving pair (or the baseline) at key k: every blocker in the key's shaft rendered from
   // the key's samples; the key's form factors read back from the spill or recomputed.
-  const std::vector<double>& movingTransmittance(OcclusionMaskRenderer& gl, const BadPair& p, int k) {
+  const std::vector<double>& movingTransmittance(OcclusionMaskRenderer& gl, const BadPair& p,
+                                                 int k) {
     auto clock = SteadyClock::now();
     const std::vector<glm::dvec3> samples = geo_.samplesAt(p, k);
     const SampleMask valid = frontSampleMask(geo_.receiverWorld(k), samples);

@@ -54,18 +54,16 @@ void forEachStat(F&& f, Stats&... stats) {
 
 nlohmann::json TextureMovieBakerStats::toJson() const {
   nlohmann::json j = nlohmann::json::object();
-  forEachStat(
-      [&](const char* group, const char* key, const auto& value) {
-        (*group ? j[group][key] : j[key]) = value;
-      },
-      *this);
+  forEachStat([&](const char* group, const char* key,
+                  const auto& value) { (*group ? j[group][key] : j[key]) = value; },
+              *this);
   j["warnings"] = warnings;
   return j;
 }
 
 TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBakerStats& o) {
-  forEachStat([](const char*, const char*, auto& mine, const auto& theirs) { mine += theirs; }, *this,
-              o);
+  forEachStat([](const char*, const char*, auto& mine, const auto& theirs) { mine += theirs; },
+              *this, o);
   for (const std::string& w : o.warnings)
     if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
   return *this;
