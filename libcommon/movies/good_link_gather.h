@@ -11,7 +11,8 @@
 // (GlobalSolution::topClusterIrradiance, linkhier 1.3; 0 in older files), averaged at the
 // top's corners over the coplanar tops that share them and interpolated over the top
 // (GoodLinksByReceiver::clusterCorners; the Gouraud layer's vertex values include it the same
-// way, so both layers carry the same cluster light),
+// way, so both layers carry the same cluster light), and scaled per texel by what the texel
+// sees of the top's far surfaces (cluster_light_rays.h);
 // F(x -> q) the exact point-to-polygon form factor at the texel, about its shading normal,
 // and \bar V_l = V_l / e_p clamped to [0, 1]: the link's stored visibility (linkhier 1.2; older
 // files: F·V / \bar F, the area-average form factor) over the receiver's exposure e_p (the share
@@ -25,44 +26,33 @@
 // active (none of its ray pairs got through, yet it may be partly visible), takes its
 // visibility per texel instead when its risk B_q F (1 - V) is at least --gather-partial-share s
 // of what the texel gathers, or when it is among the smaller ones beyond the first that sum to
-// 10 s (selectPartialLinks; a quarter of the rays then), V(x, q): --gather-rays shadow rays from
-// x to points on the shooter part q (the same points for every texel), each weighted by the
-// kernel and by the global solution's B at its end (pointVisibility), so that
+// kPartialSumShares s (selectPartialLinks; a quarter of the rays then), V(x, q): --gather-rays
+// shadow rays from x to points on the shooter part q (the same points for every texel), each
+// weighted by the kernel and by the global solution's B at its end (pointVisibility), so that
 //
 //   term = B_q(k) F(x -> q) V(x, q)
 //
-// One V per receiver node stepped where two nodes whose links are occluded differently meet
-// (4.3 % on the bundled scene's back wall); per texel the bundled scene went from 7.5 to 6.0 %
-// RMSE / mean, and the B weights keep a double-sided lamp's gap from leaking (+0.1 %, against
-// +8.7 % unweighted). Static blockers are cast once per movie, moving ones per key (§5).
+// Why: one V per receiver node steps where two nodes whose links are occluded differently meet;
+// the B weights keep the light of a shooter bright where the texel cannot see it (a
+// double-sided lamp's far side) from leaking through its visible part. Static blockers are cast
+// once per movie, moving ones per key (§5). ("The per-texel good-link gather" and "Which
+// gathered links take their visibility per texel" in docs/results.md.)
 //
-// Cost: texels are planned in tiles of 8 x 8; a link whose shooter part is far from a tile
-// (kTileFarRatio times its size) is evaluated at the tile's corners and interpolated
-// bilinearly, so only near links cost a form factor per texel. A far partial link stays on the
-// tile only while its V at the tile's middle texel is what the corners interpolate, within s of
-// what the texel gathers (perTexelOnTiles).
+// Cost: texels are planned in tiles of kTile x kTile (gather_tiles.cpp); a link whose shooter
+// part is far from a tile (kTileFarRatio times its size) is evaluated at the tile's corners and
+// interpolated bilinearly, so only near links cost a form factor per texel. A far partial link
+// stays on the tile only while its V at the tile's middle texel is what the corners
+// interpolate, within s of what the texel gathers (perTexelOnTiles).
 //
-// Near shooters (--near-shooter-levels L > 0, issue 15): a shooter part that is a leaf and still
-// larger than shooterRatio times its distance to the receiver is split further into the cells
-// of its virtual quadtree down to L levels, each carrying its own radiosity
-//
-//   B(y) = E + \rho (H_c + \sum_{l = (p <- s), p \in chain(q)} B_s F(y -> s) V(y, s))
-//
-// re-gathered at the cell centre y from every link of the leaf's chain (good and bad: the
-// lights' links too), with V(y, s) from --gather-rays rays where the link is partly occluded
-// (0 in a cell covered by a touching solid). A leaf's B is its chain's gather, and an
-// ancestor's link carries the visibility averaged over the ancestor: the floor strip in front of
-// the Cornell box's short box, in the box's shadow, took its ceiling light through 0/3.2 (V 0.17
-// to 0.63 over a node 0.2 m across) and came out at B 0.023 where the movie's own gather (and
-// the reference) has 0.015-0.017; the box front's foot, which sees that strip over half its
-// hemisphere, was 31-60 % too bright. The estimate depends only on the leaf and the key, so it
-// is made once per rad-movies run (GoodLinksByReceiver::nearShooterCells). Costly (the final
-// setting only): at L = 2 the Cornell box's rad-movies 5.1 -> 16.0 s, the table's 12.8 -> 86.7 s.
+// Near shooters (--near-shooter-levels L > 0): a near leaf shooter is split into cells whose
+// radiosity is re-gathered once per run (near_shooter_cells.h); each cell is then a shooter part
+// of its own, weighted by its B over the leaf's (cellRatio).
 //
 // Between key times the gather is linear in t, as the Gouraud layer is. Coherence (§5): for a
 // link whose two ends do not move during the movie, F(x -> q) is computed once per movie and
 // kept (up to a memory budget); only B and \bar V change per key. A link with a moving end
-// recomputes F at every movie key.
+// recomputes F at every movie key. The result does not depend on the order in which a baker's
+// movies are made (what GoodLinksByReceiver stores is the same whichever movie made it).
 #pragma once
 
 #include <array>
@@ -74,104 +64,13 @@
 #include <glm/glm.hpp>
 
 #include "libcommon/intervals/movie_extent.h"
+#include "libcommon/movies/good_links_by_receiver.h"
+#include "libcommon/movies/solid_contact.h"
 #include "libcommon/radiosity/global_solution.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {
-
-// Where the ray from point p of top-level patch `top` (direction d) starts at time t: inside a
-// touching solid (a box's foot on the floor: the first surface it meets is the back of a
-// one-sided patch), outside, or undecided (a front and such a back at one distance; rayStart),
-// as rad-global's exposure decides (exposureOf).
-RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
-                        const PatchHierarchy& h, uint32_t top, const glm::dvec3& p,
-                        const glm::dvec3& d, double t);
-
-// Whether point p of top-level patch `top` (normal n) lies inside a touching solid at time t:
-// the four rays 88 degrees from the normal, `size` long, all start inside or undecided
-// (coveredBySolid), one at least inside. rad-movies' fill of covered texels and the near
-// shooters' cells decide so.
-bool insideSolid(const VisibilityScene& blockers, const Scene& scene, const PatchHierarchy& h,
-                 uint32_t top, const glm::dvec3& p, const glm::dvec3& n, double size, double t);
-
-// The good links that gather (not refined, not of a bad pair), grouped by receiver node: built
-// once per solution, shared by every movie.
-struct GoodLinksByReceiver {
-  explicit GoodLinksByReceiver(const GlobalSolution& solution);
-  std::vector<uint32_t> start;  // per node: its links are rows[start[i] .. start[i + 1])
-  std::vector<uint32_t> rows;   // indices into solution.links
-  // Near shooters: every link that gathers, good or bad, by receiver node (indexAllLinks), and
-  // the re-gathered radiosity of each near leaf shooter's cells already made, keyed by
-  // leaf * keyCount + key: per cell, its B's channel sum over the leaf's (0: covered).
-  std::vector<uint32_t> allStart, allRows;
-  std::unordered_map<uint64_t, std::vector<float>> nearShooterCells;
-  // Per static near leaf: F(y_i -> s) V(y_i, s) of its chain's links that do not change (both
-  // ends static, one F·V sample over the keys: no moving node crossed their shaft), per cell,
-  // made at its first key and kept for the others, which then only sum B_s times them.
-  struct FixedTerms {
-    std::vector<uint32_t> rows;  // link rows, in the chain's order
-    std::vector<float> factor;   // [row index * cells + cell]
-  };
-  std::unordered_map<uint32_t, FixedTerms> nearShooterFixed;
-  // F(receiver node -> shooter part), integrated, of the links that no ray pair got through
-  // (GoodLinkGather::planWeights: the risk of their hidden share), static links only, by link
-  // row, shooter node and cell: the same for every movie of the receiver's top. The 10k-triangle
-  // hall's movies had integrated 800,192 of them, 131,783 distinct, 6 % of rad-movies' time.
-  struct HiddenLink {
-    uint32_t row, shooter, cell;
-    bool operator==(const HiddenLink& o) const {
-      return row == o.row && shooter == o.shooter && cell == o.cell;
-    }
-  };
-  struct HiddenLinkHash {
-    size_t operator()(const HiddenLink& k) const {
-      return size_t(splitMix64(((uint64_t(k.row) << 32) | k.shooter) ^ splitMix64(k.cell)));
-    }
-  };
-  std::unordered_map<HiddenLink, double, HiddenLinkHash> hiddenFormFactor;
-  // Per static top and global key (top * keyCount + key): the points on its far surfaces that
-  // its texels' cluster-light rays go to, and the mean open share of those rays over the top's
-  // uncovered part (GoodLinkGather::planClusterVisibility); the same for every movie of the top
-  // (none: the top gets no per-texel cluster light). And the static tops' world polygons
-  // (empty until the first movie needs them; a moving top's is left empty).
-  struct ClusterLightRays {
-    std::vector<glm::dvec3> points;
-    double meanOpenShare = 0.0;
-  };
-  std::unordered_map<uint64_t, ClusterLightRays> clusterLightRays;
-  std::vector<Polygon> staticTopWorld;
-  std::vector<char> topMoves;
-  // Per global key: kFarCandidates points on the static tops, the tops drawn by emitted and
-  // reflected power B A (stratified) and each point area-uniform on its top, from which every
-  // top's far points are drawn again by its own kernel. Drawing from all tops for every top had
-  // made the 100k-triangle hall's rad-movies 48 -> 140 s.
-  struct FarCandidate {
-    glm::dvec3 point, normal;
-    uint32_t top;
-  };
-  std::unordered_map<int, std::vector<FarCandidate>> farCandidates;
-  static constexpr int kFarCandidates = 4096;
-  void indexAllLinks(const GlobalSolution& solution);
-  // The cluster irradiance at each top's corners, [(top * K + k) * 4 + c] (empty without
-  // cluster links): the mean of topClusterIrradiance, weighted by exposed area, over the tops of
-  // the same mesh node that share the corner's position and face the same way (normals within 8
-  // degrees; the plain mean where all of them are covered). The gather
-  // interpolates it over the top, so that a wall of tiles whose clusters link differently shades
-  // smoothly instead of in steps of one value per tile (the 10k hall's back wall). A top whose
-  // own value lies beyond kClusterBand of its corners' mean keeps it but for the band
-  // (keepOwnClusterLight).
-  std::vector<glm::vec3> clusterCorners;
-
- private:
-  void smoothClusterIrradiance(const GlobalSolution& solution);
-  void keepOwnClusterLight(const GlobalSolution& solution);
-  // How far (relative) a top's own cluster light may lie from its corners' mean and still be
-  // smoothed over (keepOwnClusterLight). 10k hall, frame 48 against the all-pairs frames:
-  // ceiling RMSE / mean 2.0 % smoothed, 1.0 % unsmoothed (0), 1.3 % at 0.1; walls 1.2, 1.4,
-  // 1.3 %.
-  static constexpr double kClusterBand = 0.1;
-};
 
 // The texels of one movie: their (u,v) in the receiver's top-level patch and their points in
 // its local frame (MovieGeometry's, shared).
@@ -255,17 +154,16 @@ class GoodLinkGather {
   // is at least this share of what its receiver chain carries (TextureMovieBakerOptions).
   double partialShare_;
   // The small partial links left on the link's one V sum to at most this many shares
-  // (selectPartialLinks). On the 10k hall (frames 40-56 baked, frame 48 against its
-  // references): 10 took the floor strip's bias from 9.4 to 4.5 %.
+  // (selectPartialLinks): each misplaces little, but a receiver with many of them (a floor
+  // seeing the ceiling past many table edges) misplaces their sum.
   static constexpr double kPartialSumShares = 10.0;
   // Per partial link, what its receiver chain carries (selectPartialLinks' total): the scale of
   // the tiles' visibility test.
   std::vector<double> linkGather_;
   static constexpr double kTileFarRatio = 2.0;
   // The same for the links of the nodes below a tile's common node (Tile::groups), which hold
-  // only some of its texels. At 2 the bundled scene's frame 20 went from 2.46 to 2.50 % RMSE /
-  // mean against its references; at 4 it stays at 2.46 % with 29 % fewer per-texel form factors
-  // than none at all (8: 2.46 %, 10 % fewer).
+  // only some of its texels: larger than kTileFarRatio, the smallest ratio that costs no
+  // accuracy against per-texel form factors.
   static constexpr double kTileFarRatioBelow = 4.0;
   struct Tile {
     int i0 = 0, j0 = 0, i1 = 0, j1 = 0;  // first texel and the corner texels (last column, row)
@@ -319,8 +217,8 @@ class GoodLinkGather {
   std::vector<float> texelFormFactor_;
   std::vector<uint64_t> texelOpen_;  // with texelFormFactor_: rays open past static blockers
   // The kernels of a texel's partial-link rays (pointKernels), the same at every key, from
-  // texelKernelAt_[e] in texelKernel_ (kNoKernels: made at each key): pointVisibility had made
-  // them again at every movie key, 8 % of the 10k hall's rad-movies samples.
+  // texelKernelAt_[e] in texelKernel_ (kNoKernels: made at each key), so that pointVisibility
+  // does not make them again at every movie key.
   static constexpr uint32_t kNoKernels = ~0u;
   std::vector<uint32_t> texelKernelAt_;
   std::vector<double> texelKernel_;
@@ -338,8 +236,8 @@ class GoodLinkGather {
   void planNearShooters(const std::vector<char>& neededKeys, GoodLinkGatherStats& stats);
   // fixed: the leaf's kept terms, or null; fresh: where to keep them when null (static leaf).
   std::vector<float> regatherCells(uint32_t leaf, int key, double t,
-                                   const GoodLinksByReceiver::FixedTerms* fixed,
-                                   GoodLinksByReceiver::FixedTerms* fresh) const;
+                                   const NearShooterStore::FixedTerms* fixed,
+                                   NearShooterStore::FixedTerms* fresh) const;
   double cellRatio(const Link& l, int key) const;  // the cell's B over its leaf's (1: no cell)
   // Per near leaf shooter, the areas of its 4^nearShooterLevels_ cells (cellRatio's weights).
   std::unordered_map<uint32_t, std::vector<double>> cellAreas_;
@@ -349,23 +247,14 @@ class GoodLinkGather {
   void planWeights(const std::vector<char>& neededKeys);
   void selectPartialLinks(const std::vector<double>& risk, const std::vector<double>& carried);
   void planTexels(double cacheBytes);
-  // The cluster light's visibility per texel (clusterVisibility_): rad-global gathers the
-  // light of far surfaces through cluster links, one V per link shared by every member of the
-  // receiver, and stores one irradiance per top and key; where a top is partly hidden from its
-  // far surfaces (a chair's seat under a desk, its back in the open) the camera sees its open
-  // parts, and the all-pairs frames, whose far links take V per texel, were brighter there
-  // (10k hall, frame 48: chairs -2.2 to -2.9 % against the references, -4.4 to -5.1 % with
-  // the far links' per-texel V turned off, -4.6 to -5.9 % with clusters). Per top and global key: k
-  // points on its far surfaces (the static tops that are neither shooters of its nodes' good links
-  // nor of its bad pairs; drawn from the key's farCandidates by cos cos / d^4 from the top's
-  // centroid), seeded by the top, and their mean open share at 64 uncovered points of the top
-  // (clusterLightRays); a texel's cluster light is scaled by the open share of its rays to them
-  // over that mean (so the top keeps rad-global's total). At the tiles' corner texels, bilinear in
-  // between, once per movie against the static blockers at its first key. (10k hall: chairs -2.0 to
-  // -4.1 %, the frame's bias -1.10 -> -0.98 %.)
+  // The cluster light's visibility per texel (clusterVisibility_; cluster_light_rays.h): per
+  // top and global key, clusterVisibilityRays_ far points and their mean open share at
+  // kClusterVisibilityPoints uncovered points of the top (clusterLightRays); a texel's cluster
+  // light is scaled by the open share of its rays to them over that mean. At the tiles' corner
+  // texels, bilinear in between, once per movie against the static blockers at its first key.
   void planClusterVisibility();
   // The top's far points and mean open share at global key k (cached in byReceiver_).
-  const GoodLinksByReceiver::ClusterLightRays& clusterLightRays(int k);
+  const ClusterLightStore::Rays& clusterLightRays(int k);
   static constexpr int kClusterVisibilityPoints = 64;
   struct TexelFrame {  // the receiver's local-to-world map and its normal map at one time
     glm::dmat4 m;
@@ -376,6 +265,43 @@ class GoodLinkGather {
     glm::dvec3 normal(const glm::dvec3& local) const { return glm::normalize(normalMap * local); }
   };
   TexelFrame texelFrame(double t) const;
+  // planTexels' steps (gather_tiles.cpp).
+  using LinkRanges = std::map<int, std::pair<uint32_t, uint32_t>>;  // receiver node -> links_
+  LinkRanges linkRanges() const;
+  struct ShooterBounds {  // per link, its shooter part at the movie's first key
+    std::vector<Polygon> polygon;
+    std::vector<glm::dvec3> centre;
+    std::vector<double> radius;  // of the sphere about centre holding the polygon
+  };
+  ShooterBounds shooterBounds(double t) const;
+  void makeTiles();
+  void sortTileLinks(size_t tile, const LinkRanges& linksOf, const std::vector<int>& leaf,
+                     const TexelFrame& frame, const ShooterBounds& shooters, bool covered,
+                     std::vector<uint32_t>& nearOfTile,
+                     std::vector<std::pair<uint64_t, uint32_t>>& nearBelow);
+  void planCorners(const TexelFrame& frame, const std::vector<Polygon>& shooter);
+  void listTexelLinks(const std::vector<std::vector<uint32_t>>& nearOfTile,
+                      const std::vector<std::vector<std::pair<uint64_t, uint32_t>>>& nearBelow);
+  void cacheTexelTerms(const TexelFrame& frame, const std::vector<Polygon>& shooter,
+                       double cacheBytes);
+  void cacheTexelKernels(const TexelFrame& frame, const std::vector<Polygon>& shooter, double left);
+  // gather's steps: what every texel shares at one time, then the tiles.
+  struct KeyTerms {
+    std::vector<glm::dvec3> weight;               // per link: B_q \bar V at t; 0 when inactive
+    std::vector<Polygon> shooter;                 // per link: its part at t (when needed)
+    std::vector<glm::dvec3> shooterNormal;        // partial links
+    std::vector<std::vector<glm::dvec3>> points;  // moving partial links: points at t
+    std::vector<double> pointWeight;              // [link * visibilityRays_ + i]
+    std::vector<char> movingNow;                  // a moving node meets the shaft at t
+  };
+  KeyTerms keyTerms(double t) const;
+  const std::vector<glm::dvec3>& pointsOf(const KeyTerms& key, uint32_t link) const;
+  std::array<glm::dvec3, 4> clusterCornersAt(double t) const;
+  glm::dvec3 clusterAt(const std::array<glm::dvec3, 4>& corners, size_t texel) const;
+  std::vector<double> farLinksAtCorners(const KeyTerms& key, const TexelFrame& frame) const;
+  void gatherTile(const Tile& tile, const KeyTerms& key, const std::array<glm::dvec3, 4>& cluster,
+                  const TexelFrame& frame, const std::vector<double>& cornerValue,
+                  std::vector<glm::dvec3>& acc) const;
   std::vector<char> coveredTiles() const;
   void perTexelOnTiles(const std::vector<Polygon>& shooter,
                        std::vector<std::vector<uint32_t>>& nearOfTile,

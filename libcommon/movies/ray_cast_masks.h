@@ -1,11 +1,11 @@
 // Occlusion masks by exact segment tests on the CPU, and the renderer the baker uses by
 // default: these for small masks, OSMesa projective shadows (transmittance.h) for large ones.
 //
-// Why: a render pass through OSMesa costs about half a millisecond whatever it draws (state,
-// clear, a 64-instance draw, read-back). The 10k-triangle hall's movies are mostly 4 x 4
-// texels with one or two blocker triangles in their shaft: 356,636 passes, 161 s of rad-movies'
-// 257 s. The same masks by segment tests are at most texels x samples x blockers tests (each
-// blocker only over the texels its shadows' box covers), a few microseconds there.
+// Why: a render pass through OSMesa has a fixed cost whatever it draws (state, clear, a
+// 64-instance draw, read-back), and a large scene's movies are mostly tiny textures
+// with one or two blocker triangles in their shaft, so the passes' fixed cost dominates. The same
+// masks by segment tests are at most texels x samples x blockers tests (each blocker only over
+// the texels its shadows' box covers).
 //
 // Same answer as the projective render (occlusion_mask_renderer.h): bit s of texel (i, j) is
 // set when a blocker triangle crosses the segment from samples[s] to the texel centre's point

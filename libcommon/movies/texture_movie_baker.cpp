@@ -27,30 +27,15 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "libcommon/movies/movie_geometry.h"
 #include "libcommon/movies/ray_cast_masks.h"
+#include "libcommon/movies/solid_contact.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/scene/box_tree.h"
 #include "libcommon/scene/frame_range.h"
 
 namespace rad {
 namespace {
-
-struct Box {
-  glm::dvec3 lo{std::numeric_limits<double>::infinity()};
-  glm::dvec3 hi{-std::numeric_limits<double>::infinity()};
-  void grow(const glm::dvec3& p) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  void grow(const Polygon& p) {
-    for (int k = 0; k < p.count; ++k) grow(p.v[k]);
-  }
-  bool overlaps(const Box& o) const {
-    return lo.x <= o.hi.x && o.lo.x <= hi.x && lo.y <= o.hi.y && o.lo.y <= hi.y && lo.z <= o.hi.z &&
-           o.lo.z <= hi.z;
-  }
-  bool contains(const glm::dvec3& p) const { return overlaps(Box{p, p}); }
-};
 
 // The reversed copy a doubleSided material adds is the same surface: never its own blocker.
 bool sameSurface(const InputPolygon& a, const InputPolygon& b) {
@@ -63,10 +48,6 @@ bool sameSurface(const InputPolygon& a, const InputPolygon& b) {
   return true;
 }
 
-void appendTriangles(const Polygon& p, std::vector<BlockerTriangle>& out) {
-  for (int i = 1; i + 1 < p.count; ++i) out.push_back({p.v[0], p.v[i], p.v[i + 1]});
-}
-
 uint32_t mix32(uint64_t x) {
   x ^= x >> 33;
   x *= 0xff51afd7ed558ccdull;
@@ -76,306 +57,12 @@ uint32_t mix32(uint64_t x) {
   return uint32_t(x);
 }
 
-// Bad pairs' unoccluded form factors over tiles (MovieGeometry::formFactorsAt). At 4, twice
-// the good layer's ratio for a tile's own links: these are mostly the lights' direct light.
-constexpr int kFormFactorTile = 8;
-constexpr double kFarFormFactorRatio = 4.0;
-
 template <class F>
 void parallelRows(int height, F&& body) {
   tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
     for (int j = r.begin(); j != r.end(); ++j) body(j);
   });
 }
-
-// A bad pair's per-movie data, computed before the first key (paper §5: what the coherence
-// makes per-movie instead of per-key).
-struct Pair {
-  uint32_t shooter = 0;
-  bool coherent = false;
-  std::vector<Polygon> shooterWorld;       // per key
-  int samples = 0;                         // N
-  std::vector<glm::dvec2> unitSamples;     // fixed in the shooter's frame
-  std::vector<int> candidates;             // non-coherent: every possible blocker
-  std::vector<int> dynamicList;            // coherent: moving blockers in the swept shaft
-  std::vector<glm::dvec3> keyZeroSamples;  // coherent: the samples (the pair does not move)
-  SampleMask valid = 0;                    // coherent
-  std::vector<double> formFactor;          // coherent: F(x -> S), once per movie
-  std::vector<SampleMask> staticMask;      // coherent: static blockers; empty = none (all 0)
-  std::vector<long long> spilled;          // moving: key k's form factors in the spill, or -1
-  double maxFormFactor = 0.0;              // over the texels and the keys scanned
-  double share = 1.0;  // the largest share of a texel's direct light its light gives
-                       // (directShares)
-  // A subdivided shooter: the union leaf under each sample, whose radiosity over the shooter's
-  // mean weights the sample (shapedTransmittance); empty: the shooter is one leaf.
-  std::vector<int> sampleLeaf;
-  std::vector<int> leaves;  // its union leaves (the near texels' exact shape)
-};
-
-// A subdivided bad shooter's radiosity over its mean at one key (MovieBake::shapeAt): per
-// shadow sample, the union leaf's under it (shapedTransmittance), and for the texels nearer than
-// the samples' spacing the leaves themselves, in the world at the key whose geometry the masks
-// use. Empty: the shooter is taken as uniform.
-struct ShooterShape {
-  std::vector<glm::vec3> sample;  // per sample, per channel
-  Polygon shooter;
-  double nearDistance = 0.0;
-  std::vector<Polygon> leafWorld;
-  std::vector<glm::dvec3> leafShape;
-  bool empty() const { return sample.empty(); }
-};
-
-// The receiver of one movie at its key times, and what the blocker tests ask of the scene
-// over the movie (each node's answer computed once).
-class MovieGeometry {
- public:
-  MovieGeometry(const Scene& scene, const std::vector<InputPolygon>& tops, const MovieExtent& req,
-                const std::vector<double>& keyTimes)
-      : scene_(scene),
-        tops_(tops),
-        receiverTop_(tops[req.patch.top]),
-        keyTimes_(keyTimes),
-        w_(req.width),
-        h_(req.height),
-        t0_(keyTimes.front()),
-        t1_(keyTimes.back()),
-        nodeMoves_(scene.nodes.size(), -1) {
-    texelPoints(req.patch);
-    receiverDynamic_ = movesDuringMovie(receiverTop_.node);
-    const size_t K = keyTimes_.size();
-    receiverWorld_.resize(K);
-    receiverTransform_.resize(K);
-    receiverNormalMap_.resize(K);
-    for (size_t k = 0; k < K; ++k) {
-      receiverTransform_[k] = scene_.worldTransform(receiverTop_.node, keyTimes_[k]);
-      receiverNormalMap_[k] = glm::transpose(glm::inverse(glm::dmat3(receiverTransform_[k])));
-      receiverWorld_[k] = nodeWorldPolygon(scene_, receiverTop_, req.patch, keyTimes_[k]);
-    }
-  }
-
-  int width() const { return w_; }
-  int height() const { return h_; }
-  size_t texels() const { return size_t(w_) * h_; }
-  int keys() const { return int(keyTimes_.size()); }
-  double keyTime(int k) const { return keyTimes_[size_t(k)]; }
-  const Scene& scene() const { return scene_; }
-  const glm::dvec2& topUv(size_t x) const { return topUv_[x]; }
-  MovieTexels texelPoints() const { return {topUv_, localPoint_, localNormal_, w_, h_}; }
-  const Polygon& receiverWorld(int k) const { return receiverWorld_[size_t(k)]; }
-  bool receiverDynamic() const { return receiverDynamic_; }
-
-  // Whether a node moves during the movie, and its swept bounds, are asked for every blocker
-  // candidate of every bad pair (with 32 moving cubes that was over half of rad-movies' time,
-  // recomputing the same answers); each node's answer over [t0, t1] is computed once.
-  bool movesDuringMovie(int node) {
-    if (node < 0 || node >= int(nodeMoves_.size())) return scene_.isDynamic(node, t0_, t1_);
-    signed char& m = nodeMoves_[size_t(node)];
-    if (m < 0) m = scene_.isDynamic(node, t0_, t1_) ? 1 : 0;
-    return m == 1;
-  }
-  const std::array<glm::dvec3, 2>& sweptDuringMovie(int node) {
-    auto it = nodeSwept_.find(node);
-    if (it == nodeSwept_.end())
-      it = nodeSwept_.emplace(node, scene_.sweptBounds(node, t0_, t1_)).first;
-    return it->second;
-  }
-
-  // Unoccluded form factors F(x -> S) per texel at key k, about the texel's shading normal.
-  // Texels in tiles of kFormFactorTile x kFormFactorTile: where every corner of a tile is farther
-  // from the shooter than kFarFormFactorRatio times the tile's diagonal, F is evaluated at the
-  // corners (texel centres shared with the neighbouring tiles) and interpolated bilinearly over
-  // the tile, as the good layer's far links are (GoodLinkGather::planTexels), but as its ratio
-  // to the point kernel (below): at 6.4 diagonals the worst texel was 1.2 % off with F itself
-  // and 0.022 % with the ratio (TextureMovieBaker.AFarLightsFormFactorIsInterpolatedOverTiles
-  // OfTexels). The shadow stays per texel: only the smooth unoccluded factor is interpolated. Per
-  // texel, the lights' form factors had been 13 % of rad-movies' time on the 10k-triangle hall,
-  // whose movies are mostly 4 x 4 texels under lights metres away. Returns how many texels were
-  // interpolated.
-  size_t formFactorsAt(const Pair& p, int k, std::vector<double>& f) const {
-    f.resize(texels());
-    const Polygon& sw = p.shooterWorld[size_t(k)];
-    auto exact = [&](size_t x) {
-      return pointToPolygonFormFactor(texelPoint(k, x), texelNormal(k, x), sw);
-    };
-    const int tilesX = (w_ + kFormFactorTile - 1) / kFormFactorTile;
-    const int tilesY = (h_ + kFormFactorTile - 1) / kFormFactorTile;
-    std::atomic<size_t> interpolated{0};
-    tbb::parallel_for(0, tilesX * tilesY, [&](int ti) {
-      const int i0 = (ti % tilesX) * kFormFactorTile, j0 = (ti / tilesX) * kFormFactorTile;
-      const int iEnd = std::min(i0 + kFormFactorTile, w_),
-                jEnd = std::min(j0 + kFormFactorTile, h_);
-      const int i1 = std::min(i0 + kFormFactorTile, w_ - 1),
-                j1 = std::min(j0 + kFormFactorTile, h_ - 1);
-      const std::array<size_t, 4> corner = {size_t(j0) * w_ + i0, size_t(j0) * w_ + i1,
-                                            size_t(j1) * w_ + i0, size_t(j1) * w_ + i1};
-      bool far = i1 > i0 && j1 > j0;
-      if (far) {
-        std::array<glm::dvec3, 4> c;
-        for (int q = 0; q < 4; ++q) c[size_t(q)] = texelPoint(k, corner[size_t(q)]);
-        const double size = std::max(glm::length(c[3] - c[0]), glm::length(c[2] - c[1]));
-        for (int q = 0; q < 4 && far; ++q)
-          far = distanceToPolygon(c[size_t(q)], sw) > kFarFormFactorRatio * size;
-      }
-      if (!far) {
-        for (int j = j0; j < jEnd; ++j)
-          for (int i = i0; i < iEnd; ++i) f[size_t(j) * w_ + i] = exact(size_t(j) * w_ + i);
-        return;
-      }
-      // What is interpolated is F over the point kernel max(0, n.d) max(0, -n_S.d) / |d|^4
-      // (d from the texel to the shooter's centroid), which varies far more slowly than F: F's
-      // fall-off and both cosines are the kernel's, evaluated per texel. Where the kernel is 0
-      // at a corner (the shooter across a horizon), F itself.
-      const glm::dvec3 centre = sw.centroid(), shooterNormal = sw.normal();
-      auto kernel = [&](size_t x) {
-        const glm::dvec3 d = centre - texelPoint(k, x);
-        const double r2 = glm::dot(d, d);
-        return std::max(0.0, glm::dot(texelNormal(k, x), d)) *
-               std::max(0.0, -glm::dot(shooterNormal, d)) / (r2 * r2);
-      };
-      std::array<double, 4> fc, kc;
-      bool ratio = true;
-      for (int q = 0; q < 4; ++q) {
-        fc[size_t(q)] = exact(corner[size_t(q)]);
-        kc[size_t(q)] = kernel(corner[size_t(q)]);
-        ratio = ratio && kc[size_t(q)] > 0.0;
-      }
-      if (ratio)
-        for (int q = 0; q < 4; ++q) fc[size_t(q)] /= kc[size_t(q)];
-      interpolated += size_t(jEnd - j0) * size_t(iEnd - i0);
-      for (int j = j0; j < jEnd; ++j) {
-        const double v = double(j - j0) / double(j1 - j0);
-        for (int i = i0; i < iEnd; ++i) {
-          const double u = double(i - i0) / double(i1 - i0);
-          const size_t x = size_t(j) * w_ + i;
-          const double b =
-              (1.0 - v) * ((1.0 - u) * fc[0] + u * fc[1]) + v * ((1.0 - u) * fc[2] + u * fc[3]);
-          f[x] = ratio ? b * kernel(x) : b;
-        }
-      }
-    });
-    return interpolated;
-  }
-  glm::dvec3 texelPoint(int k, size_t x) const {
-    return glm::dvec3(receiverTransform_[size_t(k)] * glm::dvec4(localPoint_[x], 1.0));
-  }
-  glm::dvec3 texelNormal(int k, size_t x) const {
-    return glm::normalize(receiverNormalMap_[size_t(k)] * localNormal_[x]);
-  }
-  // The texel's transmittance at key k from its occluded samples (kernelWeightedTransmittance).
-  double texelTransmittance(int k, size_t x, const std::vector<glm::dvec3>& samples,
-                            const glm::dvec3& shooterNormal, SampleMask occluded,
-                            SampleMask valid) const {
-    const SampleMask open = valid & ~occluded;
-    if (open == valid) return 1.0;  // most texels: no point or normal needed
-    if (open == 0) return 0.0;
-    return kernelWeightedTransmittance(texelPoint(k, x), texelNormal(k, x), samples, shooterNormal,
-                                       occluded, valid);
-  }
-  // A subdivided shooter's shaped transmittance at texel x (shapedTransmittance). Near the shooter
-  // (nearer than its samples' spacing) the samples' kernel peaks within one of them, and their
-  // quadrature of the shooter's radiosity does not hold (a Cornell-box wall's leaves beside the
-  // corner it shares with the receiver): there the shape is the leaves' own point form factors,
-  //   sum_l beta_l F(x -> l) / F(x -> S),
-  // times the kernel-weighted transmittance.
-  glm::dvec3 shapedTransmittanceAt(int k, size_t x, const std::vector<glm::dvec3>& samples,
-                                   const glm::dvec3& shooterNormal, SampleMask occluded,
-                                   SampleMask valid, const ShooterShape& shape) const {
-    const glm::dvec3 pt = texelPoint(k, x), n = texelNormal(k, x);
-    if (!shape.leafWorld.empty() && distanceToPolygon(pt, shape.shooter) < shape.nearDistance) {
-      const double T = kernelWeightedTransmittance(pt, n, samples, shooterNormal, occluded, valid);
-      const double whole = pointToPolygonFormFactor(pt, n, shape.shooter);
-      if (T == 0.0 || !(whole > 0.0)) return glm::dvec3(T);
-      glm::dvec3 shaped(0.0);
-      for (size_t l = 0; l < shape.leafWorld.size(); ++l)
-        shaped += shape.leafShape[l] * pointToPolygonFormFactor(pt, n, shape.leafWorld[l]);
-      return T * shaped / whole;
-    }
-    return shapedTransmittance(pt, n, samples, shooterNormal, occluded, valid, shape.sample);
-  }
-
-  std::vector<glm::dvec3> samplesAt(const Pair& p, int k) const {
-    std::vector<glm::dvec3> s(static_cast<size_t>(p.samples));
-    for (int i = 0; i < p.samples; ++i)
-      s[size_t(i)] = samplePointOnPolygon(p.shooterWorld[size_t(k)], p.unitSamples[size_t(i)]);
-    return s;
-  }
-  Box shaftAt(const Pair& p, int k) const {
-    Box box;
-    box.grow(receiverWorld_[size_t(k)]);
-    box.grow(p.shooterWorld[size_t(k)]);
-    return box;
-  }
-  // The convex hull of the shooter and the receiver's texture domain (a triangle's (u,v) square
-  // is the parallelogram v0, v1, v1 + v2 - v0, v2): every segment from a shooter sample to a
-  // texel centre lies in it, so a blocker whose box misses it covers no texel, and culling it
-  // changes no mask. The box shaft alone kept, on the 10k-triangle hall, every table and chair
-  // in the box spanned by a floor patch and a ceiling light.
-  Shaft hullAt(const Pair& p, int k) const {
-    Polygon domain = receiverWorld_[size_t(k)];
-    if (domain.count == 3) {
-      domain.v[3] = domain.v[2];
-      domain.v[2] = domain.v[1] + domain.v[3] - domain.v[0];
-      domain.count = 4;
-    }
-    return Shaft(domain, p.shooterWorld[size_t(k)]);
-  }
-  // World polygon of top-level patch b at key k. The node's world transform is computed once
-  // per movie and key: the blockers of every pair at every key are placed with it, several
-  // polygons per node.
-  Polygon worldPolygon(int b, int k) {
-    const int node = tops_[size_t(b)].node;
-    const long long key = (long long)k * (long long)(scene_.nodes.size() + 1) + (node + 1);
-    auto it = nodeWorldAtKey_.find(key);
-    if (it == nodeWorldAtKey_.end())
-      it = nodeWorldAtKey_.emplace(key, scene_.worldTransform(node, keyTimes_[size_t(k)])).first;
-    return tops_[size_t(b)].local.transformed(it->second);
-  }
-  // Blockers of candidate list `list` in the pair's shaft at key k, as world triangles.
-  std::vector<BlockerTriangle> blockersAt(const Pair& p, const std::vector<int>& list, int k) {
-    Box shaft = shaftAt(p, k);
-    const Shaft hull = hullAt(p, k);
-    std::vector<BlockerTriangle> tris;
-    for (int b : list) {
-      Polygon poly = worldPolygon(b, k);
-      Box pb;
-      pb.grow(poly);
-      if (pb.overlaps(shaft) && hull.meets(pb.lo, pb.hi)) appendTriangles(poly, tris);
-    }
-    return tris;
-  }
-
- private:
-  // Texel centres: node (u,v) -> top (u,v) -> local point.
-  void texelPoints(PatchId patch) {
-    const bool triangle = receiverTop_.local.count == 3;
-    topUv_.resize(texels());
-    localPoint_.resize(texels());
-    localNormal_.resize(texels());
-    for (int j = 0; j < h_; ++j)
-      for (int i = 0; i < w_; ++i) {
-        size_t x = size_t(j) * w_ + i;
-        topUv_[x] = topUvFromNodeUv(patch, {(i + 0.5) / w_, (j + 0.5) / h_}, triangle);
-        localPoint_[x] = polygonPointAt(receiverTop_.local, topUv_[x]);
-        localNormal_[x] = shadingNormalAt(receiverTop_, topUv_[x]);
-      }
-  }
-
-  const Scene& scene_;
-  const std::vector<InputPolygon>& tops_;
-  const InputPolygon& receiverTop_;
-  const std::vector<double>& keyTimes_;
-  const int w_, h_;
-  const double t0_, t1_;
-  std::vector<glm::dvec2> topUv_;
-  std::vector<glm::dvec3> localPoint_, localNormal_;  // texel centres and shading normals
-  std::vector<signed char> nodeMoves_;
-  std::unordered_map<int, std::array<glm::dvec3, 2>> nodeSwept_;
-  bool receiverDynamic_ = false;
-  std::vector<Polygon> receiverWorld_;
-  std::vector<glm::dmat4> receiverTransform_;
-  std::vector<glm::dmat3> receiverNormalMap_;  // of the shading normals, per key
-  std::unordered_map<long long, glm::dmat4> nodeWorldAtKey_;
-};
 
 // Merge (paper §5): a coherent pair's transmittance at one key from its static-blocker mask
 // (empty: no static blocker) and the key's dynamic-blocker mask. kExact ORs the masks (the
@@ -404,9 +91,8 @@ void mergeOcclusion(MergeMode merge, const std::vector<SampleMask>& staticMask,
 
 // Where a pair's blocker candidates come from: the top-level patches of nodes that never move,
 // in a box tree of their world bounds, and the few of nodes that move somewhere in the
-// animation, in a list. Scanning every top for every pair had been rad-movies' largest cost on
-// the 10k-triangle hall after the masks themselves (349k pairs x 5,051 tops, each placed in
-// the world and tested against the shaft).
+// animation, in a list. Why: scanning every top for every pair costs pairs x tops placements
+// and shaft tests, which grows as the square of the scene.
 struct BlockerIndex {
   BoxTree fixedTops;
   std::vector<int> movableTops;  // ascending
@@ -423,9 +109,7 @@ struct BlockerIndex {
       auto it = world.find(node);
       if (it == world.end())
         it = world.emplace(node, scene.worldTransform(node, scene.startTime())).first;
-      Box box;
-      box.grow(tops[b].local.transformed(it->second));
-      boxes[b] = {box.lo, box.hi};
+      boxes[b] = boxOf(tops[b].local.transformed(it->second));
     }
     fixedTops = BoxTree(boxes);
   }
@@ -467,114 +151,121 @@ class MovieBake {
         transmittance_(texels_),
         texture_(texels_ * 3) {}
 
-  // Texels under a touching solid at key k (a box's foot on the floor, coveredBySolid) are never
-  // seen, and gather nothing: ~0. A pixel between such a texel's centre and an exposed one's
-  // (the floor just beside the box) interpolated the two, and came out up to 4x too dark: the
-  // largest single errors of the Cornell box's frame. Each covered texel next to an exposed one
-  // takes the mean of its exposed 8-neighbours, twice outwards (lightmap dilation), so that
-  // the bilinear lookup meets exposed values only. Static blockers are tested once per movie,
-  // moving ones at each key where their swept bounds meet the receiver.
+  // Texels under a touching solid at key k (a box's foot on the floor, solid_contact.h) are
+  // never seen, and gather nothing: ~0. A pixel between such a texel's centre and an exposed
+  // one's (the floor just beside the box) interpolates the two and comes out far too dark. Each
+  // covered texel next to an exposed one takes the mean of its exposed 8-neighbours, twice
+  // outwards (lightmap dilation), so that the bilinear lookup meets exposed values only. Static
+  // blockers are tested once per movie, moving ones at each key where their swept bounds meet
+  // the receiver.
   void fillCoveredTexels(int k, double t) {
     auto clock = SteadyClock::now();
-    const int w = geo_.width(), h = geo_.height();
-    const PatchHierarchy& hierarchy = solution_.hierarchy;
-    const uint32_t top = req_.patch.top;
-    const Polygon& receiver = geo_.receiverWorld(k);
-    const double size = polygonSize(receiver);
-    // Inside a solid every way: the four rays tilted 88 degrees from the normal (nearly along
-    // the surface) meet backs. The normal ray alone took the ceiling above a lamp panel hung
-    // 1 mm under it, which the camera sees, dark, through the gap; rays 88 degrees from the
-    // normal leave through a gap g from every point within g / tan(2 deg) = 28.6 g of the
-    // panel's edge, and under a box they meet its sides from inside. The normal ray is not
-    // asked: under an open tube closed by a top (the table scene's legs under the table top)
-    // it meets the top's underside, a front, and the leg's footprint gathered as if exposed
-    // (0.5-0.8 against 1.1-1.6 beside it; a floor point inside an open chimney is taken as
-    // covered the same way, and shows its neighbours' light).
-    auto solidAt = [&](const VisibilityScene& blockers, double at, const glm::dvec3& p,
-                       const glm::dvec3& n) {
-      return insideSolid(blockers, geo_.scene(), hierarchy, top, p, n, size, at);
-    };
-    // A texel whose centre lies within a quarter texel outside a solid's foot (a partition
-    // standing on a texel row: the cubic scene's walls are 5 cm from the floor tiles' edges, a
-    // texel centre 0.2 mm from the wall) is covered too: its own gather meets the foot's edge,
-    // where the occlusion masks' rasterization decides the light either way (the row came out at
-    // 24 % of its neighbours, a dashed dark line along the wall in the frame), while its
-    // exposed neighbours' mean is its value to a quarter texel. Tested where a 4-neighbour was
-    // covered by this pass: the centre moved a quarter of the way towards that neighbour.
-    auto coverNearEdges = [&](const VisibilityScene& blockers, double at,
-                              std::vector<char>& covered, const std::vector<char>& before) {
-      std::vector<char> add(texels_, 0);
-      tbb::parallel_for(0, h, [&](int j) {
-        for (int i = 0; i < w; ++i) {
-          const size_t x = size_t(j) * w + i;
-          if (covered[x]) continue;
-          const int di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
-          for (int e = 0; e < 4; ++e) {
-            const int a = i + di[e], b = j + dj[e];
-            if (a < 0 || b < 0 || a >= w || b >= h) continue;
-            const size_t y = size_t(b) * w + a;
-            if (!covered[y] || before[y]) continue;
-            const glm::dvec3 p = geo_.texelPoint(k, x);
-            if (solidAt(blockers, at, p + 0.25 * (geo_.texelPoint(k, y) - p),
-                        geo_.texelNormal(k, x))) {
-              add[x] = 1;
-              break;
-            }
-          }
-        }
-      });
-      for (size_t x = 0; x < texels_; ++x) covered[x] |= add[x];
-    };
-    // `inside`: when given, only texels inside one of these boxes can be covered (the moving
-    // nodes' bounds at t: a texel under a moving box lies in the box's bounds).
-    auto test = [&](const VisibilityScene& blockers, double at, std::vector<char>& covered,
-                    const std::vector<Box>* inside) {
-      const std::vector<char> before = covered;
-      tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
-        if (covered[x]) return;
-        if (inside && std::none_of(inside->begin(), inside->end(),
-                                   [&](const Box& b) { return b.contains(geo_.texelPoint(k, x)); }))
-          return;
-        const glm::dvec3 p = geo_.texelPoint(k, x), n = geo_.texelNormal(k, x);
-        if (solidAt(blockers, at, p, n)) covered[x] = 1;
-      });
-      coverNearEdges(blockers, at, covered, before);
-    };
-    const bool receiverMoves = geo_.receiverDynamic();
-    if (staticCovered_.empty() || receiverMoves) {
-      staticCovered_.assign(texels_, 0);
-      test(visibility_->staticPart(), t, staticCovered_, nullptr);
-      // A triangle's texture is the half square u + v <= 1 of its (u,v) map; the texels beyond
-      // its long edge lie outside the patch, and those on it (a square texture puts a diagonal of
-      // texel centres exactly on the edge) are half-shadowed by whatever touches the edge there.
-      // A pixel inside near the edge interpolated them: the Cornell box's left wall (two
-      // triangles) showed a dark line along its seam with the back wall, the texels on the edge
-      // at 15 % of their inside neighbours. Both are filled as the covered ones are.
-      if (tops_[top].local.count == 3)
-        for (int j = 0; j < h; ++j)
-          for (int i = 0; i < w; ++i)
-            if ((i + 0.5) / w + (j + 0.5) / h >= 1.0 - 1e-9) staticCovered_[size_t(j) * w + i] = 1;
-      Box box;
-      box.grow(receiver);
-      movingNear_.clear();
-      for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
-                                    solution_.keyTimes.back())) {
-        const auto b =
-            geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
-        if (box.overlaps(Box{b[0], b[1]})) movingNear_.push_back(node);
-      }
-    }
+    const double size = polygonSize(geo_.receiverWorld(k));
+    if (staticCovered_.empty() || geo_.receiverDynamic()) coverStaticTexels(k, t, size);
     covered_ = staticCovered_;
     if (!movingNear_.empty() && visibility_->dynamicNodeCount() > 0) {
-      std::vector<Box> now;
+      std::vector<AxisBox> now;
       for (int node : movingNear_) {
         const auto b = geo_.scene().sweptBounds(node, t, t);
         const glm::dvec3 pad(1e-9 * std::max(size, glm::length(b[1] - b[0])));
-        now.push_back(Box{b[0] - pad, b[1] + pad});
+        now.push_back(AxisBox{b[0] - pad, b[1] + pad});
       }
       visibility_->setTime(t);
-      test(visibility_->movingPart(), t, covered_, &now);
+      coverTexels(visibility_->movingPart(), k, t, size, covered_, &now);
     }
+    stats_.coveredTexelsFilled += fillFromExposedNeighbours();
+    stats_.secondsCombine += secondsSince(clock);
+  }
+
+ private:
+  // Whether texel point p (normal n) of the receiver lies inside a solid of `blockers` at time
+  // `at` (insideSolid: the four rays 88 degrees from the normal, so that a gap between the
+  // solid and the surface lets them out, and the texels under an open tube closed by a top
+  // are covered as those under a box are).
+  bool solidAt(const VisibilityScene& blockers, double at, double size, const glm::dvec3& p,
+               const glm::dvec3& n) const {
+    return insideSolid(blockers, geo_.scene(), solution_.hierarchy, req_.patch.top, p, n, size, at);
+  }
+
+  // Marks in `covered` the texels at key k inside a solid of `blockers` at time `at`, then those
+  // near a solid's edge (coverNearEdges). `inside`: when given, only texels inside one of these
+  // boxes can be covered (the moving nodes' bounds at t: a texel under a moving box lies in the
+  // box's bounds).
+  void coverTexels(const VisibilityScene& blockers, int k, double at, double size,
+                   std::vector<char>& covered, const std::vector<AxisBox>* inside) {
+    const std::vector<char> before = covered;
+    tbb::parallel_for(size_t(0), texels_, [&](size_t x) {
+      if (covered[x]) return;
+      if (inside && std::none_of(inside->begin(), inside->end(), [&](const AxisBox& b) {
+            return boxHolds(b, geo_.texelPoint(k, x));
+          }))
+        return;
+      const glm::dvec3 p = geo_.texelPoint(k, x), n = geo_.texelNormal(k, x);
+      if (solidAt(blockers, at, size, p, n)) covered[x] = 1;
+    });
+    coverNearEdges(blockers, k, at, size, covered, before);
+  }
+
+  // A texel whose centre lies within a quarter texel outside a solid's foot (a partition
+  // standing on a texel row, a texel centre a fraction of a millimetre from the wall) is covered
+  // too: its own gather meets the foot's edge, where the occlusion masks' rasterization decides
+  // the light either way (a dashed dark line along the wall), while its exposed neighbours'
+  // mean is its value to a quarter texel. Tested where a 4-neighbour was covered by this pass
+  // (covered and not `before`): the centre moved a quarter of the way towards that neighbour.
+  void coverNearEdges(const VisibilityScene& blockers, int k, double at, double size,
+                      std::vector<char>& covered, const std::vector<char>& before) {
+    const int w = geo_.width(), h = geo_.height();
+    std::vector<char> add(texels_, 0);
+    tbb::parallel_for(0, h, [&](int j) {
+      for (int i = 0; i < w; ++i) {
+        const size_t x = size_t(j) * w + i;
+        if (covered[x]) continue;
+        const int di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};
+        for (int e = 0; e < 4; ++e) {
+          const int a = i + di[e], b = j + dj[e];
+          if (a < 0 || b < 0 || a >= w || b >= h) continue;
+          const size_t y = size_t(b) * w + a;
+          if (!covered[y] || before[y]) continue;
+          const glm::dvec3 p = geo_.texelPoint(k, x);
+          if (solidAt(blockers, at, size, p + 0.25 * (geo_.texelPoint(k, y) - p),
+                      geo_.texelNormal(k, x))) {
+            add[x] = 1;
+            break;
+          }
+        }
+      }
+    });
+    for (size_t x = 0; x < texels_; ++x) covered[x] |= add[x];
+  }
+
+  // The texels covered by static solids (staticCovered_; once per movie unless the receiver
+  // moves) and the moving nodes whose bounds over the movie meet the receiver (movingNear_).
+  void coverStaticTexels(int k, double t, double size) {
+    const int w = geo_.width(), h = geo_.height();
+    staticCovered_.assign(texels_, 0);
+    coverTexels(visibility_->staticPart(), k, t, size, staticCovered_, nullptr);
+    // A triangle's texture is the half square u + v <= 1 of its (u,v) map; the texels beyond
+    // its long edge lie outside the patch, and those on it (a square texture puts a diagonal of
+    // texel centres exactly on the edge) are half-shadowed by whatever touches the edge there.
+    // A pixel inside near the edge interpolated them (a dark line along the seam of two
+    // triangles). Both are filled as the covered ones are.
+    if (tops_[req_.patch.top].local.count == 3)
+      for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i)
+          if ((i + 0.5) / w + (j + 0.5) / h >= 1.0 - 1e-9) staticCovered_[size_t(j) * w + i] = 1;
+    const AxisBox box = boxOf(geo_.receiverWorld(k));
+    movingNear_.clear();
+    for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
+                                  solution_.keyTimes.back())) {
+      const auto b = geo_.scene().sweptBounds(node, geo_.keyTime(0), geo_.keyTime(geo_.keys() - 1));
+      if (boxesMeet(box, AxisBox{b[0], b[1]})) movingNear_.push_back(node);
+    }
+  }
+
+  // Each covered texel (covered_) next to an exposed one takes the mean of its exposed
+  // 8-neighbours in texture_, in two rings outwards. Returns how many were filled.
+  long fillFromExposedNeighbours() {
+    const int w = geo_.width(), h = geo_.height();
     std::vector<char> exposed(texels_);
     for (size_t x = 0; x < texels_; ++x) exposed[x] = covered_[x] ? 0 : 1;
     long filled = 0;
@@ -600,10 +291,10 @@ class MovieBake {
         }
       exposed.swap(next);
     }
-    stats_.coveredTexelsFilled += filled;
-    stats_.secondsCombine += secondsSince(clock);
+    return filled;
   }
 
+ public:
   // Planning: the per-movie part of every bad pair, in badShooters order.
   void plan(const std::vector<uint32_t>& badShooters) {
     saturatedSamples_ = transmittanceSampleCount(std::numeric_limits<double>::infinity(),
@@ -611,18 +302,18 @@ class MovieBake {
                                                  options_.maxSamples);
     // Every pair's form factors first: a pair's share of the direct light needs them all.
     for (uint32_t S : badShooters) {
-      Pair p;
+      BadPair p;
       if (scanPair(S, p)) pairs_.push_back(std::move(p));
     }
     directShares();
-    for (Pair& p : pairs_) planPair(p);
+    for (BadPair& p : pairs_) planPair(p);
   }
 
   // Key k: H = G + sum over the pairs, in badShooters order, of B_S F T (the same arithmetic
   // and per-texel order as accumulating pair by pair over all keys), into the sink.
   void bakeKey(int k, double t, BakedKeySink& sink) {
     goodLayer(t);
-    for (const Pair& p : pairs_) {
+    for (const BadPair& p : pairs_) {
       OcclusionMaskRenderer& gl = renderer_();
       shapeAt(p, p.coherent ? 0 : k, t);
       const std::vector<double>& f =
@@ -649,18 +340,18 @@ class MovieBake {
   }
   // Key 0's form factors of a pair: a coherent pair's own, a moving pair's from the spill (its
   // scan put them there first) or recomputed, into `scratch`.
-  const std::vector<double>& keyZeroFormFactors(const Pair& p, std::vector<double>& scratch) {
+  const std::vector<double>& keyZeroFormFactors(const BadPair& p, std::vector<double>& scratch) {
     if (p.coherent) return p.formFactor;
     scratch.resize(texels_);
     if (!spill_.get(p.spilled[0], scratch)) countFormFactors(geo_.formFactorsAt(p, 0, scratch));
     return scratch;
   }
-  bool scanPair(uint32_t S, Pair& p);
+  bool scanPair(uint32_t S, BadPair& p);
   void directShares();
-  void planPair(Pair& p);
-  double scanFormFactors(Pair& p);
-  std::vector<int> blockerCandidates(uint32_t S, const Pair& p);
-  void planCoherentBlockers(Pair& p, const std::vector<int>& candidates);
+  void planPair(BadPair& p);
+  double scanFormFactors(BadPair& p);
+  std::vector<int> blockerCandidates(uint32_t S, const BadPair& p);
+  void planCoherentBlockers(BadPair& p, const std::vector<int>& candidates);
 
   // Good layer: gathered per texel over the good links, or (paper §3.1) Gouraud over the patch
   // from the global solution. Both carry the top's cluster light (topClusterIrradiance): the
@@ -684,7 +375,7 @@ class MovieBake {
 
   // A static pair at key k: its dynamic blockers rendered from the movie's samples, merged
   // with the static mask. Returns the pair's form factors (once per movie).
-  const std::vector<double>& coherentTransmittance(OcclusionMaskRenderer& gl, const Pair& p,
+  const std::vector<double>& coherentTransmittance(OcclusionMaskRenderer& gl, const BadPair& p,
                                                    int k) {
     auto clock = SteadyClock::now();
     std::vector<BlockerTriangle> dynamicTris = p.dynamicList.empty()
@@ -715,7 +406,8 @@ class MovieBake {
 
   // A moving pair (or the baseline) at key k: every blocker in the key's shaft rendered from
   // the key's samples; the key's form factors read back from the spill or recomputed.
-  const std::vector<double>& movingTransmittance(OcclusionMaskRenderer& gl, const Pair& p, int k) {
+  const std::vector<double>& movingTransmittance(OcclusionMaskRenderer& gl, const BadPair& p,
+                                                 int k) {
     auto clock = SteadyClock::now();
     const std::vector<glm::dvec3> samples = geo_.samplesAt(p, k);
     const SampleMask valid = frontSampleMask(geo_.receiverWorld(k), samples);
@@ -742,7 +434,7 @@ class MovieBake {
   // The shape of a subdivided shooter at time t into shape_, per channel (colour bleeds unevenly
   // over a wall: the back wall's part beside the red wall is redder). Empty: a light or a leaf
   // (planPair), uniform within 1e-3, or an approximate --merge (popcount transmittances only).
-  void shapeAt(const Pair& p, int geometryKey, double t) {
+  void shapeAt(const BadPair& p, int geometryKey, double t) {
     shape_.sample.clear();
     shape_.leafWorld.clear();
     shape_.leafShape.clear();
@@ -777,7 +469,7 @@ class MovieBake {
   }
 
   // Combine: the bad layer B_S(t) F T added to the irradiance.
-  void combine(const Pair& p, double t, const std::vector<double>& f) {
+  void combine(const BadPair& p, double t, const std::vector<double>& f) {
     auto clock = SteadyClock::now();
     const glm::dvec3 B = solution_.radiosity(int(p.shooter), t);
     if (!shape_.empty())
@@ -800,7 +492,7 @@ class MovieBake {
   SceneVisibility* visibility_;   // null: covered texels are left as they are
   const size_t texels_;
   int saturatedSamples_ = 0;
-  std::vector<Pair> pairs_;
+  std::vector<BadPair> pairs_;
   // Per-key buffers (movieWorkingBytes counts them).
   std::vector<glm::dvec3> acc_;
   std::vector<float> transmittance_, texture_;
@@ -814,7 +506,7 @@ class MovieBake {
 };
 
 // One bad pair's form factors; false when the shooter cannot reach the patch.
-bool MovieBake::scanPair(uint32_t S, Pair& p) {
+bool MovieBake::scanPair(uint32_t S, BadPair& p) {
   if (S >= tops_.size()) return false;
   const InputPolygon& shooterTop = tops_[S];
   ++stats_.badPairs;
@@ -872,7 +564,7 @@ void MovieBake::directShares() {
 }
 
 // One bad pair's per-movie part after the scan: its samples and blockers.
-void MovieBake::planPair(Pair& p) {
+void MovieBake::planPair(BadPair& p) {
   const uint32_t S = p.shooter;
   // Shooter samples (paper §3.1 step 1), fixed in the shooter's frame for the whole movie. A
   // weak pair (under --weak-share of every texel's direct light) takes a quarter of the
@@ -927,7 +619,7 @@ void MovieBake::planPair(Pair& p) {
 // coherent pair keeps its one set; a moving pair's sets are spilled as they are scanned and the
 // scan stops once N has reached its maximum (more keys cannot change it; their sets are
 // computed when their key is baked).
-double MovieBake::scanFormFactors(Pair& p) {
+double MovieBake::scanFormFactors(BadPair& p) {
   auto clock = SteadyClock::now();
   double maxF = 0.0;
   if (p.coherent) {
@@ -955,18 +647,18 @@ double MovieBake::scanFormFactors(Pair& p) {
 // key (all keys' for a pair that moves, key 0's for a static one: planCoherentBlockers places
 // blockers at key 0), but the two ends and their reversed copies. Each list is filtered again
 // against the shafts where it is used; this only keeps far patches out.
-std::vector<int> MovieBake::blockerCandidates(uint32_t S, const Pair& p) {
+std::vector<int> MovieBake::blockerCandidates(uint32_t S, const BadPair& p) {
   const uint32_t R = req_.patch.top;
   const InputPolygon &receiverTop = tops_[R], &shooterTop = tops_[S];
-  Box shaft = geo_.shaftAt(p, 0);
+  AxisBox shaft = geo_.shaftAt(p, 0);
   if (!p.coherent)
     for (int k = 1; k < geo_.keys(); ++k) {
-      Box b = geo_.shaftAt(p, k);
-      shaft.grow(b.lo);
-      shaft.grow(b.hi);
+      const AxisBox b = geo_.shaftAt(p, k);
+      growBox(shaft, b[0]);
+      growBox(shaft, b[1]);
     }
   std::vector<int> candidates;
-  for (int b : blockers_.near(shaft.lo, shaft.hi)) {
+  for (int b : blockers_.near(shaft[0], shaft[1])) {
     if (b == int(R) || b == int(S) || sameSurface(tops_[size_t(b)], receiverTop) ||
         sameSurface(tops_[size_t(b)], shooterTop))
       continue;
@@ -977,20 +669,18 @@ std::vector<int> MovieBake::blockerCandidates(uint32_t S, const Pair& p) {
 
 // §5: a static pair's shaft blockers split into static ones, rendered here once per movie into
 // the pair's static mask, and dynamic ones (in the shaft swept over the movie), rendered per key.
-void MovieBake::planCoherentBlockers(Pair& p, const std::vector<int>& candidates) {
-  Box shaft = geo_.shaftAt(p, 0);
+void MovieBake::planCoherentBlockers(BadPair& p, const std::vector<int>& candidates) {
+  const AxisBox shaft = geo_.shaftAt(p, 0);
   const Shaft hull = geo_.hullAt(p, 0);
   std::vector<int> staticList;
   for (int b : candidates) {
     int node = tops_[size_t(b)].node;
     if (!geo_.movesDuringMovie(node)) {
-      Box pb;
-      pb.grow(geo_.worldPolygon(b, 0));  // t0 is key 0's time
-      if (pb.overlaps(shaft) && hull.meets(pb.lo, pb.hi)) staticList.push_back(b);
+      const AxisBox pb = boxOf(geo_.worldPolygon(b, 0));  // t0 is key 0's time
+      if (boxesMeet(pb, shaft) && hull.meets(pb[0], pb[1])) staticList.push_back(b);
     } else {
       const std::array<glm::dvec3, 2>& sb = geo_.sweptDuringMovie(node);
-      Box swept{sb[0], sb[1]};
-      if (swept.overlaps(shaft)) p.dynamicList.push_back(b);
+      if (boxesMeet(AxisBox{sb[0], sb[1]}, shaft)) p.dynamicList.push_back(b);
     }
   }
   stats_.staticBlockers += long(staticList.size());
@@ -1036,45 +726,6 @@ nlohmann::json TextureMovieBakerOptions::toJson() const {
           {"moving-shadow-key-step", movingShadowKeyStep},
           {"no-coherence", !coherence},
           {"max-texture-memory", maxTextureMemoryMiB}};
-}
-
-nlohmann::json TextureMovieBakerStats::toJson() const {
-  return {{"movies", movies},
-          {"constant_movies", constantMovies},
-          {"keys", keys},
-          {"texels", texels},
-          {"bad_pairs", badPairs},
-          {"static_pairs", staticPairs},
-          {"dynamic_pairs", dynamicPairs},
-          {"samples", samples},
-          {"weak_pairs", weakPairs},
-          {"blockers_static", staticBlockers},
-          {"blockers_dynamic", dynamicBlockers},
-          {"render_passes", passes},
-          {"ray_cast_passes", rayCastPasses},
-          {"sample_passes", samplePasses},
-          {"render_passes_saved_by_coherence", passesSavedByCoherence},
-          {"good_layer_gather",
-           {{"links", gather.links},
-            {"entries", gather.entries},
-            {"cached_entries", gather.cachedEntries},
-            {"tile_entries", gather.tileEntries},
-            {"partial_links", gather.partialLinks},
-            {"partial_links_moving_blockers", gather.partialLinksMovingBlockers},
-            {"partial_links_few_rays", gather.partialLinksFewRays},
-            {"partial_tile_links_per_texel", gather.partialTileLinksPerTexel},
-            {"near_shooter_leaves", gather.nearShooterLeaves},
-            {"near_shooter_seconds", gather.nearShooterSeconds}}},
-          {"covered_texels_filled", coveredTexelsFilled},
-          {"form_factor_texels", formFactorTexels},
-          {"form_factor_texels_interpolated", formFactorTexelsInterpolated},
-          {"seconds",
-           {{"good_layer", secondsGood},
-            {"form_factors", secondsFormFactor},
-            {"form_factor_max_scan", secondsFormFactorScan},
-            {"transmittance", secondsTransmittance},
-            {"combine", secondsCombine}}},
-          {"warnings", warnings}};
 }
 
 Polygon nodePolygonIn(const Polygon& top, PatchId node) {
@@ -1155,45 +806,6 @@ void TextureMovieBaker::addStats(const TextureMovieBakerStats& stats) {
   stats_ += stats;
 }
 
-TextureMovieBakerStats& TextureMovieBakerStats::operator+=(const TextureMovieBakerStats& o) {
-  movies += o.movies;
-  constantMovies += o.constantMovies;
-  keys += o.keys;
-  texels += o.texels;
-  badPairs += o.badPairs;
-  staticPairs += o.staticPairs;
-  dynamicPairs += o.dynamicPairs;
-  samples += o.samples;
-  weakPairs += o.weakPairs;
-  staticBlockers += o.staticBlockers;
-  dynamicBlockers += o.dynamicBlockers;
-  passes += o.passes;
-  samplePasses += o.samplePasses;
-  rayCastPasses += o.rayCastPasses;
-  passesSavedByCoherence += o.passesSavedByCoherence;
-  coveredTexelsFilled += o.coveredTexelsFilled;
-  gather.links += o.gather.links;
-  gather.entries += o.gather.entries;
-  gather.cachedEntries += o.gather.cachedEntries;
-  gather.tileEntries += o.gather.tileEntries;
-  gather.partialLinks += o.gather.partialLinks;
-  gather.partialLinksMovingBlockers += o.gather.partialLinksMovingBlockers;
-  gather.partialLinksFewRays += o.gather.partialLinksFewRays;
-  gather.partialTileLinksPerTexel += o.gather.partialTileLinksPerTexel;
-  gather.nearShooterLeaves += o.gather.nearShooterLeaves;
-  gather.nearShooterSeconds += o.gather.nearShooterSeconds;
-  formFactorTexels += o.formFactorTexels;
-  formFactorTexelsInterpolated += o.formFactorTexelsInterpolated;
-  secondsGood += o.secondsGood;
-  secondsFormFactor += o.secondsFormFactor;
-  secondsTransmittance += o.secondsTransmittance;
-  secondsCombine += o.secondsCombine;
-  secondsFormFactorScan += o.secondsFormFactorScan;
-  for (const std::string& w : o.warnings)
-    if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
-  return *this;
-}
-
 double TextureMovieBaker::movieWorkingBytes(int width, int height, size_t badShooters) {
   // Per texel: texel (u,v) and local point (16 + 24); the key's double accumulator (24), its
   // float texture (12) and the sink's copy of key 0 (12, constant-movie check); one pair's
@@ -1266,15 +878,14 @@ bool TextureMovieBaker::shadowsMove(const MovieExtent& req,
   for (int node : movingNodesOf(scene_, tops_, t0, t1))
     swept.push_back(scene_.sweptBounds(node, t0, t1));
   if (swept.empty()) return false;
-  Box receiver;
-  receiver.grow(nodeWorldPolygon(scene_, receiverTop, req.patch, t0));
+  const AxisBox receiver = boxOf(nodeWorldPolygon(scene_, receiverTop, req.patch, t0));
   for (uint32_t S : badShooters) {
     if (S >= tops_.size()) continue;
     if (scene_.isDynamic(tops_[S].node, t0, t1)) return true;
-    Box shaft = receiver;
-    shaft.grow(tops_[S].local.transformed(scene_.worldTransform(tops_[S].node, t0)));
+    AxisBox shaft = receiver;
+    growBoxTo(shaft, tops_[S].local.transformed(scene_.worldTransform(tops_[S].node, t0)));
     for (const auto& b : swept)
-      if (shaft.overlaps(Box{b[0], b[1]})) return true;
+      if (boxesMeet(shaft, AxisBox{b[0], b[1]})) return true;
   }
   return false;
 }

@@ -67,9 +67,9 @@ double transmittanceFromMask(SampleMask occluded, SampleMask valid);
 // the shooter's normal taken either way, as a planar shooter lies wholly on one side of x):
 //   T(x) = sum_{s open} K(x, s) / sum_s K(x, s),
 // the quadrature of F(x -> S, visible) / F(x -> S) by the samples, where the popcount fraction
-// weights every part of the shooter alike. A large light near a receiver varies K by 2x over
-// itself (the Cornell box's lamp seen from the foot of a side wall), and there a box's penumbra
-// came out up to 10 % wrong. Fully open or fully occluded: exactly 1 or 0 whatever the weights;
+// weights every part of the shooter alike. A large light near a receiver varies K over itself
+// (a lamp seen from the foot of a side wall), and there a penumbra weighted alike is wrong.
+// Fully open or fully occluded: exactly 1 or 0 whatever the weights;
 // no weight at any valid sample: the popcount fraction.
 double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
                                    const std::vector<glm::dvec3>& samples,
@@ -81,8 +81,8 @@ double kernelWeightedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
 // beta_s = B(y_s) / B_S, the radiosity of the leaf under it over the shooter's mean,
 //   T_B(x) = sum_{s open} K(x, s) beta_s / sum_s K(x, s),
 // so that B_S F(x -> S) T_B(x) estimates the irradiance $\int_S B(y) V K dy$ of the shooter's
-// leaves, not of its mean (a Cornell-box wall's mean radiosity put 6.5 % too little light on
-// the ceiling, whose near parts see the wall's brighter upper half). Not 1 where every sample
+// leaves, not of its mean (a wall's mean radiosity puts too little light on a ceiling whose near
+// parts see the wall's brighter upper half). Not 1 where every sample
 // is open: the kernel still weights the shooter's parts.
 // Per channel (beta_s for R, G, B).
 glm::dvec3 shapedTransmittance(const glm::dvec3& x, const glm::dvec3& n,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -11,6 +12,26 @@
 namespace rad {
 
 using AxisBox = std::array<glm::dvec3, 2>;  // {lo, hi}
+
+// The empty box (lo +inf, hi -inf): growBox makes it the box of the first point it is given.
+inline AxisBox emptyAxisBox() {
+  return {glm::dvec3(std::numeric_limits<double>::infinity()),
+          glm::dvec3(-std::numeric_limits<double>::infinity())};
+}
+// Grows b to hold point p.
+inline void growBox(AxisBox& b, const glm::dvec3& p) {
+  b[0] = glm::min(b[0], p);
+  b[1] = glm::max(b[1], p);
+}
+// Whether two boxes meet (touching counts; an empty box meets nothing).
+inline bool boxesMeet(const AxisBox& a, const AxisBox& b) {
+  return a[0].x <= b[1].x && b[0].x <= a[1].x && a[0].y <= b[1].y && b[0].y <= a[1].y &&
+         a[0].z <= b[1].z && b[0].z <= a[1].z;
+}
+// Whether b holds point p (its faces included).
+inline bool boxHolds(const AxisBox& b, const glm::dvec3& p) {
+  return boxesMeet(b, AxisBox{p, p});
+}
 
 class BoxTree {
  public:
