@@ -15,6 +15,7 @@
 #include <OpenEXR/ImfVecAttribute.h>
 
 #include "formats/exr_header_scan.h"
+#include "formats/pixel_checksum.h"
 #include "formats/provenance.h"
 #include "libcommon/core/error.h"
 
@@ -67,6 +68,19 @@ const char* pixelTypeName(Imf::PixelType t) {
   }
 }
 
+const char* compressionName(Imf::Compression c) {
+  static const char* const kNames[] = {"none",  "rle", "zips", "zip",  "piz",
+                                       "pxr24", "b44", "b44a", "dwaa", "dwab"};
+  return int(c) >= 0 && int(c) < 10 ? kNames[int(c)] : "unknown";
+}
+
+// Any of the attributes every rad EXR writer puts in its parts.
+bool hasRadAttributes(const Imf::Header& h) {
+  for (const char* name : {"rad.format", kPixelChecksumAttribute, "rad.provenance"})
+    if (h.find(name) != h.end()) return true;
+  return false;
+}
+
 }  // namespace
 
 nlohmann::json readExrInfo(const std::string& path) {
@@ -74,8 +88,12 @@ nlohmann::json readExrInfo(const std::string& path) {
   try {
     Imf::MultiPartInputFile file(path.c_str());
     nlohmann::json parts = nlohmann::json::array();
+    bool radAttributes = false;
+    std::string foreignWriter;
     for (int p = 0; p < file.parts(); ++p) {
       const Imf::Header& h = file.header(p);
+      radAttributes = radAttributes || hasRadAttributes(h);
+      if (foreignWriter.empty()) foreignWriter = exrForeignWriter(h);
       nlohmann::json part;
       part["name"] = h.hasName() ? rad::toValidUtf8(h.name()) : "";
       part["type"] = h.hasType() ? rad::toValidUtf8(h.type()) : "scanlineimage";
@@ -88,6 +106,7 @@ nlohmann::json readExrInfo(const std::string& path) {
             {{"name", rad::toValidUtf8(it.name())}, {"type", pixelTypeName(it.channel().type)}});
       }
       part["channels"] = channels;
+      part["compression"] = compressionName(h.compression());
       nlohmann::json attrs = nlohmann::json::object();
       for (auto it = h.begin(); it != h.end(); ++it)
         attrs[rad::toValidUtf8(it.name())] = attributeValue(it.attribute());
@@ -98,7 +117,11 @@ nlohmann::json readExrInfo(const std::string& path) {
       part["attributes"] = attrs;
       parts.push_back(part);
     }
-    return {{"parts", parts}};
+    nlohmann::json info = {{"parts", parts},
+                           {"written_by_rad", radAttributes && foreignWriter.empty()}};
+    if (!radAttributes) info["foreign_writer"] = "no rad.* attributes";
+    if (!foreignWriter.empty()) info["foreign_writer"] = rad::toValidUtf8(foreignWriter);
+    return info;
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {

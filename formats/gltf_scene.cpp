@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "formats/gltf_scene_file.h"
+#include "formats/gltf_triangles.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -39,6 +40,17 @@ class Reader {
   void requireFloat(int accessor, const std::string& what) const;
   void readNodes(Scene& scene);
   void readMesh(int meshIndex, Scene& scene);
+  void readPrimitive(const tinygltf::Primitive& prim, const std::string& where, Mesh& mesh,
+                     Scene& scene);
+  std::vector<double> readPositions(const tinygltf::Primitive& prim,
+                                    const std::string& where) const;
+  std::vector<double> readTexCoords(const tinygltf::Primitive& prim, const Material* mat,
+                                    size_t vertexCount, const std::string& where,
+                                    Scene& scene) const;
+  std::vector<double> readNormals(const tinygltf::Primitive& prim, size_t vertexCount,
+                                  const std::string& where) const;
+  std::vector<uint32_t> readIndices(const tinygltf::Primitive& prim, size_t vertexCount,
+                                    const std::string& where) const;
   int material(int index, Scene& scene);
   void clampReflectance(Material& mat, const std::string& where, Scene& scene) const;
   int texture(int index, Scene& scene);
@@ -430,135 +442,118 @@ void Reader::readNodes(Scene& scene) {
 
 void Reader::readMesh(int meshIndex, Scene& scene) {
   const tinygltf::Mesh& gm = m_.meshes[size_t(meshIndex)];
-  Mesh& mesh = scene.meshes[size_t(meshIndex)];
-  for (size_t pi = 0; pi < gm.primitives.size(); ++pi) {
-    const tinygltf::Primitive& prim = gm.primitives[pi];
-    const std::string where =
-        "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(pi);
-    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-    if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE ||
-        mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP) {
-      scene.warnings.push_back(where + ": skipped points/lines primitive (mode " +
-                               std::to_string(mode) + ")");
-      continue;
-    }
-    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-        mode != TINYGLTF_MODE_TRIANGLE_FAN)
-      fail(where + ": unknown primitive mode " + std::to_string(mode));
-    auto pos = prim.attributes.find("POSITION");
-    if (pos == prim.attributes.end()) fail(where + ": no POSITION attribute");
-    requireFloat(pos->second, where + ": POSITION");
-    int nc = 0;
-    std::vector<double> p = readAccessor(pos->second, where + " POSITION", nc);
-    if (nc != 3) fail(where + ": POSITION is not VEC3");
-    if (!allFinite(p)) fail(where + ": non-finite (NaN or Inf) vertex position");
-    for (double x : p)
-      if (std::abs(x) > kMaxCoordinate)
-        fail(where + ": vertex coordinate " + number(x) + " beyond the limit " +
-             number(kMaxCoordinate));
-    const size_t vertexCount = p.size() / 3;
-    const int matIndex = material(prim.material, scene);
-    const Material* mat = matIndex >= 0 ? &scene.materials[size_t(matIndex)] : nullptr;
-    std::vector<double> uv;
-    if (mat && mat->baseColorTexture >= 0) {
-      auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(mat->baseColorTexCoord));
-      if (tc != prim.attributes.end()) {
-        // glTF §3.7.2: TEXCOORD is float or normalized unsigned byte/short.
-        const int ct = tc->second >= 0 && tc->second < int(m_.accessors.size())
-                           ? m_.accessors[size_t(tc->second)].componentType
-                           : TINYGLTF_COMPONENT_TYPE_FLOAT;
-        uv = readAccessor(tc->second, where + " TEXCOORD", nc, ct != TINYGLTF_COMPONENT_TYPE_FLOAT);
-        if (nc != 2) fail(where + ": TEXCOORD is not VEC2");
-        if (uv.size() / 2 != vertexCount)
-          fail(where + ": TEXCOORD count differs from POSITION count");
-        if (!allFinite(uv)) fail(where + ": non-finite texture coordinate");
-      } else {
-        scene.warnings.push_back(where + ": material has a base colour texture but no TEXCOORD_" +
-                                 std::to_string(mat->baseColorTexCoord));
-      }
-    }
-    // glTF §3.7.2.1: NORMAL is float VEC3, unit length; the shading normal (flat without it).
-    std::vector<double> normals;
-    auto na = prim.attributes.find("NORMAL");
-    if (na != prim.attributes.end()) {
-      requireFloat(na->second, where + ": NORMAL");
-      normals = readAccessor(na->second, where + " NORMAL", nc);
-      if (nc != 3) fail(where + ": NORMAL is not VEC3");
-      if (normals.size() / 3 != vertexCount)
-        fail(where + ": NORMAL count differs from POSITION count");
-      if (!allFinite(normals)) fail(where + ": non-finite normal");
-    }
-    std::vector<uint32_t> idx;
-    if (prim.indices >= 0) {
-      if (prim.indices >= int(m_.accessors.size())) fail(where + ": indices accessor out of range");
-      const int ct = m_.accessors[size_t(prim.indices)].componentType;
-      if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-          ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-          ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-        fail(where + ": index component type " + std::to_string(ct) + " not allowed");
-      std::vector<double> raw = readAccessor(prim.indices, where + " indices", nc);
-      if (nc != 1) fail(where + ": indices are not SCALAR");
-      idx.reserve(raw.size());
-      for (double v : raw) {
-        if (v >= double(vertexCount))
-          fail(where + ": index " + std::to_string(uint64_t(v)) + " out of range (" +
-               std::to_string(vertexCount) + " vertices)");
-        idx.push_back(uint32_t(v));
-      }
-    } else {
-      idx.resize(vertexCount);
-      for (size_t i = 0; i < vertexCount; ++i) idx[i] = uint32_t(i);
-    }
-    // Triangle list per glTF §3.7.2 (strip: p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}};
-    // fan: p_i = {v_{i+1}, v_{i+2}, v_0}).
-    std::vector<std::array<uint32_t, 3>> tris;
-    if (mode == TINYGLTF_MODE_TRIANGLES) {
-      if (idx.size() % 3 != 0)
-        scene.warnings.push_back(where + ": " + std::to_string(idx.size() % 3) +
-                                 " trailing indices ignored");
-      for (size_t i = 0; i + 2 < idx.size(); i += 3)
-        tris.push_back({idx[i], idx[i + 1], idx[i + 2]});
-    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-      for (size_t i = 0; i + 2 < idx.size(); ++i)
-        tris.push_back({idx[i], idx[i + 1 + i % 2], idx[i + 2 - i % 2]});
-    } else {
-      for (size_t i = 0; i + 2 < idx.size(); ++i) tris.push_back({idx[i + 1], idx[i + 2], idx[0]});
-    }
-    for (const auto& t : tris) {
-      MeshTriangle mt;
-      mt.material = matIndex;
-      for (size_t k = 0; k < 3; ++k) {
-        const size_t v = t[k];
-        mt.p[k] = {p[3 * v], p[3 * v + 1], p[3 * v + 2]};
-        if (!uv.empty()) mt.uv[k] = {uv[2 * v], uv[2 * v + 1]};
-        if (!normals.empty()) {
-          const glm::dvec3 n(normals[3 * v], normals[3 * v + 1], normals[3 * v + 2]);
-          const double len = glm::length(n);
-          mt.normal[k] = len > 1e-12 ? n / len : glm::dvec3(0.0);
-        }
-      }
-      // A triangle with a zero normal at a vertex, or whose normals all equal its flat
-      // normal (a flat-shaded export), stays flat.
-      bool smooth = !normals.empty(), flat = true;
-      const glm::dvec3 faceNormal =
-          glm::normalize(glm::cross(mt.p[1] - mt.p[0], mt.p[2] - mt.p[0]));
-      for (size_t k = 0; k < 3 && smooth; ++k) {
-        smooth = mt.normal[k] != glm::dvec3(0.0);
-        flat = flat && glm::dot(mt.normal[k], faceNormal) > 1.0 - 1e-9;
-      }
-      if (!smooth || flat) mt.normal = {};
-      // Zero area (relative to the longest edge, so needles of collinear points count too).
-      const double twiceArea = glm::length(glm::cross(mt.p[1] - mt.p[0], mt.p[2] - mt.p[0]));
-      double edge = 0.0;
-      for (size_t k = 0; k < 3; ++k)
-        edge = std::max(edge, glm::length(mt.p[(k + 1) % 3] - mt.p[k]));
-      if (!(twiceArea > 1e-12 * edge * edge)) {
-        ++droppedTriangles_;
-        continue;
-      }
-      mesh.triangles.push_back(mt);
-    }
+  for (size_t pi = 0; pi < gm.primitives.size(); ++pi)
+    readPrimitive(gm.primitives[pi],
+                  "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(pi),
+                  scene.meshes[size_t(meshIndex)], scene);
+}
+
+// One primitive, in passes: mode, positions, material, texture coordinates, normals, indices,
+// then the triangles (formats/gltf_triangles.h).
+void Reader::readPrimitive(const tinygltf::Primitive& prim, const std::string& where, Mesh& mesh,
+                           Scene& scene) {
+  const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+  if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE ||
+      mode == TINYGLTF_MODE_LINE_LOOP || mode == TINYGLTF_MODE_LINE_STRIP) {
+    scene.warnings.push_back(where + ": skipped points/lines primitive (mode " +
+                             std::to_string(mode) + ")");
+    return;
   }
+  if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    fail(where + ": unknown primitive mode " + std::to_string(mode));
+  const std::vector<double> p = readPositions(prim, where);
+  const size_t vertexCount = p.size() / 3;
+  const int matIndex = material(prim.material, scene);
+  const Material* mat = matIndex >= 0 ? &scene.materials[size_t(matIndex)] : nullptr;
+  const std::vector<double> uv = readTexCoords(prim, mat, vertexCount, where, scene);
+  const std::vector<double> normals = readNormals(prim, vertexCount, where);
+  const std::vector<uint32_t> idx = readIndices(prim, vertexCount, where);
+  const auto tris = unrollTriangles(mode, idx, where, scene.warnings);
+  droppedTriangles_ += appendTriangles(tris, PrimitiveVertices{p, uv, normals}, matIndex, mesh);
+}
+
+std::vector<double> Reader::readPositions(const tinygltf::Primitive& prim,
+                                          const std::string& where) const {
+  auto pos = prim.attributes.find("POSITION");
+  if (pos == prim.attributes.end()) fail(where + ": no POSITION attribute");
+  requireFloat(pos->second, where + ": POSITION");
+  int nc = 0;
+  std::vector<double> p = readAccessor(pos->second, where + " POSITION", nc);
+  if (nc != 3) fail(where + ": POSITION is not VEC3");
+  if (!allFinite(p)) fail(where + ": non-finite (NaN or Inf) vertex position");
+  for (double x : p)
+    if (std::abs(x) > kMaxCoordinate)
+      fail(where + ": vertex coordinate " + number(x) + " beyond the limit " +
+           number(kMaxCoordinate));
+  return p;
+}
+
+// The base colour texture's TEXCOORD_n; empty without a texture (or, with a warning, without
+// the attribute).
+std::vector<double> Reader::readTexCoords(const tinygltf::Primitive& prim, const Material* mat,
+                                          size_t vertexCount, const std::string& where,
+                                          Scene& scene) const {
+  std::vector<double> uv;
+  if (!mat || mat->baseColorTexture < 0) return uv;
+  auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(mat->baseColorTexCoord));
+  if (tc == prim.attributes.end()) {
+    scene.warnings.push_back(where + ": material has a base colour texture but no TEXCOORD_" +
+                             std::to_string(mat->baseColorTexCoord));
+    return uv;
+  }
+  // glTF §3.7.2: TEXCOORD is float or normalized unsigned byte/short.
+  const int ct = tc->second >= 0 && tc->second < int(m_.accessors.size())
+                     ? m_.accessors[size_t(tc->second)].componentType
+                     : TINYGLTF_COMPONENT_TYPE_FLOAT;
+  int nc = 0;
+  uv = readAccessor(tc->second, where + " TEXCOORD", nc, ct != TINYGLTF_COMPONENT_TYPE_FLOAT);
+  if (nc != 2) fail(where + ": TEXCOORD is not VEC2");
+  if (uv.size() / 2 != vertexCount) fail(where + ": TEXCOORD count differs from POSITION count");
+  if (!allFinite(uv)) fail(where + ": non-finite texture coordinate");
+  return uv;
+}
+
+// glTF §3.7.2.1: NORMAL is float VEC3, unit length; the shading normal (flat without it).
+std::vector<double> Reader::readNormals(const tinygltf::Primitive& prim, size_t vertexCount,
+                                        const std::string& where) const {
+  std::vector<double> normals;
+  auto na = prim.attributes.find("NORMAL");
+  if (na == prim.attributes.end()) return normals;
+  requireFloat(na->second, where + ": NORMAL");
+  int nc = 0;
+  normals = readAccessor(na->second, where + " NORMAL", nc);
+  if (nc != 3) fail(where + ": NORMAL is not VEC3");
+  if (normals.size() / 3 != vertexCount) fail(where + ": NORMAL count differs from POSITION count");
+  if (!allFinite(normals)) fail(where + ": non-finite normal");
+  return normals;
+}
+
+// The primitive's indices, each checked against the vertex count; 0..n-1 without an accessor.
+std::vector<uint32_t> Reader::readIndices(const tinygltf::Primitive& prim, size_t vertexCount,
+                                          const std::string& where) const {
+  std::vector<uint32_t> idx;
+  if (prim.indices < 0) {
+    idx.resize(vertexCount);
+    for (size_t i = 0; i < vertexCount; ++i) idx[i] = uint32_t(i);
+    return idx;
+  }
+  if (prim.indices >= int(m_.accessors.size())) fail(where + ": indices accessor out of range");
+  const int ct = m_.accessors[size_t(prim.indices)].componentType;
+  if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+      ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+    fail(where + ": index component type " + std::to_string(ct) + " not allowed");
+  int nc = 0;
+  std::vector<double> raw = readAccessor(prim.indices, where + " indices", nc);
+  if (nc != 1) fail(where + ": indices are not SCALAR");
+  idx.reserve(raw.size());
+  for (double v : raw) {
+    if (v >= double(vertexCount))
+      fail(where + ": index " + std::to_string(uint64_t(v)) + " out of range (" +
+           std::to_string(vertexCount) + " vertices)");
+    idx.push_back(uint32_t(v));
+  }
+  return idx;
 }
 
 // rho = 1 reflects all it receives: with any emission the solve diverges (NaN or huge values).

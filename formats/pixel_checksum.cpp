@@ -78,8 +78,30 @@ std::optional<uint64_t> parseFnv1a64(const std::string& text) {
   return v;
 }
 
+std::string exrForeignWriter(const Imf::Header& header) {
+  if (const auto* software = header.findTypedAttribute<Imf::StringAttribute>("Software")) {
+    const std::string& s = software->value();
+    if (s.rfind("rad", 0) != 0) return s.substr(0, 200);
+  }
+  switch (header.compression()) {
+    case Imf::PXR24_COMPRESSION:
+      return "a program writing PXR24 compression";
+    case Imf::B44_COMPRESSION:
+      return "a program writing B44 compression";
+    case Imf::B44A_COMPRESSION:
+      return "a program writing B44A compression";
+    case Imf::DWAA_COMPRESSION:
+      return "a program writing DWAA compression";
+    case Imf::DWAB_COMPRESSION:
+      return "a program writing DWAB compression";
+    default:
+      return "";
+  }
+}
+
 std::optional<uint64_t> storedPixelChecksum(const Imf::Header& header, const std::string& path,
                                             const std::string& part) {
+  if (!exrForeignWriter(header).empty()) return {};
   bool required = false;
   if (const auto* format = header.findTypedAttribute<Imf::StringAttribute>("rad.format")) {
     const std::string& f = format->value();

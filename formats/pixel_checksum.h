@@ -43,11 +43,21 @@ std::optional<uint64_t> parseFnv1a64(const std::string& text);
 uint64_t requiredPixelChecksum(const std::string* stored, const std::string& path,
                                const std::string& part);
 
+// The program that rewrote an OpenEXR part, when a header says it was not rad; empty when
+// nothing does. A re-saved rad file (`oiiotool frame.exr -d half --compression dwaa -o x.exr`)
+// keeps the rad.* attributes of the file it was made from, rad.pixelChecksum included, but not
+// its pixels: such a part is another program's EXR, not a corrupted rad one. The tells, none of
+// which a rad writer produces: a "Software" string attribute that does not start with "rad"
+// (OpenImageIO, Blender and Nuke write one; the value is returned, cut at 200 bytes), or a
+// lossy compression (PXR24, B44, B44A, DWAA, DWAB: "a program writing DWAA compression").
+std::string exrForeignWriter(const Imf::Header& header);
+
 // The checksum a part's header stores, parsed. Throws rad::inputError(path, "<part>: ...") if
 // the attribute is malformed, or missing where the part's rad.format version requires it
 // (frame >= 2, texture-movie >= 2); an older version of those is refused with the stage to
 // re-run. Nothing for a part that has none and need not (rad-reference's older frames, EXR
-// files from other programs).
+// files from other programs), nor for a part another program rewrote (exrForeignWriter): its
+// rad.* attributes describe the file it was made from.
 std::optional<uint64_t> storedPixelChecksum(const Imf::Header& header, const std::string& path,
                                             const std::string& part);
 

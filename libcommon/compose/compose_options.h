@@ -3,7 +3,7 @@
 // so a flag's name is written once (docs/conventions.md §7 "Stages with one shape"). The defaults
 // that come from the inputs (the intervals' window, fps and size, the scene's first camera) are
 // filled in by the tool once the inputs are read, before toJson(), so the provenance records
-// every value in effect. The frame loop is formats/frame_sequence.h.
+// every value in effect. The frame loop is tools/stages/frame_sequence.h.
 #pragma once
 
 #include <optional>

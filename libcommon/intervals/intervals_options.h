@@ -1,7 +1,7 @@
 // rad-intervals' options (paper §4.1, §4.3; docs/design.md §6.2 rad-intervals): the command line
 // binds each flag to a field here (the algorithm's own in `build`), and toJson() is the provenance
 // parameters of intervals.rti, so a flag's name and default are written once (docs/conventions.md
-// §7 "Stages with one shape"). The frame loop is formats/interval_sequence.h.
+// §7 "Stages with one shape"). The frame loop is tools/stages/interval_sequence.h.
 #pragma once
 
 #include <string>

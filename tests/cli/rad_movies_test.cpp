@@ -151,7 +151,7 @@ TEST_F(RadMoviesCli, ShardsPartitionTheMoviesAndBaselineAgrees) {
   EXPECT_EQ(files, movieCount_);
 }
 
-// rad-movies bakes whole movies on one worker per thread (formats/movie_sequence.h): the
+// rad-movies bakes whole movies on one worker per thread (tools/stages/movie_sequence.h): the
 // movies must not depend on how many there are, and the report adds the workers' counts up.
 TEST_F(RadMoviesCli, WorkersPerThreadChangeNoMovieAndTheReportAddsUp) {
   ASSERT_EQ(runCommand(command("one", "--threads 1 --report " + path("one.json"))).exitCode, 0);

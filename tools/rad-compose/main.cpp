@@ -2,7 +2,7 @@
 // "rad-compose"). Reads the scene, the global solution, the intervals and the movies; writes
 // FRAMES_DIR/NNNN.exr (linear radiance) and NNNN.png (sRGB). The options are
 // libcommon/compose/compose_options.h; the work is in libcommon/compose/frame_composer.h and
-// formats/frame_sequence.h (the frame loop). This main parses, checks the inputs agree, fills
+// tools/stages/frame_sequence.h (the frame loop). This main parses, checks the inputs agree, fills
 // in the defaults they give, calls the loop and reports.
 #include <unistd.h>
 
@@ -14,7 +14,6 @@
 #include "formats/atomic_file.h"
 #include "formats/container.h"
 #include "formats/frame_image.h"
-#include "formats/frame_sequence.h"
 #include "formats/frame_window.h"
 #include "formats/gltf_scene.h"
 #include "formats/link_hierarchy.h"
@@ -23,6 +22,7 @@
 #include "libcommon/compose/compose_options.h"
 #include "tools/common/made_from_scene.h"
 #include "tools/common/tool_main.h"
+#include "tools/stages/frame_sequence.h"
 
 namespace {
 

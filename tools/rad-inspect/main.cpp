@@ -149,7 +149,7 @@ nlohmann::json inspectContainer(const std::string& path, const Options& o, std::
 nlohmann::json verifyExr(const std::string& path, const nlohmann::json& info) {
   const nlohmann::json& attrs = info["parts"][0]["attributes"];
   const auto format = attrs.find("rad.format");
-  if (format != attrs.end() && format->is_string() &&
+  if (info["written_by_rad"].get<bool>() && format != attrs.end() && format->is_string() &&
       format->get<std::string>().rfind("texture-movie ", 0) == 0) {
     const rad::TextureMovie movie = rad::readTextureMovie(path);
     return {{"parts", movie.keys.size()}, {"checksummed_parts", movie.keys.size()}};
@@ -192,11 +192,18 @@ nlohmann::json inspectOne(const std::string& path, const Options& o, std::string
       info["type"] = "openexr";
       info["pixels"] = verifyExr(path, info);
       std::ostringstream os;
-      os << path << ": OpenEXR, " << info["parts"].size() << " part(s), pixels read, "
-         << info["pixels"]["checksummed_parts"] << " verified against rad.pixelChecksum\n";
+      // A valid OpenEXR file rad did not write (or another program re-saved): summarised, not
+      // an error; its rad.* attributes, if any, are those of the file it was made from.
+      if (!info["written_by_rad"].get<bool>())
+        os << path << ": EXR not written by rad (" << info["foreign_writer"].get<std::string>()
+           << "), " << info["parts"].size() << " part(s), pixels read\n";
+      else
+        os << path << ": OpenEXR, " << info["parts"].size() << " part(s), pixels read, "
+           << info["pixels"]["checksummed_parts"] << " verified against rad.pixelChecksum\n";
       for (const auto& p : info["parts"]) {
         os << "  part '" << p["name"].get<std::string>() << "' " << p["width"] << "x" << p["height"]
-           << " channels " << p["channels"].dump() << "\n";
+           << " channels " << p["channels"].dump() << " compression "
+           << p["compression"].get<std::string>() << "\n";
         for (const auto& [k, v] : p["attributes"].items())
           os << "    " << k << " = " << v.dump() << "\n";
       }

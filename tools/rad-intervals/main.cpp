@@ -1,20 +1,20 @@
 // rad-intervals: texture-movie extents from per-frame item buffers (paper §4.1, §4.3;
 // docs/design.md §6.2 rad-intervals). The options are libcommon/intervals/intervals_options.h, the
 // algorithm libcommon/intervals/texture_intervals_builder.h, the frame loop
-// formats/interval_sequence.h; this main parses, calls them, writes intervals.rti and reports.
+// tools/stages/interval_sequence.h; this main parses, calls them, writes intervals.rti and reports.
 #include <cstdio>
 #include <vector>
 
 #include "formats/atomic_file.h"
 #include "formats/container.h"
 #include "formats/gltf_scene.h"
-#include "formats/interval_sequence.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
 #include "libcommon/intervals/intervals_options.h"
 #include "libcommon/scene/frame_range.h"
 #include "libcommon/scene/scene_digest.h"
 #include "tools/common/tool_main.h"
+#include "tools/stages/interval_sequence.h"
 
 namespace {
 

@@ -1,7 +1,7 @@
 // rad-movies: bakes the texture movies of intervals.rti from the global solution (paper §3.1
 // transmittance textures, §5 frame-to-frame coherence; docs/design.md §6.3 "rad-movies"). The baker
 // is libcommon/movies/texture_movie_baker.h, the shard loop and the movie files
-// formats/movie_sequence.h; this main parses, reads and checks the inputs, calls, reports.
+// tools/stages/movie_sequence.h; this main parses, reads and checks the inputs, calls, reports.
 #include <chrono>
 #include <iostream>
 
@@ -11,7 +11,6 @@
 #include "formats/frame_window.h"
 #include "formats/gltf_scene.h"
 #include "formats/link_hierarchy.h"
-#include "formats/movie_sequence.h"
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
 #include "libcommon/core/stopwatch.h"
@@ -19,6 +18,7 @@
 #include "libcommon/scene/scene_digest.h"
 #include "tools/common/made_from_scene.h"
 #include "tools/common/tool_main.h"
+#include "tools/stages/movie_sequence.h"
 
 namespace {
 

@@ -2,7 +2,7 @@
 // "converged reference" of docs/design.md §8 that rad-diff compares the pipeline's frames with.
 // Shares only the scene loader and the camera with the pipeline (see
 // libcommon/reference/path_tracer.h). The options are libcommon/reference/reference_options.h,
-// the frame loop formats/reference_sequence.h; this main parses, calls it and reports.
+// the frame loop tools/stages/reference_sequence.h; this main parses, calls it and reports.
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -10,10 +10,10 @@
 #include "formats/container.h"
 #include "formats/gltf_scene.h"
 #include "formats/provenance.h"
-#include "formats/reference_sequence.h"
 #include "libcommon/reference/reference_options.h"
 #include "libcommon/scene/frame_range.h"
 #include "tools/common/tool_main.h"
+#include "tools/stages/reference_sequence.h"
 
 namespace {
 

@@ -1,7 +1,7 @@
 // rad-compose's frame loop with lazily loaded, evicted texture movies (paper §5: the movie
 // files are the disk cache; only the movies of the current frame, and of each only the key
 // textures around the current time, are in memory).
-#include "formats/frame_sequence.h"
+#include "tools/stages/frame_sequence.h"
 
 #include <algorithm>
 #include <chrono>

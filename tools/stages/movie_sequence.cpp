@@ -1,5 +1,5 @@
 // rad-movies' shard loop and movie-file sink. Sources in movie_sequence.h.
-#include "formats/movie_sequence.h"
+#include "tools/stages/movie_sequence.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,4 +1,4 @@
-#include "formats/reference_sequence.h"
+#include "tools/stages/reference_sequence.h"
 
 #include <chrono>
 #include <cstdio>

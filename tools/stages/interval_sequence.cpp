@@ -1,4 +1,4 @@
-#include "formats/interval_sequence.h"
+#include "tools/stages/interval_sequence.h"
 
 #include <algorithm>
 #include <chrono>
