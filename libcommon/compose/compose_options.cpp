@@ -1,18 +1,40 @@
 #include "libcommon/compose/compose_options.h"
 
+#include "libcommon/core/shared_parameters.h"
+
 namespace rad {
 
+const ParameterTable<ComposeOptions>& composeParameters() {
+  using O = ComposeOptions;
+  using Group = ParameterGroup;
+  static const ParameterTable<O> table = [] {
+    ParameterTable<O> t;
+    addFramesParameter(t, &O::frames, "the intervals' window");
+    addFpsParameter(t, &O::fps, "the intervals'");
+    addSizeParameter(t, &O::size, "the intervals'");
+    addCameraParameter(t, &O::camera);
+    t.add("exposure", &O::exposure, "PNG exposure in EV: PNG = sRGB(L * 2^EV) (default 0)",
+          ParameterCheck::finite(), Group::kCommon);
+    t.addFlag("auto-exposure", &O::autoExposure, true,
+              "one exposure for the whole sequence: the 99th area percentile of the global "
+              "solution's non-emitter radiance maps to white",
+              Group::kCommon);
+    t.addFlag("half", &O::half, true, "write HALF instead of FLOAT EXR channels");
+    t.addEnum(
+        "compression", &O::compression,
+        EnumNames<std::string>({{"none", "none"}, {"rle", "rle"}, {"zip", "zip"}, {"piz", "piz"}}),
+        "EXR compression: none, rle, zip, piz (ZIP saves ~7 % of noise-free float "
+        "radiance and doubles the compose time)");
+    t.addFlag("no-png", &O::noPng, true, "write only the EXR frames", Group::kCommon);
+    return t;
+  }();
+  return table;
+}
+
 nlohmann::json ComposeOptions::toJson() const {
-  return {{"output", output},
-          {"frames", frames},
-          {"fps", fps ? nlohmann::json(*fps) : nlohmann::json()},
-          {"size", size},
-          {"camera", camera},
-          {"exposure", exposure.value_or(0.0)},
-          {"auto-exposure", autoExposure},
-          {"half", half},
-          {"compression", compression},
-          {"no-png", noPng}};
+  nlohmann::json out = composeParameters().toJson(*this);
+  out["output"] = output;  // -o
+  return out;
 }
 
 }  // namespace rad

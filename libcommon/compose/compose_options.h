@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "libcommon/core/parameter_table.h"
+
 namespace rad {
 
 struct ComposeOptions {
@@ -30,10 +32,13 @@ struct ComposeOptions {
   bool noPng = false;
   std::string report;  // JSON report file; empty: none
 
-  // Provenance parameters; keys are the long option names without "--": output, frames, fps,
-  // size, camera, exposure, auto-exposure, half, compression, no-png. An unset fps is null and
-  // an unset exposure 0.
+  // Provenance parameters: composeParameters() under their flags' names, and output. An unset
+  // fps or exposure is null.
   nlohmann::json toJson() const;
 };
+
+// rad-compose's parameters, declared once (libcommon/core/parameter_table.h). It has no quality
+// preset: the README's recommended settings leave it as shipped.
+const ParameterTable<ComposeOptions>& composeParameters();
 
 }  // namespace rad

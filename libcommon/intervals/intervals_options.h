@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "libcommon/core/parameter_table.h"
 #include "libcommon/intervals/texture_intervals_builder.h"
 
 namespace rad {
@@ -24,10 +25,12 @@ struct IntervalsOptions {
   std::string report;            // JSON report file; empty: none
   TextureIntervalsOptions build;
 
-  // Provenance parameters; keys are the long option names without "--": frames, fps, size,
-  // camera, item-buffers, max-level, min-visible-fraction, level-hysteresis, texel-density,
-  // min-size, max-size, resize-tolerance, max-length, hidden-gap.
+  // Provenance parameters: intervalsParameters() under their flags' names.
   nlohmann::json toJson() const;
 };
+
+// rad-intervals' parameters, declared once (libcommon/core/parameter_table.h). It has no
+// quality preset: the README's recommended settings leave it as shipped.
+const ParameterTable<IntervalsOptions>& intervalsParameters();
 
 }  // namespace rad

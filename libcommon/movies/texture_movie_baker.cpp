@@ -708,25 +708,7 @@ GoodLayer parseGoodLayer(const std::string& name) {
   throw Error(ExitCode::kUsage, "--good-layer", "'" + name + "': expected gather or gouraud");
 }
 
-nlohmann::json TextureMovieBakerOptions::toJson() const {
-  return {{"movie-key-step", keyStep},
-          {"min-samples", minSamples},
-          {"weak-share", weakShare},
-          {"max-samples", maxSamples},
-          {"samples-per-form-factor", samplesPerFormFactor},
-          {"merge", mergeModeName(merge)},
-          {"ray-cast-budget", rayCastBudget},
-          {"good-layer", goodLayerName(goodLayer)},
-          {"gather-shooter-ratio", gatherShooterRatio},
-          {"gather-rays", gatherRays},
-          {"gather-partial-share", gatherPartialShare},
-          {"cluster-visibility-rays", clusterVisibilityRays},
-          {"near-shooter-levels", nearShooterLevels},
-          {"no-fill-covered", !fillCovered},
-          {"moving-shadow-key-step", movingShadowKeyStep},
-          {"no-coherence", !coherence},
-          {"max-texture-memory", maxTextureMemoryMiB}};
-}
+// TextureMovieBakerOptions::toJson is movies_options.cpp's (its parameter table).
 
 Polygon nodePolygonIn(const Polygon& top, PatchId node) {
   const bool triangle = top.count == 3;

@@ -125,6 +125,7 @@ struct TextureMovieBakerOptions {
   // Working memory of one movie (one key's buffers plus the per-pair buffers, see
   // movieWorkingBytes); a movie that needs more is refused with an environment error.
   double maxTextureMemoryMiB = 1024.0;
+  // The provenance parameters: moviesParameters() (movies_options.h) under their flags' names.
   nlohmann::json toJson() const;
 };
 

@@ -7,32 +7,153 @@
 #include <sstream>
 
 #include "libcommon/core/error.h"
+#include "libcommon/core/shared_parameters.h"
 
 namespace rad {
 
+namespace {
+
+using Group = ParameterGroup;
+using Check = ParameterCheck;
+
+RadiosityOptions& radiosity(GlobalOptions& g) {
+  return g.spaceTime.radiosity;
+}
+
+// The key times, refinement and solver.
+void addSolveParameters(ParameterTable<GlobalOptions>& t) {
+  addFramesParameter(t, &GlobalOptions::frames, "the scene's animation, docs/design.md §1");
+  addFpsParameter(t, &GlobalOptions::fps);
+  t.add("key-step", &GlobalOptions::keyStep,
+        "frames between key times (the last frame is always one)", Check::positive(),
+        Group::kQuality);
+  t.add(
+      "eps", [](GlobalOptions& g) -> double& { return radiosity(g).eps; },
+      "refinement threshold: refine while B_q F_pq V A_p > eps x the largest power emitted "
+      "or, once it is larger, carried (sum of A B over the patches)",
+      Check::nonNegative(), Group::kQuality);
+  t.add(
+      "rays", [](GlobalOptions& g) -> int& { return radiosity(g).rays; },
+      "shadow-ray pairs per link", Check::positive(), Group::kQuality);
+  t.addEnum(
+      "oracle", [](GlobalOptions& g) -> RefinementOracle& { return radiosity(g).oracle; },
+      EnumNames<RefinementOracle>::of(
+          {RefinementOracle::kPower, RefinementOracle::kError, RefinementOracle::kBoth},
+          refinementOracleName),
+      "what --eps bounds: power (B_q F_pq V A_p, HSA'91), error (B_q V times the spread "
+      "of the point form factor over either patch, x its area), both");
+  t.add(
+      "min-area", [](GlobalOptions& g) -> double& { return radiosity(g).minArea; },
+      "do not subdivide patches of this area (m^2) or less; 0: 1e-4 of the largest "
+      "top-level patch",
+      Check::nonNegative());
+  t.add(
+      "tol", [](GlobalOptions& g) -> double& { return radiosity(g).tol; },
+      "solver stop: relative change < tol x (1 - max reflectance)", Check::positive());
+  t.add(
+      "max-links", [](GlobalOptions& g) -> size_t& { return radiosity(g).maxLinks; },
+      "memory bound: a key time stops refining at this many links (~160 bytes each) and "
+      "warns; at most 2^31",
+      Check::range(1, double(kMaxLinkBound)));
+}
+
+// The bad links the second pass takes, and the clusters.
+void addLinkParameters(ParameterTable<GlobalOptions>& t) {
+  t.addEnum(
+      "bad-links", [](GlobalOptions& g) -> BadLinkRule& { return g.spaceTime.badLinks; },
+      EnumNames<BadLinkRule>::of(
+          {BadLinkRule::kLights, BadLinkRule::kPartial, BadLinkRule::kAll, BadLinkRule::kNone},
+          badLinkRuleName),
+      "which (receiver, shooter) pairs the second pass computes per texel: lights "
+      "(emitting shooters), partial (also partly visible links), all, none");
+  t.add(
+      "partial-threshold", [](GlobalOptions& g) -> double& { return g.spaceTime.partialThreshold; },
+      "partial: a link is partly visible when threshold < V < 1", Check::range(0.0, 1.0));
+  t.add(
+      "partial-power-share",
+      [](GlobalOptions& g) -> double& { return g.spaceTime.partialPowerShare; },
+      "partial: a pair whose shooter does not emit only when its partly visible links' "
+      "shadow, sum B F (1 - V) A, is at least this share of the power the surfaces carry "
+      "(sum A B); 0: every such pair",
+      Check::range(0.0, 1.0));
+  t.add(
+      "cluster-separation",
+      [](GlobalOptions& g) -> double& { return radiosity(g).clusterSeparation; },
+      "keep a cluster link only while its ends' centres are at least this many times the sum "
+      "of their bounding radii apart; larger is more accurate and slower",
+      Check::range(1.0, 1e6));
+  t.add(
+      "light-cluster-share",
+      [](GlobalOptions& g) -> double& { return radiosity(g).lightClusterShare; },
+      "a link from a light stays a cluster link (smooth light, no per-texel shadows) while "
+      "its power bound is under this share of eps times the power; 0 refines every light's "
+      "links to patch pairs",
+      Check::range(0.0, 1e6));
+  t.add(
+      "cluster-member-rays",
+      [](GlobalOptions& g) -> int& { return radiosity(g).clusterMemberRays; },
+      "shadow-ray pairs per member top of a cluster link's receiver, for that top's own "
+      "visibility; 0: each member takes its facing group's visibility",
+      Check::range(0, 64));
+}
+
+// The switches that exist to compare against a baseline.
+void addBaselineParameters(ParameterTable<GlobalOptions>& t) {
+  t.addFlag(
+      "no-closure", [](GlobalOptions& g) -> bool& { return radiosity(g).closure; }, false,
+      "gather without the closure factor (each leaf's row sum its own; exact energy "
+      "balance in closed rooms): the plain hierarchical gather, for comparison",
+      Group::kBaseline);
+  t.addFlag(
+      "no-closed-rooms", [](GlobalOptions& g) -> bool& { return radiosity(g).closedRooms; }, false,
+      "do not scale the row sums of leaves inside a closed room (no escaping ray) to "
+      "exactly 1; only the unoccluded tops' share is corrected, as in open scenes",
+      Group::kBaseline);
+  t.addFlag(
+      "no-clustering", [](GlobalOptions& g) -> bool& { return radiosity(g).clustering; }, false,
+      "link every pair of top-level patches (the baseline) instead of starting from the "
+      "root cluster's self-link of a cluster hierarchy over them",
+      Group::kBaseline);
+  t.addFlag(
+      "isotropic-clusters",
+      [](GlobalOptions& g) -> bool& { return radiosity(g).isotropicClusters; }, true,
+      "take each cluster as emitting and receiving alike in every direction (area / 4) "
+      "instead of by its members' facing groups",
+      Group::kBaseline);
+  t.addFlag(
+      "no-shooter-shape", [](GlobalOptions& g) -> bool& { return radiosity(g).shooterShape; },
+      false,
+      "gather each link's shooter at its mean radiosity, not as the receiver's ray pairs "
+      "see its leaves' radiosity",
+      Group::kBaseline);
+  t.addFlag(
+      "no-coherence", [](GlobalOptions& g) -> bool& { return g.spaceTime.coherence; }, false,
+      "recompute every link at every key time (the baseline of the speed-up)", Group::kBaseline);
+}
+
+}  // namespace
+
+const ParameterTable<GlobalOptions>& globalParameters() {
+  static const ParameterTable<GlobalOptions> table = [] {
+    ParameterTable<GlobalOptions> t;
+    addSolveParameters(t);
+    addLinkParameters(t);
+    addBaselineParameters(t);
+    return t;
+  }();
+  return table;
+}
+
+const std::vector<Preset>& globalPresets() {
+  static const std::vector<Preset> presets{
+      {"draft", {{"eps", "0.02"}}},
+      {"final", {{"eps", "1e-5"}, {"key-step", "4"}, {"rays", "64"}}},
+  };
+  return presets;
+}
+
 nlohmann::json GlobalOptions::toJson() const {
-  const RadiosityOptions& r = spaceTime.radiosity;
-  return {{"frames", frames},
-          {"fps", fps},
-          {"key-step", keyStep},
-          {"eps", r.eps},
-          {"oracle", refinementOracleName(r.oracle)},
-          {"min-area", r.minArea},
-          {"rays", r.rays},
-          {"tol", r.tol},
-          {"bad-links", badLinkRuleName(spaceTime.badLinks)},
-          {"partial-threshold", spaceTime.partialThreshold},
-          {"partial-power-share", spaceTime.partialPowerShare},
-          {"max-links", r.maxLinks},
-          {"no-closure", !r.closure},
-          {"no-closed-rooms", !r.closedRooms},
-          {"no-clustering", !r.clustering},
-          {"cluster-separation", r.clusterSeparation},
-          {"light-cluster-share", r.lightClusterShare},
-          {"cluster-member-rays", r.clusterMemberRays},
-          {"isotropic-clusters", r.isotropicClusters},
-          {"no-shooter-shape", !r.shooterShape},
-          {"no-coherence", !spaceTime.coherence}};
+  return globalParameters().toJson(*this);
 }
 
 std::vector<double> keyTimesOf(const FrameRange& frames, int keyStep, double fps) {

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "libcommon/core/parameter_table.h"
 #include "libcommon/radiosity/space_time_radiosity.h"
 #include "libcommon/scene/frame_range.h"
 #include "libcommon/scene/scene.h"
@@ -40,12 +41,17 @@ struct GlobalOptions {
   std::string window;
   std::vector<std::string> merge;
 
-  // The provenance parameters: every parameter under its flag's name ("frames", "fps",
-  // "key-step", "eps", "oracle", "min-area", "rays", "tol", "bad-links", "partial-threshold",
-  // "max-links", "no-coherence"). Call it once frames and min-area are resolved, so the record says
-  // what ran.
+  // The provenance parameters: every entry of globalParameters() under its flag's name. Call
+  // it once frames and min-area are resolved, so the record says what ran.
   nlohmann::json toJson() const;
 };
+
+// rad-global's parameters (everything but the render farm's --window and --merge, which are not
+// parameters of the solution), declared once: flag name, field, help, check, help group.
+const ParameterTable<GlobalOptions>& globalParameters();
+// rad-global's quality presets (README "Recommended settings"): draft --eps 0.02; final
+// --eps 1e-5 --key-step 4 --rays 64; default: the struct's values.
+const std::vector<Preset>& globalPresets();
 
 // The key indices (into keyTimesOf(frames, ...)) of the key frames within frames `window`
 // (FIRST-LAST, the --window syntax). Usage Error when the window is malformed, leaves the run's

@@ -1,5 +1,7 @@
 #include "libcommon/reference/reference_options.h"
 
+#include "libcommon/core/shared_parameters.h"
+
 namespace rad {
 
 PathTracerOptions ReferenceOptions::pathTracer() const {
@@ -12,16 +14,31 @@ PathTracerOptions ReferenceOptions::pathTracer() const {
   return options;
 }
 
+const ParameterTable<ReferenceOptions>& referenceParameters() {
+  using O = ReferenceOptions;
+  using Check = ParameterCheck;
+  static const ParameterTable<O> table = [] {
+    ParameterTable<O> t;
+    addFramesParameter(t, &O::frames, "the scene's animation, docs/design.md §1");
+    addFpsParameter(t, &O::fps);
+    addSizeParameter(t, &O::size);
+    addCameraParameter(t, &O::camera);
+    t.add("spp", &O::spp, "samples per pixel", Check::range(1, 1 << 24), ParameterGroup::kQuality);
+    t.add("max-depth", &O::maxDepth, "maximum number of reflections per path",
+          Check::range(0, 100000));
+    t.add("seed", &O::seed, "random seed");
+    t.addFlag("decorrelate-frames", &O::decorrelateFrames, true,
+              "independent noise per frame (default: the same per-pixel seeds every frame, so "
+              "what does not change does not flicker)");
+    t.addFlag("pixel-centres", &O::pixelCentres, true,
+              "every sample through the pixel centre (no antialiasing), as rad-compose samples");
+    return t;
+  }();
+  return table;
+}
+
 nlohmann::json ReferenceOptions::toJson() const {
-  return {{"frames", frames},
-          {"fps", fps},
-          {"size", size},
-          {"spp", spp},
-          {"camera", camera},
-          {"max-depth", maxDepth},
-          {"seed", seed},
-          {"decorrelate-frames", decorrelateFrames},
-          {"pixel-centres", pixelCentres}};
+  return referenceParameters().toJson(*this);
 }
 
 }  // namespace rad

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "libcommon/core/parameter_table.h"
+
 #include "libcommon/reference/path_tracer.h"
 
 namespace rad {
@@ -30,9 +32,11 @@ struct ReferenceOptions {
 
   // The path tracer's options (samples, depth, seed, decorrelation, pixel centres).
   PathTracerOptions pathTracer() const;
-  // Provenance parameters; keys are the long option names without "--": frames, fps, size,
-  // spp, camera, max-depth, seed, decorrelate-frames, pixel-centres.
+  // Provenance parameters: referenceParameters() under their flags' names.
   nlohmann::json toJson() const;
 };
+
+// rad-reference's parameters, declared once (libcommon/core/parameter_table.h).
+const ParameterTable<ReferenceOptions>& referenceParameters();
 
 }  // namespace rad

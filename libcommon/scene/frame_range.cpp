@@ -13,8 +13,9 @@ std::string FrameRange::toString() const {
 
 FrameRange animationFrames(const Scene& scene, double fps) {
   const double end = std::max(0.0, scene.endTime()) * fps;
-  // Clamped so an absurd end time cannot overflow the frame number.
-  return {0, int(std::clamp(std::ceil(end - 1e-9), 0.0, 2e9))};
+  // ceil(end) frames; clamped so an absurd end time cannot overflow the frame number.
+  const double count = std::clamp(std::ceil(end - 1e-9), 1.0, 2e9);
+  return {0, int(count) - 1};
 }
 
 std::vector<int> keyFrames(int first, int last, int step) {

@@ -16,16 +16,16 @@ class Scene;
 struct FrameRange {
   int first = 0, last = 0;
   int count() const { return last - first + 1; }
-  bool covers(const FrameRange& other) const {
-    return first <= other.first && other.last <= last;
-  }
+  bool covers(const FrameRange& other) const { return first <= other.first && other.last <= last; }
   std::string toString() const;  // "0-95"
 };
 
-// The scene's whole animation at `fps`: frames 0 .. ceil(endTime x fps), so the frames cover
-// [0, endTime] (the last frame is at or just past the end, where the animation holds its last
-// pose); a static scene is the one frame 0. The ceiling forgives 1e-9 of rounding, so an end
-// of exactly 4 s at 24 fps is frame 96, not 97.
+// The frames every tool covers without --frames (docs/design.md §1 "The default frame range"):
+// the frames whose times f / fps lie in [0, endTime), i.e. 0 .. ceil(endTime x fps) - 1, so an
+// animation of 4 s at 24 fps is 96 frames, 0-95, a video of exactly its length (a looping
+// animation's frame 96 would repeat frame 0). An animation shorter than a frame, or a static
+// scene, is the one frame 0. The ceiling forgives 1e-9 of rounding, so an end of exactly 4 s at
+// 24 fps ends at frame 95, not 96. `rad-inspect --default-frames SCENE [--fps F]` prints it.
 FrameRange animationFrames(const Scene& scene, double fps);
 
 // Key frames first, first + step, first + 2 step, ... below last, and always last itself;

@@ -1,6 +1,7 @@
-// Flags mean one thing (issue 14): without --frames every tool covers the scene's whole
-// animation, frames 0 .. ceil(end x fps) (libcommon/scene/frame_range.h animationFrames). The
-// bundled scene lasts 4 s; at 24 fps that is frames 0-96. Each tool runs as a user would, at a
+// Flags mean one thing (issues 14, 55): without --frames every tool covers the scene's
+// animation, frames 0 .. ceil(end x fps) - 1 (libcommon/scene/frame_range.h animationFrames,
+// docs/design.md §1). The bundled scene lasts 4 s; at 24 fps that is frames 0-95, what
+// `rad-inspect --default-frames` prints. Each tool runs as a user would, at a
 // tiny size so the test is quick, and the range it wrote is read back from its output.
 #include <filesystem>
 
@@ -16,8 +17,8 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::string kScene = RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
-constexpr int kLastFrame = 96;  // 4 s x 24 fps
-const std::string kWholeAnimation = "0-96";
+constexpr int kLastFrame = 95;  // 4 s x 24 fps = 96 frames
+const std::string kWholeAnimation = "0-95";
 
 fs::path freshDir(const std::string& name) {
   fs::path d =
@@ -62,6 +63,20 @@ TEST(FramesDefault, RadIntervalsCoversTheAnimation) {
   EXPECT_EQ(iv.metadata().at("last_frame"), kLastFrame);
   EXPECT_EQ(iv.provenance().parameters.at("frames"), kWholeAnimation);
   fs::remove_all(d);
+}
+
+// The rule on stdout, for a Makefile; --fps changes it.
+TEST(FramesDefault, RadInspectPrintsTheRule) {
+  CommandResult r = runCommand(tool("rad-inspect") + " --default-frames " + kScene);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.out, kWholeAnimation + "\n");
+  r = runCommand(tool("rad-inspect") + " --default-frames " + kScene + " --fps 12");
+  EXPECT_EQ(r.out, "0-47\n");
+  r = runCommand(tool("rad-inspect") + " --default-frames " + kScene + " --fps 0");
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  r = runCommand(tool("rad-inspect") + " --default-frames /nonexistent.gltf");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("rad-inspect: /nonexistent.gltf: "), std::string::npos) << r.err;
 }
 
 TEST(FramesDefault, RadReferenceCoversTheAnimation) {

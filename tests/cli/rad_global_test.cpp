@@ -125,9 +125,9 @@ TEST(RadGlobal, SameBytesOnOneCoreAndOnAll) {
   fs::remove_all(d);
 }
 
-// Without --frames rad-global covers the scene's whole animation (frame_range.h
-// animationFrames): the bundled scene lasts 4 s, so at 24 fps its frames are 0-96. (Before issue
-// 14 the default was 0-0, one key time at t = 0.)
+// Without --frames rad-global covers the scene's animation (frame_range.h animationFrames): the
+// bundled scene lasts 4 s, so at 24 fps its frames are 0-95 (0-96 before issue 55; 0-0, one key
+// time at t = 0, before issue 14).
 TEST(RadGlobal, WithoutFramesCoversTheWholeAnimation) {
   fs::path d = scratchDir();
   const std::string out = (d / "whole.rlh").string();
@@ -137,11 +137,11 @@ TEST(RadGlobal, WithoutFramesCoversTheWholeAnimation) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const nlohmann::json meta = ContainerReader::open(out).metadata();
   EXPECT_EQ(meta.at("first_frame"), 0) << meta.dump();
-  EXPECT_EQ(meta.at("last_frame"), 96) << meta.dump();
-  EXPECT_EQ(meta.at("parameters").at("frames"), "0-96") << meta.dump();
+  EXPECT_EQ(meta.at("last_frame"), 95) << meta.dump();
+  EXPECT_EQ(meta.at("parameters").at("frames"), "0-95") << meta.dump();
   nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "report.json").string()));
-  ASSERT_EQ(rep["key_times"].size(), 3u);  // frames 0, 48, 96
-  EXPECT_DOUBLE_EQ(rep["key_times"][2]["time"].get<double>(), 4.0);
+  ASSERT_EQ(rep["key_times"].size(), 3u);  // frames 0, 48, 95
+  EXPECT_DOUBLE_EQ(rep["key_times"][2]["time"].get<double>(), 95 / 24.0);
   fs::remove_all(d);
 }
 

@@ -8,13 +8,17 @@
 
 namespace rad {
 
-void addSceneReadOptions(CLI::App& app, const std::string& tool) {
-  app.add_option("--max-texture-pixels", defaultGltfReadOptions().maxTexturePixels,
-                 "a scene's texture with more pixels (read from its header) is ignored with a "
-                 "warning")
+CLI::Option* addSceneReadOptions(CLI::App& app) {
+  return app
+      .add_option("--max-texture-pixels", defaultGltfReadOptions().maxTexturePixels,
+                  "a scene's texture with more pixels (read from its header) is ignored with a "
+                  "warning")
       ->capture_default_str()
       ->check(positiveInteger());
-  // A scene read twice in one run (rad-diff) prints its warnings once.
+}
+
+void setGltfWarnings(const std::string& tool) {  // A scene read twice in one run (rad-diff) prints
+                                                 // its warnings once.
   setGltfWarningHandler([tool](const std::string& path, const std::string& warning) {
     static std::set<std::string> printed;
     if (printed.insert(path + '\n' + warning).second)

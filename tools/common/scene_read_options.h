@@ -8,9 +8,11 @@
 
 namespace rad {
 
-// Adds --max-texture-pixels (bound to defaultGltfReadOptions(), which readGltfScene(path) uses)
-// and installs a warning handler that prints each warning of each scene read, once per run, as
-// `tool: SCENE: warning: TEXT` on stderr. Called by setUpApp, so every tool has both.
-void addSceneReadOptions(CLI::App& app, const std::string& tool);
+// Adds --max-texture-pixels (bound to defaultGltfReadOptions(), which readGltfScene(path) uses).
+// Called by parseCommandLine, so every tool has it.
+CLI::Option* addSceneReadOptions(CLI::App& app);
+// Installs a warning handler that prints each warning of each scene read, once per run, as
+// `tool: SCENE: warning: TEXT` on stderr. Called by setUpApp.
+void setGltfWarnings(const std::string& tool);
 
 }  // namespace rad

@@ -20,6 +20,7 @@
 
 #include "formats/build_info.h"
 #include "libcommon/core/failure.h"
+#include "libcommon/core/parameter_table.h"
 #include "libcommon/scene/scene.h"
 #include "tools/common/scene_read_options.h"
 
@@ -88,18 +89,34 @@ void setUpApp(CLI::App& app, const std::string& tool, const std::string& example
   app.set_version_flag("--version", std::string(tool) + " " RAD_VERSION " (" + gitRevision() + ")");
   app.footer(std::string("Example:\n  ") + example + "\n\n" + exitCodeHelp());
   app.get_formatter()->column_width(34);
+  // --help lists the Common group first: CLI11 orders groups by their first option.
+  const std::string common = parameterGroupTitle(ParameterGroup::kCommon);
+  app.get_help_ptr()->group(common);
+  app.get_version_ptr()->group(common);
+  app.add_flag_callback(
+         kPrintDefaults, [] { throw CallForDefaults(); },
+         "print every option's default as one JSON object on stdout and exit")
+      ->group(common);
+  setGltfWarnings(tool);  // scene warnings on stderr
+}
+
+namespace {
+// The options every tool has that --help lists among the Advanced ones, added last so the
+// tool's own groups come first.
+void addAdvancedOptions(CLI::App& app) {
+  const std::string advanced = parameterGroupTitle(ParameterGroup::kAdvanced);
   // Results never depend on it (work is split by item, not by thread, and every sample seed
   // comes from ids): it only bounds the cores used, e.g. for make -j or a shared machine.
   app.add_option("--threads", gThreads, "worker threads; 0: all cores")
       ->capture_default_str()
-      ->check(integerRange(0, kMaxThreads));
-  app.add_flag_callback(
-      kPrintDefaults, [] { throw CallForDefaults(); },
-      "print every option's default as one JSON object on stdout and exit");
-  addSceneReadOptions(app, tool);  // --max-texture-pixels; scene warnings on stderr
+      ->check(integerRange(0, kMaxThreads))
+      ->group(advanced);
+  addSceneReadOptions(app)->group(advanced);  // --max-texture-pixels
 }
+}  // namespace
 
 int parseCommandLine(CLI::App& app, const std::string& tool, int argc, char** argv) {
+  addAdvancedOptions(app);
   const nlohmann::json defaults = optionDefaults(app);  // before parsing changes the values
   try {
     app.parse(argc, argv);

@@ -21,6 +21,7 @@
 #include "formats/texture_intervals.h"
 #include "libcommon/compose/compose_options.h"
 #include "tools/common/made_from_scene.h"
+#include "tools/common/parameter_cli.h"
 #include "tools/common/tool_main.h"
 #include "tools/stages/frame_sequence.h"
 
@@ -94,7 +95,7 @@ std::vector<int> emptyFrames(const rad::ComposeSequenceReport& report) {
   return empty;
 }
 
-int run(const rad::ComposeOptions& given, int argc, char** argv) {
+int run(const rad::ComposeOptions& given, const std::string& preset, int argc, char** argv) {
   rad::ComposeOptions o = given;
   rad::Scene scene = rad::readGltfScene(o.scene);
   // Of global.rlh only the radiosity (fallback pixels, auto exposure) is kept, and the file's
@@ -115,7 +116,9 @@ int run(const rad::ComposeOptions& given, int argc, char** argv) {
   rad::requireGlobalCoversIntervals(o.global, solution, o.intervals, intervals);
 
   const rad::ComposeSequenceOptions c = resolve(o, scene, intervals);
-  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, o.toJson());
+  nlohmann::json parameters = o.toJson();
+  parameters["preset"] = preset;
+  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
   rad::addInput(provenance, o.scene);
   provenance.inputs.push_back(std::move(globalInput));
   rad::addInput(provenance, intervalsReader);
@@ -159,36 +162,23 @@ int main(int argc, char** argv) {
   rad::setUpApp(app, kTool,
                 "rad-compose scene.gltf out/global.rlh out/intervals.rti out/movies -o out/frames "
                 "--frames 0-95 --auto-exposure");
+  // A preset sets nothing here (README "Recommended settings"); it is taken so one --preset
+  // goes to every stage, and recorded.
+  std::string preset;
+  rad::addPresetOption(app, preset, argc, argv);
+  const std::string common = rad::parameterGroupTitle(rad::ParameterGroup::kCommon);
   app.add_option("SCENE", o.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
   app.add_option("GLOBAL", o.global, "global solution from rad-global (global.rlh)")->required();
   app.add_option("INTERVALS", o.intervals, "texture-movie extents from rad-intervals (.rti)")
       ->required();
   app.add_option("MOVIES_DIR", o.movies, "texture movies from rad-movies (MMMMMM.exr)")->required();
   app.add_option("-o,--output", o.output, "output directory for NNNN.exr / NNNN.png (created)")
-      ->required();
-  app.add_option("--frames", o.frames,
-                 "frames to compose, FIRST-LAST[xSTEP] (default: all of "
-                 "the intervals' window)");
-  app.add_option("--fps", o.fps, "frames per second, frame f at f/fps (default: the intervals')")
-      ->check(rad::positiveFinite());
-  app.add_option("--size", o.size, "image size WIDTHxHEIGHT (default: the intervals')");
-  app.add_option("--camera", o.camera, "camera node or camera name (default: the first camera)");
-  auto* exposure = app.add_option("--exposure", o.exposure,
-                                  "PNG exposure in EV: PNG = sRGB(L * 2^EV) "
-                                  "(default 0)")
-                       ->check(rad::finiteNumber());
-  app.add_flag("--auto-exposure", o.autoExposure,
-               "one exposure for the whole sequence: the 99th area percentile of the global "
-               "solution's non-emitter radiance maps to white")
-      ->excludes(exposure);
-  app.add_flag("--half", o.half, "write HALF instead of FLOAT EXR channels");
-  app.add_option("--compression", o.compression,
-                 "EXR compression: none, rle, zip, piz (ZIP saves ~7 % of noise-free float "
-                 "radiance and doubles the compose time)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"none", "rle", "zip", "piz"}));
-  app.add_flag("--no-png", o.noPng, "write only the EXR frames");
-  app.add_option("--report", o.report, "write per-frame times and fallback pixel counts as JSON");
+      ->required()
+      ->group(common);
+  rad::bindParameters(app, rad::composeParameters(), o);
+  app.get_option("--auto-exposure")->excludes(app.get_option("--exposure"));
+  app.add_option("--report", o.report, "write per-frame times and fallback pixel counts as JSON")
+      ->group(common);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
-  return rad::runTool(kTool, [&]() { return run(o, argc, argv); });
+  return rad::runTool(kTool, [&]() { return run(o, preset, argc, argv); });
 }

@@ -20,6 +20,7 @@
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/global_stage.h"
 #include "libcommon/scene/scene_digest.h"
+#include "tools/common/parameter_cli.h"
 #include "tools/common/tool_main.h"
 
 namespace {
@@ -28,110 +29,22 @@ constexpr const char* kTool = "rad-global";
 
 struct Options {
   std::string scene, output, report;
+  std::string preset;    // --preset: recorded in the provenance beside the values it set
   int printWindows = 0;  // > 0: print that many --window ranges and exit (no solve)
   rad::GlobalOptions global;
 };
 
-// Binds every flag straight into the options; the defaults shown are the structs'.
+// Binds the parameter table (globalParameters) and the run's plumbing: files and the farm.
 void addOptions(CLI::App& app, Options& o) {
   rad::GlobalOptions& g = o.global;
-  rad::RadiosityOptions& r = g.spaceTime.radiosity;
   app.add_option("SCENE", o.scene, "glTF scene")->required();
-  app.add_option("-o,--output", o.output, "output link hierarchy (.rlh)")->required();
-  app.add_option("--frames", g.frames,
-                 "frame range a-b (time = frame / fps); default: the scene's whole animation");
-  app.add_option("--fps", g.fps, "frames per second")
-      ->capture_default_str()
-      ->check(rad::positiveFinite());
-  app.add_option("--key-step", g.keyStep, "frames between key times (the last frame is always one)")
-      ->capture_default_str()
-      ->check(rad::positiveInteger());
-  app.add_option(
-         "--eps", r.eps,
-         "refinement threshold: refine while B_q F_pq V A_p > eps x the largest power emitted or, "
-         "once it is larger, carried (sum of A B over the patches)")
-      ->capture_default_str()
-      ->check(rad::nonNegativeFinite());
-  app.add_option_function<std::string>(
-         "--oracle", [&r](const std::string& s) { r.oracle = rad::parseRefinementOracle(s); },
-         "what --eps bounds: power (B_q F_pq V A_p, HSA'91), error (B_q V times the spread of the "
-         "point form factor over either patch, x its area), both")
-      ->default_str(rad::refinementOracleName(r.oracle))
-      ->check(CLI::IsMember({"power", "error", "both"}));
-  app.add_option("--min-area", r.minArea,
-                 "do not subdivide patches of this area (m^2) or less; 0: 1e-4 of the largest "
-                 "top-level patch")
-      ->capture_default_str()
-      ->check(rad::nonNegativeFinite());
-  app.add_option("--rays", r.rays, "shadow-ray pairs per link")
-      ->capture_default_str()
-      ->check(rad::positiveInteger());
-  app.add_option("--tol", r.tol, "solver stop: relative change < tol x (1 - max reflectance)")
-      ->capture_default_str()
-      ->check(rad::positiveFinite());
-  app.add_option_function<std::string>(
-         "--bad-links",
-         [&g](const std::string& s) { g.spaceTime.badLinks = rad::parseBadLinkRule(s); },
-         "which (receiver, shooter) pairs the second pass computes per texel: lights (emitting "
-         "shooters), partial (also partly visible links), all, none")
-      ->default_str(rad::badLinkRuleName(g.spaceTime.badLinks))
-      ->check(CLI::IsMember({"lights", "partial", "all", "none"}));
-  app.add_option("--partial-threshold", g.spaceTime.partialThreshold,
-                 "partial: a link is partly visible when threshold < V < 1")
-      ->capture_default_str()
-      ->check(rad::finiteRange(0.0, 1.0));
-  app.add_option("--partial-power-share", g.spaceTime.partialPowerShare,
-                 "partial: a pair whose shooter does not emit only when its partly visible "
-                 "links' shadow, sum B F (1 - V) A, is at least this share of the power the "
-                 "surfaces carry (sum A B); 0: every such pair")
-      ->capture_default_str()
-      ->check(rad::finiteRange(0.0, 1.0));
-  app.add_option("--max-links", r.maxLinks,
-                 "memory bound: a key time stops refining at this many links (~160 bytes each) "
-                 "and warns; at most 2^31")
-      ->capture_default_str()
-      ->check(rad::positiveInteger())
-      ->check(CLI::Range(size_t(1), rad::kMaxLinkBound));
-  app.add_flag_callback(
-      "--no-closure", [&r] { r.closure = false; },
-      "gather without the closure factor (each leaf's row sum its own; exact energy balance in "
-      "closed rooms): the plain hierarchical gather, for comparison");
-  app.add_flag_callback(
-      "--no-closed-rooms", [&r] { r.closedRooms = false; },
-      "do not scale the row sums of leaves inside a closed room (no escaping ray) to exactly 1; "
-      "only the unoccluded tops' share is corrected, as in open scenes");
-  app.add_option("--cluster-separation", r.clusterSeparation,
-                 "keep a cluster link only while its ends' centres are at least this many times "
-                 "the sum of their bounding radii apart; larger is more accurate and slower")
-      ->capture_default_str()
-      ->check(rad::finiteRange(1.0, 1e6));
-  app.add_option("--light-cluster-share", r.lightClusterShare,
-                 "a link from a light stays a cluster link (smooth light, no per-texel shadows) "
-                 "while its power bound is under this share of eps times the power; 0 refines "
-                 "every light's links to patch pairs")
-      ->capture_default_str()
-      ->check(rad::finiteRange(0.0, 1e6));
-  app.add_option("--cluster-member-rays", r.clusterMemberRays,
-                 "shadow-ray pairs per member top of a cluster link's receiver, for that top's "
-                 "own visibility; 0: each member takes its facing group's visibility")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 64));
-  app.add_flag_callback(
-      "--isotropic-clusters", [&r] { r.isotropicClusters = true; },
-      "take each cluster as emitting and receiving alike in every direction (area / 4) instead "
-      "of by its members' facing groups");
-  app.add_flag_callback(
-      "--no-clustering", [&r] { r.clustering = false; },
-      "link every pair of top-level patches (the baseline) instead of starting from the root "
-      "cluster's self-link of a cluster hierarchy over them");
-  app.add_flag_callback(
-      "--no-shooter-shape", [&r] { r.shooterShape = false; },
-      "gather each link's shooter at its mean radiosity, not as the receiver's ray pairs see its "
-      "leaves' radiosity");
-  app.add_flag_callback(
-      "--no-coherence", [&g] { g.spaceTime.coherence = false; },
-      "recompute every link at every key time (the baseline of the speed-up)");
-  app.add_option("--report", o.report, "also write the run report as JSON to this file");
+  app.add_option("-o,--output", o.output, "output link hierarchy (.rlh)")
+      ->required()
+      ->group(rad::parameterGroupTitle(rad::ParameterGroup::kCommon));
+  rad::bindParameters(app, rad::globalParameters(), g);
+  app.add_option("--report", o.report, "also write the run report as JSON to this file")
+      ->group(rad::parameterGroupTitle(rad::ParameterGroup::kCommon));
+  const std::string farm = "Render farm";
   // The render farm (issue 17): windows side by side, then one merge.
   auto* window =
       app.add_option(
@@ -141,26 +54,30 @@ void addOptions(CLI::App& app, Options& o) {
              "--frames and --key-step, so put the whole run's --frames) and write them to -o as a "
              "key "
              "window file for --merge; a window starts from scratch, so windows need not overlap")
-          ->type_name("FIRST-LAST");
+          ->type_name("FIRST-LAST")
+          ->group(farm);
   app.add_option("--merge", g.merge,
                  "render farm: instead of solving, merge these key window files (--window runs "
                  "of this same command line that together hold every key time) into -o: the "
                  "same bytes as the run without --merge, provenance included")
       ->type_name("WINDOW")
-      ->excludes(window);
+      ->excludes(window)
+      ->group(farm);
   app.add_option("--print-windows", o.printWindows,
                  "render farm: print at most N --window ranges of the run's frames, each holding "
                  "whole key times, on one line, and exit without solving (pipelines/slurm.mk's "
                  "GLOBAL_WINDOWS)")
       ->type_name("N")
       ->check(rad::positiveInteger())
-      ->excludes(window);
+      ->excludes(window)
+      ->group(farm);
 }
 
 // The parameters both outputs' provenance records: the options and the digests of the scene's
 // parts the solution depends on (the camera is not one of them).
-nlohmann::json provenanceParameters(const rad::GlobalOptions& g, const rad::Scene& scene) {
-  nlohmann::json params = g.toJson();
+nlohmann::json provenanceParameters(const Options& o, const rad::Scene& scene) {
+  nlohmann::json params = o.global.toJson();
+  params["preset"] = o.preset;
   params[rad::kSceneDigestsKey] =
       rad::sceneDigests(scene, {rad::ScenePart::kGeometry, rad::ScenePart::kMaterials,
                                 rad::ScenePart::kLights, rad::ScenePart::kAnimation});
@@ -182,7 +99,7 @@ void writeWindow(const Options& o, const rad::Scene& scene, const rad::FrameRang
   const rad::GlobalOptions& g = o.global;
   rad::KeyWindow window =
       rad::solveKeyWindow(scene, keyTimes, keys.first, keys.last, g.spaceTime, &report.solve);
-  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, provenanceParameters(g, scene));
+  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, provenanceParameters(o, scene));
   rad::addInput(prov, o.scene);
   nlohmann::json metadata = runMetadata(g, frames);
   metadata["window"] = g.window;
@@ -214,7 +131,7 @@ void writeHierarchy(const Options& o, const rad::Scene& scene, const rad::FrameR
   std::vector<const char*> args;
   for (const std::string& w : words) args.push_back(w.c_str());
   rad::Provenance prov =
-      rad::makeProvenance(kTool, int(args.size()), args.data(), provenanceParameters(g, scene));
+      rad::makeProvenance(kTool, int(args.size()), args.data(), provenanceParameters(o, scene));
   rad::addInput(prov, o.scene);
   auto tWrite = std::chrono::steady_clock::now();
   rad::writeLinkHierarchy(o.output, solution, prov, runMetadata(g, frames));
@@ -290,6 +207,8 @@ int main(int argc, char** argv) {
       "  rad-global scene.gltf -o w0.rkw --frames 0-95 --window 0-47\n"
       "  rad-global scene.gltf -o w1.rkw --frames 0-95 --window 48-95\n"
       "  rad-global scene.gltf -o global.rlh --frames 0-95 --merge w0.rkw w1.rkw");
+  const std::string preset = rad::addPresetOption(app, o.preset, argc, argv);
+  rad::globalParameters().apply(o.global, rad::findPreset(rad::globalPresets(), preset).values);
   addOptions(app, o);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o, argc, argv); });

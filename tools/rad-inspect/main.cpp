@@ -16,6 +16,8 @@
 #include "formats/pixel_checksum.h"
 #include "formats/provenance.h"
 #include "formats/texture_movie.h"
+#include "libcommon/radiosity/global_stage.h"
+#include "libcommon/scene/frame_range.h"
 #include "libcommon/scene/scene_summary.h"
 #include "tools/common/tool_main.h"
 
@@ -27,8 +29,10 @@ struct Options {
   std::vector<std::string> files;
   bool json = false;
   bool check = false;
-  std::string array;   // dump one array of a container
-  std::string inputs;  // --inputs: the files a scene is made of, with hashes
+  std::string array;          // dump one array of a container
+  std::string inputs;         // --inputs: the files a scene is made of, with hashes
+  std::string defaultFrames;  // --default-frames: the frames a stage covers without --frames
+  double fps = rad::GlobalOptions{}.fps;  // --fps for --default-frames: the stages' default
 };
 
 // count, min, max and non-finite count of one array, whatever its dtype.
@@ -234,9 +238,26 @@ int main(int argc, char** argv) {
                  "nothing")
       ->option_text("SCENE")
       ->excludes(files);
+  CLI::Option* defaultFrames =
+      app.add_option("--default-frames", o.defaultFrames,
+                     "instead: print the frames every stage covers without --frames, FIRST-LAST "
+                     "(the scene's animation at --fps, docs/design.md §1), for a Makefile")
+          ->option_text("SCENE")
+          ->excludes(files)
+          ->excludes("--inputs");
+  app.add_option("--fps", o.fps, "frames per second for --default-frames")
+      ->capture_default_str()
+      ->check(rad::positiveFinite())
+      ->needs(defaultFrames);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   // The summary shows a scene's warnings; stderr need not repeat them.
   rad::setGltfWarningHandler(nullptr);
+  if (!o.defaultFrames.empty())
+    return rad::runTool(kTool, [&]() {
+      std::cout << rad::animationFrames(rad::readGltfScene(o.defaultFrames), o.fps).toString()
+                << "\n";
+      return 0;
+    });
   if (!o.inputs.empty())
     return rad::runTool(kTool, [&]() {
       std::cout << rad::gltfInputsText(rad::gltfInputs(o.inputs));

@@ -13,6 +13,7 @@
 #include "libcommon/intervals/intervals_options.h"
 #include "libcommon/scene/frame_range.h"
 #include "libcommon/scene/scene_digest.h"
+#include "tools/common/parameter_cli.h"
 #include "tools/common/tool_main.h"
 #include "tools/stages/interval_sequence.h"
 
@@ -40,7 +41,7 @@ void printSummary(const nlohmann::json& report, size_t movies) {
                report["item_buffer_ms_median"].get<double>(), report["ms_per_frame"].get<double>());
 }
 
-int run(const rad::IntervalsOptions& given, int argc, char** argv) {
+int run(const rad::IntervalsOptions& given, const std::string& preset, int argc, char** argv) {
   rad::IntervalsOptions o = given;
   auto [w, h] = rad::parseImageSize(o.size);
   o.build.imageSize = {w, h};
@@ -55,6 +56,7 @@ int run(const rad::IntervalsOptions& given, int argc, char** argv) {
 
   // The item buffers see the patches where the camera sees them: geometry, motion, camera.
   nlohmann::json parameters = o.toJson();
+  parameters["preset"] = preset;
   parameters[rad::kSceneDigestsKey] = rad::sceneDigests(
       scene, {rad::ScenePart::kGeometry, rad::ScenePart::kAnimation, rad::ScenePart::kCamera});
   rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
@@ -87,54 +89,20 @@ int main(int argc, char** argv) {
       "Computes texture-movie extents (which patch node gets a movie, from which frame "
       "to which, at what size) from per-frame item buffers (paper §4.1, §4.3)."};
   rad::IntervalsOptions o;
+  std::string preset;
   rad::setUpApp(app, kTool,
                 "rad-intervals scene.gltf -o intervals.rti --frames 0-95 --fps 24 --size 352x240");
+  // A preset sets nothing here (README "Recommended settings"); it is taken so one --preset
+  // goes to every stage, and recorded.
+  rad::addPresetOption(app, preset, argc, argv);
+  const std::string common = rad::parameterGroupTitle(rad::ParameterGroup::kCommon);
   app.add_option("SCENE", o.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
-  app.add_option("-o,--output", o.output, "output intervals file (.rti)")->required();
-  app.add_option(
-      "--frames", o.frames,
-      "frame range a-b or a-bxstep (default: the whole animation, 0 to ceil(end x fps))");
-  app.add_option("--fps", o.build.fps, "frames per second; frame f is at time f/fps")
-      ->capture_default_str()
-      ->check(rad::positiveFinite());
-  app.add_option("--size", o.size, "item buffer size WxH (the final frame size)")
-      ->capture_default_str();
-  app.add_option("--camera", o.camera, "camera node or camera name (default: the first)");
-  app.add_option("--item-buffers", o.itemBuffers,
-                 "also write each frame's item buffer to DIR/NNNN.exr (UINT id, FLOAT Z)");
-  app.add_option("--report", o.report, "write a JSON report (times, movies, texels) to FILE");
-  app.add_option("--max-level", o.build.maxLevel, "subdivision depth below the top-level patches")
-      ->capture_default_str();
-  app.add_option("--min-visible-fraction", o.build.minVisibleFraction,
-                 "theta: below this visible fraction a patch is represented by its children")
-      ->capture_default_str()
-      ->check(rad::finiteRange(0.0, 1.0));
-  app.add_option("--level-hysteresis", o.build.levelHysteresis,
-                 "keep a patch's level while its visible fraction stays within this of theta (each "
-                 "level change ends movies and starts new ones); 0: the paper's rule; not with "
-                 "--max-length 1 (from scratch)")
-      ->capture_default_str()
-      ->check(rad::finiteRange(0.0, 1.0));
-  app.add_option("--texel-density", o.build.texelDensity, "texels per covered pixel")
-      ->capture_default_str()
-      ->check(rad::positiveFinite());
-  app.add_option("--min-size", o.build.minSize, "smallest texture side")->capture_default_str();
-  app.add_option("--max-size", o.build.maxSize, "largest texture side")->capture_default_str();
-  app.add_option("--resize-tolerance", o.build.resizeTolerance,
-                 "keep a texture size while the ideal size is within a factor 1+tol of it")
-      ->capture_default_str()
-      ->check(rad::nonNegativeFinite());
-  app.add_option("--size-ratio", o.build.sizeRatio,
-                 "texture sides are round(r^k): the default sqrt 2 holds a patch's pixels in at "
-                 "most twice their texels, 2 (the paper's powers of two) in up to four times")
-      ->capture_default_str()
-      ->check(rad::finiteRange(1.2, 4.0));
-  app.add_option("--max-length", o.build.maxLength, "longest movie in frames (0 = no limit)")
-      ->capture_default_str();
-  app.add_option("--hidden-gap", o.build.hiddenGap,
-                 "keep a movie whose node is hidden for at most this many frames and then seen "
-                 "again at the same size (0: close it at the first hidden frame)")
-      ->capture_default_str();
+  app.add_option("-o,--output", o.output, "output intervals file (.rti)")
+      ->required()
+      ->group(common);
+  rad::bindParameters(app, rad::intervalsParameters(), o);
+  app.add_option("--report", o.report, "write a JSON report (times, movies, texels) to FILE")
+      ->group(common);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
-  return rad::runTool(kTool, [&]() { return run(o, argc, argv); });
+  return rad::runTool(kTool, [&]() { return run(o, preset, argc, argv); });
 }

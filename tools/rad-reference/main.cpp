@@ -12,6 +12,7 @@
 #include "formats/provenance.h"
 #include "libcommon/reference/reference_options.h"
 #include "libcommon/scene/frame_range.h"
+#include "tools/common/parameter_cli.h"
 #include "tools/common/tool_main.h"
 #include "tools/stages/reference_sequence.h"
 
@@ -60,26 +61,10 @@ int main(int argc, char** argv) {
   rad::setUpApp(app, kTool,
                 "rad-reference scene.gltf -o ref --frames 0-23 --size 176x120 --spp 256");
   app.add_option("SCENE", o.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
-  app.add_option("-o,--output", o.output, "output directory for NNNN.exr frames")->required();
-  app.add_option("--frames", o.frames,
-                 "frame range a-b (default: the whole animation, 0 to ceil(end x fps))");
-  app.add_option("--fps", o.fps, "frames per second")
-      ->capture_default_str()
-      ->check(rad::positiveFinite());
-  app.add_option("--size", o.size, "image size WxH")->capture_default_str();
-  app.add_option("--spp", o.spp, "samples per pixel")
-      ->capture_default_str()
-      ->check(rad::integerRange(1, 1 << 24));
-  app.add_option("--camera", o.camera, "camera node or camera name (default: the first)");
-  app.add_option("--max-depth", o.maxDepth, "maximum number of reflections per path")
-      ->capture_default_str()
-      ->check(rad::integerRange(0, 100000));
-  app.add_option("--seed", o.seed, "random seed")->capture_default_str();
-  app.add_flag("--pixel-centres", o.pixelCentres,
-               "every sample through the pixel centre (no antialiasing), as rad-compose samples");
-  app.add_flag("--decorrelate-frames", o.decorrelateFrames,
-               "independent noise per frame (default: the same per-pixel seeds every frame, so "
-               "what does not change does not flicker)");
+  app.add_option("-o,--output", o.output, "output directory for NNNN.exr frames")
+      ->required()
+      ->group(rad::parameterGroupTitle(rad::ParameterGroup::kCommon));
+  rad::bindParameters(app, rad::referenceParameters(), o);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o, argc, argv); });
 }
