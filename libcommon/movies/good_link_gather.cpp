@@ -15,6 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/radiosity/shaft.h"
 
 namespace rad {
 

@@ -76,6 +76,7 @@
 #include "libcommon/intervals/movie_extent.h"
 #include "libcommon/radiosity/global_solution.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/radiosity/scene_visibility.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {

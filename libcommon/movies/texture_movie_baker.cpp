@@ -29,6 +29,7 @@
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/movies/ray_cast_masks.h"
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/radiosity/shaft.h"
 #include "libcommon/scene/box_tree.h"
 #include "libcommon/scene/frame_range.h"
 
