@@ -11,6 +11,7 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/radiosity/scene_visibility.h"
 
 namespace rad {
 namespace {

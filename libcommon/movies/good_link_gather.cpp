@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/radiosity/shaft.h"
 
 namespace rad {
 namespace {

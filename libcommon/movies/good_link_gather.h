@@ -68,6 +68,7 @@
 #include "libcommon/movies/solid_contact.h"
 #include "libcommon/radiosity/global_solution.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/radiosity/scene_visibility.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {

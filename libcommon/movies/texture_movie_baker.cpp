@@ -31,6 +31,7 @@
 #include "libcommon/movies/ray_cast_masks.h"
 #include "libcommon/movies/solid_contact.h"
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/radiosity/shaft.h"
 #include "libcommon/scene/box_tree.h"
 #include "libcommon/scene/frame_range.h"
 

@@ -183,47 +183,61 @@ bool ClusterLinks::wantsRefinement(const ClusterLink& l, double epsAbs) const {
   return bv * std::min(R.area * f, S.area) > epsAbs;
 }
 
-size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
-                            std::vector<std::pair<int, int>>& patchPairs, bool& overBudget) {
-  // Level by level: `work` holds one level's links, `next` their children, `kept` the links
-  // that stay. A refined link is dropped at once, so memory holds the links in use and one
-  // level's children, not every link refinement went through: on the 10k-triangle hall the
-  // vector that kept them all until the end had reached 470 MB for 1.2 M live links (heaptrack).
-  // The links keep the order they had that way (each level's survivors after the last's). The
-  // levels below the first hold new links, which have only their ends (8 bytes instead of a
-  // link's 40: on the 10k-triangle hall a level and its children had been 105 MB of
-  // rad-global's peak).
-  // The first level is compacted in place (a kept link goes to an index at or below its own),
-  // and the deeper levels' survivors are appended behind it: a second array of the links next
-  // to the first had been the whole 48 MB by which rad-global's peak on the 10k-triangle hall
-  // rose in each refinement round after the first.
-  std::vector<ClusterLink> kept;
-  kept.swap(links_);
-  kept.reserve(std::max(kept.size(), expectedLinks_));
-  size_t firstSize = kept.size(), written = 0;
-  bool firstLevel = true;
-  // Where each link of the first level goes (kGone: refined) and which receivers' links
-  // change, so that the gather lists of the links before this round can be taken over for the
-  // tops whose links did not change (buildReceiverLists).
-  const bool remap = listsValid_;
-  const size_t T = emission_.size();
-  std::vector<uint32_t> moved(remap ? firstSize : 0, kGone);
-  std::vector<char> changed(remap ? T + size_t(tree_.size()) : 0, 0);
-  auto changes = [&](ClusterRef r) {
-    if (remap) changed[clusterLinkEnd(r, T)] = 1;
-  };
-  size_t current = 0;  // the first level's index of the link at hand
-  auto keep = [&](const ClusterLink& l) {
-    if (firstLevel) {
-      if (remap) moved[current] = uint32_t(written);
-      kept[written++] = l;
-    } else {
-      changes(l.receiver);
-      kept.push_back(l);
+// One call of ClusterLinks::refine, level by level: `work_` holds one level's links, their
+// children become the next level, `kept_` the links that stay. A refined link is dropped at
+// once, so memory holds the links in use and one level's children, not every link refinement
+// went through. The links keep the order they had that way (each level's survivors after the
+// last's). The levels below the first hold new links, which have only their ends (LinkEnds,
+// not whole links). The first level is compacted in place (a kept link goes to an index at or
+// below its own), and the deeper levels' survivors are appended behind it, so no second array
+// of the links is held beside the first. (Their memory: docs/results.md, "Figures moved out of
+// the radiosity code's comments (issue 55)".)
+class ClusterLinks::RefineRound {
+ public:
+  RefineRound(ClusterLinks& links, double epsAbs, bool refineAll, size_t budget,
+              std::vector<std::pair<int, int>>& patchPairs, bool& overBudget)
+      : c_(links),
+        epsAbs_(epsAbs),
+        refineAll_(refineAll),
+        budget_(budget),
+        patchPairs_(patchPairs),
+        overBudget_(overBudget) {
+    kept_.swap(c_.links_);
+    kept_.reserve(std::max(kept_.size(), c_.expectedLinks_));
+    firstSize_ = kept_.size();
+    // Where each link of the first level goes (kGone: refined) and which receivers' links
+    // change, so that the gather lists of the links before this round can be taken over for
+    // the tops whose links did not change (buildReceiverLists).
+    remap_ = c_.listsValid_;
+    T_ = c_.emission_.size();
+    moved_.assign(remap_ ? firstSize_ : 0, kGone);
+    changed_.assign(remap_ ? T_ + size_t(c_.tree_.size()) : 0, 0);
+  }
+
+  // The first level (the links before this round), then the levels of new links until none is
+  // made; returns the number of links refined.
+  size_t run() {
+    refineLevel(firstSize_, [&](size_t i) { return kept_[i]; });
+    kept_.resize(written_);
+    firstLevel_ = false;
+    while (!work_.empty())
+      refineLevel(work_.size(), [&](size_t i) {
+        ClusterLink l;
+        l.receiver = work_[i].receiver;
+        l.shooter = work_[i].shooter;
+        return l;
+      });
+    c_.links_.swap(kept_);
+    // A round that refined nothing left every link where it was, and the gather lists hold.
+    if (count_ > 0) {
+      c_.listsValid_ = false;
+      c_.movedTo_.swap(moved_);
+      c_.changedReceiver_.swap(changed_);
     }
-  };
-  std::vector<LinkEnds> work;
-  size_t made = 0, count = 0;
+    return count_;
+  }
+
+ private:
   // Appends a refined link's children to `next` and `patchPairs` (the serial path).
   struct Appender {
     std::vector<LinkEnds>& next;
@@ -247,70 +261,106 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
     void link(ClusterRef r, ClusterRef s) { *links++ = {r, s}; }
     void pair(ClusterRef r, ClusterRef s) { *pairs++ = {r, s}; }
   };
-  auto refineLevel = [&](size_t size, auto&& linkAt) {
-    // The refinement test of every link first, in parallel (a pure function of the link): the
-    // serial loop below still decides in link order, so the links and their order are the same.
-    // Serial, the tests had been 3 % of the 10k-triangle hall's rad-global on one thread.
-    std::vector<char> wants(refineAll ? 0 : size);
-    if (!refineAll)
+
+  void changes(ClusterRef r) {
+    if (remap_) changed_[clusterLinkEnd(r, T_)] = 1;
+  }
+
+  void keep(const ClusterLink& l) {
+    if (firstLevel_) {
+      if (remap_) moved_[current_] = uint32_t(written_);
+      kept_[written_++] = l;
+    } else {
+      changes(l.receiver);
+      kept_.push_back(l);
+    }
+  }
+
+  bool refines(size_t i, const ClusterLink& l) const {
+    return l.receiver == l.shooter || refineAll_ || wants_[i];
+  }
+
+  // One level: the tests, the children (in parallel where the link bound allows), then the
+  // decisions in link order; the children become the next level.
+  template <class LinkAt>
+  void refineLevel(size_t size, LinkAt&& linkAt) {
+    testLevel(size, linkAt);
+    std::vector<LinkEnds> next;
+    const bool parallel = expandInParallel(size, linkAt, next);
+    decideInOrder(size, linkAt, parallel, next);
+    work_.swap(next);
+  }
+
+  // The refinement test of every link first, in parallel (a pure function of the link): the
+  // serial loop of decideInOrder still decides in link order, so the links and their order are
+  // the same.
+  template <class LinkAt>
+  void testLevel(size_t size, LinkAt& linkAt) {
+    wants_.assign(refineAll_ ? 0 : size, 0);
+    if (!refineAll_)
       tbb::parallel_for(size_t(0), size, [&](size_t i) {
         const ClusterLink l = linkAt(i);
-        wants[i] = l.receiver != l.shooter && wantsRefinement(l, epsAbs);
+        wants_[i] = l.receiver != l.shooter && c_.wantsRefinement(l, epsAbs_);
       });
-    auto refines = [&](size_t i, const ClusterLink& l) {
-      return l.receiver == l.shooter || refineAll || wants[i];
-    };
-    std::vector<LinkEnds> next;
-    // The children in parallel, in chunks of a fixed size (so the same whatever the thread
-    // count): counted, then written at the offsets the counts give, in link order as the
-    // serial loop would. Only where the link bound cannot be reached within the level, which
-    // the serial loop checks link by link (a chunk's count bounds what its links add). Serial,
-    // the level's loop had been 5 % of the 10k-triangle hall's rad-global with one core idle.
+  }
+
+  // The children in parallel, in chunks of a fixed size (so the same whatever the thread
+  // count): counted, then written at the offsets the counts give, in link order as the serial
+  // loop would. Only where the link bound cannot be reached within the level, which the serial
+  // loop checks link by link (a chunk's count bounds what its links add). Returns whether the
+  // children were made here.
+  template <class LinkAt>
+  bool expandInParallel(size_t size, LinkAt& linkAt, std::vector<LinkEnds>& next) {
     constexpr size_t kChunk = 2048;
     const size_t chunks = (size + kChunk - 1) / kChunk;
     std::vector<Counter> counted(chunks);
-    bool parallel = !overBudget;
+    bool parallel = !overBudget_;
     if (parallel) {
       tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         for (size_t i = c * kChunk; i < std::min(size, (c + 1) * kChunk); ++i) {
           const ClusterLink l = linkAt(i);
-          if (refines(i, l)) expand(l, counted[c]);
+          if (refines(i, l)) c_.expand(l, counted[c]);
         }
       });
-      size_t added = made + patchPairs.size();
+      size_t added = made_ + patchPairs_.size();
       for (const Counter& c : counted) {
         added += c.links + c.pairs;
-        parallel = parallel && added <= budget + count;
+        parallel = parallel && added <= budget_ + count_;
       }
     }
     if (parallel) {
-      std::vector<size_t> linkAt0(chunks + 1, 0), pairAt0(chunks + 1, patchPairs.size());
+      std::vector<size_t> linkAt0(chunks + 1, 0), pairAt0(chunks + 1, patchPairs_.size());
       for (size_t c = 0; c < chunks; ++c) {
         linkAt0[c + 1] = linkAt0[c] + counted[c].links;
         pairAt0[c + 1] = pairAt0[c] + counted[c].pairs;
       }
       next.resize(linkAt0[chunks]);
-      patchPairs.resize(pairAt0[chunks]);
+      patchPairs_.resize(pairAt0[chunks]);
       tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-        Writer w{next.data() + linkAt0[c], patchPairs.data() + pairAt0[c]};
+        Writer w{next.data() + linkAt0[c], patchPairs_.data() + pairAt0[c]};
         for (size_t i = c * kChunk; i < std::min(size, (c + 1) * kChunk); ++i) {
           const ClusterLink l = linkAt(i);
-          if (refines(i, l)) expand(l, w);
+          if (refines(i, l)) c_.expand(l, w);
         }
       });
-      made += next.size();
+      made_ += next.size();
     }
-    // The decisions in link order (the children already made when `parallel`).
-    Appender append{next, patchPairs, made};
+    return parallel;
+  }
+
+  // The decisions in link order (the children already made when `parallel`). Past the link
+  // bound only the lights' links go on (as far as the light share asks): a light left inside a
+  // cluster link reaches its receivers without shadows, so stopping wherever the bound fell
+  // would lose the lights' bad pairs. A refined link is replaced by its children, so it no
+  // longer counts (count_ of them this call).
+  template <class LinkAt>
+  void decideInOrder(size_t size, LinkAt& linkAt, bool parallel, std::vector<LinkEnds>& next) {
+    Appender append{next, patchPairs_, made_};
     for (size_t i = 0; i < size; ++i) {
       const ClusterLink l = linkAt(i);
-      current = i;
-      // Past the link bound only the lights' links go on (as far as the light share asks): a
-      // light left inside a cluster link reaches its receivers without shadows (stopped
-      // wherever the bound fell, the 30k-triangle hall had lost 92 % of its bad pairs). A refined
-      // link is replaced by its children, so it no longer counts (`count` of them this call).
-      if (!parallel && made + patchPairs.size() > budget + count) overBudget = true;
-      if (overBudget && !emits(l.shooter)) {
+      current_ = i;
+      if (!parallel && made_ + patchPairs_.size() > budget_ + count_) overBudget_ = true;
+      if (overBudget_ && !c_.emits(l.shooter)) {
         keep(l);
         continue;
       }
@@ -318,30 +368,34 @@ size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
         keep(l);
         continue;
       }
-      if (!parallel) expand(l, append);
-      if (firstLevel) changes(l.receiver);
-      ++count;
+      if (!parallel) c_.expand(l, append);
+      if (firstLevel_) changes(l.receiver);
+      ++count_;
     }
-    work.swap(next);
-  };
-  refineLevel(firstSize, [&](size_t i) { return kept[i]; });
-  kept.resize(written);
-  firstLevel = false;
-  while (!work.empty())
-    refineLevel(work.size(), [&](size_t i) {
-      ClusterLink l;
-      l.receiver = work[i].receiver;
-      l.shooter = work[i].shooter;
-      return l;
-    });
-  links_.swap(kept);
-  // A round that refined nothing left every link where it was, and the gather lists hold.
-  if (count > 0) {
-    listsValid_ = false;
-    movedTo_.swap(moved);
-    changedReceiver_.swap(changed);
   }
-  return count;
+
+  ClusterLinks& c_;
+  const double epsAbs_;
+  const bool refineAll_;
+  const size_t budget_;
+  std::vector<std::pair<int, int>>& patchPairs_;
+  bool& overBudget_;
+  std::vector<ClusterLink> kept_;
+  size_t firstSize_ = 0, written_ = 0;
+  bool firstLevel_ = true;
+  bool remap_ = false;
+  size_t T_ = 0;
+  std::vector<uint32_t> moved_;
+  std::vector<char> changed_;
+  size_t current_ = 0;  // the first level's index of the link at hand
+  std::vector<LinkEnds> work_;
+  size_t made_ = 0, count_ = 0;
+  std::vector<char> wants_;  // per link of the level: wantsRefinement (empty: refineAll_)
+};
+
+size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
+                            std::vector<std::pair<int, int>>& patchPairs, bool& overBudget) {
+  return RefineRound(*this, epsAbs, refineAll, budget, patchPairs, overBudget).run();
 }
 
 void ClusterLinks::evaluate() {

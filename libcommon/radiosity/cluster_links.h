@@ -77,9 +77,8 @@ inline uint8_t quantizedVisibility(double v) {
 }
 
 // 36 bytes: the direction and V in single precision, V per receiver facing group in bytes, and
-// where its members' own V start (1.2 M links per key on the 10k-triangle hall, held with the
-// next key's cache of them; 56 bytes had been 20 MB more of each, and the group V in floats 46
-// MB more of rad-global's peak).
+// where its members' own V start: a key holds a million or more of them, beside the next key's
+// cache of them, at rad-global's peak.
 struct ClusterLink {
   ClusterRef receiver = 0, shooter = 0;
   glm::vec3 direction{0.0f};  // unit, from the receiver's centre towards the shooter's
@@ -137,8 +136,7 @@ class ClusterLinks {
   size_t refine(double epsAbs, bool refineAll, size_t budget,
                 std::vector<std::pair<int, int>>& patchPairs, bool& overBudget);
   // About how many links refinement will keep (the previous key's count with a margin): the
-  // kept links are reserved once instead of doubling as they grow (69 MB of spare capacity on
-  // the 10k-triangle hall).
+  // kept links are reserved once instead of doubling as they grow (no spare capacity held).
   void expectLinks(size_t n) { expectedLinks_ = n; }
   // Transfer and visibility of the links made since the last call (parallel, deterministic).
   void evaluate();
@@ -149,9 +147,9 @@ class ClusterLinks {
   // the top, the covered ones included, so its irradiance is divided by the exposure (as the
   // patch links' is); a link at an ancestor cluster took V from points all over the cluster's
   // tops, where this top's covered part is a sliver, so its irradiance is the exposed part's
-  // as it is. Dividing that too had made a ceiling tile mostly behind a light (exposure 1/16)
-  // gather 6 times its neighbours' cluster light, and rad-movies spread it along every light of
-  // the 10k-triangle hall (its ceiling 3.1 % brighter than with all pairs). A covered top
+  // as it is. Dividing that too would make a ceiling tile mostly behind a light (exposure 1/16)
+  // gather many times its neighbours' cluster light, which rad-movies spreads along every
+  // light. A covered top
   // (exposure 0) gathers nothing.
   void gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
               std::vector<glm::dvec3>& out);
@@ -174,6 +172,8 @@ class ClusterLinks {
   struct LinkEnds {
     ClusterRef receiver, shooter;
   };
+  // One call of refine, as its named steps (cluster_links.cpp).
+  class RefineRound;
   // Whether a link between r and s may carry energy (see the .cpp).
   bool canExchange(ClusterRef r, ClusterRef s) const;
   // The children of refined link l, in order: links through sink.link(r, s), pairs of
@@ -199,8 +199,7 @@ class ClusterLinks {
   static constexpr double kParallelCosine = 1e-6;
   // The group V's prior weight, in mean pair kernels: a group's V is (its open kernel + p k V)
   // / (its kernel + p k), so that a group that drew one or two of the link's pairs does not
-  // take 0 or 1 from them (10k-triangle hall, frame 48 against all pairs: 1.16 % with p = 0,
-  // 1.09 % with 0.5, 1.09 % with 2, 1.12 % with one V per link).
+  // take 0 or 1 from them (0.5: as good as 2 against all pairs, better than 0).
   static constexpr double kGroupPrior = 0.5;
   // F V of link l at member top `top` of its receiver, whose exposure is `exposure`.
   double formFactor(const ClusterLink& l, uint32_t top, double exposure) const;
@@ -273,12 +272,12 @@ class ClusterLinks {
   std::vector<uint32_t> memberPosition_;  // per top: its index in tree_.members()
   size_t expectedLinks_ = 0;
   // Per link: its shooter's B towards its receiver (gather). This and the gather's form
-  // factors in single precision: 1.2 M links and 2.5 M entries on the 10k-triangle hall.
+  // factors in single precision: there are millions of them on a large scene.
   std::vector<glm::vec3> linkB_;
   // Per top, what the gather sums at every sweep: the links at the top and at its ancestor
   // clusters, in that order, with their form factor to the top where it is > 0. The geometry is
   // fixed within a key time, and walking the links themselves at every sweep (each a cache
-  // miss) had been a third of a coherent key's time on the 10k-triangle hall. Held in blocks of
+  // miss) would cost far more than reading these lists in order. Held in blocks of
   // kGatherBlockTops tops, each built by one task: top t's entries start at gatherStart_[t] in
   // its block and end where the next top's start (its block's end for the block's last top).
   struct GatherEntry {

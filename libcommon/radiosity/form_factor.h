@@ -37,9 +37,8 @@ double pointToPolygonFormFactor(const glm::dvec3& p, const glm::dvec3& n,
                                 const std::vector<glm::dvec3>& v);
 // The angle in [0, pi] between two vectors a, b from |a x b| (`crossLength`, >= 0) and a . b
 // (`dot`): atan2(crossLength, dot) within 4 eps relative for finite input (1.96 eps measured
-// over 10^6 angles), the contour formula's gamma_k. glibc's correctly rounded atan2 had been
-// 17 % of rad-global's key 0 and 7 % of rad-movies on the 10k-triangle hall (perf); this is one
-// division and a polynomial.
+// over 10^6 angles), the contour formula's gamma_k. glibc's correctly rounded atan2 is a large
+// share of rad-global's and rad-movies' time; this is one division and a polynomial.
 double edgeAngle(double crossLength, double dot);
 
 // Order used by polygonToPolygonFormFactor when it is given order <= 0 (kAutoOrder).

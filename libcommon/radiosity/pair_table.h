@@ -2,8 +2,8 @@
 // compressed row table: per row the start of its entries, and within a row the columns sorted.
 // The coherence caches of rad-global (a key time's link values that the next key may take
 // over, paper §4.2) are built once per key and looked up once per new link: an
-// std::unordered_map of 1.5 M links had cost ~100 bytes and one allocation per entry (157 MB
-// and ~0.5 s per key on the 10k-triangle hall); this costs the value plus 8 bytes.
+// std::unordered_map costs ~100 bytes and one allocation per entry; this costs the value plus
+// 8 bytes.
 #pragma once
 
 #include <algorithm>
@@ -28,8 +28,8 @@ RowOrder sortByRow(size_t n, uint32_t rows, RowOf rowOf) {
   out.order.resize(n);
   // In parallel over up to kMaxParts fixed parts of the items (so the same whatever the thread
   // count): each counts its rows, and a row's items from part c follow those of the parts
-  // before it, which is the one-pass order. One pass over 1.4 M links had been 3 % of the
-  // 10k-triangle hall's rad-global with the other core idle (its gather lists each round).
+  // before it, which is the one-pass order (a serial pass over the links leaves the other cores
+  // idle at every round's gather lists).
   constexpr size_t kMinPart = size_t(1) << 16, kMaxParts = 16;
   const size_t parts = std::min(kMaxParts, (n + kMinPart - 1) / kMinPart);
   if (parts <= 1) {
@@ -73,9 +73,9 @@ class PairTable {
     const size_t n = keys.size();
     // Counting sort by row (stable), then each row by column (stable: the first of equal keys
     // stays first, and lower_bound finds it), the rows in parallel. The values stay where they
-    // are, reached through the sorted order: moving 1.4 M 40-byte values into it, cycle by
-    // cycle, had been most of the 10k-triangle hall's link cache build (~0.3 s a key, serial);
-    // the order kept is 4 bytes an entry, as a second array of values would have been 40.
+    // are, reached through the sorted order: moving the values into it, cycle by cycle, would be
+    // most of the cache build, serially; the order kept is 4 bytes an entry, as a second array of
+    // values would have been 40.
     RowOrder byRow = sortByRow(n, rows, [&](size_t i) { return keys[i].first; });
     rowStart_ = std::move(byRow.rowStart);
     entry_ = std::move(byRow.order);

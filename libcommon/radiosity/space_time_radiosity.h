@@ -24,6 +24,7 @@
 
 #include "libcommon/radiosity/global_solution.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/radiosity/key_solve_inputs.h"
 #include "libcommon/radiosity/key_window.h"
 #include "libcommon/scene/scene.h"
 

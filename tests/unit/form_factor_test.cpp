@@ -1,6 +1,7 @@
 // Form factors against the exact references in tests/data/reference (see its README).
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/radiosity/link_form_factor.h"
 
 #include <chrono>
 #include <cmath>

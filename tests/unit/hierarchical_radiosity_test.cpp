@@ -4,6 +4,7 @@
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/form_factor.h"
+#include "libcommon/radiosity/shaft.h"
 
 #include <array>
 #include <chrono>

@@ -3,6 +3,7 @@
 // after the first key time, and the merged GlobalSolution is consistent (activity intervals,
 // push-down, Gouraud vertices).
 #include "libcommon/radiosity/space_time_radiosity.h"
+#include "libcommon/radiosity/scene_visibility.h"
 
 #include <cmath>
 #include <iostream>

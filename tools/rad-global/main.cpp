@@ -190,9 +190,9 @@ int run(Options o, int argc, char** argv) {
 int main(int argc, char** argv) {
 #if defined(__GLIBC__)
   // Arrays of 1 MB and more are mapped and unmapped on their own. glibc's threshold otherwise
-  // grows with each large block freed, and the key solves' freed arrays stayed in the heap:
-  // the 10k-triangle hall's peak RSS was 638 MiB (619-656) for a 570 MB heap, 547 MiB now, for
-  // 4 % more time (the fresh pages' faults; farm-bench, two runs each).
+  // grows with each large block freed, and the key solves' freed arrays would stay in the heap
+  // and raise the peak RSS; the cost is the fresh pages' faults (docs/results.md, "Figures
+  // moved out of the radiosity code's comments (issue 55)").
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
 #endif
   CLI::App app{

@@ -1,0 +1,303 @@
+// The key-time solver's closure (each leaf's own row sum, exact in closed rooms) and exposure
+// (a patch's covered part left out). See key_time_solver.h.
+#include "libcommon/radiosity/key_time_solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "libcommon/core/error.h"
+#include "libcommon/radiosity/pair_table.h"
+#include "libcommon/radiosity/visibility.h"
+
+namespace rad {
+
+namespace {
+
+// Cosine-distributed directions about a node's normal (Malley's method), the k-th from two
+// counter-based numbers of `seed`: the exposure's rays and the closed-room test's.
+struct CosineRays {
+  glm::dvec3 normal, t, b;
+  explicit CosineRays(const glm::dvec3& n) : normal(n) {
+    t = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+    t = glm::normalize(glm::cross(t, n));
+    b = glm::cross(n, t);
+  }
+  glm::dvec3 operator()(uint64_t seed, size_t k) const {
+    const double u = uniformOpen01(seed, 2 * k), v = uniformOpen01(seed, 2 * k + 1);
+    const double r = std::sqrt(u), phi = 2.0 * M_PI * v;
+    return r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1.0 - u) * normal;
+  }
+};
+
+struct TopShare {  // one top-level shooter's links in a leaf's chain
+  uint32_t top = 0;
+  double fv = 0;
+  bool unoccluded = true;
+  bool fromAncestor = false;  // some of them are at an ancestor (else F is the leaf's own)
+};
+
+}  // namespace
+
+// Closure (energy conservation whatever the refinement): a leaf r gathers through a link
+// (a <- b) at an ancestor a the area average F(a -> b), not its own F(r -> b), so its row sum
+// $\sum_k F(a_k \to b_k) V_k$ over the links of r and its ancestors is not its own: 0.82 ..
+// 1.37 in the refined unit-cube furnace (1 in the area average), whose B that error,
+// amplified by 1 / (1 - rho), made 7 % too bright at rho = 0.9 and 52 % at 0.99. The shooters
+// b_k of a leaf's links tile the top-level patches it is linked with, so for a top-level
+// patch q that every one of those links sees unoccluded (V = 1), the links to q carry exactly
+// $F(r \to q)$ at the leaf's own resolution; the leaf's links to such a q are scaled by
+//   $c_{rq} = G_q / \sum_{k \in q} F(a_k \to b_k) V_k$,  $G_q = F(r \to q)$
+// (topExcess_ holds c_rq - 1 per link), the links to a q any of whose links is occluded are
+// kept: row sums exact in a closed empty room at any refinement, and the averaging error of
+// unoccluded pairs (a wall meeting the floor) removed in any scene, while the occluded pairs
+// keep hierarchical radiosity's estimate (scaling them by an unoccluded ratio would brighten
+// what an occluder darkens). Per top, not one ratio for the row: a floor leaf beside a dim
+// wall had its light scaled by the wall's ratio (1.85 in the bundled scene). The good-link
+// share (shooters that do not emit: the default bad-link rule's good links) also gets one
+// factor, goodClosure, which rad-global's merge applies to the good-link irradiance the
+// Gouraud layer interpolates.
+void KeyTimeSolver::computeClosure() {
+  buildGatherLists();
+  const size_t N = size_t(h_.size());
+  s_.closure.assign(N, 1.0);
+  s_.goodClosure.assign(N, 1.0);
+  goodFactor_.assign(N, 1.0);
+  closed_.resize(N, -1);  // kept from the rounds before: a node's rays do not change
+  // The previous key's values (coherence) start each node's list: closeLeaf finds them as
+  // its own, and they are kept for the next key (all of them static pairs, valid at every key).
+  if (leafTopFormFactor_.empty() && input_.reuseLeafFormFactors)
+    leafTopFormFactor_ = std::move(*input_.reuseLeafFormFactors);
+  leafTopFormFactor_.resize(N);
+  topExcess_.assign(N, {});
+  std::vector<int> leaves;
+  for (size_t i = 0; i < N; ++i)
+    if (s_.inTree(int(i), h_) && !s_.split[i]) leaves.push_back(int(i));
+  tbb::parallel_for(size_t(0), leaves.size(), [&](size_t li) { closeLeaf(leaves[li]); });
+}
+
+bool KeyTimeSolver::closedAt(int r) {
+  // Once per node and key: the refinement rounds ask again for the leaves they keep. A static
+  // node's answer is the same at every key (the static geometry alone decides it), so it is
+  // also taken over from the keys before (coherence).
+  if (closed_[size_t(r)] >= 0) return closed_[size_t(r)] != 0;
+  const ClosedNodeCache* before = moves(h_.node(r).id.top) ? nullptr : input_.reuseClosed;
+  const auto known =
+      before ? before->find(h_.node(r).id.packed()) : ClosedNodeCache::const_iterator();
+  const bool closed = before && known != before->end() ? known->second : castEscapeRays(r);
+  closed_[size_t(r)] = closed ? 1 : 0;
+  return closed;
+}
+
+bool KeyTimeSolver::castEscapeRays(int r) const {
+  if (!input_.visibility) return false;
+  const PatchNode& n = h_.node(r);
+  const Polygon& P = s_.world[size_t(r)];
+  const glm::dvec3 normal = P.normal();
+  if (normal == glm::dvec3(0.0)) return false;
+  const CosineRays direction(normal);
+  const uint64_t seed = splitMix64(receiverSeed(n.id) ^ 0x636c6f736564ull);  // "closed"
+  const std::vector<glm::dvec3> points = VisibilityScene::samplePoints(P, kEscapeRays, seed);
+  const double size = polygonSize(P);
+  const glm::dvec3 centroid = P.centroid();
+  for (size_t k = 0; k < points.size(); ++k) {
+    const glm::dvec3 d = direction(seed, k);
+    // A ray that escapes is cast again from 1 % of the way to the leaf's centroid and 1e-3 of
+    // its size above it: a point 2e-5 m from the wall that the leaf's edge meets, whose ray
+    // into that wall started within the ray's tnear of it, passed through (a floor leaf of a
+    // closed cube); from there it meets the wall.
+    if (input_.visibility->firstStaticHit(points[k], d * size, n.id.top) ==
+            VisibilityScene::kNoSurface &&
+        input_.visibility->firstStaticHit(
+            points[k] + 0.01 * (centroid - points[k]) + normal * (1e-3 * size), d * size,
+            n.id.top) == VisibilityScene::kNoSurface)
+      return false;
+  }
+  return true;
+}
+
+// F(leaf r -> top q), integrated (closeLeaf looks in leafTopFormFactor_ first, which holds
+// the previous key's values under coherence: the same value recomputing gives).
+double KeyTimeSolver::leafToTop(int r, uint32_t q) const {
+  if (opt_.quadratureOrder != kAutoOrder)
+    return polygonToPolygonFormFactor(s_.world[size_t(r)], s_.world[q], opt_.quadratureOrder);
+  return areaAverageFormFactor(s_.world[size_t(r)], s_.world[q],
+                               std::max(opt_.formFactorTolerance, 1e-4));
+}
+
+void KeyTimeSolver::closeLeaf(int r) {
+  std::vector<TopShare> shares;
+  // Per top, its index in `shares` (first-seen order, so the sums below do not depend on
+  // it), -1 elsewhere; one per thread, reset after each leaf.
+  thread_local std::vector<int> slot;
+  slot.resize(size_t(h_.topCount()), -1);
+  for (int a = r; a >= 0; a = h_.node(a).parent)
+    for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k) {
+      const SolverLink& l = s_.links[adj_[k]];
+      const uint32_t q = h_.node(l.shooter).id.top;
+      if (slot[q] < 0) {
+        slot[q] = int(shares.size());
+        shares.push_back(TopShare{q, 0.0, true, false});
+      }
+      TopShare& t = shares[size_t(slot[q])];
+      t.fv += l.fv();
+      t.unoccluded = t.unoccluded && l.rayVisibility >= 1.0;
+      t.fromAncestor = t.fromAncestor || a != r;
+    }
+  for (const TopShare& t : shares) slot[t.top] = -1;
+  std::vector<std::pair<uint32_t, double>>& known = leafTopFormFactor_[size_t(r)];
+  // Per top, its index in `known` (the slots reused; a linear search per share had been 14 %
+  // of rad-global's time on the table scene at eps 1e-4).
+  for (size_t i = 0; i < known.size(); ++i) slot[known[i].first] = int(i);
+  glm::dvec2 own(0.0), averaged(0.0);  // (all, good)
+  // Per top whose share is replaced, G_q / sum_k F V - 1 (0: kept), indexed like `slot`.
+  thread_local std::vector<double> excess;
+  excess.resize(size_t(h_.topCount()), 0.0);
+  bool anyExcess = false;
+  for (const TopShare& t : shares) {
+    double g = t.fv;
+    if (t.unoccluded && t.fromAncestor && !moves(t.top) && !moves(h_.node(r).id.top)) {
+      int& at = slot[t.top];
+      if (at < 0) {
+        at = int(known.size());
+        known.push_back({t.top, leafToTop(r, t.top)});
+      }
+      g = known[size_t(at)].second;
+      if (t.fv > 0.0 && g != t.fv) {
+        excess[t.top] = g / t.fv - 1.0;
+        anyExcess = true;
+      }
+    }
+    const double good = surfaces_[t.top].isEmitter() ? 0.0 : 1.0;
+    own += glm::dvec2(g, good * g);
+    averaged += glm::dvec2(t.fv, good * t.fv);
+  }
+  for (const std::pair<uint32_t, double>& k : known) slot[k.first] = -1;
+  // Each replaced top's links are scaled by their own top's ratio, the others kept: a leaf
+  // beside a wall sees much more of that dim wall than its ancestor's links say, and one
+  // ratio for the whole row had scaled the light by the wall's share too (the bundled
+  // scene's floor strip in front of the tall box came out 1.8x too bright, the box's foot on
+  // the frames with it).
+  std::vector<std::pair<size_t, double>>& extra = topExcess_[size_t(r)];
+  extra.clear();
+  if (anyExcess)
+    for (int a = r; a >= 0; a = h_.node(a).parent) {
+      const double e = exposure_[size_t(a)];
+      if (!(e > 0.0)) continue;
+      for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k) {
+        const double x = excess[h_.node(s_.links[adj_[k]].shooter).id.top];
+        if (x != 0.0) extra.emplace_back(adj_[k], x / e);
+      }
+    }
+  for (const TopShare& t : shares) excess[t.top] = 0.0;
+  // The good-link irradiance rad-movies interpolates (Gouraud layer) takes the good share's
+  // ratio as one factor.
+  if (averaged.y > 0.0) s_.goodClosure[size_t(r)] = own.y / averaged.y;
+  if (opt_.closedRooms) closeRoomRow(r);
+}
+
+// A leaf's replaced tops' excess irradiance (topExcess_), (emitting shooters, the others).
+std::pair<glm::dvec3, glm::dvec3> KeyTimeSolver::excessIrradiance(int r) const {
+  std::pair<glm::dvec3, glm::dvec3> H{glm::dvec3(0.0), glm::dvec3(0.0)};
+  if (size_t(r) >= topExcess_.size()) return H;
+  for (const auto& [k, c] : topExcess_[size_t(r)]) {
+    const SolverLink& l = s_.links[k];
+    (shooterEmits_[k] ? H.first : H.second) +=
+        c * double(l.fv()) * l.shooterShape * B_[size_t(l.shooter)];
+  }
+  return H;
+}
+
+// A leaf inside a closed room sees the scene's surfaces and nothing else, so the row sum of
+// its exposed part is exactly 1, occluded links included. An occluded link's visibility is a
+// ratio estimate from a few ray pairs, and its error does not cancel within one receiver:
+// the closed 2 m furnace with a slab standing in it (make_furnace.py --partition) came out
+// 7.5 % too bright at rho = 0.99 with 16 rays, 36 % with 64 rays and 18 % too dark with the
+// slab floating; the cubic scene's leaves summed to 0.986 on average (0.80 .. 1.34), and its
+// frames were 1.6 % too dark. The links to emitting shooters keep the closure above (mostly
+// unoccluded, and recomputed per texel by the second pass); the others' factor fills the row
+// to 1, each node's links counted over its exposure as the gather divides them. Where every
+// shooter emits (the furnace), or the others' share cannot take the difference, the whole
+// row is scaled.
+void KeyTimeSolver::closeRoomRow(int r) {
+  if (!(exposure_[size_t(r)] > 0.0)) return;
+  glm::dvec2 coef(0.0);  // (emitting shooters, the others), the replaced tops' excess included
+  for (int a = r; a >= 0; a = h_.node(a).parent) {
+    const double e = exposure_[size_t(a)];
+    if (!(e > 0.0)) continue;
+    for (size_t k = adjStart_[size_t(a)]; k < adjStart_[size_t(a) + 1]; ++k)
+      (shooterEmits_[adj_[k]] ? coef.x : coef.y) += s_.links[adj_[k]].fv() / e;
+  }
+  for (const auto& [k, c] : topExcess_[size_t(r)])
+    (shooterEmits_[k] ? coef.x : coef.y) += c * s_.links[k].fv();
+  if (!(coef.x + coef.y > 0.0) || !closedAt(r)) return;
+  // The cluster links' share (gathered at the top, over its exposure) is taken as it is.
+  const uint32_t top = h_.node(r).id.top;
+  const double cluster = clusterRow_.empty() ? 0.0 : clusterRow_[top];
+  if (!(cluster < 1.0)) return;
+  const double good =
+      coef.y > 0.0 ? (1.0 - cluster - s_.closure[size_t(r)] * coef.x) / coef.y : 0.0;
+  if (good > 0.5 && good < 2.0) {
+    goodFactor_[size_t(r)] = good;
+  } else {
+    s_.closure[size_t(r)] = (1.0 - cluster) / (coef.x + coef.y);
+    goodFactor_[size_t(r)] = s_.closure[size_t(r)];
+  }
+  s_.goodClosure[size_t(r)] = goodFactor_[size_t(r)];
+}
+
+// Exposure (the darkening at contacts): a box standing on the floor covers part of the
+// floor's patches, whose links' shadow rays then start under the box and are blocked, so
+// the area-averaged H and B of a patch straddling the box's footprint mix the lit part with
+// the dark covered one; the camera sees only the lit part, and the ceiling and walls that
+// gather from that patch see only its lit part too. With the boxes of the bundled Cornell
+// scene that made every surface 6-20 % too dark (-0.4 % with the boxes removed). A node's
+// exposure e is the fraction of its ray start points (samplePoints, the same for all its
+// links) that are not covered: a point is covered when a cosine-distributed ray from it
+// first meets the back of a one-sided surface (the inside of a solid, the back of a wall).
+// The gather divides a node's links' irradiance by e, so B and H are those of the exposed
+// part (the covered points' pairs are exactly the ones removed), and a parent pulls its
+// children's B weighted by exposed area.
+void KeyTimeSolver::computeExposures() {
+  const size_t N = size_t(h_.size());
+  exposure_.resize(N, -1.0);
+  std::vector<int> todo;
+  for (size_t i = 0; i < N; ++i)
+    if (exposure_[i] < 0.0 && s_.inTree(int(i), h_)) todo.push_back(int(i));
+  tbb::parallel_for(size_t(0), todo.size(),
+                    [&](size_t k) { exposure_[size_t(todo[k])] = exposureOf(todo[k]); });
+}
+
+double KeyTimeSolver::exposureOf(int i) const {
+  if (!input_.visibility) return 1.0;
+  const PatchNode& n = h_.node(i);
+  const Polygon& P = s_.world[size_t(i)];
+  const glm::dvec3 normal = P.normal();
+  if (normal == glm::dvec3(0.0)) return 1.0;
+  const CosineRays direction(normal);
+  const std::vector<glm::dvec3> points =
+      VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(n.id));
+  const uint64_t seed = splitMix64(receiverSeed(n.id));
+  const double size = polygonSize(P);
+  // Undecided rays (a front and a back at one distance: a partition flush with the ceiling,
+  // a sheet of two back-to-back patches) go with the majority of the decided ones.
+  int exposed = 0, inside = 0, undecided = 0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const glm::dvec3 d = direction(seed, k) * size;  // firstHit's tnear is relative to |d|
+    const RayStart r = rayStart(*input_.visibility, points[k], d, n.id.top, [&](uint32_t hit) {
+      return hit < uint32_t(h_.topCount()) && !surfaces_[hit].doubleSided &&
+             glm::dot(s_.world[hit].normal(), d) > 0.0;
+    });
+    (r == RayStart::kOutside ? exposed : r == RayStart::kInside ? inside : undecided) += 1;
+  }
+  if (inside > exposed)
+    inside += undecided;
+  else
+    exposed += undecided;
+  return points.empty() ? 1.0 : double(exposed) / double(points.size());
+}
+
+}  // namespace rad

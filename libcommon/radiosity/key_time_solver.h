@@ -1,0 +1,175 @@
+// The solver of one key time (hierarchical_radiosity.h's solveKeyTime), private to
+// libcommon/radiosity: the state its named passes share, declared once, with each pass defined
+// in its own file:
+//  * hierarchical_radiosity.cpp: the driver (run: the rounds of the passes, in order), the
+//    thresholds and the solution handed back (finish);
+//  * key_time_links.cpp: link (cluster links' refinement), evaluate, refine, the accurate pass
+//    and the radiosity-weighted visibility;
+//  * key_time_closure.cpp: closure (each leaf's own row sum) and exposure;
+//  * key_time_gather.cpp: gather + push-pull, the Gauss-Seidel sweeps.
+// Nothing outside libcommon/radiosity includes this file; the contract is solveKeyTime's.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcommon/radiosity/cluster_links.h"
+#include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/radiosity/link_form_factor.h"
+
+namespace rad {
+
+// One key-time solve as its named passes (see hierarchical_radiosity.h): link top level, then
+// rounds of evaluate + refine, accurate pass, gather + push-pull, until a round refines
+// nothing. The passes share the solution being built, the radiosity B of every node and the
+// thresholds. One object solves one key time once (run moves its solution out).
+class KeyTimeSolver {
+ public:
+  // A link's index in a key solve's links: 32 bits (RadiosityOptions::maxLinks is at most
+  // kMaxLinkBound), half the size_t lists of links the refinement and the gather hold.
+  using LinkIndex = uint32_t;
+
+  KeyTimeSolver(PatchHierarchy& h, const std::vector<SurfaceProperties>& surfaces,
+                const KeySolveInput& input, const RadiosityOptions& opt)
+      : h_(h), surfaces_(surfaces), input_(input), opt_(opt) {
+    addNewNodes();
+    setThresholds();
+  }
+
+  // A vector's size from the previous key's, with a margin: this key makes about as many, so
+  // its vectors are reserved once instead of doubling as they grow (KeySolveInput::expected*).
+  static size_t withMargin(size_t n) { return n + n / 32 + 1024; }
+
+  KeySolution run();
+
+ private:
+  static double maxComponent(const glm::dvec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+
+  // The passes' driver and the state between rounds (hierarchical_radiosity.cpp).
+  void releaseRayPairs();
+  void addNewNodes();
+  void setThresholds();
+  void raiseThresholdToCarriedPower();
+  KeySolution finish();
+
+  // Link, evaluate, refine, the accurate pass and the radiosity-weighted visibility
+  // (key_time_links.cpp).
+  size_t refineClusterLinks();
+  void measureShooterRanges();
+  void evaluateNewLinks();
+  void evaluateLink(SolverLink& l) const;
+  void weightVisibilityByShooterRadiosity();
+  bool weighted(const SolverLink& l) const;
+  void setWeightedVisibility(SolverLink& l, double v, double seen) const;
+  void weightLinkVisibility(SolverLink& l) const;
+  bool oracleWantsRefinement(const SolverLink& l) const;
+  int nodeToSplit(const SolverLink& l) const;
+  void splitLink(LinkIndex li, int node, std::vector<LinkIndex>& next);
+
+  size_t refine(std::vector<LinkIndex> work);
+  std::vector<LinkIndex> unrefinedLinks() const;
+  void computeAccurateFormFactors();
+
+  // Closure and exposure (key_time_closure.cpp).
+  void computeClosure();
+  // Whether leaf r is inside a closed room: none of kEscapeRays cosine-distributed rays from
+  // its points leaves the scene. A room's opening of form factor f goes unseen with probability
+  // (1 - f)^64 (f = 5 %: 4 %), and then brightens that leaf by at most f.
+  static constexpr int kEscapeRays = 64;
+  bool closedAt(int r);
+  bool castEscapeRays(int r) const;
+  double leafToTop(int r, uint32_t q) const;
+
+  // A pair with a moving end would need its F(leaf -> top) at every key time (with many moving
+  // objects, most of rad-global's time); moving objects are small against the rooms they
+  // move in, and the closed rooms the closure is exact for are static.
+  bool moves(uint32_t top) const {
+    return top < input_.movingTops.size() && input_.movingTops[top];
+  }
+  void closeLeaf(int r);
+
+  std::pair<glm::dvec3, glm::dvec3> excessIrradiance(int r) const;
+  void closeRoomRow(int r);
+  void computeExposures();
+  double exposureOf(int i) const;
+
+  // Gather + push-pull, the Gauss-Seidel sweeps (key_time_gather.cpp).
+  void buildGatherLists();
+
+  // What a node gives its parent's pull: its exposed area e A and e A B.
+  struct Pulled {
+    glm::dvec3 power{0.0};
+    double area = 0;
+  };
+
+  // Gather + push-pull at node i (HSA'91 §5): $H_i = H_{down} + \sum_j F_{ij} V_{ij} B_j / e_i$
+  // over its links (e_i its exposure, computeExposures), pushed down to the children; a leaf
+  // sets $B_i = E_i + \rho_i c_i H_i$ (c_i its closure factor), a parent pulls up the average of
+  // its children weighted by exposed area.
+  // The irradiance pushed down, from emitting shooters and from the others: a closed leaf
+  // scales them by different closure factors (closeLeaf).
+  struct Gathered {
+    glm::dvec3 light{0.0}, good{0.0};
+    glm::dvec3 cluster{0.0};  // through cluster links, at the top (no closure factor)
+  };
+
+  Pulled gatherPushPull(int i, const Gathered& down);
+
+  // The sweeps' links in gather order, each its shooter (kSweepEmits set when it emits) and
+  // F V times its shooter shape: 12 bytes read in order instead of a 64-byte SolverLink and a
+  // flag reached through adj_ (the sweeps are serial, and memory-bound). The same products, so the
+  // same B bit for bit. The shooters overwrite adj_ (the next buildGatherLists makes it again):
+  // rad-global's peak is in the solve.
+  static constexpr uint32_t kSweepEmits = 0x80000000u;
+  void buildSweepLists();
+  void solve();
+
+  PatchHierarchy& h_;
+  const std::vector<SurfaceProperties>& surfaces_;
+  const KeySolveInput& input_;
+  // input_.reuseRayPairs until the first round has copied them (releaseRayPairs).
+  const std::vector<LinkRayPair>* reuseRayPairs_ = input_.reuseRayPairs;
+  const RadiosityOptions& opt_;
+  KeySolution s_;
+  std::vector<glm::dvec3> B_;  // per dense node: radiosity (W/m^2), area average of a parent
+  size_t evaluated_ = 0;       // links [0, evaluated_) have their estimate and visibility
+  double epsAbs_ = 0;          // eps * Phi
+  bool refineOn_ = false;
+  double stopChange_ = 0;  // tol * (1 - rho_max)
+  std::vector<size_t> adjStart_;
+  std::vector<LinkIndex> adj_;
+  std::vector<glm::dvec3> irr_;   // per dense node: H gathered at it and its ancestors
+  std::vector<double> exposure_;  // per dense node: exposureOf once computed, else < 0
+  // Per dense node: the closure factor of a leaf's links to shooters that do not emit (its
+  // closure factor, or the closed-room one).
+  std::vector<double> goodFactor_;
+  // Per leaf: its chain's links whose top's share the closure replaces (link index, the top's
+  // G_q / sum F V - 1 over the exposure of the node that gathers it).
+  std::vector<std::vector<std::pair<size_t, double>>> topExcess_;
+  std::vector<int8_t> closed_;          // per dense node: closedAt once cast (0 or 1), else -1
+  std::vector<uint8_t> shooterEmits_;   // per link: its shooter's top-level patch emits
+  std::vector<uint32_t> sweepShooter_;  // per adj_ entry (buildSweepLists)
+  std::vector<double> sweepCoefficient_;
+  std::vector<double> shooterRange_;  // per dense node: measureShooterRanges
+  // Per dense node: F(node -> top-level patch) computed for the closure in this key's solve.
+  std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor_;
+  // weightVisibilityByShooterRadiosity's ray pairs, opt_.rays per link from pairStart_[link]
+  // (kNoRayPairs: not weighted yet in this key solve).
+  std::vector<uint32_t> pairStart_;
+  std::vector<LinkRayPair> pairs_;
+  double maxDelta_ = 0, maxB_ = 0;  // of the current sweep
+  bool nonFinite_ = false;          // a sweep produced NaN or Inf
+  double radiosityBound_ = 0;       // 1e6 E_max / (1 - rho_max): above it the solve diverges
+  std::unique_ptr<ClusterLinks> clusters_;  // null: all-pairs linking
+  std::vector<double> topEmission_;         // per top: largest emitted channel (clusters_)
+  std::vector<glm::dvec3> clusterH_;        // per top: irradiance through cluster links
+  std::vector<double> clusterRow_;          // per top: its cluster links' form factor sum
+  std::vector<FacingPlane> topPlanes_;      // per top at this key (refineClusterLinks)
+};
+}  // namespace rad
