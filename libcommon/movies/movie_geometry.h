@@ -20,6 +20,7 @@
 #include "libcommon/movies/transmittance.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
+#include "libcommon/radiosity/shaft.h"
 #include "libcommon/scene/box_tree.h"
 #include "libcommon/scene/scene.h"
 
