@@ -2,7 +2,7 @@
 # The pipeline's variables, checked while the Makefile is read and before anything runs or is
 # written (stages.mk). Prints one line saying what is wrong, or nothing; the Makefile stops on it.
 #
-#   pipelines/check-variables.sh REPO SCENE OUT BIN FRAMES SIZE FPS
+#   pipelines/check-variables.sh REPO SCENE OUT BIN FRAMES SIZE FPS QUALITY
 #
 # Paths (SCENE, OUT, BIN) may hold only letters, digits, `. _ - + @ /` and non-ASCII bytes:
 # Make splits file names at spaces and gives `:`, `%`, `=`, `#`, `$` meanings of its own, and
@@ -11,7 +11,7 @@
 # is not the pipeline's own: the root, the home folder, the repository or a folder holding it,
 # and an existing file that is not a folder.
 set -u
-repo=$1 scene=$2 out=$3 bin=$4 frames=$5 size=$6 fps=$7
+repo=$1 scene=$2 out=$3 bin=$4 frames=$5 size=$6 fps=$7 quality=$8
 
 fail() {
   printf '%s\n' "$1"
@@ -40,8 +40,12 @@ case "$abs_repo/" in
 esac
 if [ -e "$out" ] && ! [ -d "$out" ]; then fail "OUT=$out exists and is not a folder"; fi
 
-[[ "$frames" =~ ^[0-9]+(-[0-9]+(x[1-9][0-9]*)?)?$ ]] ||
-  fail "FRAMES=$frames: give FIRST-LAST, FIRST-LASTxSTEP or one frame (0-95, 0-95x2, 7)"
+[ -z "$frames" ] || [[ "$frames" =~ ^[0-9]+(-[0-9]+(x[1-9][0-9]*)?)?$ ]] ||
+  fail "FRAMES=$frames: give FIRST-LAST, FIRST-LASTxSTEP or one frame (0-95, 0-95x2, 7), or nothing for the scene's animation"
 [[ "$size" =~ ^[1-9][0-9]*x[1-9][0-9]*$ ]] || fail "SIZE=$size: give WIDTHxHEIGHT (352x240)"
 [[ "$fps" =~ ^[0-9]*\.?[0-9]+$ ]] && [[ "$fps" =~ [1-9] ]] ||
   fail "FPS=$fps: give a positive number of frames a second (24)"
+case $quality in
+  draft | default | final) ;;
+  *) fail "QUALITY=$quality: give draft, default or final" ;;
+esac

@@ -15,9 +15,14 @@ SCENE ?= $(call in-repository,pipelines/scenes/cornell-moving.gltf)
 OUT   ?= out/$(basename $(notdir $(SCENE)))
 BIN   ?= $(call in-repository,build/bin)
 
-FRAMES ?= 0-95
-FPS    ?= 24
-SIZE   ?= 352x240
+# FRAMES empty: the scene's animation, frames 0 to ceil(end x FPS) - 1, as the tools take it
+# without --frames (rad-inspect --default-frames says which).
+FRAMES  ?=
+FPS     ?= 24
+SIZE    ?= 352x240
+# The stages' quality preset (--preset: draft, default or final; docs/design.md §1). Only
+# rad-global and rad-movies have quality knobs, so only their command lines take it.
+QUALITY ?= default
 
 GLOBAL_FLAGS    ?=
 INTERVALS_FLAGS ?=
@@ -35,7 +40,7 @@ quote = '$(subst ','\'',$(1))'
 # with one line.
 VARIABLES_PROBLEM := $(shell $(PIPELINES)check-variables.sh $(call quote,$(REPOSITORY)) \
   $(call quote,$(SCENE)) $(call quote,$(OUT)) $(call quote,$(BIN)) $(call quote,$(FRAMES)) \
-  $(call quote,$(SIZE)) $(call quote,$(FPS)))
+  $(call quote,$(SIZE)) $(call quote,$(FPS)) $(call quote,$(QUALITY)))
 ifneq ($(VARIABLES_PROBLEM),)
 $(error $(MAKEFILE_NAME): $(VARIABLES_PROBLEM))
 endif
@@ -45,9 +50,22 @@ override SCENE := $(call dash-safe,$(SCENE))
 override OUT   := $(call dash-safe,$(OUT))
 override BIN   := $(call dash-safe,$(BIN))
 
-GLOBAL_ARGS    = --frames $(FRAMES) --fps $(FPS) $(GLOBAL_FLAGS)
+ifeq ($(FRAMES),)
+ifneq ($(filter-out clean,$(or $(MAKECMDGOALS),all)),)
+ifeq ($(wildcard $(BIN)/rad-inspect),)
+$(error $(MAKEFILE_NAME): $(BIN)/rad-inspect is not built; run pipelines/bootstrap.sh first)
+endif
+override FRAMES := $(shell $(BIN)/rad-inspect --default-frames $(SCENE) --fps $(FPS) 2>&1)
+ifneq ($(.SHELLSTATUS),0)
+$(error $(FRAMES))
+endif
+endif
+endif
+PRESET_ARG = $(if $(filter-out default,$(QUALITY)),--preset $(QUALITY))
+
+GLOBAL_ARGS    = --frames $(FRAMES) --fps $(FPS) $(PRESET_ARG) $(GLOBAL_FLAGS)
 INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) $(INTERVALS_FLAGS)
-MOVIES_ARGS    = $(MOVIES_FLAGS)
+MOVIES_ARGS    = $(PRESET_ARG) $(MOVIES_FLAGS)
 COMPOSE_ARGS   = --frames $(FRAMES) $(COMPOSE_FLAGS)
 
 # The stage command lines, written once: the rules run them, `make -f animation.mk

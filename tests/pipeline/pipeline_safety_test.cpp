@@ -74,6 +74,7 @@ TEST_F(PipelineSafety, UnsafeVariablesAreRefusedBeforeAnythingRuns) {
       {{"OUT=" + d + "/o", "FRAMES=0-7;touch " + d + "/injected"}, "FRAMES=0-7;touch"},
       {{"OUT=" + d + "/o", "SIZE=88"}, "SIZE=88: give WIDTHxHEIGHT"},
       {{"OUT=" + d + "/o", "FPS=0"}, "FPS=0: give a positive number"},
+      {{"OUT=" + d + "/o", "QUALITY=best"}, "QUALITY=best: give draft, default or final"},
   };
   for (const Case& c : cases) {
     for (const std::string goal : {"clean", ""}) {
@@ -292,10 +293,36 @@ TEST_F(PipelineSafety, TheMp4StepStopsItsFfmpegOnSigterm) {
 
 // A path that starts with `-` is passed as a path (`./-scene.gltf`), not read as an option.
 TEST_F(PipelineSafety, APathStartingWithADashIsAPath) {
-  CommandResult r = runMake({"SCENE=-scene.gltf", "OUT=/tmp/-out"}, "-s stage-commands");
+  CommandResult r =
+      runMake({"SCENE=-scene.gltf", "OUT=/tmp/-out", "FRAMES=0-7"}, "-s stage-commands");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("rad-global ./-scene.gltf -o /tmp/-out/global.rlh"), std::string::npos)
       << r.out;
+}
+
+// QUALITY becomes rad-global's and rad-movies' --preset (the stages with quality knobs); without
+// FRAMES the stages cover the scene's animation, as the tools do without --frames.
+TEST_F(PipelineSafety, QualityAndTheScenesFramesReachTheStages) {
+  CommandResult r = runMake({"OUT=/tmp/q", "QUALITY=final", "FPS=12"}, "-s stage-commands");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const std::string line : {"global\t", "movies\t"}) {
+    const size_t at = r.out.find(line);
+    ASSERT_NE(at, std::string::npos) << r.out;
+    EXPECT_NE(r.out.substr(at, r.out.find('\n', at) - at).find(" --preset final"),
+              std::string::npos)
+        << r.out;
+  }
+  for (const std::string line : {"intervals\t", "compose\t"}) {
+    const size_t at = r.out.find(line);
+    EXPECT_EQ(r.out.substr(at, r.out.find('\n', at) - at).find("--preset"), std::string::npos)
+        << r.out;
+  }
+  CommandResult frames =
+      runCommand(tool("rad-inspect") + " --default-frames " + kScene + " --fps 12");
+  ASSERT_EQ(frames.exitCode, 0) << frames.err;
+  EXPECT_NE(r.out.find("--frames " + frames.out.substr(0, frames.out.find('\n')) + " --fps 12"),
+            std::string::npos)
+      << frames.out << r.out;
 }
 
 // Run from another folder, the defaults (BIN, SCENE) are the repository's, not the folder's.
