@@ -180,8 +180,9 @@ class Scanner {
     uint64_t chunks = 0;
     for (size_t p = 0; p < headers.size(); ++p) {
       // A single-part file's type is in its version flags (a "type" attribute may repeat it).
-      // Without the attribute, OpenEXR reads the part as an image whatever the deep flag, so it
-      // is bounded as one (a 214-byte file flagged deep had been read as 134 M pixels: 1.6 GB).
+      // Without the attribute, OpenEXR reads the part as an image whatever the deep flag, so it is
+      // bounded as one (a small file flagged deep is otherwise read as an image of the size it
+      // declares).
       std::string type = multiPart ? "scanlineimage" : singlePartType(version & ~kFlagDeep);
       if (headers[p].type) type = *headers[p].type;
       scan.parts.push_back(boundPart(headers[p], type, int(p)));

@@ -1,10 +1,10 @@
 // The bounds every rad EXR reader checks before OpenEXR sees a file (issue 18, hostile input).
 //
-// OpenEXR allocates what a header declares: a string attribute's size, a data window's line
-// offset table and decode buffers, a preview's pixels. A 476-byte file declaring a 1.9 GB string
-// made the frame readers take 1.9 GB and 5.8 s before refusing it. scanExrHeaders walks the
-// headers from the file's bytes, bounds-checked, and refuses (rad::inputError naming the file)
-// what no file of that size can back:
+// OpenEXR allocates what a header declares: a string attribute's size, a data window's line offset
+// table and decode buffers, a preview's pixels. A file of a few hundred bytes declaring a 1.9 GB
+// string made the frame readers allocate it before refusing it. scanExrHeaders walks the headers
+// from the file's bytes, bounds-checked, and refuses (rad::inputError naming the file) what no file
+// of that size can back:
 //
 //   - a magic number other than 20000630, a version other than 2, unknown version flags;
 //   - a name or type that is empty or unterminated within 256 bytes, or cut by the end of file;

@@ -28,11 +28,11 @@ FloatImage readExrImage(const std::string& path,
 void writeExrImage(const std::string& path, const FloatImage& image,
                    const std::map<std::string, std::string>& stringAttributes = {});
 
-// An OpenEXR output stream onto a new file that collects writes in memory and hands them over
-// in large writes. Uncompressed files are one chunk per scanline and OpenEXR writes each chunk
-// (and seeks for each chunk table) separately: 127,000 system calls for the table scene's
-// 1,325 texture movies, 240 per rad-compose frame. The buffer is flushed at 1 MiB, so memory
-// stays bounded whatever the file's size. Errors are rad::outputError(name, ...).
+// An OpenEXR output stream onto a new file that collects writes in memory and hands them over in
+// large writes. Uncompressed files are one chunk per scanline and OpenEXR writes each chunk (and
+// seeks for each chunk table) separately: a system call per scanline, for every movie a stage
+// writes. The buffer is flushed at 1 MiB, so memory stays bounded whatever the file's size. Errors
+// are rad::outputError(name, ...).
 class ExrFileStream : public Imf::OStream {
  public:
   // Creates (truncates) `path`; `name` is the path errors report (the final one, not a

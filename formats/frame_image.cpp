@@ -116,7 +116,7 @@ void pngWarning(png_structp, png_const_charp) {}
 }  // namespace
 
 // libpng rather than OpenImageIO: linking OIIO made rad-compose load its whole dependency tree
-// (GDAL, OpenVDB, FFmpeg, ...), 125 MiB of resident memory before the first frame.
+// (GDAL, OpenVDB, FFmpeg, ...) into resident memory before the first frame.
 void writeFramePng(const std::string& path, const ComposedFrame& frame,
                    const FrameImageInfo& info) {
   const int w = frame.size.width, h = frame.size.height;
@@ -151,9 +151,8 @@ void writeFramePng(const std::string& path, const ComposedFrame& frame,
   png_set_IHDR(png, pinfo, png_uint_32(w), png_uint_32(h), 8, PNG_COLOR_TYPE_RGB,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_sRGB_gAMA_and_cHRM(png, pinfo, PNG_sRGB_INTENT_PERCEPTUAL);
-  // zlib's fastest level: the same pixels, deflated at about a third of the default level's
-  // cost (perf: writing the PNGs was 40 % of rad-compose on the table scene, deflate 26 %), for
-  // PNGs about a quarter larger (the table scene's 400: 19 -> 24 MB, beside 390 MB of EXRs).
+  // zlib's fastest level: the same pixels, deflated at a fraction of the default level's cost, for
+  // somewhat larger PNGs (small beside the EXRs either way).
   png_set_compression_level(png, 1);
   png_text text[2] = {};
   text[0].compression = PNG_TEXT_COMPRESSION_zTXt;  // the provenance JSON compresses well

@@ -1,9 +1,9 @@
 // frames/NNNN.exr and frames/NNNN.png: rad-compose's final frames (docs/design.md §5).
 //
-// EXR: one scanline part, channels R, G, B of linear exitant radiance W/(m^2 sr), FLOAT (or
-// HALF with --half; values above 65504 are clamped there), row 0 = top; uncompressed unless
-// --compression says otherwise (ZIP saved 7 % of the bytes of noise-free float radiance and
-// doubled rad-compose's time on the table scene).
+// EXR: one scanline part, channels R, G, B of linear exitant radiance W/(m^2 sr), FLOAT (or HALF
+// with --half; values above 65504 are clamped there), row 0 = top; uncompressed unless
+// --compression says otherwise (ZIP saves little of noise-free float radiance, for much of
+// rad-compose's time).
 // String/int/double attributes: rad.format "frame 2.0", rad.pixelChecksum
 // (formats/pixel_checksum.h), rad.frame, rad.time, rad.units, rad.exposureEV (what the PNG used),
 // rad.coveredPixels, rad.moviePixels, rad.fallbackPixels and rad.provenance
@@ -33,7 +33,7 @@ struct FrameImageInfo {
   double exposureEV = 0.0;
   std::string provenanceJson;
   // kDeferred: the caller calls syncFileSystemOf() once after the last frame (composeSequence
-  // does); an fsync per frame was 10 % of rad-compose's wall time at 352x240.
+  // does), not an fsync per frame, which costs rad-compose wall time.
   AtomicFile::Durability durability = AtomicFile::Durability::kEachFile;
 };
 

@@ -255,8 +255,8 @@ std::vector<double> Reader::readAccessor(int index, const std::string& what, int
            " bytes");
     return {b.data.data() + v.byteOffset, v.byteLength};
   };
-  // Every bound is checked before the output is allocated: a count of 2^25 on a 48-byte view
-  // used to allocate 800 MB before its error.
+  // Every bound is checked before the output is allocated: a count of 2^25 on a 48-byte view would
+  // otherwise allocate 800 MB before its error.
   const unsigned char* data = nullptr;
   size_t stride = elementSize;
   if (a.bufferView >= 0) {

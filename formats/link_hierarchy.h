@@ -29,10 +29,10 @@ void writeLinkHierarchy(const std::string& path, const GlobalSolution& solution,
 // must form the hierarchy in subdivision order. Errors are rad::inputError(path, ...).
 GlobalSolution readLinkHierarchy(const ContainerReader& reader, const Scene& scene);
 GlobalSolution readLinkHierarchy(const std::string& path, const Scene& scene);
-// The same checks and content without the links, their F·V samples, the good irradiance, the
-// bad pairs and the cluster irradiance (left empty): keyTimes, hierarchy, nodeRadiosity and
-// leafRow, all rad-compose reads (radiosity(), leafAtTopUv, autoExposureEV). The container's
-// checksums still cover the arrays not copied. Saves rad-compose ~45 MB on the 32-cube scene.
+// The same checks and content without the links, their F·V samples, the good irradiance, the bad
+// pairs and the cluster irradiance (left empty): keyTimes, hierarchy, nodeRadiosity and leafRow,
+// all rad-compose reads (radiosity(), leafAtTopUv, autoExposureEV), so that it holds none of the
+// rest. The container's checksums still cover the arrays not copied.
 GlobalSolution readLinkHierarchyRadiosity(const ContainerReader& reader, const Scene& scene);
 
 // The hierarchy whose dense node ids are `ids` (node_ids of linkhier and keywindow files): the

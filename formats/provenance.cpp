@@ -249,8 +249,9 @@ std::string hashFile(const std::string& path) {
     ::close(fd);
     throw inputError(path, "not a regular file");
   }
-  // 64 KiB, not zero-filled: rad-compose hashes every movie it reads (74,000 in a from-scratch
-  // run), and a fresh zeroed 1 MiB buffer per file cost a memset and 256 page faults each.
+  // 64 KiB, not zero-filled: rad-compose hashes every movie it reads (tens of thousands in a
+  // from-scratch run), and a fresh zeroed 1 MiB buffer per file cost a memset and 256 page faults
+  // each.
   constexpr size_t kChunk = size_t(1) << 16;
   std::unique_ptr<unsigned char[]> buf(new unsigned char[kChunk]);
   uint64_t h = kFnv1a64Offset;

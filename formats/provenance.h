@@ -63,9 +63,9 @@ std::string toValidUtf8(const std::string& text);
 // single quotes ('it'\''s').
 std::string shellQuote(const std::string& word);
 
-// Content hash of a whole file, "fnv1a64:<16 hex>". Streams in 1 MiB chunks (~0.15 s per
-// 100 MB). Throws rad::inputError(path, ...) if it cannot be read or is not a regular file (a
-// FIFO is refused, not waited on).
+// Content hash of a whole file, "fnv1a64:<16 hex>". Streams in 64 KiB chunks. Throws
+// rad::inputError(path, ...) if it cannot be read or is not a regular file (a FIFO is refused, not
+// waited on).
 std::string hashFile(const std::string& path);
 
 // Compares the parameters a file was built with against those this run needs, for each of

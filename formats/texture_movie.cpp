@@ -99,14 +99,14 @@ namespace {
 // The part headers of a movie with the given keys (key frames/times of the parts).
 std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<int>& keyFrames,
                                       const std::vector<double>& keyTimes) {
-  // Reserved and moved in: each reallocation had copied every header made so far, attribute by
-  // attribute (a few % of rad-movies on the 10k hall's small movies).
+  // Reserved and moved in: a reallocation would copy every header made so far, attribute by
+  // attribute.
   std::vector<Imf::Header> headers;
   headers.reserve(keyFrames.size());
   for (size_t k = 0; k < keyFrames.size(); ++k) {
     Imf::Header h(m.width, m.height);
-    // ZIP kept 91 % of the bytes of the table scene's movies (206 of 227 MB) and took half of
-    // rad-movies' time (6.0 of 11.3 s).
+    // Uncompressed: ZIP keeps most of the bytes of the movies' float irradiance and costs much of
+    // rad-movies' time.
     h.compression() = Imf::NO_COMPRESSION;
     h.lineOrder() = Imf::INCREASING_Y;
     for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
@@ -359,8 +359,8 @@ class PartAttributes {
 
 // Every part's header checked and the movie's metadata filled in (keys left empty), from a core
 // context: OpenEXR's C++ reader, which this replaces, builds every part's Header (a map of
-// allocated attributes) and reads the chunk tables, and had been a third of rad-compose's time on
-// the 10k-triangle hall's 6,173 movies (perf), where the core context parses the headers alone.
+// allocated attributes) and reads the chunk tables, where the core context parses the headers
+// alone.
 TextureMovie readHeaders(exr_const_context_t ctx, const std::string& path) {
   TextureMovie m;
   int parts = 0;
@@ -459,14 +459,14 @@ TextureMovie readTextureMovieHeaders(const std::string& path) {
   });
 }
 
-// The pixels are read with OpenEXR's core (C) API: the C++ MultiPartInputFile keeps a decoder
-// for every part it has read until the file is closed (690 MiB for the table scene's movies),
-// and reopening it for each key parses every part's header each time (compose 2.2x slower).
-// The core context holds only the headers and the chunk tables of the parts read.
+// The pixels are read with OpenEXR's core (C) API: the C++ MultiPartInputFile keeps a decoder for
+// every part it has read until the file is closed, and reopening it for each key parses every
+// part's header each time. The core context holds only the headers and the chunk tables of the
+// parts read.
 //
-// An uncompressed part is one chunk per scanline, and the core API reads each with its own
-// pread: 750,000 system calls for the table scene's 400 frames. Reads go through a window
-// instead (one pread fills it; the window is dropped after each key so memory stays flat).
+// An uncompressed part is one chunk per scanline, and the core API reads each with its own pread, a
+// system call per scanline. Reads go through a window instead (one pread fills it; the window is
+// dropped after each key so memory stays flat).
 struct TextureMovieStream::Reader {
   static constexpr size_t kWindow = size_t(1) << 16;
   exr_context_t ctx = nullptr;

@@ -274,12 +274,11 @@ CameraView FrameComposer::Impl::renderItems(double t) {
   return view;
 }
 
-// The item buffer's silhouettes decided by the pixel centre's ray. GL rasterizes with a few
-// bits of sub-pixel precision (llvmpipe: 8), so a silhouette edge that passes within ~1/256
-// pixel of a centre can give the pixel either surface, while rad-reference --pixel-centres
-// (and a renderer's first hit) takes the surface the centre's ray meets first. Such pixels are
-// few but far off (the Cornell box: the wall behind a box's top edge at 2.2x the box's
-// radiance; the 10 worst pixels were 0.3 points of its 3.1 % RMSE / mean). A pixel whose item
+// The item buffer's silhouettes decided by the pixel centre's ray. GL rasterizes with a few bits of
+// sub-pixel precision (llvmpipe: 8), so a silhouette edge that passes within ~1/256 pixel of a
+// centre can give the pixel either surface, while rad-reference --pixel-centres (and a renderer's
+// first hit) takes the surface the centre's ray meets first. Such pixels are few but far off (the
+// Cornell box: the wall behind a box's top edge, much brighter than the box). A pixel whose item
 // differs from a 4-neighbour's casts that ray (Embree, the scene's patches at t) and takes the
 // patch it meets when that patch faces the camera, as the rasterizer's back-face rule would; a
 // pixel whose ray meets nothing, or a back face, keeps its item.

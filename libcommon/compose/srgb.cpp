@@ -32,14 +32,13 @@ float bitsFloat(uint32_t u) {
   return f;
 }
 
-// srgbCode of a float at exposure 0 by its 255 thresholds instead of a pow per channel (pow
-// and lround were 6 % of rad-compose on the table scene, perf): t[c] is the least float with
-// srgbCode >= c, found by bisection over the non-negative floats (ordered as their bits). The
-// code is monotonic in the value (pow's error is below one ulp), so between thresholds it is
-// constant; `exact` checks that around each threshold, 64 floats either side, where a
-// non-monotonic pow could show, and pow is used instead if not. Every float of [0, 1.125] was
-// checked once against srgbCode (no difference); Srgb.ExposureZeroTableEqualsPowOnFloats
-// checks every 61st.
+// srgbCode of a float at exposure 0 by its 255 thresholds instead of a pow and an lround per
+// channel: t[c] is the least float with srgbCode >= c, found by bisection over the non-negative
+// floats (ordered as their bits). The code is monotonic in the value (pow's error is below one
+// ulp), so between thresholds it is constant; `exact` checks that around each threshold, 64 floats
+// either side, where a non-monotonic pow could show, and pow is used instead if not. Every float of
+// [0, 1.125] was checked once against srgbCode (no difference);
+// Srgb.ExposureZeroTableEqualsPowOnFloats checks every 61st.
 struct SrgbThresholds {
   float t[256];
   bool exact = true;

@@ -122,10 +122,10 @@ constexpr const char* kProbeChildVariable = "RAD_GL_PROBE_CHILD";
 // or zink without Vulkan): a SIGSEGV inside OSMesaCreateContextAttribs that no check in this
 // process can catch. The child (its output silenced: Mesa's own complaints are several lines)
 // takes the fall; the screen is made once per process, so one probe serves every context.
-// The child is a new copy of the program (posix_spawn), not a fork: the first context is often
-// made by a worker thread, and a fork copies the locks other threads hold at that moment;
-// Mesa's atexit registration in a forked child waited forever on glibc's exit-function lock,
-// and rad-movies with it (the 10k hall, 17 minutes at 0 % CPU before it was killed).
+// The child is a new copy of the program (posix_spawn), not a fork: the first context is often made
+// by a worker thread, and a fork copies the locks other threads hold at that moment; Mesa's atexit
+// registration in a forked child can wait forever on glibc's exit-function lock, and rad-movies
+// with it.
 std::string probeContextInChild() {
   std::vector<std::string> env;
   for (char** e = environ; *e; ++e)

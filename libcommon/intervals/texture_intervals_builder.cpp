@@ -23,8 +23,8 @@ namespace {
 constexpr double kGuardBand = 64.0;
 
 // Largest subdivision the builder makes: ~480 bytes per node (patch hierarchy, GL and item
-// geometry), so at most ~1 GB. 2^19 had refused the 100k-triangle hall (53,621 top-level
-// patches, 1.13 M nodes at the default --max-level 2, ~540 MB), whose goal is 2 GB a stage.
+// geometry), so at most ~1 GB, within the goal of 2 GB a stage, and room for the 100k-triangle hall
+// at the default --max-level 2.
 constexpr long kMaxNodes = 1L << 21;
 
 }  // namespace
@@ -162,8 +162,8 @@ struct TextureIntervalsBuilder::Impl {
     openBelow.assign(hierarchy.size(), 0);
   }
 
-  // The leaves as item objects (one per mesh node, ids dense index + 1): made for each renderer
-  // and dropped once uploaded (at the 100k-triangle hall's 850,000 leaves ~130 MB).
+  // The leaves as item objects (one per mesh node, ids dense index + 1): made for each renderer and
+  // dropped once uploaded, so that they are not held through the frames.
   std::vector<ItemObject> itemObjects() const {
     std::vector<ItemObject> objects(meshNodes.size());
     for (int i = 0; i < hierarchy.size(); ++i)
@@ -216,12 +216,11 @@ struct TextureIntervalsBuilder::Impl {
       theta += h;
     bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
     // A node seen on fewer pixels than its four children's smallest textures hold (4 minSize^2)
-    // keeps one texture: splitting it adds movies, not resolution (the 10k-triangle hall's
-    // partly hidden chair triangles made 67,660 of its 75,727 movies at levels 1 and 2).
-    // But only while its own texture is small too (at most 4 minSize a side): a big patch leaving
-    // the frustum, a few pixels left on screen, had kept its whole-area texture (the 10k hall's
-    // floor tiles at 181-256 texels a side for one frame, ~1 s of rad-movies each), where the
-    // children holding those pixels need a sixteenth of it and carry on the movies they had.
+    // keeps one texture: splitting it adds movies, not resolution (partly hidden small triangles, a
+    // chair's, would otherwise make most of a scene's movies). But only while its own texture is
+    // small too (at most 4 minSize a side): a big patch leaving the frustum, a few pixels left on
+    // screen, would keep its whole-area texture, where the children holding those pixels need a
+    // sixteenth of it and carry on the movies they had.
     const bool tiny = double(visible[i]) < 4.0 * options.minSize * options.minSize &&
                       textureSideFor(area[i], 0, options) <= 4 * options.minSize;
     if (enough || tiny || hierarchy.isLeaf(i)) {
@@ -404,12 +403,12 @@ struct TextureIntervalsBuilder::Impl {
 
 namespace {
 
-// Item buffers rendered ahead of the builder on worker threads, frame i by worker i mod N into
-// its slot, taken in frame order (take). Each worker makes and uses its own renderer: an OSMesa
-// context is current on one thread at a time. A frame's buffer does not depend on the others',
-// and llvmpipe draws one on about one core (the 10k-triangle hall's 120,000 leaf triangles: 20
-// of the 22 ms a frame took), so the workers draw N frames at once while the builder reads the
-// last. The same buffers as one renderer's: the same driver and geometry, frame by frame.
+// Item buffers rendered ahead of the builder on worker threads, frame i by worker i mod N into its
+// slot, taken in frame order (take). Each worker makes and uses its own renderer: an OSMesa context
+// is current on one thread at a time. A frame's buffer does not depend on the others', and llvmpipe
+// draws one on about one core (drawing is most of a frame's time), so the workers draw N frames at
+// once while the builder reads the last. The same buffers as one renderer's: the same driver and
+// geometry, frame by frame.
 class ItemBufferPipeline {
  public:
   using View = std::function<FrameView(int frame)>;

@@ -24,8 +24,8 @@
 //    n^2 / whole area wherever the patch is on screen), rounded up to the ladder of sides
 //    round(r^k), r = sizeRatio, and clamped to [minSize, maxSize]. The paper takes powers of
 //    two (r = 2: up to 4 texels per pixel, 2.2 on average over sizes spread evenly in log);
-//    r = sqrt 2 holds the same pixels with at most 2 (1.4 on average): the 10k hall's
-//    texels per frame 311 k -> 217 k;
+//    r = sqrt 2 holds the same pixels with at most 2 (1.4 on average), so fewer texels per
+//    frame;
 //  * events (§4.1): a movie opens when its node becomes chosen and closes when the node leaves
 //    the frustum, is hidden, is replaced by an ancestor or descendant (level change), needs
 //    another size, or has lasted maxLength frames; movies open at the end of the window close
@@ -33,25 +33,24 @@
 //
 // Level hysteresis (levelHysteresis = h, beyond the paper, default 0.4): a node represented by
 // itself in the previous frame stays so while its visible fraction is >= theta - h; a node
-// represented by its descendants in the previous frame goes back to one texture only when
-// its fraction is >= theta + h. Other nodes use theta. This keeps patches whose fraction
-// hovers around theta from switching level every frame: each switch ends the movies of one
-// level and starts the other's, and a new movie pays its whole setup (links, per-texel form
-// factors, static shadows) whatever its length. With the paper's rule (h = 0) level changes
-// ended 7,480 of cubes-32's 9,541 movies over 400 frames and 2,117 of the 10k hall's 7,811 in
-// 96; at h = 0.4 (children below 10 % visible, the node again from 90 %) 2,833 and 5,661
-// movies for 1.5 % and 2.4 % more texels per frame. The from-scratch baseline (maxLength 1)
-// keeps no movie from frame to frame, so it takes theta alone: each frame's choice is its own.
+// represented by its descendants in the previous frame goes back to one texture only when its
+// fraction is >= theta + h. Other nodes use theta. This keeps patches whose fraction hovers around
+// theta from switching level every frame: each switch ends the movies of one level and starts the
+// other's, and a new movie pays its whole setup (links, per-texel form factors, static shadows)
+// whatever its length. With the paper's rule (h = 0) level changes end many movies early (most of
+// them in a scene of small moving cubes); h = 0.4 (children below 10 % visible, the node again from
+// 90 %) makes far fewer movies for a few more texels per frame. The from-scratch baseline
+// (maxLength 1) keeps no movie from frame to frame, so it takes theta alone: each frame's choice is
+// its own.
 //
 // Hidden gaps (hiddenGap = g, beyond the paper): a node hidden behind a nearer surface (in the
 // frustum, no relative chosen) for at most g consecutive frames, then chosen again at the same
-// size, keeps its movie over the gap, which then spans frames where no pixel shows it. Tiny
-// patches flicker in and out of the item buffer behind the frame's chairs and desks: on the
-// 10k-triangle hall 12,514 of 17,050 movies closed as hidden, and 9,055 of them were followed
-// by a movie of the same node and size within 6 frames, each a new movie's setup (links,
-// form factors, static shadows) for a few texels. While the node is hidden a relative chosen,
-// a gap past g, or a resize or maxLength on return closes the movie as hidden at its last
-// visible frame, so a node and its relatives still never overlap.
+// size, keeps its movie over the gap, which then spans frames where no pixel shows it. Tiny patches
+// flicker in and out of the item buffer behind a frame's chairs and desks: most movies closed as
+// hidden would be followed within a few frames by a movie of the same node and size, each a new
+// movie's setup (links, form factors, static shadows) for a few texels. While the node is hidden a
+// relative chosen, a gap past g, or a resize or maxLength on return closes the movie as hidden at
+// its last visible frame, so a node and its relatives still never overlap.
 //
 // Size hysteresis: a movie of size s (a rung of the ladder) is right for ideal sizes n in
 // (s/r, s]. It keeps s while n stays in (s / (r (1 + tol)), s (1 + tol)], i.e. within a factor
@@ -85,11 +84,9 @@ struct TextureIntervalsOptions {
   double texelDensity = 1.0;       // texels per covered pixel
   int minSize = 4, maxSize = 256;  // texture side bounds (need not be rungs of the ladder)
   double resizeTolerance = 0.5;    // hysteresis factor (see above)
-  // Texture sides are round(sizeRatio^k) (see above). sqrt 2, not the paper's 2: against the
-  // 4096-spp references (frame 20 of 0-24, RMSE / mean over non-emitters) the bundled scene,
-  // Cornell box, table, cubes-8 and cubic scene change by -0.01 to +0.02 points (2.46 -> 2.45 %,
-  // 2.30 -> 2.31, 1.60 -> 1.62, 2.37 -> 2.38, 1.77 -> 1.79) with 28-40 % fewer texels per frame;
-  // the 10k hall, whose floor tiles carry many small leg shadows, 3.22 -> 3.34 %.
+  // Texture sides are round(sizeRatio^k) (see above). sqrt 2, not the paper's 2: fewer texels per
+  // frame for about the same error against the references, a little more where a big tile carries
+  // many small shadows (a hall's floor under its chairs' legs).
   double sizeRatio = 1.4142135623730951;
   int maxLength = 0;  // frames per movie; 0 = unlimited
   // A movie whose node is hidden for at most this many consecutive frames (of those added)

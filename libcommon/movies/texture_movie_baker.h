@@ -62,27 +62,25 @@ const char* goodLayerName(GoodLayer g);
 GoodLayer parseGoodLayer(const std::string& name);  // throws a usage Error
 
 // rad-movies binds its flags to these fields; toJson() is the provenance parameters, keyed by
-// the flag names.
+// the flag names. The figures behind the defaults: docs/results.md, "Figures moved out of the
+// movies code's comments (issue 55)".
 struct TextureMovieBakerOptions {
   int keyStep = 6;  // --movie-key-step: frames between key textures (>= 1)
   // --moving-shadow-key-step: the key step of a movie whose bad links' shadows move (a moving
-  // node's swept bounds meet a bad pair's shaft, or an end moves): the paper computes the
-  // dynamic blockers' shadows every frame (§5), and a shadow interpolated between two keys
-  // six frames apart shows at both places half dark. 0: keyStep. cubes-8, frame 20 (25 frames):
-  // 4.52 % RMSE / mean with keyStep, 2.76 % at 3 (keys 18, 21), 1.66 % at 1; bundled 5.23,
-  // 4.90, 4.80 %. 3 keeps most of the coherence of the 32-cube scene.
+  // node's swept bounds meet a bad pair's shaft, or an end moves): the paper computes the dynamic
+  // blockers' shadows every frame (§5), and a shadow interpolated between two keys six frames apart
+  // shows at both places half dark. 0: keyStep. The default, half the default key step, takes most
+  // of that error away and keeps most of the coherence of a scene of many moving objects.
   int movingShadowKeyStep = 3;
-  // Shooter samples per bad link, lower bound. 16, not 4: the small light of the Cornell box
-  // got 4-8 samples (256 x its form factor), and its penumbrae showed as straight-edged bands,
-  // one hard shadow per sample; at 16 the bands are gone and rad-movies' time hardly moves.
+  // Shooter samples per bad link, lower bound. 16, not 4: a small light (the Cornell box's) gets
+  // only a few samples from 256 x its form factor, and its penumbrae then show as straight-edged
+  // bands, one hard shadow per sample; at 16 the bands are gone.
   int minSamples = 16;
-  // --weak-share: a bad pair whose light (the tops of one mesh node and material) gives less
-  // than this share of every texel's direct light (B_S F over the sum over the movie's bad
-  // pairs, at key 0) takes minSamples / 4 at least; 0: every pair takes minSamples. The 10k
-  // hall's 35 lights: 87 % of its bad pairs are weak at 0.1, rad-movies 24.2 -> 18.2 s on
-  // frames 40-56; frame 48 against 64 samples 0.41 % RMSE / mean -> 0.49 % (0.05: 0.44 %,
-  // 0.2: 0.61 %). Against the 4096-spp references the five accuracy scenes move by at most
-  // +0.02 points (the cubic scene 1.79 -> 1.81 %, its rad-movies 49.7 -> 41.5 s).
+  // --weak-share: a bad pair whose light (the tops of one mesh node and material) gives less than
+  // this share of every texel's direct light (B_S F over the sum over the movie's bad pairs, at
+  // key 0) takes minSamples / 4 at least; 0: every pair takes minSamples. In a scene of many
+  // lights most bad pairs are weak, and the fewer samples of their soft shadows change its frames
+  // little.
   double weakShare = 0.1;
   int maxSamples = 64;                  // upper bound (<= 64)
   double samplesPerFormFactor = 256.0;  // N = ceil(this * max texel form factor), then clamped
@@ -95,19 +93,16 @@ struct TextureMovieBakerOptions {
   // --gather-shooter-ratio: a gathered link's shooter is split into the parts of its sub-tree
   // larger than this times their distance to the receiver (good_link_gather.h); 0: no split.
   double gatherShooterRatio = 1.0;
-  // --gather-rays: a gathered link that is partly occluded gets its visibility per texel from
-  // this many shadow rays to its shooter part, weighted by the shooter's radiosity at their ends
-  // (good_link_gather.h); 0: the link's one V over its receiver node, whose steps showed where
-  // two receiver nodes met (the bundled scene's back wall, 4.3 %).
+  // --gather-rays: a gathered link that is partly occluded gets its visibility per texel from this
+  // many shadow rays to its shooter part, weighted by the shooter's radiosity at their ends
+  // (good_link_gather.h); 0: the link's one V over its receiver node, which steps where two
+  // receiver nodes whose links are occluded differently meet.
   int gatherRays = 16;
-  // --gather-partial-share: a partly occluded gathered link takes its visibility per texel when
-  // its risk, B F (1 - V), is at least this share of what the texel gathers, or when the smaller
-  // ones left on their V would sum to more than 10 shares; and a far one interpolated over a
-  // tile goes per texel where the tile's middle misses by this share (good_link_gather.h).
-  // Measured before the sum and tile rules, at the defaults otherwise (frame 20 of 0-24 against
-  // 4096-spp references; table default 400 frames on one core): 0.001 gives the cubic scene
-  // 1.64 % RMSE / mean and the table's rad-movies 58.7 s, 0.002 1.77 % and 42 s, 0.003 2.01 %
-  // and 31 s. The default keeps the table's 0.2 s per frame; the final setting uses 0.001.
+  // --gather-partial-share: a partly occluded gathered link takes its visibility per texel when its
+  // risk, B F (1 - V), is at least this share of what the texel gathers, or when the smaller ones
+  // left on their V would sum to more than 10 shares; and a far one interpolated over a tile goes
+  // per texel where the tile's middle misses by this share (good_link_gather.h). A smaller share
+  // sends more links per texel: more accurate and slower; the final setting uses 0.001.
   double gatherPartialShare = 0.002;
   // --cluster-visibility-rays: the cluster light of a texel (rad-global's, one value per top
   // and key) scaled by the share of this many rays from the texel to points on the top's far
@@ -115,8 +110,8 @@ struct TextureMovieBakerOptions {
   // 0: the top's one value. Needs --gather-rays > 0.
   int clusterVisibilityRays = 32;
   // --near-shooter-levels: a near leaf shooter is split into up to 4^L cells, each with its
-  // radiosity re-gathered at its centre from the leaf's links (good_link_gather.h); 0: the
-  // leaf's one B (the default: the final setting's cost, rad-movies ~10x).
+  // radiosity re-gathered at its centre from the leaf's links (good_link_gather.h); 0: the leaf's
+  // one B (the default: the cells multiply rad-movies' time, a cost the final setting pays).
   int nearShooterLevels = 0;
   // --no-fill-covered: false leaves the texels under a touching solid as they come out (~0),
   // which darkens the pixels beside the solid's foot (fillCoveredTexels).

@@ -1,4 +1,5 @@
-// Cluster links of one key-time solve (see the header).
+// Cluster links of one key-time solve (see the header). The figures behind the reasons given here:
+// docs/results.md, "Figures moved out of the radiosity code's comments (issue 55)".
 #include "libcommon/radiosity/cluster_links.h"
 
 #include <algorithm>
@@ -117,10 +118,9 @@ int ClusterLinks::facingGroupOf(const glm::dvec3& n) {
 // Whether a link between r and s may carry energy: not when an end whose member patches all
 // face one way (a top-level patch, or a cluster of parallel ones: a wall's tiles) sees nothing
 // of a cluster or top whose bounding box lies wholly on or behind every member's plane.
-// Coplanar clusters (two parts of one wall, of one ceiling) are such a pair: their transfer is
-// 0, and without this test a near pair of them was refined down to top-level patches (whose
-// pairs the patch links' facing test then dropped), and a far pair was kept as a link that
-// carried nothing (4 % of the 10k-triangle hall's cluster links, 7 % of the 1k's).
+// Coplanar clusters (two parts of one wall, of one ceiling) are such a pair: their transfer is 0,
+// and without this test a near pair of them would be refined down to top-level patches (whose pairs
+// the patch links' facing test then drops), and a far pair kept as a link that carries nothing.
 bool ClusterLinks::canExchange(ClusterRef r, ClusterRef s) const {
   auto behind = [&](ClusterRef end, ClusterRef other) {
     if (!isCluster(end) && !isCluster(other)) return false;  // the patch links' own test
@@ -170,9 +170,9 @@ bool ClusterLinks::wantsRefinement(const ClusterLink& l, double epsAbs) const {
   }
   const ClusterBounds& R = bounds(l.receiver);
   const ClusterBounds& S = bounds(l.shooter);
-  // Near (the centres closer than `separation` times the radii's sum): the point approximation
-  // does not hold, so such a link is always refined (accepting the ones that carry little, with
-  // their point estimate, made the 3k-triangle hall 1.6 % off the all-pairs frames, not 0.8 %).
+  // Near (the centres closer than `separation` times the radii's sum): the point approximation does
+  // not hold, so such a link is always refined, even one that carries little: accepted with its
+  // point estimate, it moves the frames away from the all-pairs ones.
   const double d = glm::length(S.centre() - R.centre());
   if (!(d > separation_ * (R.radius() + S.radius()))) return true;
   // A light's B before the first solve is its emission (the radiosity of the last gather is 0
@@ -477,8 +477,7 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
   if (visibility_) {
     const uint64_t seed = clusterLinkSeed(l.receiver, l.shooter);
     // A shooter holding lights is sampled by emitted power: its light comes from them, and the
-    // visibility of its area (a ceiling's, the lights a small part of it) had made the
-    // 10k-triangle hall's light through cluster links 2.4 % dark at --light-cluster-share 1.
+    // visibility of its area (a ceiling's, the lights a small part of it) is not that of its light.
     const std::vector<double>& shooterPrefix =
         emits(l.shooter) ? memberPowerPrefix_ : memberAreaPrefix_;
     // The pairs first, then the rays: where some pair's kernel is positive, V = open kernel /
@@ -670,13 +669,13 @@ Sum ClusterLinks::overExposedPart(size_t t, const std::vector<double>& exposure,
 void ClusterLinks::buildReceiverLists(const std::vector<double>& exposure) {
   if (listsValid_) return;
   const size_t T = emission_.size(), C = size_t(tree_.size());
-  // The lists of the links before the last refinement round, where it left them (movedTo_):
-  // a top none of whose receivers (itself, its ancestor clusters) gained or lost a link keeps
-  // its entries, the links renumbered; the others are made anew. At the link bound (the
-  // 100k-triangle hall, 8 rounds a key, each refining a few of the lights' links) rebuilding
-  // every list each round had been most of rad-global's time.
+  // The lists of the links before the last refinement round, where it left them (movedTo_): a top
+  // none of whose receivers (itself, its ancestor clusters) gained or lost a link keeps its
+  // entries, the links renumbered; the others are made anew. At the link bound a key takes many
+  // rounds, each refining a few of the lights' links, and rebuilding every list each round would
+  // redo the lists of the many tops whose links did not change.
   const bool remap = !movedTo_.empty() && gatherStart_.size() == T;
-  if (!remap)  // the stale lists go before the new ones are made (600 MB on the 100k hall)
+  if (!remap)  // the stale lists go before the new ones are made: never both held at once
     std::vector<std::vector<GatherEntry>>().swap(gatherBlocks_);
   // Per receiver (tops 0..T-1, then the clusters): its active links in link order (the links
   // not evaluated go to one more row, left unread).
@@ -686,10 +685,10 @@ void ClusterLinks::buildReceiverLists(const std::vector<double>& exposure) {
     return uint32_t(isCluster(l.receiver) ? T + size_t(clusterIndex(l.receiver))
                                           : size_t(l.receiver));
   });
-  // Top t's entries: the links at it, then at its ancestor clusters, where F > 0, written into
-  // its block of tops. One array for all tops needs their counts first; the pairs held per top
-  // until then had peaked at 900 MB on the 100k-triangle hall (heaptrack), next to the lists
-  // themselves, and counting by computing F twice made its rad-global 19 % slower.
+  // Top t's entries: the links at it, then at its ancestor clusters, where F > 0, written into its
+  // block of tops. One array for all tops would need their counts first: the pairs held per top
+  // until then would sit beside the lists themselves, and counting by computing F twice would
+  // double the form factors' cost; a block of tops, filled as it is made, needs neither.
   const size_t blocks = (T + kGatherBlockTops - 1) / kGatherBlockTops;
   gatherBlocks_.resize(blocks);
   std::vector<uint32_t> start(T, 0), own(T, 0);
@@ -734,10 +733,8 @@ void ClusterLinks::buildReceiverLists(const std::vector<double>& exposure) {
 // $A_g$, and a link weighs the groups' B_g = P_g / A_g by their projected areas towards R, as
 // the transfer weighs their form factors: exact for a cluster of uniform B or of one flat
 // patch. Six axis bins with squared direction weights (an estimate of the same projection that
-// left out how each group's area is oriented) had made the 10k-triangle hall's cluster light
-// darker than the exact sums of B F V over the shooters' members with the links' V: at its
-// walls' tiles 0.986-0.994 of them, at its ceiling's 0.981 (key 0, cluster separation 4);
-// with the groups 0.998-1.002 and 0.989.
+// leaves out how each group's area is oriented) come out darker than the exact sums of B F V over
+// the shooters' members with the links' V; the groups' projected areas come closer to them.
 void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
                           std::vector<glm::dvec3>& out) {
   buildReceiverLists(exposure);
@@ -802,8 +799,7 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector
 
 std::vector<double> ClusterLinks::rowSums(const std::vector<double>& exposure) {
   // From the gather's lists, so that the row sums are of the very form factors the gather
-  // multiplies (in parallel; the serial pass over every link and member top it replaces was
-  // 6 % of the 10k-triangle hall's rad-global).
+  // multiplies, and in parallel (a pass over every link and member top would be serial).
   buildReceiverLists(exposure);
   const size_t T = emission_.size();
   std::vector<double> out(T, 0.0);

@@ -28,23 +28,22 @@
 // over S's facing groups g: its member patches grouped by their normal's dominant axis and sign
 // (six at most), each with its area-weighted normal sum $N_g = \sum_{j \in g} A_j n_j$ and
 // area centroid c_g. Both cosines are taken from each member i of R to each group's own centre.
-// One point and one direction for all of S, from R's centre, was first order wrong where a
-// link is seen at a grazing angle (a wall's tiles seen from the perpendicular wall beside them:
-// 0.6 and 1.4 times the exact form factor) and had made every cluster link of an open room 2 %
-// dark against the exact point-to-polygon sums (ClusterLinks.
-// ExposedFloorMatchesAllPairsAtTheDefaultSeparation). B_S is S's radiosity as R sees it: its
-// facing groups' area-average radiosities B_g weighted by the groups' projected areas towards
-// R, $B_S = \sum_g \max(0, -N_g \cdot \omega) B_g / \sum_g \max(0, -N_g \cdot \omega)$, ω the
-// link's direction (gather), as the transfer above weighs the groups; and V_RS the
+// One point and one direction for all of S, from R's centre, is first order wrong where a link is
+// seen at a grazing angle (a wall's tiles seen from the perpendicular wall beside them) and leaves
+// every cluster link of an open room dark against the exact point-to-polygon sums
+// (ClusterLinks.ExposedFloorMatchesAllPairsAtTheDefaultSeparation). B_S is S's radiosity as R sees
+// it: its facing groups' area-average radiosities B_g weighted by the groups' projected areas
+// towards R, $B_S = \sum_g \max(0, -N_g \cdot \omega) B_g / \sum_g \max(0, -N_g \cdot \omega)$, ω
+// the link's direction (gather), as the transfer above weighs the groups; and V_RS the
 // kernel-weighted share of k shadow-ray pairs between points of R's and S's patches that are
 // unoccluded, each end's patch drawn by area among those that may face the other end
-// (evaluateLink). At a member i of a cluster R, V is i's own: the kernel-weighted open share of
-// a few more pairs from points of i to S's tops (visibilityAtMember; one V for a wall's tiles
-// had given its upper tiles, open to the seats' clusters, the V of its lower ones, hidden
-// behind the seats); where i is partly covered (its rays would start under the cover too) or
-// none of its pairs has a kernel, the V of the pairs whose R end lies in i's facing group, with
-// the link's V as a prior (a group holds few of the k pairs). The irradiance is pushed down to
-// every member top of R, so the gather goes through the clusters.
+// (evaluateLink). At a member i of a cluster R, V is i's own: the kernel-weighted open share of a
+// few more pairs from points of i to S's tops (visibilityAtMember; one V for a wall's tiles had
+// given its upper tiles, open to the seats' clusters, the V of its lower ones, hidden behind the
+// seats); where i is partly covered (its rays would start under the cover too) or none of its pairs
+// has a kernel, the V of the pairs whose R end lies in i's facing group, with the link's V as a
+// prior (a group holds few of the k pairs). The irradiance is pushed down to every member top of R,
+// so the gather goes through the clusters.
 //
 // Isotropic clusters (the option; Smits, Arvo, Greenberg 1994 §3): a cluster end is taken as
 // emitting and receiving alike in every direction, as if its members' orientations were

@@ -1,5 +1,7 @@
 // Baum, Rushmeier, Winget 1989, "Improving radiosity solutions through the use of analytically
 // determined form-factors"; Gauss-Legendre area quadrature as in Cohen & Wallace ch. 4.
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/form_factor.h"
 
 #include <algorithm>
@@ -80,10 +82,10 @@ namespace {
 // Contour sum for a polygon entirely in front of the element's tangent plane:
 // \frac{1}{2\pi} \sum_k \gamma_k \hat n \cdot \widehat{R_{k+1} \times R_k}.
 // R_k \times R_{k+1} is computed as R \times (v_{k+1} - v_k) with R the shorter of R_k, R_{k+1}:
-// the same value, with no cancellation when p is far away and R_k, R_{k+1} are nearly parallel,
-// nor when p is near one end of a long edge (R_k nearly -(v_{k+1} - v_k): the cross product of
-// two 1e10 m vectors left 1e-6 of noise in a needle's F of 1e-11, and the adaptive rule chased
-// it to its cell bound: issue 18).
+// the same value, with no cancellation when p is far away and R_k, R_{k+1} are nearly parallel, nor
+// when p is near one end of a long edge (R_k nearly -(v_{k+1} - v_k): the cross product of two
+// 1e10 m vectors leaves noise far above a needle's F, and the adaptive rule chased it to its cell
+// bound: issue 18).
 double contourSum(const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3* w,
                   std::size_t count) {
   double sum = 0.0;
@@ -260,16 +262,15 @@ double roundingHeight(const std::vector<glm::dvec3>& from, const std::vector<glm
   return kHeightRounding * scale;
 }
 
-// The part of `from` in front of `to`'s plane (normal `m`): `from` itself when no vertex is
-// behind it by more than `eps`, else its part above roundingHeight, made in `clipped`.
-// Points behind `to`'s plane see none of its front (pointToPolygonFormFactor is 0 there), and
-// where `from` passes through `to` the point factor jumps from 0 to as much as 1/2: inside a
-// cell, that line kept the adaptive rule refining along it to its cell bound (30 ms a pair of
-// interpenetrating triangles, 35x a scene's time: issue 18) and no fixed rule resolves it. Over
-// the front part only, the jump lies on the cells' boundary; the integral is the same. The part is
-// cut at the height where the point factor's rounding rule starts giving nonzero, not at the
-// plane: a strip between the two (a millimetre wide next to a vertex 1e10 m away, issue 18) is
-// a jump inside the cells again.
+// The part of `from` in front of `to`'s plane (normal `m`): `from` itself when no vertex is behind
+// it by more than `eps`, else its part above roundingHeight, made in `clipped`. Points behind
+// `to`'s plane see none of its front (pointToPolygonFormFactor is 0 there), and where `from` passes
+// through `to` the point factor jumps from 0 to as much as 1/2: inside a cell, that line keeps the
+// adaptive rule refining along it to its cell bound (interpenetrating triangles, issue 18) and no
+// fixed rule resolves it. Over the front part only, the jump lies on the cells' boundary; the
+// integral is the same. The part is cut at the height where the point factor's rounding rule starts
+// giving nonzero, not at the plane: a strip between the two (a millimetre wide next to a vertex
+// 1e10 m away, issue 18) is a jump inside the cells again.
 const std::vector<glm::dvec3>& frontPart(const std::vector<glm::dvec3>& from,
                                          const std::vector<glm::dvec3>& to, const glm::dvec3& m,
                                          double eps, std::vector<glm::dvec3>& clipped) {

@@ -22,13 +22,11 @@ struct GlobalOptions {
   // (animationFrames). The key times span the first to the last frame named.
   std::string frames;
   double fps = 24.0;  // frame f is at time f / fps
-  // Frames between key times (>= 1; the last frame is always one). 16: on the bundled scene and
-  // 8 cubes (frames 0-24, tradeoff.py at f74227a) 16 gave the error of 8 to 0.003 points at 17 %
-  // less CPU time, so 8 was off the speed/accuracy front. With a moving light over 400 frames
-  // (table-dynamic-static, frames 8, 24, ..., 392, midway between keys 16 apart) the frames
-  // differ from --key-step 2 by 0.28-0.34 % RMSE / mean (8: 0.17-0.23 %), against a default
-  // error of 1.6-2.5 %; rad-global took 13.6 s instead of 22.7 s. The good links' indirect
-  // light between keys is smooth, and the lights' (bad) links are re-evaluated per movie key.
+  // Frames between key times (>= 1; the last frame is always one). 16: on the bundled scene and 8
+  // cubes 16 gave the error of 8 for less CPU time, so 8 was off the speed/accuracy front; with a
+  // moving light, the frames midway between keys 16 apart stay well within the default setting's
+  // error (docs/results.md, "A key time every 16 frames"). The good links' indirect light between
+  // keys is smooth, and the lights' (bad) links are re-evaluated per movie key.
   int keyStep = 16;
   // radiosity.minArea 0 (the default): resolveMinArea's 1e-4 of the largest top-level patch.
   SpaceTimeOptions spaceTime;

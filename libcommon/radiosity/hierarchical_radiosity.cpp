@@ -1,6 +1,8 @@
 // Hierarchical radiosity at one key time (Hanrahan, Salzman, Aupperle 1991); see the header.
 // The driver of the key-time solver's passes (key_time_solver.h): the rounds in order, the
 // thresholds, and the solution handed back; the passes are in key_time_*.cpp.
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 
 #include <algorithm>
@@ -144,12 +146,12 @@ void KeyTimeSolver::setThresholds() {
     rhoMax = std::max(rhoMax, maxComponent(surfaces_[size_t(t)].reflectance));
     emissionMax = std::max(emissionMax, maxComponent(surfaces_[size_t(t)].emission));
   }
-  // No patch gathers more than the whole hemisphere (form factors sum to <= 1), so a solve
-  // is bounded by $B \le E_{max} / (1 - \rho_{max})$ (the furnace's B everywhere). Sweeps may
-  // overshoot that while refinement is under way (the furnace at rho = 0.99 passes 2x on the
-  // way to a finite answer), so only a solve a million times above it is called diverging:
-  // at rho x rowsum = 1.002 (the furnace at rho = 0.999) that takes ~7000 sweeps, long before
-  // B overflows to Inf and NaN, which the stop rule's std::max would not see.
+  // No patch gathers more than the whole hemisphere (form factors sum to <= 1), so a solve is
+  // bounded by $B \le E_{max} / (1 - \rho_{max})$ (the furnace's B everywhere). Sweeps may
+  // overshoot that while refinement is under way (the furnace at high rho does, on the way to a
+  // finite answer), so only a solve a million times above it is called diverging: at rho x rowsum =
+  // 1.002 (the furnace at rho = 0.999) that takes ~7000 sweeps, long before B overflows to Inf and
+  // NaN, which the stop rule's std::max would not see.
   radiosityBound_ =
       rhoMax < 1.0 ? 1e6 * emissionMax / (1.0 - rhoMax) : std::numeric_limits<double>::infinity();
   epsAbs_ = opt_.eps * maxComponent(emitted);
@@ -179,9 +181,9 @@ KeySolution KeyTimeSolver::finish() {
     s_.clusterLinks = clusters_->size();
     s_.clusterLinksReused = clusters_->reusedCount();
     s_.clusterBounds = clusters_->clusterBounds();
-    // Moved out, and the rest of the cluster links (their gather lists) freed here, not when
-    // the solver goes: a copy beside them had made rad-global's peak on the 10k-triangle
-    // hall (+47 MB at the end of each key's solve).
+    // Moved out, and the rest of the cluster links (their gather lists) freed here, not when the
+    // solver goes: a copy held beside them until then would raise rad-global's peak at the end of
+    // each key's solve.
     s_.clusterLinkValues = std::move(*clusters_).takeLinks();
     s_.clusterMemberVisibility = std::move(*clusters_).takeMemberVisibility();
     clusters_.reset();

@@ -1,5 +1,7 @@
 // The key-time solver's closure (each leaf's own row sum, exact in closed rooms) and exposure
 // (a patch's covered part left out). See key_time_solver.h.
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/key_time_solver.h"
 
 #include <algorithm>
@@ -42,24 +44,22 @@ struct TopShare {  // one top-level shooter's links in a leaf's chain
 
 }  // namespace
 
-// Closure (energy conservation whatever the refinement): a leaf r gathers through a link
-// (a <- b) at an ancestor a the area average F(a -> b), not its own F(r -> b), so its row sum
-// $\sum_k F(a_k \to b_k) V_k$ over the links of r and its ancestors is not its own: 0.82 ..
-// 1.37 in the refined unit-cube furnace (1 in the area average), whose B that error,
-// amplified by 1 / (1 - rho), made 7 % too bright at rho = 0.9 and 52 % at 0.99. The shooters
-// b_k of a leaf's links tile the top-level patches it is linked with, so for a top-level
-// patch q that every one of those links sees unoccluded (V = 1), the links to q carry exactly
-// $F(r \to q)$ at the leaf's own resolution; the leaf's links to such a q are scaled by
+// Closure (energy conservation whatever the refinement): a leaf r gathers through a link (a <- b)
+// at an ancestor a the area average F(a -> b), not its own F(r -> b), so its row sum $\sum_k F(a_k
+// \to b_k) V_k$ over the links of r and its ancestors is not its own (in a refined furnace it
+// strays to both sides of 1, while the area average is 1), and B amplifies that error by 1 / (1 -
+// rho). The shooters b_k of a leaf's links tile the top-level patches it is linked with, so for a
+// top-level patch q that every one of those links sees unoccluded (V = 1), the links to q carry
+// exactly $F(r \to q)$ at the leaf's own resolution; the leaf's links to such a q are scaled by
 //   $c_{rq} = G_q / \sum_{k \in q} F(a_k \to b_k) V_k$,  $G_q = F(r \to q)$
-// (topExcess_ holds c_rq - 1 per link), the links to a q any of whose links is occluded are
-// kept: row sums exact in a closed empty room at any refinement, and the averaging error of
-// unoccluded pairs (a wall meeting the floor) removed in any scene, while the occluded pairs
-// keep hierarchical radiosity's estimate (scaling them by an unoccluded ratio would brighten
-// what an occluder darkens). Per top, not one ratio for the row: a floor leaf beside a dim
-// wall had its light scaled by the wall's ratio (1.85 in the bundled scene). The good-link
-// share (shooters that do not emit: the default bad-link rule's good links) also gets one
-// factor, goodClosure, which rad-global's merge applies to the good-link irradiance the
-// Gouraud layer interpolates.
+// (topExcess_ holds c_rq - 1 per link), the links to a q any of whose links is occluded are kept:
+// row sums exact in a closed empty room at any refinement, and the averaging error of unoccluded
+// pairs (a wall meeting the floor) removed in any scene, while the occluded pairs keep hierarchical
+// radiosity's estimate (scaling them by an unoccluded ratio would brighten what an occluder
+// darkens). Per top, not one ratio for the row, which would scale a floor leaf's light by the ratio
+// of a dim wall beside it. The good-link share (shooters that do not emit: the default bad-link
+// rule's good links) also gets one factor, goodClosure, which rad-global's merge applies to the
+// good-link irradiance the Gouraud layer interpolates.
 void KeyTimeSolver::computeClosure() {
   buildGatherLists();
   const size_t N = size_t(h_.size());
@@ -149,8 +149,7 @@ void KeyTimeSolver::closeLeaf(int r) {
     }
   for (const TopShare& t : shares) slot[t.top] = -1;
   std::vector<std::pair<uint32_t, double>>& known = leafTopFormFactor_[size_t(r)];
-  // Per top, its index in `known` (the slots reused; a linear search per share had been 14 %
-  // of rad-global's time on the table scene at eps 1e-4).
+  // Per top, its index in `known` (the slots reused), not a linear search per share.
   for (size_t i = 0; i < known.size(); ++i) slot[known[i].first] = int(i);
   glm::dvec2 own(0.0), averaged(0.0);  // (all, good)
   // Per top whose share is replaced, G_q / sum_k F V - 1 (0: kept), indexed like `slot`.
@@ -176,11 +175,10 @@ void KeyTimeSolver::closeLeaf(int r) {
     averaged += glm::dvec2(t.fv, good * t.fv);
   }
   for (const std::pair<uint32_t, double>& k : known) slot[k.first] = -1;
-  // Each replaced top's links are scaled by their own top's ratio, the others kept: a leaf
-  // beside a wall sees much more of that dim wall than its ancestor's links say, and one
-  // ratio for the whole row had scaled the light by the wall's share too (the bundled
-  // scene's floor strip in front of the tall box came out 1.8x too bright, the box's foot on
-  // the frames with it).
+  // Each replaced top's links are scaled by their own top's ratio, the others kept: a leaf beside a
+  // wall sees much more of that dim wall than its ancestor's links say, and one ratio for the whole
+  // row would scale the light by the wall's share too (a floor strip in front of a box, and the
+  // box's foot on the frames with it, too bright).
   std::vector<std::pair<size_t, double>>& extra = topExcess_[size_t(r)];
   extra.clear();
   if (anyExcess)
@@ -211,17 +209,15 @@ std::pair<glm::dvec3, glm::dvec3> KeyTimeSolver::excessIrradiance(int r) const {
   return H;
 }
 
-// A leaf inside a closed room sees the scene's surfaces and nothing else, so the row sum of
-// its exposed part is exactly 1, occluded links included. An occluded link's visibility is a
-// ratio estimate from a few ray pairs, and its error does not cancel within one receiver:
-// the closed 2 m furnace with a slab standing in it (make_furnace.py --partition) came out
-// 7.5 % too bright at rho = 0.99 with 16 rays, 36 % with 64 rays and 18 % too dark with the
-// slab floating; the cubic scene's leaves summed to 0.986 on average (0.80 .. 1.34), and its
-// frames were 1.6 % too dark. The links to emitting shooters keep the closure above (mostly
-// unoccluded, and recomputed per texel by the second pass); the others' factor fills the row
-// to 1, each node's links counted over its exposure as the gather divides them. Where every
-// shooter emits (the furnace), or the others' share cannot take the difference, the whole
-// row is scaled.
+// A leaf inside a closed room sees the scene's surfaces and nothing else, so the row sum of its
+// exposed part is exactly 1, occluded links included. An occluded link's visibility is a ratio
+// estimate from a few ray pairs, and its error does not cancel within one receiver: a closed
+// furnace with a slab in it (make_furnace.py --partition) comes out too bright with the slab
+// standing and too dark with it floating, and more rays do not cure it. The links to emitting
+// shooters keep the closure above (mostly unoccluded, and recomputed per texel by the second pass);
+// the others' factor fills the row to 1, each node's links counted over its exposure as the gather
+// divides them. Where every shooter emits (the furnace), or the others' share cannot take the
+// difference, the whole row is scaled.
 void KeyTimeSolver::closeRoomRow(int r) {
   if (!(exposure_[size_t(r)] > 0.0)) return;
   glm::dvec2 coef(0.0);  // (emitting shooters, the others), the replaced tops' excess included
@@ -249,18 +245,17 @@ void KeyTimeSolver::closeRoomRow(int r) {
   s_.goodClosure[size_t(r)] = goodFactor_[size_t(r)];
 }
 
-// Exposure (the darkening at contacts): a box standing on the floor covers part of the
-// floor's patches, whose links' shadow rays then start under the box and are blocked, so
-// the area-averaged H and B of a patch straddling the box's footprint mix the lit part with
-// the dark covered one; the camera sees only the lit part, and the ceiling and walls that
-// gather from that patch see only its lit part too. With the boxes of the bundled Cornell
-// scene that made every surface 6-20 % too dark (-0.4 % with the boxes removed). A node's
-// exposure e is the fraction of its ray start points (samplePoints, the same for all its
-// links) that are not covered: a point is covered when a cosine-distributed ray from it
-// first meets the back of a one-sided surface (the inside of a solid, the back of a wall).
-// The gather divides a node's links' irradiance by e, so B and H are those of the exposed
-// part (the covered points' pairs are exactly the ones removed), and a parent pulls its
-// children's B weighted by exposed area.
+// Exposure (the darkening at contacts): a box standing on the floor covers part of the floor's
+// patches, whose links' shadow rays then start under the box and are blocked, so the area-averaged
+// H and B of a patch straddling the box's footprint mix the lit part with the dark covered one; the
+// camera sees only the lit part, and the ceiling and walls that gather from that patch see only its
+// lit part too, so the mix darkens every surface of a room with boxes on its floor. A node's
+// exposure e is the fraction of its ray start points (samplePoints, the same for all its links)
+// that are not covered: a point is covered when a cosine-distributed ray from it first meets the
+// back of a one-sided surface (the inside of a solid, the back of a wall). The gather divides a
+// node's links' irradiance by e, so B and H are those of the exposed part (the covered points'
+// pairs are exactly the ones removed), and a parent pulls its children's B weighted by exposed
+// area.
 void KeyTimeSolver::computeExposures() {
   const size_t N = size_t(h_.size());
   exposure_.resize(N, -1.0);

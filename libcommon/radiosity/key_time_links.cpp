@@ -2,6 +2,8 @@
 // links, evaluate (F~ and V of each new link), refine (the oracle, the larger patch split), the
 // accurate pass (the quadrature F of every visible leaf link) and the radiosity-weighted
 // visibility before each solve. See key_time_solver.h.
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/key_time_solver.h"
 
 #include <algorithm>
@@ -132,22 +134,20 @@ void KeyTimeSolver::evaluateLink(SolverLink& l) const {
   l.visibility = l.rayVisibility;
 }
 
-// Radiosity-weighted visibility (before each solve): a link's shooter bright where the
-// receiver cannot see it and dim where it can (the ceiling above a double-sided lamp 2 cm
-// under it: the bright spot is hidden by the lamp) carries $\int B V$, not $\bar B \bar V$.
-// The mean-B-times-mean-V product let the spot's light out into the room (+11 % over the
-// whole frame, contact.py lamp-two-sided). A link whose shooter is split in this key's tree
-// and whose rays are partly blocked weights each ray pair by the radiosity of the shooter's
-// leaf at its end, from the last solve (the same pairs: no new rays). Fully visible or fully
-// hidden links are unchanged, and so are links to a leaf shooter (constant B).
+// Radiosity-weighted visibility (before each solve): a link's shooter bright where the receiver
+// cannot see it and dim where it can (the ceiling above a double-sided lamp 2 cm under it: the
+// bright spot is hidden by the lamp) carries $\int B V$, not $\bar B \bar V$. The
+// mean-B-times-mean-V product lets the spot's light out into the room (contact.py lamp-two-sided).
+// A link whose shooter is split in this key's tree and whose rays are partly blocked weights each
+// ray pair by the radiosity of the shooter's leaf at its end, from the last solve (the same pairs:
+// no new rays). Fully visible or fully hidden links are unchanged, and so are links to a leaf
+// shooter (constant B).
 //
-// The same pairs give the shooter's B as the receiver sees it, open or not: their
-// kernel-weighted mean of the leaves' B over B_q (shooterShape), which the gather multiplies
-// in. A coarse link (ceiling <- wall) gathered the wall's mean B, but the ceiling sees mostly
-// the wall's upper part, which the lamp lights best: the bundled scene's coarse ceiling was
-// 3.4 % below its converged B (eps 1e-5), 0.6 % with the shape; frames against path-traced
-// references: Cornell box 5.15 -> 4.62 % RMSE / mean, cubes-8 4.75 -> 4.52 %, bundled 5.64 ->
-// 5.23 %, table 2.04 -> 2.02 %, cubic 3.36 -> 3.53 % (--no-shooter-shape for the former).
+// The same pairs give the shooter's B as the receiver sees it, open or not: their kernel-weighted
+// mean of the leaves' B over B_q (shooterShape), which the gather multiplies in. A coarse link
+// (ceiling <- wall) would gather the wall's mean B, but the ceiling sees mostly the wall's upper
+// part, which the lamp lights best: with the mean alone (--no-shooter-shape) a coarse ceiling comes
+// out below its converged B.
 void KeyTimeSolver::weightVisibilityByShooterRadiosity() {
   if (!input_.visibility) return;
   const int k = std::max(opt_.rays, 1);
@@ -156,12 +156,11 @@ void KeyTimeSolver::weightVisibilityByShooterRadiosity() {
                       [&](size_t li) { weightLinkVisibility(s_.links[li]); });
     return;
   }
-  // The links weighted for the first time in this key solve get their pairs (kernel, the
-  // shooter's (u,v) at each pair's end): the previous key's for a link coherence took over
-  // (both ends static, so the same values), else made here; every round after takes them
-  // over, as this key's geometry and rays do not change between rounds. Regenerating the
-  // points, kernels and (u,v) of every link at every round had been 38 % of rad-global's
-  // time on the table scene (perf: samplePoints, pairedPoints, polygonUvAt, descendToChild).
+  // The links weighted for the first time in this key solve get their pairs (kernel, the shooter's
+  // (u,v) at each pair's end): the previous key's for a link coherence took over (both ends static,
+  // so the same values), else made here; every round after takes them over, as this key's geometry
+  // and rays do not change between rounds, so a link's points, kernels and (u,v) are made once a
+  // key, not at every round.
   const size_t L = s_.links.size();
   pairStart_.resize(L, kNoRayPairs);
   // The links without pairs yet, in link order (found in parallel parts).
@@ -175,9 +174,9 @@ void KeyTimeSolver::weightVisibilityByShooterRadiosity() {
   if (pairs_.size() + fresh.size() * size_t(k) >= size_t(kNoRayPairs))
     throw Error(ExitCode::kEnvironment, "",
                 "more than 4 G shadow-ray pairs in one key time; lower --max-links or --rays");
-  // Reserved at their first use, not when the solve starts: the cluster refinement before it
-  // holds a level of links and its children at once, and the two together had made
-  // rad-global's peak on the 10k-triangle hall.
+  // Reserved at their first use, not when the solve starts: the cluster refinement before it holds
+  // a level of links and its children at once, and the pairs reserved beside the two would raise
+  // rad-global's peak.
   if (pairs_.capacity() == 0 && input_.expectedRayPairs > 0)
     pairs_.reserve(withMargin(input_.expectedRayPairs));
   const size_t firstFresh = pairs_.size();
@@ -205,8 +204,8 @@ void KeyTimeSolver::weightVisibilityByShooterRadiosity() {
                    float(kernel[size_t(i)])};
     }
   });
-  // The previous key's pairs are copied: they go before the pairs' leaves are made (held
-  // together, the two had made rad-global's peak on the 10k-triangle hall).
+  // The previous key's pairs are copied: they go before the pairs' leaves are made, so the two are
+  // never held together.
   releaseRayPairs();
   tbb::parallel_for(size_t(0), L, [&](size_t li) {
     SolverLink& l = s_.links[li];
@@ -217,10 +216,9 @@ void KeyTimeSolver::weightVisibilityByShooterRadiosity() {
     const LinkRayPair* pair = &pairs_[pairStart_[li]];
     double kernel[VisibilityScene::kMaxRecordedPairs], weight[VisibilityScene::kMaxRecordedPairs];
     for (int i = 0; i < k; ++i) {
-      // The leaf under the pair's end, found again at every round from the shooter (a few
-      // levels). Keeping it per pair between rounds had held 4 bytes a pair (18 MB of the
-      // 10k-triangle hall's peak, once the sweeps' lists were made), its (u,v) too before
-      // that 24 (110 MB).
+      // The leaf under the pair's end, found again at every round from the shooter (a few levels),
+      // not kept per pair between rounds, which would hold 4 bytes a pair (24 with its (u,v))
+      // through the key's sweeps.
       int node = l.shooter;
       glm::dvec2 uv(pair[i].uv);
       while (s_.split[size_t(node)]) node = h_.node(node).firstChild + descendToChild(uv, triangle);
@@ -325,11 +323,10 @@ size_t KeyTimeSolver::refine(std::vector<LinkIndex> work) {
   size_t count = 0;
   while (!work.empty()) {
     evaluateNewLinks();
-    // Per link, the node it splits (-1: none), in parallel first: the oracle and the choice
-    // are pure functions of the link, of B and of the nodes' areas, which splitting other
-    // links of this generation does not change (a new node's B is its parent's, and an
-    // existing node keeps its own), so the decisions below are the same. Asked one link after
-    // the other they had been 2 % of the 10k-triangle hall's rad-global.
+    // Per link, the node it splits (-1: none), in parallel first: the oracle and the choice are
+    // pure functions of the link, of B and of the nodes' areas, which splitting other links of this
+    // generation does not change (a new node's B is its parent's, and an existing node keeps its
+    // own), so the decisions below are the same as if asked one link after the other.
     std::vector<int> splits(work.size());
     tbb::parallel_for(size_t(0), work.size(), [&](size_t j) {
       const SolverLink& l = s_.links[work[j]];
@@ -382,9 +379,9 @@ void KeyTimeSolver::computeAccurateFormFactors() {
     fresh.push_back(LinkIndex(li));
   }
   // Reciprocity: linkFormFactor integrates over the smaller patch of a pair, so a link and its
-  // reverse (p <- q, q <- p: 93 % of the 1.2 M links of the 10k-triangle hall's first key)
-  // take one integral, bit for bit what each would have computed. Pairs of equal area (the
-  // rule's tie keeps the receiver as the patch integrated over) are computed per link.
+  // reverse (p <- q, q <- p; most links of a key have theirs) take one integral, bit for bit what
+  // each would have computed. Pairs of equal area (the rule's tie keeps the receiver as the patch
+  // integrated over) are computed per link.
   std::vector<std::pair<uint64_t, LinkIndex>> byPair(fresh.size());
   tbb::parallel_for(size_t(0), fresh.size(), [&](size_t i) {
     const SolverLink& l = s_.links[fresh[i]];

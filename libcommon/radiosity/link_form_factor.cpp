@@ -1,4 +1,6 @@
 // The geometry of one link; see link_form_factor.h.
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/link_form_factor.h"
 
 #include <algorithm>
@@ -29,11 +31,10 @@ double linkFormFactorIntegral(const Polygon& p, const Polygon& q, double relTol)
   const bool swap = p.area() > q.area();
   const Polygon& from = swap ? q : p;
   const Polygon& to = swap ? p : q;
-  // How near is measured against the patch integrated over (areaAverageFormFactor's rule, with
-  // the adaptive rule up to a ratio of 1 so that shared edges stay adaptive): F(x -> to) varies
-  // over `from` on the scale of x's distance to `to`, whatever `to`'s size. The larger patch's
-  // size had made every pair with a giant patch adaptive (issue 18: a mutated vertex 1e10 m
-  // away cost 5x as much per link).
+  // How near is measured against the patch integrated over (areaAverageFormFactor's rule, with the
+  // adaptive rule up to a ratio of 1 so that shared edges stay adaptive): F(x -> to) varies over
+  // `from` on the scale of x's distance to `to`, whatever `to`'s size. The larger patch's size
+  // would make every pair with a giant patch adaptive (issue 18: a mutated vertex 1e10 m away).
   return areaAverageFormFactor(from, to, relTol, 1.0);
 }
 

@@ -1,4 +1,6 @@
 // Shaft culling (Haines & Wallace 1994); see shaft.h.
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/shaft.h"
 
 #include <algorithm>
@@ -34,9 +36,8 @@ std::vector<glm::dvec2> convexHull2d(std::vector<glm::dvec2> p) {
 }  // namespace
 
 bool shaftMeetsBox(const Polygon& a, const Polygon& b, const glm::dvec3& lo, const glm::dvec3& hi) {
-  // Shaft::meets' first test, on the same exact min/max, before building the shaft's hulls:
-  // nearly every link of a coherent key misses the swept boxes here, and building a Shaft for
-  // each was 0.9 s of the 10k-triangle hall's ~10 s per coherent key (a perf profile).
+  // Shaft::meets' first test, on the same exact min/max, before building the shaft's hulls: nearly
+  // every link of a coherent key misses the swept boxes here, and so needs no Shaft built.
   glm::dvec3 sLo = a.v[0], sHi = a.v[0];
   for (int i = 0; i < a.count; ++i) sLo = glm::min(sLo, a.v[i]), sHi = glm::max(sHi, a.v[i]);
   for (int i = 0; i < b.count; ++i) sLo = glm::min(sLo, b.v[i]), sHi = glm::max(sHi, b.v[i]);

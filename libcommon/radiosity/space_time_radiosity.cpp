@@ -1,4 +1,6 @@
 // Space-time hierarchical radiosity: key-time solves, coherence, merge (see the header).
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/space_time_radiosity.h"
 
 #include <algorithm>
@@ -100,8 +102,7 @@ LinkCache reusableLinks(const KeySolution& prev, const PatchHierarchy& h, const 
   for (int node : scene.meshNodes())
     if (scene.isDynamic(node, t0, t1)) swept.push_back(scene.sweptBounds(node, t0, t1));
   // Per link, in parallel: whether it is kept (both ends static) and whether a moving object's
-  // swept box meets its shaft; then the kept ones in link order. The shaft tests one after the
-  // other had been 2 % of the 10k-triangle hall's rad-global, with the other core idle.
+  // swept box meets its shaft; then the kept ones in link order, as a serial loop would keep them.
   enum : char { kSkipped, kFree, kShadowed };
   std::vector<char> state(prev.links.size());
   tbb::parallel_for(size_t(0), prev.links.size(), [&](size_t li) {
@@ -169,10 +170,10 @@ void markBadPair(char& bad, BadLinkRule rule, const SolverLink& l, bool shooterE
   }
 }
 
-// --partial-power-share: what a partly visible link's shadow takes from its receiver,
-// B_q F (1 - V) A_p (the mean of the channels), summed per pair. The pairs whose shadows are
-// strong move to the second pass's per-texel shadows; the weak ones stay with the gathered good
-// layer (the 10k-triangle hall's 1.0 M partly visible pairs made rad-movies 10x slower).
+// --partial-power-share: what a partly visible link's shadow takes from its receiver, B_q F (1 - V)
+// A_p (the mean of the channels), summed per pair. The pairs whose shadows are strong move to the
+// second pass's per-texel shadows; the weak ones stay with the gathered good layer (per-texel
+// shadows for every partly visible pair of a large scene would multiply rad-movies' time).
 double meanChannel(const glm::dvec3& B) {
   return (B.x + B.y + B.z) / 3.0;
 }
@@ -258,8 +259,8 @@ class KeyTimePass {
       records_[r].clusterIrradiance.assign(s.topClusterIrradiance.begin(),
                                            s.topClusterIrradiance.end());
       nodeCount_.push_back(uint32_t(h_.size()));
-      // Key 0 grew its ray pairs by doubling (no previous key to reserve by): held through the
-      // next key's solve, the spare half had been 100 MB of the 10k-triangle hall's peak.
+      // Key 0 grew its ray pairs by doubling (no previous key to reserve by): the spare capacity,
+      // held through the next key's solve, goes once it passes a quarter of the size.
       if (s.rayPairs.capacity() > s.rayPairs.size() + s.rayPairs.size() / 4)
         s.rayPairs.shrink_to_fit();
       prev = std::move(s);
@@ -290,13 +291,13 @@ class KeyTimePass {
     in.expectedClusterLinks = prev.clusterLinkValues.size();
     if (opt_.coherence && k > first_) {
       auto tc = std::chrono::steady_clock::now();
-      // The caches hold what the solve takes over of prev's links and cluster links; of prev
-      // itself it still reads the ray pairs (reuseRayPairs). Each part of prev goes as soon as
-      // its cache is made, so that at most one cache is being built beside all of prev: held
-      // beside the caches and the new key's links, prev was ~200 MB of the 10k-triangle hall's
-      // peak, and building all three before freeing any made the peak between keys (+50 MB).
-      // Swapped with empty vectors: `v = {}` would pick operator=(initializer_list), which
-      // empties v but keeps its capacity (it had freed 11 MB of the hall's 220).
+      // The caches hold what the solve takes over of prev's links and cluster links; of prev itself
+      // it still reads the ray pairs (reuseRayPairs). Each part of prev goes as soon as its cache
+      // is made, so that at most one cache is being built beside all of prev: prev held beside the
+      // caches and the new key's links, or all three built before any is freed, would set the peak
+      // between keys.
+      // Swapped with empty vectors: `v = {}` would pick operator=(initializer_list), which empties
+      // v but keeps its capacity.
       cache = reusableLinks(prev, h_, scene_, keyTimes_[k - 1], t);
       in.reuse = &cache;
       std::vector<SolverLink>().swap(prev.links);

@@ -1,5 +1,7 @@
 // Shadow-ray visibility with Embree 3 (Wald et al. 2014); stratified ray pairs after Hanrahan,
 // Salzman, Aupperle 1991; splitmix64 from Steele, Lea, Flood 2014.
+// The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
+// code's comments (issue 55)".
 #include "libcommon/radiosity/visibility.h"
 
 #include <algorithm>
@@ -350,10 +352,9 @@ void VisibilityScene::commit() {
 }
 
 // Whether the segment from a to b may meet the scene's (widened) bounds: a slab test. A segment
-// that misses them cannot hit a triangle, so occluded() answers without Embree. Most of
-// rad-movies' rays against the moving objects (a small car in a room) miss their box, and each
-// rtcOccluded1 call through the instance had cost far more than this test (perf: 53 % of
-// rad-movies in Embree).
+// that misses them cannot hit a triangle, so occluded() answers without Embree. Most of rad-movies'
+// rays against the moving objects (a small car in a room) miss their box, and an rtcOccluded1 call
+// through the instance costs far more than this test.
 bool VisibilityScene::segmentMayHit(const glm::dvec3& a, const glm::dvec3& b) const {
   const glm::dvec3& lo = impl_->lo;
   const glm::dvec3& hi = impl_->hi;
@@ -549,9 +550,8 @@ std::uint64_t VisibilityScene::openSegments(const glm::dvec3* from, size_t fromS
                                             const glm::dvec3* to, int k, std::uint32_t ignoreA,
                                             std::uint32_t ignoreB, std::uint64_t candidates) const {
   // Packets of 8 segments (Embree's AVX2 width), one traversal for 8 rays instead of 8: the
-  // cubic scene's rad-movies had spent 71 % of its time in rtcOccluded1, nearly all of it on the
-  // per-texel rays of one texel, which share their origin. Each lane is the segment occluded()
-  // tests, so the answers are the same.
+  // per-texel rays of one texel share their origin, and so mostly their path through the tree. Each
+  // lane is the segment occluded() tests, so the answers are the same.
   std::uint64_t open = 0;
   k = std::min(k, kMaxRecordedPairs);
   FilterContext fc = filterContext(ignoreA, ignoreB);

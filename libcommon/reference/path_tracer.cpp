@@ -405,7 +405,7 @@ struct PathTracer::Impl {
           // The search restarts from the same origin just short of this hit, with this
           // polygon ignored: a coincident front face (a polygon modelled seen from both sides
           // as two faces) is still met whichever of the two the rounding put first.
-          // Restarting at the hit point with tNear = 0 lost it for 8 % of the rays.
+          // Restarting at the hit point with tNear = 0 would lose it for some of the rays.
           ++culledPasses;
           tNear = t * (1.0 - 1e-6);
           from = hit;

@@ -82,8 +82,8 @@ struct Ray {
   double tNear = 0.0, tFar = 0.0;
 };
 
-// Primary rays of one view: the lens is validated and tan(yfov/2) evaluated once, not per
-// pixel (they were 14 % of rad-compose's time). Gives bit-identical rays to primaryRay().
+// Primary rays of one view: the lens is validated and tan(yfov/2) evaluated once, not per pixel.
+// Gives bit-identical rays to primaryRay().
 class PrimaryRays {
  public:
   // Throws like projectionMatrix() on an unusable lens.

@@ -219,8 +219,7 @@ std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPol
       }
       // A gap there must be: a polygon lying on B (a box's bottom on a floor, a partition's top
       // against a ceiling) hides what it covers, which rad-global's exposure and rad-movies'
-      // covered texels already leave out; cutting B there too only added patches (the cubic
-      // scene: 189 -> 557, and its default frames 1.65 -> 1.98 %).
+      // covered texels already leave out; cutting B there too only adds patches, and error.
       if (lo < -tol || hi <= tol || hi > kContactGap * A.size) continue;
       // A's outline on B's plane, CCW about B's normal.
       Outline a;
@@ -229,12 +228,10 @@ std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPol
         a.push_back(x - glm::dot(x - B.world.v[0], B.normal) * B.normal);
       }
       if (facing < 0.0) std::reverse(a.begin(), a.end());
-      // A gap makes B's radiosity fall towards the outline over a few gaps on either side: a
-      // point d from a long edge loses (1 - a / sqrt(1 + a^2)) / 2 of its cosine hemisphere to
-      // A, a = d / gap (50 % at the edge, 15 % at 1 gap, 5 % at 2, 1.5 % at 4). Rims 2 gaps wide
-      // outside and inside the outline are pieces of their own, whose movies resolve that fall
-      // (the bundled scene, final setting: rims of 1, 2, 4, 8 gaps gave 0.94, 0.96, 1.05,
-      // 1.13 %; none, 1.18 %).
+      // A gap makes B's radiosity fall towards the outline over a few gaps on either side: a point
+      // d from a long edge loses (1 - a / sqrt(1 + a^2)) / 2 of its cosine hemisphere to A, a = d /
+      // gap (50 % at the edge, 15 % at 1 gap, 5 % at 2, 1.5 % at 4). Rims 2 gaps wide outside and
+      // inside the outline are pieces of their own, whose movies resolve that fall.
       const double rim = kRimGaps * hi;
       std::vector<Outline> outlines{a};
       if (rim > tol) {

@@ -14,16 +14,15 @@ struct InputPolygon;
 // A static polygon A parallel to a static polygon B, in front of B with a gap smaller than
 // kContactGap times A's size, makes B's radiosity jump along A's outline: under A, B sees almost
 // nothing. An element or a movie texel that straddles the outline averages the two sides (the
-// bundled scene's lamp, 1 mm under the ceiling: its 578 surrounding pixels held 37 % of frame
-// 20's squared error, the gap's ceiling 0.03 against 0.004 and the ceiling beside the lamp 0.055
-// against 0.077). So B is cut into B ∩ A's outline and, per edge k of A, B ∩ outside(edge k) ∩
-// inside(edge k + 1) (a pinwheel: convex pieces that reach B's boundary without slivers along
-// A's edge lines), each piece then split into quads and a triangle. B's radiosity falls towards
-// the outline over a few gaps on either side, so B is cut the same way along rims kRimGaps gaps
-// wide outside and inside the outline too, whose own movies resolve that fall (the bundled
-// scene, final setting: 1.12 % without the cuts, 1.18 % with the outline alone, 0.96 % with the
-// rims). Pieces keep B's node, material, face and uv map; the union of the pieces is B. Order
-// and result are deterministic.
+// bundled scene's lamp, 1 mm under the ceiling: the pixels around it held much of the frame's
+// squared error, the gap's ceiling too bright and the ceiling beside the lamp too dark). So B is
+// cut into B ∩ A's outline and, per edge k of A, B ∩ outside(edge k) ∩ inside(edge k + 1) (a
+// pinwheel: convex pieces that reach B's boundary without slivers along A's edge lines), each piece
+// then split into quads and a triangle. B's radiosity falls towards the outline over a few gaps on
+// either side, so B is cut the same way along rims kRimGaps gaps wide outside and inside the
+// outline too, whose own movies resolve that fall (the outline alone does not lower the error).
+// Pieces keep B's node, material, face and uv map; the union of the pieces is B. Order and result
+// are deterministic.
 inline constexpr double kContactGap = 0.02;
 inline constexpr double kRimGaps = 2.0;
 std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPolygon> polygons);

@@ -98,9 +98,9 @@ std::vector<int> emptyFrames(const rad::ComposeSequenceReport& report) {
 int run(const rad::ComposeOptions& given, const std::string& preset, int argc, char** argv) {
   rad::ComposeOptions o = given;
   rad::Scene scene = rad::readGltfScene(o.scene);
-  // Of global.rlh only the radiosity (fallback pixels, auto exposure) is kept, and the file's
-  // bytes are released once read. On the 32-cube scene the file (49 MB) and a copy of its links
-  // and F·V samples (45 MB) were otherwise held for the whole sequence.
+  // Of global.rlh only the radiosity (fallback pixels, auto exposure) is kept, and the file's bytes
+  // are released once read; otherwise the file and a copy of its links and F·V samples would be
+  // held for the whole sequence.
   rad::GlobalSolution solution;
   rad::InputRecord globalInput;  // taken while the file's bytes are held
   {

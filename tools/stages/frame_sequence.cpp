@@ -63,8 +63,8 @@ bool usedByFrames(const MovieExtent& iv, const std::vector<int>& frames) {
 // present, patch, frames, size) before the first frame is written, so that a bad or missing
 // movie leaves no frame behind. The pixels are verified as each key is loaded. Returns the
 // headers by interval index, for the streams to open with (MovieCache::get).
-// The files are read in parallel (serial, they had been a third of rad-compose on the 10k hall's
-// 5,661 movies); of several bad movies the first in interval order is reported.
+// The files are read in parallel (a run has thousands of them); of several bad movies the first in
+// interval order is reported.
 std::map<size_t, TextureMovie> checkMovieHeaders(const TextureIntervals& intervals,
                                                  const std::string& dir,
                                                  const std::vector<int>& frames) {
@@ -77,8 +77,8 @@ std::map<size_t, TextureMovie> checkMovieHeaders(const TextureIntervals& interva
     const std::string path = textureMoviePath(dir, iv.movie);
     read[u] = readTextureMovieHeaders(path);
     requireMovieMatches(read[u], iv, path);
-    // Kept until the movie is opened: without the baking tool's provenance, which the frames
-    // do not use (a from-scratch run's 74,000 one-frame movies held 150 MB of it).
+    // Kept until the movie is opened: without the baking tool's provenance, which the frames do not
+    // use (a from-scratch run has tens of thousands of one-frame movies).
     std::string().swap(read[u].provenanceJson);
   });
   std::map<size_t, TextureMovie> headers;
@@ -99,9 +99,9 @@ class MovieCache {
     if (it != loaded_.end()) return *it->second;
     const MovieExtent& iv = intervals_.movies[index];
     std::string path = textureMoviePath(dir_, iv.movie);
-    // The headers checkMovieHeaders read: parsing every part's header again with OpenEXR's
-    // C++ reader had been 7 % of rad-compose (perf, table scene). A file changed since is
-    // still caught: the stream checks its part count, each chunk's size and each key's checksum.
+    // The headers checkMovieHeaders read, not every part's header parsed again with OpenEXR's C++
+    // reader. A file changed since is still caught: the stream checks its part count, each chunk's
+    // size and each key's checksum.
     auto known = headers_.find(index);
     std::unique_ptr<TextureMovieStream> stream;
     if (known != headers_.end()) {
@@ -218,8 +218,8 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
         mt.patch = movie.patch;
         mt.width = movie.width;
         mt.height = movie.height;
-        // The two key textures around t, blended per sampled texel by the composer (no copy of
-        // the texture: those copies, one per active movie, grew to 41 MB on the 32-cube scene).
+        // The two key textures around t, blended per sampled texel by the composer (no copy of the
+        // texture, which would be one per active movie).
         if (movie.constant())
           mt.irradiance = stream.key(0).data();
         else

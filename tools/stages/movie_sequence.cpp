@@ -96,11 +96,11 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
   const std::string provenanceJson = provenance.toJson().dump();
   const std::vector<const MovieExtent*> movies = shardMovies(intervals, options.shard);
 
-  // One worker per allowed thread (--threads), each baking whole movies with its own baker:
-  // the 10k hall's movies are mostly 4 x 4 texels, too small for the per-texel loops inside a
-  // movie to keep two cores busy. `baker` is worker 0 on this thread; the others are its
-  // siblings, made, used and destroyed on their own threads (each holds a GL context). A movie
-  // is made whole by one baker, so the files do not depend on the number of workers.
+  // One worker per allowed thread (--threads), each baking whole movies with its own baker: a big
+  // scene's movies are mostly a few texels, too small for the per-texel loops inside a movie to
+  // keep two cores busy. `baker` is worker 0 on this thread; the others are its siblings, made,
+  // used and destroyed on their own threads (each holds a GL context). A movie is made whole by one
+  // baker, so the files do not depend on the number of workers.
   const size_t workers = std::clamp<size_t>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1,
       std::max<size_t>(movies.size(), 1));
@@ -119,10 +119,10 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
 
   auto work = [&](TextureMovieBaker& mine, Worker& w) {
     MovieFileSink sink(mine.options().coherence, w.secondsWrite);
-    // While every worker has a movie of its own, a movie's per-texel loops run on its worker
-    // alone (an arena of one thread): in the shared arena every loop of a few texels went
-    // through TBB's partitioning and stealing (rad-movies 5 % slower on the 10k-triangle hall).
-    // The last movies, fewer than the workers, take every thread again.
+    // While every worker has a movie of its own, a movie's per-texel loops run on its worker alone
+    // (an arena of one thread): in the shared arena every loop of a few texels would go through
+    // TBB's partitioning and stealing. The last movies, fewer than the workers, take every thread
+    // again.
     tbb::task_arena alone(1);
     for (size_t i; !stop && (i = next++) < movies.size();) {
       const MovieExtent& m = *movies[i];
