@@ -34,16 +34,18 @@ $(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-int
 	$(INTERVALS_CMD)
 
 # The folder is emptied first (of the pipeline's own files, clean.sh): movies of an earlier run
-# (another intervals.rti) must not linger.
+# (another intervals.rti) must not linger. Two runs into one OUT take turns on the folders
+# (flock): a folder is emptied and written under its exclusive lock and read under a shared one
+# (rad-compose reads movies/, encode.sh frames/; the order movies before frames), so neither
+# run empties what the other is reading. The tool is exec'd, so a signal to make reaches it.
 $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
-	@$(PIPELINES)clean.sh $(OUT) movies
-	$(MOVIES_CMD)
+	exec 8>$(OUT)/.movies.lock && flock 8 && $(PIPELINES)clean.sh $(OUT) movies && exec $(MOVIES_CMD)
 	@touch $@
 
 $(OUT)/frames/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
-	@$(PIPELINES)clean.sh $(OUT) frames
-	$(COMPOSE_CMD)
+	exec 8>$(OUT)/.movies.lock 9>$(OUT)/.frames.lock && flock -s 8 && flock 9 && \
+	  $(PIPELINES)clean.sh $(OUT) frames && exec $(COMPOSE_CMD)
 	@touch $@
 
 $(OUT)/movie.mp4: $(OUT)/frames/.done

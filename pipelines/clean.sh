@@ -52,7 +52,7 @@ clean_part() {
       remove_folder "$out/logs" ;;
     all)
       for p in movies frames global-windows logs; do clean_part "$p"; done
-      remove_matching "$out" "global\.rlh|intervals\.rti|scene\.json|movie\.mp4|contact-sheet\.png|slurm-jobs|(scene|global|intervals|movies|compose)\.params|(global|intervals|movies|compose)-report(-[0-9x-]+|-[0-9]+of[0-9]+)?\.json|$temporaries"
+      remove_matching "$out" "global\.rlh|intervals\.rti|scene\.json|\.(movies|frames)\.lock|movie\.mp4|contact-sheet\.png|slurm-jobs|(scene|global|intervals|movies|compose)\.params|(global|intervals|movies|compose)-report(-[0-9x-]+|-[0-9]+of[0-9]+)?\.json|$temporaries"
       remove_folder "$out" ;;
     *) echo "clean.sh: unknown part $1" >&2; exit 2 ;;
   esac

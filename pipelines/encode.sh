@@ -27,6 +27,11 @@ for ((f = first; f <= last; f += step)); do
   names+=("$name")
 done
 
+# Read under a shared lock on the frames (animation.mk: another run into the same OUT empties
+# frames/ only under the exclusive one).
+exec 9>"$(dirname -- "$dir")/.frames.lock"
+flock -s 9
+
 tmp="$output.tmp.$$"
 ffmpeg_pid=
 cleanup() {

@@ -291,6 +291,20 @@ TEST_F(PipelineSafety, TheMp4StepStopsItsFfmpegOnSigterm) {
   fs::remove_all(dir);
 }
 
+// Two runs into one OUT at once both succeed (a fixed temporary name, or one run emptying the
+// folder the other was reading, had failed one of them).
+TEST_F(PipelineSafety, TwoRunsIntoOneOutBothSucceed) {
+  fs::path dir = freshDir("concurrent");
+  fs::path out = dir / "out";
+  const std::string make = makeCommand(out) + " -s";
+  CommandResult r =
+      runCommand("{ " + make + " & a=$!; " + make + "; b=$?; wait $a; " + "echo \"runs=$?,$b\"; }");
+  EXPECT_NE(r.out.find("runs=0,0"), std::string::npos) << r.out << r.err;
+  EXPECT_TRUE(stagesMakeWouldRun(makeCommand(out)).empty());
+  EXPECT_TRUE(fs::exists(out / "movie.mp4"));
+  fs::remove_all(dir);
+}
+
 // A path that starts with `-` is passed as a path (`./-scene.gltf`), not read as an option.
 TEST_F(PipelineSafety, APathStartingWithADashIsAPath) {
   CommandResult r =
