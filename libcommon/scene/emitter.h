@@ -1,7 +1,7 @@
 // The light seam (docs/design.md §4 "Lights"): what a light emits toward a point, how to sample
-// it, where it is over time, whether it moves, and its power. Every stage that asks "which
-// things emit, where, how much" asks an Emitter; the scene's list of them is made in one place
-// (scene_emitters.h).
+// it, where it is over time, whether it moves, and its power. The stages ask "which things
+// emit, where, how much" of the scene's list of Emitters, made in one place (scene_emitters.h);
+// what still reads a material's emission directly is a patch's own B_e (below).
 //
 // Two levels:
 //  * Emitter: a light of the scene over time (its node's animation included). Holds a reference
