@@ -12,6 +12,7 @@
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/radiosity/scene_visibility.h"
+#include "libcommon/scene/scene_emitters.h"
 
 namespace rad {
 namespace {
@@ -412,13 +413,11 @@ PixelSource FrameComposer::Impl::shadePixel(double t, const std::vector<MovieTex
 
 double autoExposureEV(const Scene& scene, const GlobalSolution& solution, double percentile) {
   const PatchHierarchy& h = solution.hierarchy;
+  const SceneEmitters emitters(scene, h.tops());   // the lights are left out of the exposure
   std::vector<std::pair<double, double>> lumArea;  // (luminance of B/pi, area)
   for (int i = 0; i < h.size(); ++i) {
     if (!h.isLeaf(i)) continue;
-    const InputPolygon& top = h.topOf(i);
-    if (top.material >= 0 && top.material < int(scene.materials.size()) &&
-        scene.materials[top.material].isEmitter())
-      continue;
+    if (emitters.topEmits(int(h.node(i).id.top))) continue;
     double area = h.node(i).local.area();
     if (!(area > 0.0)) continue;
     for (int k = 0; k < solution.keyCount(); ++k) {

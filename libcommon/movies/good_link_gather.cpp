@@ -36,14 +36,16 @@ double nearestDistance(const std::vector<Polygon>& receiverAt, const std::vector
 }  // namespace
 
 GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
-                               GoodLinksByReceiver& byReceiver, const MovieExtent& request,
-                               const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
-                               double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
+                               const SceneEmitters& emitters, GoodLinksByReceiver& byReceiver,
+                               const MovieExtent& request, const MovieTexels& texels,
+                               const std::vector<double>& movieKeyTimes, double shooterRatio,
+                               double cacheBytes, GoodLinkGatherStats& stats,
                                SceneVisibility* visibility, int visibilityRays,
                                int nearShooterLevels, double partialShare,
                                int clusterVisibilityRays)
     : scene_(scene),
       solution_(solution),
+      emitters_(emitters),
       clusterCorners_(byReceiver.clusterCorners),
       shooterRatio_(shooterRatio),
       texels_(texels),
@@ -136,7 +138,7 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
       for (double t : times) receiverAt.push_back(nodeWorld(uint32_t(r), t));
       shooterParts(receiverAt, times, shooter, shooters);
       for (uint32_t q : shooters) {
-        const bool emitter = scene_.emits(h.topOf(int(q)));
+        const bool emitter = emitters_.topEmits(int(h.node(int(q)).id.top));
         if (nearShooterLevels_ > 0 && h.isLeaf(int(q)) && !emitter)
           nearCells(receiverAt, times, q, cells);
         else

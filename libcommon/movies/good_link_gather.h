@@ -70,6 +70,7 @@
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/radiosity/scene_visibility.h"
 #include "libcommon/scene/scene.h"
+#include "libcommon/scene/scene_emitters.h"
 
 namespace rad {
 
@@ -101,7 +102,8 @@ class GoodLinkGather {
   // sub-tree larger than shooterRatio times their distance to the receiver; 0: no split), their
   // visibility at the global keys it needs and, within `cacheBytes`, the per-texel form factors
   // of the links whose ends do not move.
-  GoodLinkGather(const Scene& scene, const GlobalSolution& solution,
+  // `emitters` are the lights among the solution's tops (SceneEmitters of hierarchy.tops()).
+  GoodLinkGather(const Scene& scene, const GlobalSolution& solution, const SceneEmitters& emitters,
                  GoodLinksByReceiver& byReceiver, const MovieExtent& request,
                  const MovieTexels& texels, const std::vector<double>& movieKeyTimes,
                  double shooterRatio, double cacheBytes, GoodLinkGatherStats& stats,
@@ -138,6 +140,7 @@ class GoodLinkGather {
   };
   const Scene& scene_;
   const GlobalSolution& solution_;
+  const SceneEmitters& emitters_;
   const std::vector<glm::vec3>& clusterCorners_;  // GoodLinksByReceiver::clusterCorners
   const double shooterRatio_;
   const MovieTexels texels_;

@@ -132,12 +132,13 @@ namespace {
 class MovieBake {
  public:
   MovieBake(const GlobalSolution& solution, const std::vector<InputPolygon>& tops,
-            const TextureMovieBakerOptions& options, TextureMovieBakerStats& stats,
-            const std::function<OcclusionMaskRenderer&()>& renderer, FormFactorSpill& spill,
-            const MovieExtent& req, MovieGeometry& geometry, const GoodLinkGather* gather,
-            SceneVisibility* visibility, const BlockerIndex& blockers)
+            const SceneEmitters& emitters, const TextureMovieBakerOptions& options,
+            TextureMovieBakerStats& stats, const std::function<OcclusionMaskRenderer&()>& renderer,
+            FormFactorSpill& spill, const MovieExtent& req, MovieGeometry& geometry,
+            const GoodLinkGather* gather, SceneVisibility* visibility, const BlockerIndex& blockers)
       : solution_(solution),
         tops_(tops),
+        emitters_(emitters),
         blockers_(blockers),
         options_(options),
         stats_(stats),
@@ -482,6 +483,7 @@ class MovieBake {
 
   const GlobalSolution& solution_;
   const std::vector<InputPolygon>& tops_;
+  const SceneEmitters& emitters_;  // the lights among tops_
   const BlockerIndex& blockers_;
   const TextureMovieBakerOptions& options_;
   TextureMovieBakerStats& stats_;
@@ -585,7 +587,7 @@ void MovieBake::planPair(BadPair& p) {
   // A subdivided shooter that does not emit: its leaves' radiosity shapes its light (a light's
   // is its emission, uniform; skipping it keeps the lights' pairs as they were, at no cost).
   const PatchHierarchy& h = solution_.hierarchy;
-  if (!h.isLeaf(int(S)) && !geo_.scene().emits(tops_[S])) {
+  if (!h.isLeaf(int(S)) && !emitters_.topEmits(int(S))) {
     const Polygon& shooter = p.shooterWorld[0];
     for (const glm::dvec2& a : p.unitSamples)
       p.sampleLeaf.push_back(
@@ -735,7 +737,8 @@ TextureMovieBaker::TextureMovieBaker(const Scene& scene, const GlobalSolution& s
       fps_(fps),
       options_(options),
       backends_(std::move(backends)),
-      tops_(solution.hierarchy.tops()) {
+      tops_(solution.hierarchy.tops()),
+      emitters_(scene, tops_) {
   if (options_.keyStep < 1) throw Error(ExitCode::kUsage, "--movie-key-step", "must be >= 1");
   if (options_.maxSamples < 1 || options_.maxSamples > kMaxTransmittanceSamples)
     throw Error(ExitCode::kUsage, "--max-samples", "must be in 1..64");
@@ -907,15 +910,15 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     if (!goodLinks_) goodLinks_ = std::make_unique<GoodLinksByReceiver>(solution_);
     auto clock = SteadyClock::now();
     gather = std::make_unique<GoodLinkGather>(
-        scene_, solution_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
+        scene_, solution_, emitters_, *goodLinks_, req, geometry.texelPoints(), movie.keyTimes,
         options_.gatherShooterRatio, 0.5 * options_.maxTextureMemoryMiB * 1048576.0, stats_.gather,
         options_.gatherRays > 0 ? sceneVisibility() : nullptr, options_.gatherRays,
         options_.nearShooterLevels, options_.gatherPartialShare, options_.clusterVisibilityRays);
     stats_.secondsGood += secondsSince(clock);
   }
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);
-  MovieBake bake(solution_, tops_, options_, stats_, gl, *spill, req, geometry, gather.get(),
-                 options_.fillCovered ? sceneVisibility() : nullptr, *blockers_);
+  MovieBake bake(solution_, tops_, emitters_, options_, stats_, gl, *spill, req, geometry,
+                 gather.get(), options_.fillCovered ? sceneVisibility() : nullptr, *blockers_);
   bake.plan(badShooters);
   sink.begin(movie);
   for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);

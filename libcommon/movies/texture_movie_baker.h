@@ -52,6 +52,7 @@
 #include "libcommon/radiosity/global_solution.h"
 #include "libcommon/scene/patch_hierarchy.h"
 #include "libcommon/scene/scene.h"
+#include "libcommon/scene/scene_emitters.h"
 
 namespace rad {
 
@@ -231,6 +232,7 @@ class TextureMovieBaker {
   TextureMovieBakerOptions options_;
   TextureMovieBakerBackends backends_;
   std::vector<InputPolygon> tops_;
+  SceneEmitters emitters_;  // the lights among tops_ (the light seam, scene_emitters.h)
   std::unique_ptr<OcclusionMaskRenderer> renderer_;
   std::unique_ptr<BlockerIndex> blockers_;          // made on the first bake
   std::unique_ptr<GoodLinksByReceiver> goodLinks_;  // --good-layer gather

@@ -24,6 +24,7 @@
 #include "libcommon/radiosity/link_intervals.h"
 #include "libcommon/radiosity/scene_visibility.h"
 #include "libcommon/radiosity/shaft.h"
+#include "libcommon/scene/scene_emitters.h"
 
 namespace rad {
 
@@ -237,6 +238,7 @@ class KeyTimePass {
     if (h_.topCount() == 0) throw inputError(scene.path, "has no polygons");
     T_ = size_t(h_.topCount());
     surfaces_ = surfacePropertiesOf(scene, h_);
+    emitters_ = std::make_unique<SceneEmitters>(scene, h_.tops());
     vis_ = std::make_unique<SceneVisibility>(scene, h_, keyTimes.front(), keyTimes.back());
     rep_.topPatches = T_;
     records_.resize(last - first + 1);
@@ -338,7 +340,7 @@ class KeyTimePass {
                         float(l.visibility), l.refined});
       uint32_t rt = h_.node(l.receiver).id.top, st = h_.node(l.shooter).id.top;
       const uint64_t pair = (uint64_t(rt) << 32) | st;
-      const bool emits = surfaces_[st].isEmitter();
+      const bool emits = emitters_->topEmits(int(st));
       if (byPower && !emits) {
         if (partlyVisible(l, opt_.partialThreshold)) shadowPower[pair] += partialShadowPower(s, l);
         continue;
@@ -363,6 +365,9 @@ class KeyTimePass {
   PatchHierarchy h_;
   size_t T_ = 0;
   std::vector<SurfaceProperties> surfaces_;
+  // The lights among the tops (the light seam): which pairs are the lights' bad pairs. The
+  // solve itself treats a polygon light as a patch with B_e (surfaces_).
+  std::unique_ptr<SceneEmitters> emitters_;
   std::unique_ptr<SceneVisibility> vis_;
   std::vector<KeyRecord> records_;   // per key first..last
   std::vector<uint32_t> nodeCount_;  // per key: h_.size() after its solve

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -16,6 +17,7 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/visibility.h"  // splitMix64, uniformOpen01 (counter-based random numbers)
+#include "libcommon/scene/scene_emitters.h"
 
 namespace rad {
 
@@ -91,23 +93,23 @@ struct PathTracer::Impl {
     int frontEmitter = -1;  // index into emitters of the side facing the front normal
     int backEmitter = -1;   // of the back side (doubleSided emitters only)
   };
+  // A light of the scene (scene_emitters.h) placed at the current time.
   struct Emitter {
-    Polygon world;
-    glm::dvec3 normal{0.0};
-    glm::dvec3 radiance{0.0};
-    double area = 0.0;
+    std::unique_ptr<PlacedEmitter> placed;
+    double area = 0.0;         // placed->area(), read once per frame
     double probability = 0.0;  // of being chosen for next-event estimation
   };
 
   RTCDevice device = nullptr;
   RTCScene bvh = nullptr;
-  std::vector<InputPolygon> inputs;      // Scene::inputPolygons(), in local frames
-  std::vector<Surface> surfaces;         // ray-castable polygons (reversed copies left out)
-  std::vector<std::uint32_t> polygonOf;  // Embree triangle -> surface index
-  std::vector<std::uint8_t> fanIndex;    // Embree triangle -> k of its fan triangle (0, k, k+1)
-  std::vector<Emitter> emitters;         // every emitting side (reversed copies included)
-  std::vector<double> emitterCdf;        // cumulative probabilities
-  double sceneSize = 1.0;                // largest coordinate magnitude (ray offsets)
+  std::vector<InputPolygon> inputs;       // Scene::inputPolygons(), in local frames
+  std::unique_ptr<SceneEmitters> lights;  // the scene's emitters, top() indexing `inputs`
+  std::vector<Surface> surfaces;          // ray-castable polygons (reversed copies left out)
+  std::vector<std::uint32_t> polygonOf;   // Embree triangle -> surface index
+  std::vector<std::uint8_t> fanIndex;     // Embree triangle -> k of its fan triangle (0, k, k+1)
+  std::vector<Emitter> emitters;          // every emitting side (reversed copies included)
+  std::vector<double> emitterCdf;         // cumulative probabilities
+  double sceneSize = 1.0;                 // largest coordinate magnitude (ray offsets)
   std::mutex errorMutex;
   std::string lastError;
 
@@ -138,7 +140,8 @@ struct PathTracer::Impl {
     std::vector<glm::dmat4> worldFromLocal(scene.nodes.size());
     std::vector<bool> known(scene.nodes.size(), false);
     double emitterWeight = 0.0;
-    for (const InputPolygon& in : inputs) {
+    for (size_t i = 0; i < inputs.size(); ++i) {
+      const InputPolygon& in = inputs[i];
       if (!known[size_t(in.node)]) {
         worldFromLocal[size_t(in.node)] = scene.worldTransform(in.node, t);
         known[size_t(in.node)] = true;
@@ -152,11 +155,15 @@ struct PathTracer::Impl {
       for (int k = 0; k < world.count; ++k)
         for (int d = 0; d < 3; ++d) sceneSize = std::max(sceneSize, std::abs(world.v[k][d]));
       int emitter = -1;
-      if (m.isEmitter()) {
-        Emitter e{world, n, m.emission, world.area(), 0.0};
-        emitterWeight += e.area * (e.radiance.x + e.radiance.y + e.radiance.z);
-        emitter = int(emitters.size());
-        emitters.push_back(e);
+      if (const int light = lights->indexOfTop(int(i)); light >= 0) {
+        // Placed from the same node transform as `world` above: the same polygon, bit for bit.
+        Emitter e{(*lights)[size_t(light)].at(t), 0.0, 0.0};
+        if (e.placed) {
+          e.area = e.placed->area();
+          emitterWeight += e.placed->samplingWeight();
+          emitter = int(emitters.size());
+          emitters.push_back(std::move(e));
+        }
       }
       if (in.backFace) {
         // Scene::inputPolygons puts the reversed copy right after its front polygon, which
@@ -188,7 +195,7 @@ struct PathTracer::Impl {
     emitterCdf.clear();
     double sum = 0.0;
     for (Emitter& e : emitters) {
-      e.probability = e.area * (e.radiance.x + e.radiance.y + e.radiance.z) / emitterWeight;
+      e.probability = e.placed->samplingWeight() / emitterWeight;
       sum += e.probability;
       emitterCdf.push_back(sum);
     }
@@ -354,13 +361,14 @@ struct PathTracer::Impl {
     const Emitter& em = emitters[std::min(e, emitters.size() - 1)];
     if (!(em.probability > 0.0)) return glm::dvec3(0.0);
     const glm::dvec3 origin = liftOff(x, geometric);
-    const glm::dvec3 y = pointOnPolygon(em.world, u1, u2);
+    const EmitterSample sample = em.placed->sample(glm::dvec2(u1, u2));
+    const glm::dvec3& y = sample.point;
     const glm::dvec3 d = y - origin;
     const double dist2 = glm::dot(d, d);
     if (!(dist2 > 0.0)) return glm::dvec3(0.0);
     const double dist = std::sqrt(dist2);
     const glm::dvec3 w = d / dist;
-    const double cosX = glm::dot(n, w), cosY = -glm::dot(em.normal, w);
+    const double cosX = glm::dot(n, w), cosY = -glm::dot(sample.normal, w);
     if (cosX <= 0.0 || cosY <= 0.0) return glm::dvec3(0.0);     // one-sided emitter / receiver
     if (glm::dot(geometric, w) <= 0.0) return glm::dvec3(0.0);  // below the surface itself
     if (occluded(origin, w, dist * (1.0 - kShadowShortening), surface)) return glm::dvec3(0.0);
@@ -369,7 +377,7 @@ struct PathTracer::Impl {
     const double pdfLight = em.probability / em.area * dist2 / cosY;
     const double pdfBsdf = cosX / kPi;
     const double weight = pdfLight * pdfLight / (pdfLight * pdfLight + pdfBsdf * pdfBsdf);
-    return em.radiance * (cosX / pdfLight * weight);
+    return em.placed->emittedRadiance(y, -w) * (cosX / pdfLight * weight);
   }
 
   // Solid-angle density with which directLight() picks the point at distance `dist` on
@@ -422,7 +430,8 @@ struct PathTracer::Impl {
         // Found by the continuation: MIS weight against next-event estimation.
         const double pdfLight = lightPdf(emitter, t, -glm::dot(dir, n));
         const double weight = pdfBsdf * pdfBsdf / (pdfBsdf * pdfBsdf + pdfLight * pdfLight);
-        L += throughput * emitters[size_t(emitter)].radiance * weight;
+        L += throughput *
+             emitters[size_t(emitter)].placed->emittedRadiance(origin + t * dir, -dir) * weight;
       }
       if (bounce >= o.maxDepth) break;
       const glm::dvec3 rho = reflectanceAt(s, h);
@@ -459,6 +468,7 @@ PathTracer::PathTracer(const Scene& scene, double t) : impl_(new Impl), scene_(s
     throw Error(ExitCode::kEnvironment, "embree", "rtcNewDevice failed (unsupported CPU?)");
   rtcSetDeviceErrorFunction(impl_->device, &Impl::onError, impl_.get());
   impl_->inputs = scene.inputPolygons();
+  impl_->lights = std::make_unique<SceneEmitters>(scene, impl_->inputs);
   setTime(t);
 }
 
