@@ -17,6 +17,11 @@ if [[ $frames == *-* ]]; then
   if [[ $last == *x* ]]; then step=${last#*x} last=${last%x*}; fi
 fi
 
+# The frames are listed and read under a shared lock on them (animation.mk: another run into the
+# same OUT empties frames/ only under the exclusive one).
+exec 9>"$(dirname -- "$dir")/.frames.lock"
+flock -s 9
+
 names=()
 for ((f = first; f <= last; f += step)); do
   name=$(printf '%s/%04d.png' "$dir" "$f")
@@ -26,11 +31,6 @@ for ((f = first; f <= last; f += step)); do
   fi
   names+=("$name")
 done
-
-# Read under a shared lock on the frames (animation.mk: another run into the same OUT empties
-# frames/ only under the exclusive one).
-exec 9>"$(dirname -- "$dir")/.frames.lock"
-flock -s 9
 
 tmp="$output.tmp.$$"
 ffmpeg_pid=
