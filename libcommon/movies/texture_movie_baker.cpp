@@ -705,12 +705,6 @@ const char* goodLayerName(GoodLayer g) {
   return g == GoodLayer::kGather ? "gather" : "gouraud";
 }
 
-GoodLayer parseGoodLayer(const std::string& name) {
-  if (name == "gather") return GoodLayer::kGather;
-  if (name == "gouraud") return GoodLayer::kGouraud;
-  throw Error(ExitCode::kUsage, "--good-layer", "'" + name + "': expected gather or gouraud");
-}
-
 // TextureMovieBakerOptions::toJson is movies_options.cpp's (its parameter table).
 
 Polygon nodePolygonIn(const Polygon& top, PatchId node) {

@@ -60,7 +60,6 @@ namespace rad {
 // irradiance, or the per-texel gather over its good links (good_link_gather.h).
 enum class GoodLayer { kGouraud, kGather };
 const char* goodLayerName(GoodLayer g);
-GoodLayer parseGoodLayer(const std::string& name);  // throws a usage Error
 
 // rad-movies binds its flags to these fields; toJson() is the provenance parameters, keyed by
 // the flag names. The figures behind the defaults: docs/results.md, "Figures moved out of the

@@ -313,13 +313,6 @@ const char* mergeModeName(MergeMode m) {
   return "?";
 }
 
-MergeMode parseMergeMode(const std::string& name) {
-  for (MergeMode m : {MergeMode::kExact, MergeMode::kMax, MergeMode::kSum, MergeMode::kIndependent})
-    if (name == mergeModeName(m)) return m;
-  throw Error(ExitCode::kUsage, "",
-              "merge mode '" + name + "'; expected exact, max, sum or independent");
-}
-
 double mergeTransmittance(MergeMode mode, double ts, double td) {
   double a = 1.0 - ts, b = 1.0 - td;  // occlusions
   double o = 0.0;

@@ -94,9 +94,7 @@ glm::dvec3 shapedTransmittance(const glm::dvec3& x, const glm::dvec3& n,
 // Figure 7): occlusions a = 1 - Ts and b = 1 - Td merge to max(a, b) (blockers overlap),
 // min(1, a + b) (disjoint) or 1 - (1 - a)(1 - b) (independent). kExact ORs the sample masks.
 enum class MergeMode { kExact, kMax, kSum, kIndependent };
-const char* mergeModeName(MergeMode m);
-// Throws a usage Error for an unknown name.
-MergeMode parseMergeMode(const std::string& name);
+const char* mergeModeName(MergeMode m);  // parsing: mergeModeNames() (movies_options.h)
 double mergeTransmittance(MergeMode mode, double staticT, double dynamicT);
 
 // The 4x4 clip-from-world transform of one sample (before the origin shift): a point y maps to

@@ -19,7 +19,6 @@ enum class RefinementOracle {
   kBoth,   // either one over eps
 };
 // "power", "error", "both"; anything else is a usage Error naming the value.
-RefinementOracle parseRefinementOracle(const std::string& name);
 const char* refinementOracleName(RefinementOracle oracle);
 
 // The largest RadiosityOptions::maxLinks (rad-global --max-links): a key solve indexes its

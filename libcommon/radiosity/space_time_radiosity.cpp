@@ -71,15 +71,6 @@ std::vector<float> pushedDownClosure(const KeySolution& s, const PatchHierarchy&
 
 }  // namespace
 
-BadLinkRule parseBadLinkRule(const std::string& s) {
-  if (s == "lights") return BadLinkRule::kLights;
-  if (s == "partial") return BadLinkRule::kPartial;
-  if (s == "all") return BadLinkRule::kAll;
-  if (s == "none") return BadLinkRule::kNone;
-  throw Error(ExitCode::kUsage, "",
-              "bad link rule '" + s + "'; expected lights, partial, all or none");
-}
-
 const char* badLinkRuleName(BadLinkRule r) {
   switch (r) {
     case BadLinkRule::kLights:

@@ -31,7 +31,6 @@
 namespace rad {
 
 enum class BadLinkRule { kLights, kPartial, kAll, kNone };
-BadLinkRule parseBadLinkRule(const std::string& s);  // lights|partial|all|none; usage Error
 const char* badLinkRuleName(BadLinkRule r);
 
 struct SpaceTimeOptions {
