@@ -53,14 +53,12 @@ KNOBS = [
     ("near-shooter-levels", "movies", "--near-shooter-levels", ["1", "2"]),
     ("gather-partial-share", "movies", "--gather-partial-share", ["0.001", "0.004"]),
 ]
-# Combined settings, each one more row of the sweep (knob "preset"): what the README recommends
-# for drafts and for final frames, so that the front shows where they stand among the knobs.
+# Combined settings, each one more row of the sweep (knob "preset"): the tools' own quality
+# presets (`--preset`, defined once in each stage's parameter table), given to the stages that
+# have quality knobs, as the Makefiles' QUALITY does.
 PRESETS = [
-    ("draft", {"global": ["--eps", "0.02"]}),
-    ("final", {"global": ["--eps", "1e-5", "--key-step", "4", "--rays", "64"],
-               "movies": ["--min-samples", "64", "--movie-key-step", "2",
-                          "--near-shooter-levels", "2", "--gather-partial-share", "0.001",
-                          "--weak-share", "0"]}),
+    ("draft", {"global": ["--preset", "draft"], "movies": ["--preset", "draft"]}),
+    ("final", {"global": ["--preset", "final"], "movies": ["--preset", "final"]}),
 ]
 TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
          "compose": "rad-compose"}
