@@ -17,18 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class SceneInputSafety : public ::testing::Test {
+class SceneInputSafety : public TexturedTriangleFolder {
  protected:
-  void SetUp() override {
-    dir = fs::temp_directory_path() /
-          ("rad_scene_safety_" + std::to_string(::getpid()) + "_" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    writeFile(at("tri.bin"), texturedTriangleBin());
-  }
-  void TearDown() override { fs::remove_all(dir); }
-  std::string at(const std::string& name) const { return (dir / name).string(); }
+  SceneInputSafety() : TexturedTriangleFolder("rad_scene_safety_") {}
   // Runs and checks it ends within `seconds` (a FIFO read must not wait for a writer).
   CommandResult runFast(const std::string& command, double seconds = 20.0) {
     const auto start = std::chrono::steady_clock::now();
@@ -38,7 +29,6 @@ class SceneInputSafety : public ::testing::Test {
         << command;
     return r;
   }
-  fs::path dir;
 };
 
 int countOf(const std::string& text, const std::string& part) {

@@ -22,18 +22,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class GltfFileAccess : public ::testing::Test {
+class GltfFileAccess : public TexturedTriangleFolder {
  protected:
-  void SetUp() override {
-    dir = fs::temp_directory_path() /
-          ("rad_gltf_access_" + std::to_string(::getpid()) + "_" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    writeFile(at("tri.bin"), texturedTriangleBin());
-  }
-  void TearDown() override { fs::remove_all(dir); }
-  std::string at(const std::string& name) const { return (dir / name).string(); }
+  GltfFileAccess() : TexturedTriangleFolder("rad_gltf_access_") {}
   std::string scene(const std::string& imageUri, double yfov = 0.8) {
     writeFile(at("scene.gltf"), texturedTriangleGltf(imageUri, yfov));
     return at("scene.gltf");
@@ -73,7 +64,6 @@ class GltfFileAccess : public ::testing::Test {
     }
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
   }
-  fs::path dir;
 };
 
 TEST_F(GltfFileAccess, ReadableTextureIsUsed) {

@@ -7,10 +7,14 @@
 
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
+#include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
 
 #include "libcommon/core/error.h"
@@ -122,5 +126,26 @@ inline std::string zeroPng(uint32_t w, uint32_t h) {
   appendPngChunk(png, "IEND", "");
   return png;
 }
+
+// A fresh folder a test, named after the fixture's `prefix` and the test, holding the textured
+// triangle's buffer (tri.bin); removed afterwards.
+class TexturedTriangleFolder : public ::testing::Test {
+ protected:
+  explicit TexturedTriangleFolder(std::string prefix) : prefix_(std::move(prefix)) {}
+  void SetUp() override {
+    dir = std::filesystem::temp_directory_path() /
+          (prefix_ + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    writeFile(at("tri.bin"), texturedTriangleBin());
+  }
+  void TearDown() override { std::filesystem::remove_all(dir); }
+  std::string at(const std::string& name) const { return (dir / name).string(); }
+  std::filesystem::path dir;
+
+ private:
+  std::string prefix_;
+};
 
 }  // namespace rad::test
