@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """docs/design.md §10's figure split into pixels at geometric edges and the rest (issue 56).
 
-usage: edge_split.py TEST REF [--ref2 REF2] --items ITEMS [--json]
+usage: edge_split.py TEST REF [--ref2 REF2] --items ITEMS [--emitter-margin PX] [--json]
 
 TEST, REF, REF2: EXR frames (rad-compose, rad-reference, cycles_reference.py); ITEMS: the
 frame's item buffer (rad-intervals --item-buffers DIR), whose Z channel places the edges. Its
@@ -12,8 +12,12 @@ unless a plane changes there (a crease: wall against wall, box on floor) or the 
 silhouette: one surface in front of another); such a pixel, and a surface pixel beside the
 background, is an edge pixel. Edges come two pixels wide, one on each side.
 
-Per class, over pixels that are not emitters (reference luminance above 10 x the median of the
-lit pixels, rad-diff's rule): RMSE / mean and bias, channels pooled, each class normalised by
+Per class, over pixels that are not emitters (luminance above 10 x the median of the lit
+reference pixels, rad-diff's rule, in the reference or in the test: Cycles' pixel-centre filter
+spreads its samples 0.01 px, so now and then a pixel whose centre lies that close to a lamp's
+outline takes part of the lamp, a few hundred times the wall's radiance, which alone would be
+the whole figure; --emitter-margin 1 leaves out the pixels beside an emitter too, where that
+happens): RMSE / mean and bias, channels pooled, each class normalised by
 its own reference mean; with --ref2 the references' noise is removed as rad-diff does. The
 classes: all (every pixel, background included: rad-diff's figure), interior (surface pixels
 away from edges), edge, and the edge pixels split into silhouette and crease. A stand-in until
@@ -82,18 +86,26 @@ def classify(items):
     return out
 
 
-def figures(test, ref, ref2, cls):
-    lum = [0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
-           for row in (ref2 and [[tuple((a + b) / 2 for a, b in zip(p, q)) for p, q in zip(r, s)]
-                                 for r, s in zip(ref, ref2)] or ref) for p in row]
+def figures(test, ref, ref2, cls, margin):
+    def luminance(image):
+        return [0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] for row in image for p in row]
+
+    lum = luminance(ref2 and [[tuple((a + b) / 2 for a, b in zip(p, q)) for p, q in zip(r, s)]
+                              for r, s in zip(ref, ref2)] or ref)
     lit = sorted(v for v in lum if v > 0)
     limit = 10.0 * lit[len(lit) // 2] if lit else float("inf")
+    lum = [max(a, b) for a, b in zip(lum, luminance(test))]
+    w, h = len(ref[0]), len(ref)
+    emitter = [v > limit for v in lum]
+    for _ in range(margin):
+        emitter = [any(emitter[(y + dy) * w + x + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1)
+                       if 0 <= y + dy < h and 0 <= x + dx < w)
+                   for y in range(h) for x in range(w)]
     acc = {k: [0, 0.0, 0.0, 0.0, 0.0, 0.0]
            for k in ("all", "interior", "edge", "silhouette", "crease")}
-    w = len(ref[0])
     for y, row in enumerate(cls):
         for x, c in enumerate(row):
-            if lum[y * w + x] > limit:
+            if emitter[y * w + x]:
                 continue
             t, r = test[y][x], ref[y][x]
             r2 = ref2[y][x] if ref2 else r
@@ -126,12 +138,14 @@ def main():
     p.add_argument("ref")
     p.add_argument("--ref2")
     p.add_argument("--items", required=True)
+    p.add_argument("--emitter-margin", type=int, default=0,
+                   help="also leave out pixels within PX of an emitter pixel")
     p.add_argument("--json", action="store_true")
     a = p.parse_args()
     test = read_exr(a.test, "R,G,B")[2]
     ref = read_exr(a.ref, "R,G,B")[2]
     ref2 = read_exr(a.ref2, "R,G,B")[2] if a.ref2 else None
-    res = figures(test, ref, ref2, classify(a.items))
+    res = figures(test, ref, ref2, classify(a.items), a.emitter_margin)
     if a.json:
         json.dump(res, sys.stdout, indent=1)
         print()
