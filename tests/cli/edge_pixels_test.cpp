@@ -1,14 +1,15 @@
 // Pixels at a polygon's border through the real tools (issue 56, "correct edge pixels"): a
-// floor lit by a small lamp that hangs just beyond one of its edges, so the irradiance is
-// steepest at that border, and nothing else reflects (the lamp's reflectance is 0), so every
+// floor lit by a lamp strip that hangs just above and beyond one of its edges, so the irradiance
+// is steepest at that border, and nothing else reflects (the lamp's reflectance is 0), so every
 // floor point's radiance is known in closed form:
 //   $L(x) = \frac{\rho}{\pi} \pi L_e F(dA_x \to \text{lamp})$
 // with the exact point-to-polygon form factor. The four stages run at the defaults and each
 // floor pixel is compared with L at the point its centre's ray meets (the sampling of
 // rad-compose and rad-reference --pixel-centres). rad-movies bakes texels at their centres
 // ((i+.5)/w); the outer half texel at the border lies beyond every texel centre, so the lookup
-// there extrapolates from the last two texels. Held flat (clamp-to-edge), the border pixels by
-// the lamp were several times further off than the pixels inside.
+// there extrapolates from the last two texels. The camera is turned 7 degrees about its axis so
+// that along the edge the pixel centres fall at every distance from it. Held flat
+// (clamp-to-edge), the border pixels were several times further off than the pixels inside.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -70,8 +71,9 @@ std::string base64Buffer() {
   return base64(bin);
 }
 
-// Floor [-0.5, 0.5]^2 at y = 0 facing up; a 0.1 m lamp 8 cm above it, facing down, centred
-// 5 cm beyond the floor's +x edge; a camera 1.2 m above the floor's centre looking down.
+// Floor [-0.5, 0.5]^2 at y = 0 facing up; a lamp strip 4 cm x 90 cm, 5 cm above it, facing
+// down, from the floor's +x edge outwards; a camera 1.2 m above the floor's centre looking down,
+// turned 7 degrees about the vertical.
 std::string writeScene(const fs::path& dir) {
   const std::string gltf = R"({
   "asset": {"version": "2.0"},
