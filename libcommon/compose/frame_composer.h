@@ -25,9 +25,10 @@
 
 #include <glm/glm.hpp>
 
-#include "libcommon/scene/camera_projection.h"
-#include "libcommon/radiosity/global_solution.h"
 #include "libcommon/gl/item_buffer.h"
+#include "libcommon/radiosity/global_solution.h"
+#include "libcommon/scene/camera_projection.h"
+#include "libcommon/scene/sample_grid.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {
@@ -66,7 +67,12 @@ class FrameComposer {
   // are scene.inputPolygons() (readLinkHierarchy checks it). cameraNode: Scene::cameraNode().
   // Throws rad::Error(kEnvironment) when no GL context can be made, kBadInput on a camera node
   // that is not one or a top count that differs.
-  FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size, int cameraNode);
+  // `sampling`: the pixel filter and sample grid (footprint_filter.h); the default is one sample
+  // through each pixel centre, unfiltered. everySample: shade every sample of every pixel's
+  // footprint (no shortcut on uniform footprints).
+  FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size, int cameraNode,
+                const PixelSampling& sampling = PixelSampling::pixelCentres(),
+                bool everySample = false);
   ~FrameComposer();
   FrameComposer(const FrameComposer&) = delete;
   FrameComposer& operator=(const FrameComposer&) = delete;
