@@ -436,13 +436,13 @@ TEST(PathTracer, PixelCentresPointSampleEdges) {
       }
   };
   int lit, dark, between;
-  o.pixelCentres = true;
+  o.filter = PixelFilter::pixelCentre();
   count(tracer.render(view, {24, 16}, o), lit, dark, between);
   EXPECT_EQ(between, 0);
   EXPECT_GT(lit, 10);
   EXPECT_GT(dark, 10);
   const int litCentres = lit;
-  o.pixelCentres = false;
+  o.filter = PixelFilter{PixelFilterType::kBox, 1.0};
   count(tracer.render(view, {24, 16}, o), lit, dark, between);
   EXPECT_GT(between, 8) << "edge pixels are averaged";
   EXPECT_LT(lit, litCentres);
