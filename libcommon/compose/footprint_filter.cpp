@@ -33,6 +33,8 @@ FootprintFilter::FootprintFilter(const PixelSampling& sampling, ImageSize image,
   for (int k = -reach_; k <= reach_; ++k)
     sum += taps_[size_t(k + reach_)] = filter.weight(double(k) / s);
   for (double& t : taps_) t /= sum;
+  for (double tl : taps_)
+    for (double tk : taps_) taps2_.push_back(tk * tl);
   const double variance = filter.variance();
   neighbour_ = (everySample || variance > 1.0) ? -1.0 : 0.5 * variance;
   uniformReach_ = reachOf(std::max(filter.radius(), 1.0), s);
@@ -123,23 +125,31 @@ uint8_t FootprintFilter::filterPixel(const float* sampleRgb, const uint8_t* samp
                                      int row, float* rgb) const {
   double sum[3] = {0.0, 0.0, 0.0};
   uint8_t tag = 0;
-  forEachSampleOf(col, row, [&](size_t sample, double weight) {
-    const float* L = sampleRgb + 3 * sample;
-    for (int c = 0; c < 3; ++c) sum[c] += weight * double(L[c]);
-    tag = std::max(tag, sampleTag[sample]);
-  });
+  if (full_[size_t(row) * grid_.image.width + col]) {
+    // forEachSampleOf's full window, unrolled: the taps' products from taps2_, row by row.
+    const size_t gw = size_t(grid_.size().width), n = size_t(2 * reach_ + 1);
+    const size_t first =
+        size_t(grid_.centre(row) - reach_) * gw + size_t(grid_.centre(col) - reach_);
+    const double* w = taps2_.data();
+    for (size_t l = 0; l < n; ++l) {
+      const size_t p = first + l * gw;
+      const float* L = sampleRgb + 3 * p;
+      for (size_t k = 0; k < n; ++k, ++w) {
+        sum[0] += *w * double(L[3 * k]);
+        sum[1] += *w * double(L[3 * k + 1]);
+        sum[2] += *w * double(L[3 * k + 2]);
+        tag = std::max(tag, sampleTag[p + k]);
+      }
+    }
+  } else {
+    forEachSampleOf(col, row, [&](size_t sample, double weight) {
+      const float* L = sampleRgb + 3 * sample;
+      for (int c = 0; c < 3; ++c) sum[c] += weight * double(L[c]);
+      tag = std::max(tag, sampleTag[sample]);
+    });
+  }
   for (int c = 0; c < 3; ++c) rgb[c] = float(std::max(sum[c], 0.0));
   return tag;
-}
-
-bool FootprintFilter::interpolated(int i, int j, uint32_t id,
-                                   const std::vector<uint32_t>& ids) const {
-  if (!interpolate_) return false;
-  const int s = grid_.perAxis, px = i / s, py = j / s;
-  const int pw = grid_.image.width + 2 * grid_.margin;
-  return smoothCentres_[size_t(py) * pw + px] &&
-         ids[size_t(py * s + (s - 1) / 2) * grid_.size().width + size_t(px * s + (s - 1) / 2)] ==
-             id;
 }
 
 void FootprintFilter::interpolate(int i, int j, const float* sampleRgb, float* rgb) const {

@@ -54,10 +54,14 @@ class FootprintFilter {
   // Per pixel: 1 where the pixel took full sampling.
   const std::vector<uint8_t>& fullPixels() const { return full_; }
 
-  // Whether grid sample (i, j), a needed one off its pixel's centre, showing item `id`, is
-  // interpolated from the centres around it (plan() decided; the centres must be shaded).
-  bool interpolated(int i, int j, uint32_t id, const std::vector<uint32_t>& ids) const;
-  // Its value then, from the shaded centres' radiance, into rgb[0..2].
+  // Whether the samples of grid pixel (px, py) (0 <= px < W + 2m: the pixel px - m of the image)
+  // that show the item its centre shows are interpolated from the centres around it, rather
+  // than shaded (plan() decided; the centres must be shaded first).
+  bool smooth(int px, int py) const {
+    return smoothCentres_[size_t(py) * (grid_.image.width + 2 * grid_.margin) + px] != 0;
+  }
+  // The value of grid sample (i, j) of a smooth pixel, from the shaded centres' radiance, into
+  // rgb[0..2].
   void interpolate(int i, int j, const float* sampleRgb, float* rgb) const;
 
   // Pixel (col, row)'s value from the shaded samples' radiance (3 floats a grid sample; only
@@ -72,6 +76,7 @@ class FootprintFilter {
  private:
   SampleGrid grid_;
   std::vector<double> taps_;      // full sampling: f(k/s) for k = -K..K, normalised to sum 1
+  std::vector<double> taps2_;     // taps_[k] taps_[l], row l major
   int reach_ = 0;                 // K
   double neighbour_ = 0.0;        // a of the 3 x 3 kernel; < 0: no shortcut
   int uniformReach_ = 0;          // grid samples max(radius, 1) px from a centre

@@ -419,34 +419,37 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
   // Only the needed samples are written and read: no fill of the whole grid.
   sampleRgb.resize(needed.size() * 3);
   sampleSource.resize(needed.size());
-  // Two passes: the pixel centres and the samples that cannot be interpolated are shaded, then
-  // the others are interpolated from the centres (footprint_filter.h).
+  // Two passes over the grid's pixels: the centres and the samples that cannot be interpolated
+  // are shaded, then the others are interpolated from the centres (footprint_filter.h).
   const int s = grid.perAxis, mid = (s - 1) / 2;
+  const int pw = gw / s, ph = gh / s;
   for (const bool second : {false, true})
-    tbb::parallel_for(tbb::blocked_range<int>(0, gh), [&](const tbb::blocked_range<int>& r) {
-      for (int j = r.begin(); j < r.end(); ++j) {
-        const int jc = j - j % s + mid;  // the row of this sample's pixel centre
-        for (int i0 = 0; i0 < gw; i0 += s)
-          for (int k = 0; k < s; ++k) {
-            const int i = i0 + k;
-            const size_t p = size_t(j) * gw + i;
-            if (!needed[p]) continue;
-            const uint32_t id = items.id[p];
-            const bool centre = k == mid && j == jc;
-            const bool interpolated = !centre && filter->interpolated(i, j, id, items.id);
-            if (interpolated != second) continue;
-            if (interpolated) {
-              filter->interpolate(i, j, sampleRgb.data(), &sampleRgb[3 * p]);
-              sampleSource[p] = sampleSource[size_t(jc) * gw + size_t(i0 + mid)];
-            } else if (id == kNoItem) {
-              std::fill_n(&sampleRgb[3 * p], 3, 0.0f);
-              sampleSource[p] = PixelSource::kBackground;
-            } else {
-              sampleSource[p] = shadeSample(t, movies, visible, active, rays, grid.position(i, j),
-                                            int(id - 1), &sampleRgb[3 * p]);
+    tbb::parallel_for(tbb::blocked_range<int>(0, ph), [&](const tbb::blocked_range<int>& r) {
+      for (int py = r.begin(); py < r.end(); ++py)
+        for (int px = 0; px < pw; ++px) {
+          const size_t centre = size_t(py * s + mid) * gw + size_t(px * s + mid);
+          const bool smooth = filter->smooth(px, py);
+          if (second && !smooth) continue;
+          const uint32_t centreId = items.id[centre];
+          for (int j = py * s; j < (py + 1) * s; ++j)
+            for (int i = px * s; i < (px + 1) * s; ++i) {
+              const size_t p = size_t(j) * gw + i;
+              if (!needed[p]) continue;
+              const uint32_t id = items.id[p];
+              const bool interpolated = smooth && p != centre && id == centreId;
+              if (interpolated != second) continue;
+              if (interpolated) {
+                filter->interpolate(i, j, sampleRgb.data(), &sampleRgb[3 * p]);
+                sampleSource[p] = sampleSource[centre];
+              } else if (id == kNoItem) {
+                std::fill_n(&sampleRgb[3 * p], 3, 0.0f);
+                sampleSource[p] = PixelSource::kBackground;
+              } else {
+                sampleSource[p] = shadeSample(t, movies, visible, active, rays, grid.position(i, j),
+                                              int(id - 1), &sampleRgb[3 * p]);
+              }
             }
-          }
-      }
+        }
     });
   static_assert(sizeof(PixelSource) == 1, "sample sources are read as bytes");
   const auto* tags = reinterpret_cast<const uint8_t*>(sampleSource.data());
