@@ -111,6 +111,7 @@ void FootprintFilter::plan(const std::vector<uint32_t>& ids, const std::vector<s
     for (int row = -grid_.margin; row < h + grid_.margin; ++row)
       for (int col = -grid_.margin; col < w + grid_.margin; ++col)
         needed_[size_t(grid_.centre(row)) * gw + size_t(grid_.centre(col))] = 1;
+  offCentre_.assign(smoothCentres_.size(), 0);
   for (int row = 0; row < h; ++row)
     for (int col = 0; col < w; ++col) {
       if (!full_[size_t(row) * w + col]) continue;
@@ -118,6 +119,10 @@ void FootprintFilter::plan(const std::vector<uint32_t>& ids, const std::vector<s
       for (int j = cy - reach_; j <= cy + reach_; ++j)
         std::fill_n(needed_.begin() + ptrdiff_t(size_t(j) * gw + size_t(cx - reach_)),
                     2 * reach_ + 1, uint8_t(1));
+      // The grid pixels the window touches (it may hold only their centres: marked anyway).
+      for (int py = (cy - reach_) / s; py <= (cy + reach_) / s; ++py)
+        std::fill_n(offCentre_.begin() + ptrdiff_t(size_t(py) * pw + size_t((cx - reach_) / s)),
+                    (cx + reach_) / s - (cx - reach_) / s + 1, uint8_t(1));
     }
 }
 
@@ -142,11 +147,20 @@ uint8_t FootprintFilter::filterPixel(const float* sampleRgb, const uint8_t* samp
       }
     }
   } else {
-    forEachSampleOf(col, row, [&](size_t sample, double weight) {
-      const float* L = sampleRgb + 3 * sample;
-      for (int c = 0; c < 3; ++c) sum[c] += weight * double(L[c]);
-      tag = std::max(tag, sampleTag[sample]);
-    });
+    // The 3 x 3 centres, unrolled (forEachSampleOf's shortcut).
+    const size_t gw = size_t(grid_.size().width), s = size_t(grid_.perAxis);
+    const size_t centre = size_t(grid_.centre(row)) * gw + size_t(grid_.centre(col));
+    const double w[3] = {neighbour_, 1.0 - 2.0 * neighbour_, neighbour_};
+    for (int dy = 0; dy < 3; ++dy)
+      for (int dx = 0; dx < 3; ++dx) {
+        const size_t p = centre + (size_t(dy) * gw + size_t(dx)) * s - (gw + 1) * s;
+        const double weight = w[dx] * w[dy];
+        const float* L = sampleRgb + 3 * p;
+        sum[0] += weight * double(L[0]);
+        sum[1] += weight * double(L[1]);
+        sum[2] += weight * double(L[2]);
+        tag = std::max(tag, sampleTag[p]);
+      }
   }
   for (int c = 0; c < 3; ++c) rgb[c] = float(std::max(sum[c], 0.0));
   return tag;

@@ -60,6 +60,11 @@ class FootprintFilter {
   bool smooth(int px, int py) const {
     return smoothCentres_[size_t(py) * (grid_.image.width + 2 * grid_.margin) + px] != 0;
   }
+  // Whether grid pixel (px, py) has a needed sample off its centre (a fully sampled pixel's
+  // window holds it); else its centre is the only sample of it that may be needed.
+  bool offCentreNeeded(int px, int py) const {
+    return offCentre_[size_t(py) * (grid_.image.width + 2 * grid_.margin) + px] != 0;
+  }
   // The value of grid sample (i, j) of a smooth pixel, from the shaded centres' radiance, into
   // rgb[0..2].
   void interpolate(int i, int j, const float* sampleRgb, float* rgb) const;
@@ -83,7 +88,9 @@ class FootprintFilter {
   bool interpolate_ = true;       // !everySample
   std::vector<double> lagrange_;  // per sub-pixel offset k: 3 weights (centres -1, 0, +1)
   std::vector<uint8_t> needed_, full_;
-  std::vector<uint8_t> smoothCentres_;  // per grid pixel: its 3 x 3 centres on one untextured item
+  std::vector<uint8_t> smoothCentres_;
+  std::vector<uint8_t> offCentre_;  // per grid pixel: offCentreNeeded()  // per grid pixel: its 3 x
+                                    // 3 centres on one untextured item
 };
 
 template <class F>

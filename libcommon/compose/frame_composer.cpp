@@ -419,6 +419,17 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
   // Only the needed samples are written and read: no fill of the whole grid.
   sampleRgb.resize(needed.size() * 3);
   sampleSource.resize(needed.size());
+  // A sample shaded, or the background's 0.
+  auto shade = [&](int i, int j, size_t p) {
+    const uint32_t id = items.id[p];
+    if (id == kNoItem) {
+      std::fill_n(&sampleRgb[3 * p], 3, 0.0f);
+      sampleSource[p] = PixelSource::kBackground;
+    } else {
+      sampleSource[p] = shadeSample(t, movies, visible, active, rays, grid.position(i, j),
+                                    int(id - 1), &sampleRgb[3 * p]);
+    }
+  };
   // Two passes over the grid's pixels: the centres and the samples that cannot be interpolated
   // are shaded, then the others are interpolated from the centres (footprint_filter.h).
   const int s = grid.perAxis, mid = (s - 1) / 2;
@@ -427,26 +438,25 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
     tbb::parallel_for(tbb::blocked_range<int>(0, ph), [&](const tbb::blocked_range<int>& r) {
       for (int py = r.begin(); py < r.end(); ++py)
         for (int px = 0; px < pw; ++px) {
-          const size_t centre = size_t(py * s + mid) * gw + size_t(px * s + mid);
+          const int ci = px * s + mid, cj = py * s + mid;
+          const size_t centre = size_t(cj) * gw + size_t(ci);
+          if (!filter->offCentreNeeded(px, py)) {  // the centre alone
+            if (!second && needed[centre]) shade(ci, cj, centre);
+            continue;
+          }
           const bool smooth = filter->smooth(px, py);
           if (second && !smooth) continue;
-          const uint32_t centreId = items.id[centre];
           for (int j = py * s; j < (py + 1) * s; ++j)
             for (int i = px * s; i < (px + 1) * s; ++i) {
               const size_t p = size_t(j) * gw + i;
               if (!needed[p]) continue;
-              const uint32_t id = items.id[p];
-              const bool interpolated = smooth && p != centre && id == centreId;
+              const bool interpolated = smooth && p != centre && items.id[p] == items.id[centre];
               if (interpolated != second) continue;
               if (interpolated) {
                 filter->interpolate(i, j, sampleRgb.data(), &sampleRgb[3 * p]);
                 sampleSource[p] = sampleSource[centre];
-              } else if (id == kNoItem) {
-                std::fill_n(&sampleRgb[3 * p], 3, 0.0f);
-                sampleSource[p] = PixelSource::kBackground;
               } else {
-                sampleSource[p] = shadeSample(t, movies, visible, active, rays, grid.position(i, j),
-                                              int(id - 1), &sampleRgb[3 * p]);
+                shade(i, j, p);
               }
             }
         }

@@ -237,6 +237,11 @@ void ItemBufferRenderer::render(const CameraView& view,
 
   m.context.makeCurrent();
   glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
+  // Without readDepth the depth target is not drawn at all (the depth buffer still decides
+  // occlusion): half the colour writes.
+  const GLenum drawBuffers[2] = {
+      GL_COLOR_ATTACHMENT0, m.options.readDepth ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
+  glDrawBuffers(2, drawBuffers);
   glViewport(0, 0, size.width, size.height);
   configureReversedZ();
   glEnable(GL_DEPTH_TEST);
@@ -258,7 +263,7 @@ void ItemBufferRenderer::render(const CameraView& view,
   const GLfloat farDepth[4] = {std::numeric_limits<float>::infinity(), 0, 0, 0};
   const GLfloat clearDepth = 0.0f;  // reversed Z: 0 is infinitely far
   glClearBufferuiv(GL_COLOR, 0, noItem);
-  glClearBufferfv(GL_COLOR, 1, farDepth);
+  if (m.options.readDepth) glClearBufferfv(GL_COLOR, 1, farDepth);
   glClearBufferfv(GL_DEPTH, 0, &clearDepth);
 
   glUseProgram(m.program);
