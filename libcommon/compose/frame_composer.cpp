@@ -218,6 +218,7 @@ struct FrameComposer::Impl {
   ItemBufferRenderer renderer;
   ItemBuffer items;                           // of the sample grid
   std::unique_ptr<SceneVisibility> rayScene;  // refineSilhouettes' rays, made on first use
+  std::vector<uint8_t> edgeMask;              // refineSilhouettes': samples with another neighbour
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
 
@@ -313,15 +314,21 @@ CameraView FrameComposer::Impl::renderItems(double t) {
 // pixel whose ray meets nothing, or a back face, keeps its item.
 std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
   const int w = items.width, h = items.height;  // the sample grid's (sample_grid.h)
+  // Each pair of neighbours compared once (right, below), both marked when they differ; then
+  // the marked samples in row-major order.
+  edgeMask.assign(items.id.size(), 0);
+  const uint32_t* id = items.id.data();
+  for (int row = 0; row < h; ++row) {
+    const size_t r = size_t(row) * w;
+    for (int col = 0; col + 1 < w; ++col)
+      if (id[r + col] != id[r + col + 1]) edgeMask[r + col] = edgeMask[r + col + 1] = 1;
+    if (row + 1 < h)
+      for (int col = 0; col < w; ++col)
+        if (id[r + col] != id[r + w + col]) edgeMask[r + col] = edgeMask[r + w + col] = 1;
+  }
   std::vector<size_t> edge;
-  for (int row = 0; row < h; ++row)
-    for (int col = 0; col < w; ++col) {
-      const size_t p = size_t(row) * w + col;
-      const uint32_t id = items.id[p];
-      if ((col > 0 && items.id[p - 1] != id) || (col + 1 < w && items.id[p + 1] != id) ||
-          (row > 0 && items.id[p - w] != id) || (row + 1 < h && items.id[p + w] != id))
-        edge.push_back(p);
-    }
+  for (size_t p = 0; p < edgeMask.size(); ++p)
+    if (edgeMask[p]) edge.push_back(p);
   if (edge.empty()) return edge;
   if (!rayScene) {
     const std::vector<double>& k = solution.keyTimes;
