@@ -312,13 +312,14 @@ ItemBuffer pixelCentreSamples(const ItemBuffer& samples, const SampleGrid& grid)
   out.width = grid.image.width;
   out.height = grid.image.height;
   out.id.resize(size_t(grid.image.pixelCount()));
-  out.depth.resize(out.id.size());
+  const bool depth = !samples.depth.empty();  // readDepth
+  out.depth.resize(depth ? out.id.size() : 0);
   for (int row = 0; row < out.height; ++row)
     for (int col = 0; col < out.width; ++col) {
       const size_t p = size_t(row) * out.width + col;
       const size_t q = size_t(grid.centre(row)) * g.width + size_t(grid.centre(col));
       out.id[p] = samples.id[q];
-      out.depth[p] = samples.depth[q];
+      if (depth) out.depth[p] = samples.depth[q];
     }
   return out;
 }

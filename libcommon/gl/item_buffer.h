@@ -33,7 +33,7 @@ struct ItemBuffer {
   // Row-major, row 0 = top of the image (camera_projection.h's pixel convention).
   std::vector<uint32_t> id;  // kNoItem where nothing is visible
   // Eye-space depth (distance from the eye plane along the view axis, metres) of the visible
-  // surface; +inf where id is kNoItem.
+  // surface; +inf where id is kNoItem. Empty when rendered without ItemBufferOptions::readDepth.
   std::vector<float> depth;
 
   uint32_t idAt(int col, int row) const { return id[size_t(row) * width + col]; }
@@ -103,6 +103,7 @@ class ItemBufferRenderer {
 // The samples at the pixel centres of `samples`, a buffer of `grid` (grid.size()): an item
 // buffer of grid.image, pixel (col, row) = sample (grid.centre(col), grid.centre(row)), which
 // lies exactly at the pixel's centre (sample_grid.h). The pixel centres' grid gives a copy.
+// Depth is copied where `samples` has it (ItemBufferOptions::readDepth).
 ItemBuffer pixelCentreSamples(const ItemBuffer& samples, const SampleGrid& grid);
 
 // A world-space triangle for the one-shot helper below.

@@ -125,6 +125,11 @@ struct TextureIntervalsBuilder::Impl {
   // The samples the item buffers hold, and how many make a pixel (s^2): counts of visible
   // samples are compared with pixel areas times this.
   SampleGrid grid() const { return options.sampling.grid(options.imageSize); }
+  ItemBufferOptions itemBufferOptions() const {
+    ItemBufferOptions o;
+    o.readDepth = options.itemBufferDepth;
+    return o;
+  }
   double samplesPerPixel() const {
     const int s = grid().perAxis;
     return double(s) * double(s);
@@ -168,7 +173,7 @@ struct TextureIntervalsBuilder::Impl {
     for (int i = 0; i < hierarchy.size(); ++i) nodeObject[i] = objectOf.at(hierarchy.topOf(i).node);
     // The GL context is made here, so that a machine without one fails before any frame; the
     // geometry goes to it with the first addFrame (addFrames' renderers have their own).
-    renderer = std::make_unique<ItemBufferRenderer>(grid());
+    renderer = std::make_unique<ItemBufferRenderer>(grid(), itemBufferOptions());
     visible.assign(hierarchy.size(), 0);
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
@@ -436,9 +441,12 @@ class ItemBufferPipeline {
     std::exception_ptr error;
   };
 
-  ItemBufferPipeline(size_t workers, SampleGrid size, const std::vector<ItemObject>& objects,
-                     std::vector<int> frames, View view)
-      : frames_(std::move(frames)), view_(std::move(view)), slots_(workers) {
+  ItemBufferPipeline(size_t workers, SampleGrid size, ItemBufferOptions itemOptions,
+                     const std::vector<ItemObject>& objects, std::vector<int> frames, View view)
+      : itemOptions_(itemOptions),
+        frames_(std::move(frames)),
+        view_(std::move(view)),
+        slots_(workers) {
     try {
       for (size_t k = 0; k < workers; ++k)
         threads_.emplace_back([this, k, size, &objects] { work(k, size, objects); });
@@ -486,7 +494,7 @@ class ItemBufferPipeline {
     std::unique_ptr<ItemBufferRenderer> renderer;
     std::exception_ptr error;
     try {
-      renderer = std::make_unique<ItemBufferRenderer>(size);
+      renderer = std::make_unique<ItemBufferRenderer>(size, itemOptions_);
       renderer->setGeometry(objects);
     } catch (...) {
       error = std::current_exception();
@@ -520,6 +528,7 @@ class ItemBufferPipeline {
     }
   }
 
+  const ItemBufferOptions itemOptions_;
   const std::vector<int> frames_;
   const View view_;
   std::vector<Slot> slots_;
@@ -543,8 +552,8 @@ void TextureIntervalsBuilder::addFrames(const std::vector<int>& frames, size_t r
     }
     return;
   }
-  ItemBufferPipeline pipeline(std::min(renderers, frames.size()), b.grid(), b.itemObjects(), frames,
-                              [&b](int f) { return b.frameView(f); });
+  ItemBufferPipeline pipeline(std::min(renderers, frames.size()), b.grid(), b.itemBufferOptions(),
+                              b.itemObjects(), frames, [&b](int f) { return b.frameView(f); });
   for (size_t i = 0; i < frames.size(); ++i) {
     const ItemBufferPipeline::Slot& s = pipeline.take(i);
     b.addRendered(s.view, s.buffer, s.seconds, observer);

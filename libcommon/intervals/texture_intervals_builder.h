@@ -98,6 +98,9 @@ struct TextureIntervalsOptions {
   // grid's, visible counts are in samples, and every rule above that counts pixels takes
   // samples / s^2; projected areas, and so texel density, stay in pixels.
   PixelSampling sampling = PixelSampling::pixelCentres();
+  // Not a parameter: whether IntervalFrame::itemBuffer carries depth (the caller writes the
+  // buffers); without it the depth target is neither drawn nor read back.
+  bool itemBufferDepth = true;
 
   // Throws rad::Error(kUsage) naming the flag of the first invalid value.
   void validate() const;

@@ -46,7 +46,9 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
 
   IntervalSequence run;
   const auto start = std::chrono::steady_clock::now();
-  TextureIntervalsBuilder builder(scene, cameraNode, options);
+  TextureIntervalsOptions built = options;
+  built.itemBufferDepth = !itemBuffersDir.empty();  // depth only for the files
+  TextureIntervalsBuilder builder(scene, cameraNode, built);
   const SampleGrid grid = options.sampling.grid(options.imageSize);
   run.setupSeconds = secondsSince(start);
   // Item buffers drawn by one GL context a thread (TextureIntervalsBuilder::addFrames).
