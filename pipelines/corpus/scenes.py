@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The corpus of public scenes: RenderPark's MGF test scenes, fetched and converted at benchmark time.
 
-  scenes.py fetch-and-convert OUTDIR [SCENE...] [--repo PATH]
+  scenes.py fetch-and-convert OUTDIR [SCENE...] [--repo PATH] [--keep REGEX]
   scenes.py list
 
 The scenes come from the public repository OscarChavarro/rpkCpp (a C++ port of RenderPark),
@@ -12,7 +12,8 @@ from the table SCENES in this script. OUTDIR/NAME/NAME.gltf (+ .bin) per scene a
 emitters, bounds, what the converter dropped) are written.
 
 --repo: the repository as a bare git directory (what `git clone --bare` or a mirror gives; the
-pinned commit is read, else HEAD with a warning) or a checkout. Default: the mirror /work/.mirror/OscarChavarro+rpkCpp/repo, or $RPKCPP_REPO. To get it:
+pinned commit is read, else HEAD with a warning) or a checkout. Default: $RPKCPP_REPO, else the
+mirror /work/.mirror/OscarChavarro+rpkCpp/repo. To get it:
   git clone --bare https://github.com/OscarChavarro/rpkCpp rpkCpp.git
 
 The RenderPark scenes office2 and classroom are kept out of the project for checking (issues 56
@@ -198,14 +199,24 @@ def merge_mover(scene, spec):
     return chosen
 
 
-def convert_scene(name, src_root, out_dir):
-    """Converts one table entry; returns (summary, mover objects)."""
+def convert_scene(name, src_root, out_dir, keep=None):
+    """Converts one table entry; returns (summary, mover objects). keep: a pattern; only the
+    objects whose names match it are written (for bisecting a scene), the mover only if it does."""
     entry = SCENES[name]
     mgf = os.path.join(src_root, entry["mgf"])
     scene = mgf_to_gltf.read(mgf, entry["up"], 1.0, entry["qcd"], entry.get("orient_closed", False))
-    chosen = merge_mover(scene, entry["mover"])
+    if keep:
+        pattern = re.compile(keep)
+        for node in [n for n in scene.nodes if not pattern.search(n)]:
+            del scene.nodes[node]
+    try:
+        chosen = merge_mover(scene, entry["mover"])
+        movers = {entry["mover"]["name"]: entry["mover"]["keys"]}
+    except CorpusError:
+        if not keep:
+            raise
+        chosen, movers = [], {}
     camera = {"yfov": math.radians(entry["yfov"]), "keys": entry["camera"]}
-    movers = {entry["mover"]["name"]: entry["mover"]["keys"]}
     os.makedirs(out_dir, exist_ok=True)
     summary = mgf_to_gltf.write(scene, os.path.join(out_dir, name + ".gltf"), camera=camera, movers=movers,
                                 name=name)
@@ -234,11 +245,12 @@ def index_block(name, summary, chosen, mgf_path):
         f"  triangles   {summary['triangles']} ({summary['emitting_triangles']} emitting, in "
         f"{summary['emitter_objects']} emitting objects); {summary['nodes']} objects, {summary['materials']} materials",
         f"  bounds      x {lo[0]:.3f}..{hi[0]:.3f}  y {lo[1]:.3f}..{hi[1]:.3f}  z {lo[2]:.3f}..{hi[2]:.3f} m (y up)",
-        f"  emission    {summary['emission_range'][0]:.4g}..{summary['emission_range'][1]:.4g} W/m2/sr "
-        f"(largest channel); PNGs at the default exposure: see results.md",
+        f"  emission    L_e {summary['emission_range'][0]:.4g}..{summary['emission_range'][1]:.4g} W/m2/sr "
+        f"(largest channel; physical units: look at the PNGs with COMPOSE_FLAGS=--auto-exposure)",
         f"  animation   {end:g} s = frames 0-{frames - 1} at {FPS:g} fps; camera from "
         f"{tuple(keys[0][1])} to {tuple(keys[-1][1])} looking at {tuple(keys[0][2])}, yfov {entry['yfov']:g} deg",
-        f"  moving      {mk['name']} ({len(chosen)} MGF objects) moves by {shift} m over {mk['keys'][-1][0]:g} s",
+        (f"  moving      {mk['name']} ({len(chosen)} MGF objects) moves by {shift} m over {mk['keys'][-1][0]:g} s"
+         if chosen else "  moving      nothing (the moving object is not among the objects kept)"),
         f"  converter   up {entry['up']}, {entry['qcd']} segments a quarter circle, one-sided surfaces; "
         + ", ".join(f"{n} {k}" for k, n in sorted(summary["faces"].items())) + " faces; "
         + (", ".join(f"{n} {k}" for k, n in sorted(summary["primitives"].items())) or "no primitives"),
@@ -248,20 +260,20 @@ def index_block(name, summary, chosen, mgf_path):
     return "\n".join(lines)
 
 
-def fetch_and_convert(out, names, repo):
+def fetch_and_convert(out, names, repo, keep=None):
     src = os.path.join(out, "src")
     needs = sorted({p for n in names for p in [SCENES[n]["mgf"]] + SCENES[n]["needs"]})
     commit = extract(repo, needs, src)
     blocks = []
     for name in names:
-        summary, chosen = convert_scene(name, src, os.path.join(out, name))
+        summary, chosen = convert_scene(name, src, os.path.join(out, name), keep)
         blocks.append(index_block(name, summary, chosen, os.path.join(src, SCENES[name]["mgf"])))
         print(f"{PROG}: {name}: {summary['triangles']} triangles, {summary['emitting_triangles']} emitting "
               f"-> {os.path.join(out, name, name + '.gltf')}", file=sys.stderr)
     header = [
         "# The RenderPark MGF corpus, converted by pipelines/corpus/scenes.py (never committed:",
         "# the scenes' licence is unclear). Source: github.com/OscarChavarro/rpkCpp etc/,",
-        f"# commit {commit}. Held out of tuning: "
+        f"# commit {commit}." + (f" Only the objects matching '{keep}'." if keep else "") + " Held out of tuning: "
         + ", ".join(n for n in names if SCENES[n]["held_out"]) + ". Not in the corpus at all: office2, classroom.",
         "",
     ]
@@ -278,6 +290,8 @@ def main(argv):
     fc.add_argument("outdir")
     fc.add_argument("scenes", nargs="*", help=f"scenes (default all: {', '.join(SCENES)})")
     fc.add_argument("--repo", help="rpkCpp as a bare git directory or a checkout")
+    fc.add_argument("--keep", metavar="REGEX",
+                    help="write only the objects whose names match (to bisect a scene; not the corpus)")
     sub.add_parser("list", help="print the scenes of the table")
     args = ap.parse_args(argv)
     if args.command == "list":
@@ -294,8 +308,10 @@ def main(argv):
         if not os.path.isdir(repo):
             raise CorpusError(f"{repo}: no copy of rpkCpp here; clone it: git clone --bare "
                               "https://github.com/OscarChavarro/rpkCpp rpkCpp.git, then --repo rpkCpp.git")
-        fetch_and_convert(args.outdir, names, repo)
-    except (CorpusError, held_out.HeldOutError, mgf_reader.MgfError, ValueError) as e:
+        if args.keep:
+            re.compile(args.keep)
+        fetch_and_convert(args.outdir, names, repo, args.keep)
+    except (CorpusError, held_out.HeldOutError, mgf_reader.MgfError, ValueError, re.error) as e:
         print(f"{PROG}: {e}", file=sys.stderr)
         return 1
     return 0
