@@ -57,7 +57,7 @@ PixelGroups EdgePixels::regions() const {
 std::vector<uint8_t> EdgePixels::clearOfEdges(int clearance) const {
   // Separable: the largest edge flag over each row's window, then over each column's.
   const int r = std::max(clearance - 1, 0);
-  std::vector<uint8_t> rows(edge.size(), 0), near(edge.size(), 0);
+  std::vector<uint8_t> rows(edge.size(), 0), clear(edge.size(), 0);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       uint8_t m = 0;
@@ -70,9 +70,9 @@ std::vector<uint8_t> EdgePixels::clearOfEdges(int clearance) const {
       uint8_t m = 0;
       for (int v = std::max(y - r, 0); v <= std::min(y + r, height - 1); ++v)
         m |= rows[size_t(v) * size_t(width) + size_t(x)];
-      near[size_t(y) * size_t(width) + size_t(x)] = !m;
+      clear[size_t(y) * size_t(width) + size_t(x)] = !m;
     }
-  return near;
+  return clear;
 }
 
 }  // namespace rad

@@ -106,7 +106,7 @@ double emitterThreshold(const FloatImage& reference, const EmitterRule& rule);
 // second reference so that both references' pixels fall on the same side. `reference2` and
 // `emitterMask` may be null; shapes as measureError checks them.
 struct EmitterPixels {
-  std::vector<uint8_t> isEmitter;  // row-major, 1: emitter
+  std::vector<uint8_t> isEmitter;                              // row-major, 1: emitter
   double threshold = std::numeric_limits<double>::infinity();  // the rule's; NaN with a mask
 };
 EmitterPixels findEmitterPixels(const FloatImage& reference, const FloatImage* reference2,

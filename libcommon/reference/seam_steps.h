@@ -36,17 +36,17 @@ constexpr long long kSeamMinPairs = 32;
 // Sums over one seam's pairs (luminance), so frames merge into exact pooled totals.
 struct SeamSums {
   long long pairs = 0;
-  double testA = 0.0, testB = 0.0;                            // test on each side
-  double reference1A = 0.0, reference1B = 0.0;                // first reference
-  double reference2A = 0.0, reference2B = 0.0;                // second (= first without one)
-  int frame = 0, x = -1, y = -1;                              // a pixel on side a, first seen
+  double testA = 0.0, testB = 0.0;              // test on each side
+  double reference1A = 0.0, reference1B = 0.0;  // first reference
+  double reference2A = 0.0, reference2B = 0.0;  // second (= first without one)
+  int frame = 0, x = -1, y = -1;                // a pixel on side a, first seen
 
   void merge(const SeamSums& other);
   double localMean() const;      // \sum (Y_a + Y_b) / (2 pairs), reference
   double testStep() const;       // relative to localMean; 0 when empty, +-inf when mean <= 0
   double referenceStep() const;  // likewise
   double excess() const { return testStep() - referenceStep(); }
-  double floor() const;          // half the difference of the two references' steps
+  double floor() const;  // half the difference of the two references' steps
 };
 
 struct SeamSteps {

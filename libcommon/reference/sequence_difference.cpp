@@ -24,22 +24,21 @@ FrameDifference measureFrame(int frame, const FrameImages& im, const EmitterRule
   fd.frame = frame;
   fd.stats = compareImages(im.test, im.reference, where);
   if (im.surfaces.empty()) {
-    fd.error = measureError(im.test, im.reference, reference2, rule, where,
-                            where2, mask, whereMask, groups);
+    fd.error = measureError(im.test, im.reference, reference2, rule, where, where2, mask, whereMask,
+                            groups);
     return fd;
   }
   const EdgePixels edges = findEdgePixels(im.surfaces);
   const PixelGroups regions = edges.regions();
-  fd.error = measureError(im.test, im.reference, reference2, rule, where,
-                          where2, mask, whereMask, groups,
-                          &regions);
+  fd.error = measureError(im.test, im.reference, reference2, rule, where, where2, mask, whereMask,
+                          groups, &regions);
   const EmitterPixels emitters = findEmitterPixels(im.reference, reference2, rule, mask);
   FloatImage smoothed;
   fd.structured = measureStructuredError(im.test, im.reference, reference2, emitters.isEmitter,
                                          edges, im.smoothedSink ? &smoothed : nullptr);
   if (im.smoothedSink) im.smoothedSink(smoothed);
-  seams.merge(
-      measureSeams(im.test, im.reference, reference2, emitters.isEmitter, im.surfaces, edges, frame));
+  seams.merge(measureSeams(im.test, im.reference, reference2, emitters.isEmitter, im.surfaces,
+                           edges, frame));
   return fd;
 }
 
@@ -74,13 +73,12 @@ SequenceDifference compareSequence(
     const std::vector<int>& frames,
     const std::function<std::pair<FloatImage, FloatImage>(int frame)>& load, double staticTolerance,
     const EmitterRule& rule) {
-  return compareSequence(
-      frames, std::function<FrameImages(int)>([&](int frame) {
-        FrameImages im;
-        std::tie(im.test, im.reference) = load(frame);
-        return im;
-      }),
-      staticTolerance, rule);
+  return compareSequence(frames, std::function<FrameImages(int)>([&](int frame) {
+                           FrameImages im;
+                           std::tie(im.test, im.reference) = load(frame);
+                           return im;
+                         }),
+                         staticTolerance, rule);
 }
 
 }  // namespace rad

@@ -79,8 +79,8 @@ double boxAverage(const std::vector<double>& error, const std::vector<uint8_t>& 
 
 StructuredError measureStructuredError(const FloatImage& test, const FloatImage& reference,
                                        const FloatImage* reference2,
-                                       const std::vector<uint8_t>& emitter,
-                                       const EdgePixels& edges, FloatImage* smoothed) {
+                                       const std::vector<uint8_t>& emitter, const EdgePixels& edges,
+                                       FloatImage* smoothed) {
   const int W = reference.width, H = reference.height;
   const LuminanceErrors e = luminanceErrors(test, reference, reference2, emitter, edges);
   const std::vector<uint8_t> clear = edges.clearOfEdges(kStructuredEdgeClearance);

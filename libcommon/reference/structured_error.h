@@ -45,8 +45,8 @@ struct StructuredError {
 // pixels the percentile is over, 0 elsewhere: the smoothed difference image to look at.
 StructuredError measureStructuredError(const FloatImage& test, const FloatImage& reference,
                                        const FloatImage* reference2,
-                                       const std::vector<uint8_t>& emitter,
-                                       const EdgePixels& edges, FloatImage* smoothed = nullptr);
+                                       const std::vector<uint8_t>& emitter, const EdgePixels& edges,
+                                       FloatImage* smoothed = nullptr);
 
 // The nearest-rank percentile of `values` (reordered): the ceil(q n)-th smallest; 0 when empty.
 double nearestRankPercentile(std::vector<double>& values, double q);

@@ -49,8 +49,7 @@ std::string regionsText(const ErrorFigures& e) {
     const PixelSetStats& s = e.regions[r];
     if (r == kBackgroundRegion && s.pixels == 0) continue;
     os << (r ? ";" : "") << "  " << pixelRegionName(int(r)) << " " << s.pixels << " px";
-    if (s.pixels > 0)
-      os << " rmse/mean " << text(s.rmseOverMean()) << " bias " << text(s.bias());
+    if (s.pixels > 0) os << " rmse/mean " << text(s.rmseOverMean()) << " bias " << text(s.bias());
   }
   return os.str();
 }
@@ -147,8 +146,8 @@ nlohmann::json seamsJson(const SeamSteps& steps, long long minPairs,
       {"seams_found", s.seamsFound},
       {"seams_measured", s.seamsMeasured},
       {"pairs", s.pairs},
-      {"test", {{"mean_abs_step", number(s.meanAbsTestStep)},
-                {"max_abs_step", number(s.maxAbsTestStep)}}},
+      {"test",
+       {{"mean_abs_step", number(s.meanAbsTestStep)}, {"max_abs_step", number(s.maxAbsTestStep)}}},
       {"reference",
        {{"mean_abs_step", number(s.meanAbsReferenceStep)},
         {"max_abs_step", number(s.maxAbsReferenceStep)}}},
@@ -162,8 +161,7 @@ nlohmann::json seamsJson(const SeamSteps& steps, long long minPairs,
 }
 
 std::string seamsText(const SeamSteps& steps, long long minPairs,
-                      const std::function<std::string(int)>& patchName, bool sequence,
-                      int worst) {
+                      const std::function<std::string(int)>& patchName, bool sequence, int worst) {
   const SeamSummary s = summariseSeams(steps, minPairs);
   std::ostringstream os;
   os << "  seams (docs/design.md §10.5: coplanar patches of one material; step = mean Y(a) - "
@@ -180,8 +178,8 @@ std::string seamsText(const SeamSteps& steps, long long minPairs,
   for (size_t k = 0; k < s.byExcess.size() && int(k) < worst; ++k) {
     const auto& key = s.byExcess[k];
     const SeamSums& seam = steps.seams.at(key);
-    os << "    patches " << key.first << "|" << key.second << " " << patchName(key.first)
-       << " at (" << seam.x << ", " << seam.y << ")";
+    os << "    patches " << key.first << "|" << key.second << " " << patchName(key.first) << " at ("
+       << seam.x << ", " << seam.y << ")";
     if (sequence) os << " of frame " << seam.frame;
     os << ": " << seam.pairs << " pairs, step test " << text(seam.testStep()) << " reference "
        << text(seam.referenceStep()) << " excess " << text(seam.excess());

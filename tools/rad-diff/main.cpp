@@ -18,6 +18,7 @@
 
 #include "formats/exr_image.h"
 #include "formats/exr_info.h"
+#include "formats/provenance.h"
 #include "libcommon/reference/sequence_difference.h"
 #include "tools/common/tool_main.h"
 #include "tools/rad-diff/geometry_report.h"
@@ -36,6 +37,8 @@ struct Options {
   double staticTolerance = 0.0;
   long long seamMinPairs = rad::kSeamMinPairs;
   rad::EmitterRule emitters;
+  int argc = 0;  // the command line, for the provenance of --smoothed-error
+  const char* const* argv = nullptr;
 };
 
 std::vector<std::string> splitChannels(const std::string& spec) {
@@ -149,8 +152,8 @@ std::string surfacesText(const rad::ErrorFigures& e, const std::vector<std::stri
   for (size_t g = 0; g < e.groups.size(); ++g) {
     const rad::PixelSetStats& s = e.groups[g];
     if (s.pixels == 0) continue;
-    os << "    " << std::left << std::setw(28) << names[g] << std::right << std::setw(8)
-       << s.pixels << "  " << std::setw(10) << text(s.meanReference()) << "  " << std::setw(10)
+    os << "    " << std::left << std::setw(28) << names[g] << std::right << std::setw(8) << s.pixels
+       << "  " << std::setw(10) << text(s.meanReference()) << "  " << std::setw(10)
        << text(s.bias()) << "  " << text(s.rmseOverMean()) << "\n";
   }
   return os.str();
@@ -194,15 +197,24 @@ const std::string& itemsPath(const Options& o) {
   return o.surfaces.empty() ? o.seams : o.surfaces;
 }
 
-// Writes a frame's smoothed difference image (--smoothed-error) with what made it.
-std::function<void(const rad::FloatImage&)> smoothedWriter(const std::string& path,
-                                                           const std::string& what) {
-  return [path, what](const rad::FloatImage& image) {
+// Writes a frame's smoothed difference image (--smoothed-error) with its provenance
+// (docs/conventions.md §1): this command line, the options and the frame's input files.
+std::function<void(const rad::FloatImage&)> smoothedWriter(const Options& o,
+                                                           const std::string& path,
+                                                           std::vector<std::string> inputs) {
+  return [&o, path, inputs](const rad::FloatImage& image) {
+    rad::Provenance p = rad::makeProvenance(kTool, o.argc, o.argv,
+                                            {{"channels", o.channels},
+                                             {"emitter-rule", emitterRuleText(o)},
+                                             {"box", rad::kStructuredBox},
+                                             {"edge-clearance", rad::kStructuredEdgeClearance}});
+    for (const std::string& input : inputs)
+      if (!input.empty()) p.inputs.push_back({input, rad::hashFile(input), nullptr});
     rad::writeExrImage(path, image,
-                       {{"rad.description",
+                       {{"rad.provenance", p.toJson().dump()},
+                        {"rad.description",
                          "structured error (docs/design.md §10.4): 7x7-smoothed luminance "
-                         "error / mean reference luminance, 0 off the measured pixels"},
-                        {"rad.comparison", what}});
+                         "error / mean reference luminance, 0 off the measured pixels"}});
   };
 }
 
@@ -230,7 +242,8 @@ void compareFiles(const Options& o, const std::vector<std::string>& channels, nl
           if (!o.surfaces.empty()) im.groups = std::move(f.groups);
           im.surfaces = std::move(f.surfaces);
           if (!o.smoothedError.empty())
-            im.smoothedSink = smoothedWriter(o.smoothedError, o.test + " vs " + o.reference);
+            im.smoothedSink = smoothedWriter(
+                o, o.smoothedError, {o.test, o.reference, o.reference2, itemsPath(o), o.scene});
         }
         return im;
       },
@@ -244,7 +257,8 @@ void compareFiles(const Options& o, const std::vector<std::string>& channels, nl
   if (!o.seams.empty()) j["seams"] = seamsJson(seq.seams, o.seamMinPairs, patchName, false);
   out << o.test << " vs " << o.reference;
   if (!o.reference2.empty()) out << " and " << o.reference2;
-  out << " (" << width << "x" << height << ", " << o.channels << "):\n" << legend(o) << "  " << errorText(e);
+  out << " (" << width << "x" << height << ", " << o.channels << "):\n"
+      << legend(o) << "  " << errorText(e);
   if (o.emitterMask.empty()) out << " (emitter threshold " << text(e.emitterThreshold) << ")";
   out << "\n" << frameGeometryText(fd, "  ");
   out << "  every pixel: " << statsText(fd.stats, kLongRelative) << "\n";
@@ -354,9 +368,9 @@ void compareDirectories(const Options& o, const std::vector<std::string>& channe
           if (!o.surfaces.empty()) im.groups = std::move(frame.groups);
           im.surfaces = std::move(frame.surfaces);
           if (!o.smoothedError.empty())
-            im.smoothedSink =
-                smoothedWriter((fs::path(o.smoothedError) / fs::path(refs[f]).filename()).string(),
-                               tests[f] + " vs " + refs[f]);
+            im.smoothedSink = smoothedWriter(
+                o, (fs::path(o.smoothedError) / fs::path(refs[f]).filename()).string(),
+                {tests[f], refs[f], refs2[f], itemFiles[f], o.scene});
         }
         return im;
       },
@@ -373,10 +387,10 @@ int run(const Options& o) {
     throw rad::Error(rad::ExitCode::kUsage, "--seams",
                      "--surfaces and --seams name one item buffer; given two");
   if (itemsPath(o).empty() != o.scene.empty())
-    throw rad::Error(rad::ExitCode::kUsage,
-                     o.scene.empty() ? (o.surfaces.empty() ? "--seams" : "--surfaces") : "--scene",
-                     o.seams.empty() ? "--surfaces and --scene go together"
-                                     : "--seams and --scene go together");
+    throw rad::Error(
+        rad::ExitCode::kUsage,
+        o.scene.empty() ? (o.surfaces.empty() ? "--seams" : "--surfaces") : "--scene",
+        o.seams.empty() ? "--surfaces and --scene go together" : "--seams and --scene go together");
   if (!o.smoothedError.empty() && itemsPath(o).empty())
     throw rad::Error(rad::ExitCode::kUsage, "--smoothed-error",
                      "needs an item buffer (--surfaces or --seams, with --scene)");
@@ -509,5 +523,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(rad::nonNegativeFinite());
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
+  o.argc = argc;
+  o.argv = argv;
   return rad::runTool(kTool, [&]() { return run(o); });
 }
