@@ -2,6 +2,7 @@
 // buffer makes possible.
 #include "libcommon/reference/sequence_difference.h"
 
+#include "libcommon/core/error.h"
 #include "libcommon/reference/edge_pixels.h"
 
 namespace rad {
@@ -28,6 +29,8 @@ FrameDifference measureFrame(int frame, const FrameImages& im, const EmitterRule
                             groups);
     return fd;
   }
+  if (im.surfaces.width != im.reference.width || im.surfaces.height != im.reference.height)
+    throw inputError(where, "item buffer surfaces are not of the image's size");
   const EdgePixels edges = findEdgePixels(im.surfaces);
   const PixelGroups regions = edges.regions();
   fd.error = measureError(im.test, im.reference, reference2, rule, where, where2, mask, whereMask,

@@ -105,6 +105,10 @@ StructuredError measureStructuredError(const FloatImage& test, const FloatImage&
         floors.push_back(relative(std::abs(boxAverage(e.floor, e.measurable, W, H, x, y))));
     }
   s.pixels = (long long)values.size();
+  if (values.empty()) {  // no pixel clear of edges: no figure, rather than a figure of 0
+    s.p95 = s.floorP95 = std::numeric_limits<double>::quiet_NaN();
+    return s;
+  }
   s.p95 = nearestRankPercentile(values, kStructuredPercentile);
   s.floorP95 = nearestRankPercentile(floors, kStructuredPercentile);
   return s;

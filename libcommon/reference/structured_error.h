@@ -34,7 +34,7 @@ constexpr double kStructuredPercentile = 0.95;
 struct StructuredError {
   long long pixels = 0;        // pixels the percentile is over
   double meanReference = 0.0;  // mean luminance of the reference over the non-emitter pixels
-  double p95 = 0.0;            // the figure (0 when no pixel qualifies)
+  double p95 = 0.0;            // the figure; NaN when no pixel qualifies
   bool hasFloor = false;       // a second reference was given
   double floorP95 = 0.0;       // the references' own floor
 };

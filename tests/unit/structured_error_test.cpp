@@ -3,6 +3,8 @@
 // emitter's error kept out.
 #include "libcommon/reference/structured_error.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace rad {
@@ -96,6 +98,16 @@ TEST(StructuredError, EdgesAndEmittersDoNotLeakIntoTheSurfaces) {
   EXPECT_EQ(s.p95, 0.0);
   // Without the emitter flags the lamp's error spreads over its neighbours.
   EXPECT_GT(measureStructuredError(lamp, ref, nullptr, kNoEmitter, edges).p95, 0.0);
+}
+
+// A frame with no pixel 3 px clear of an edge has no figure (NaN), not a figure of 0.
+TEST(StructuredError, NoPixelClearOfEdgesIsNoFigure) {
+  const EdgePixels edges =
+      findEdgePixels(oneSurface([](int x, int y) { return (x / 3 + y / 3) % 2; }));
+  const FloatImage ref = greyWithBlotch(0.5f, 0.0f, 0, 0, 0);
+  const StructuredError s = measureStructuredError(ref, ref, nullptr, kNoEmitter, edges);
+  EXPECT_EQ(s.pixels, 0);
+  EXPECT_TRUE(std::isnan(s.p95));
 }
 
 TEST(StructuredError, NearestRankPercentile) {

@@ -79,7 +79,7 @@ nlohmann::json structuredSequenceJson(const std::vector<FrameDifference>& frames
   int count = 0, worstFrame = -1;
   bool floors = false;
   for (const FrameDifference& f : frames) {
-    if (!f.structured) continue;
+    if (!f.structured || f.structured->pixels == 0) continue;  // no figure in that frame
     const StructuredError& s = *f.structured;
     if (count == 0 || s.p95 > maxP95) {
       maxP95 = s.p95;
