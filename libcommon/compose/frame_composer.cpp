@@ -306,12 +306,12 @@ CameraView FrameComposer::Impl::renderItems(double t) {
 
 // The item buffer's silhouettes decided by the pixel centre's ray. GL rasterizes with a few bits of
 // sub-pixel precision (llvmpipe: 8), so a silhouette edge that passes within ~1/256 pixel of a
-// centre can give the pixel either surface, while rad-reference --pixel-centres (and a renderer's
-// first hit) takes the surface the centre's ray meets first. Such pixels are few but far off (the
-// Cornell box: the wall behind a box's top edge, much brighter than the box). A pixel whose item
-// differs from a 4-neighbour's casts that ray (Embree, the scene's patches at t) and takes the
-// patch it meets when that patch faces the camera, as the rasterizer's back-face rule would; a
-// pixel whose ray meets nothing, or a back face, keeps its item.
+// centre can give the pixel either surface, while rad-reference --pixel-filter none (and a
+// renderer's first hit) takes the surface the centre's ray meets first. Such pixels are few but far
+// off (the Cornell box: the wall behind a box's top edge, much brighter than the box). A pixel
+// whose item differs from a 4-neighbour's casts that ray (Embree, the scene's patches at t) and
+// takes the patch it meets when that patch faces the camera, as the rasterizer's back-face rule
+// would; a pixel whose ray meets nothing, or a back face, keeps its item.
 std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
   const int w = items.width, h = items.height;  // the sample grid's (sample_grid.h)
   // Each pair of neighbours compared once (right, below), both marked when they differ; then

@@ -413,9 +413,10 @@ TEST(PathTracer, DoubleSidedReceiverReflectsOnItsBack) {
 namespace rad {
 namespace {
 
-// --pixel-centres (what rad-compose point-samples): every primary ray goes through its pixel's
-// centre, so a pixel that sees an emitter directly (rho 0: nothing else contributes) is exactly
-// L_e or exactly 0; area sampling instead averages the edge pixels to values in between.
+// --pixel-filter none (what rad-compose --pixel-filter none point-samples): every primary ray goes
+// through its pixel's centre, so a pixel that sees an emitter directly (rho 0: nothing else
+// contributes) is exactly L_e or exactly 0; area sampling instead averages the edge pixels to
+// values in between.
 TEST(PathTracer, PixelCentresPointSampleEdges) {
   const glm::dvec3 le(1.0, 2.0, 3.0);
   // A rectangle facing the camera, its edges at no pixel boundary.
