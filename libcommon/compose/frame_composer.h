@@ -11,9 +11,11 @@
 // centre alone. Shading is deferred and done on the CPU in double: the ray through each shaded
 // sample is intersected with the visible top-level patch's plane, the hit's top-level (u,v) is
 // found by inverting the patch's bilinear/affine map (patch_hierarchy.h), the deepest active
-// movie whose patch node contains that point is sampled bilinearly with clamp-to-edge texel
-// centres at ((i+.5)/w, (j+.5)/h) (exactly GL_LINEAR + CLAMP_TO_EDGE), so non-parallelogram
-// quads are mapped exactly as rad-movies baked them.
+// movie whose patch node contains that point is sampled bilinearly between texel centres at
+// ((i+.5)/w, (j+.5)/h) (GL_LINEAR's), so non-parallelogram quads are mapped exactly as
+// rad-movies baked them; in the outer half texel, up to the patch's border, the two outermost
+// texels of each axis are extrapolated linearly rather than held (GL's CLAMP_TO_EDGE), because
+// irradiance is steepest at borders (issue 56).
 //
 // A covered sample that no active movie textures falls back to the global solution: the union
 // leaf under the point gives $L = B(t)/\pi$ (B already holds the emission, B = B_e + rho H);
