@@ -108,4 +108,22 @@ ItemBuffer readItemBufferExr(const std::string& path) {
   return b;
 }
 
+double readItemBufferTime(const std::string& path) {
+  scanExrFile(path);
+  try {
+    Imf::InputFile in(path.c_str());
+    const Imf::Header& h = in.header();
+    const auto* fmt = h.findTypedAttribute<Imf::StringAttribute>("rad.format");
+    if (!fmt || fmt->value().rfind("item-buffer ", 0) != 0)
+      throw inputError(path, "not an item buffer (no rad.format \"item-buffer\")");
+    const auto* time = h.findTypedAttribute<Imf::DoubleAttribute>("rad.time");
+    if (!time) throw inputError(path, "item buffer without rad.time");
+    return time->value();
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw inputError(path, e.what());
+  }
+}
+
 }  // namespace rad

@@ -28,6 +28,9 @@ void writeItemBufferExr(const std::string& path, const ItemBuffer& buffer, int f
 // Throws rad::inputError(path, ...) when the file is not an item buffer, is an older version,
 // or its pixels do not match its rad.pixelChecksum.
 ItemBuffer readItemBufferExr(const std::string& path);
+// The rad.time attribute of an item buffer (seconds): when the frame's patches were placed.
+// Throws rad::inputError(path, ...) when the file is not an item buffer or has no rad.time.
+double readItemBufferTime(const std::string& path);
 // The rad.pixelChecksum of an item buffer's pixels.
 uint64_t itemBufferChecksum(const ItemBuffer& buffer);
 

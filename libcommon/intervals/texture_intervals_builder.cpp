@@ -52,6 +52,12 @@ void TextureIntervalsOptions::validate() const {
   if (!(sizeRatio >= 1.2 && sizeRatio <= 4.0)) throw bad("--size-ratio", "must be in [1.2, 4]");
   if (maxLength < 0) throw bad("--max-length", "must be >= 0 (0 = unlimited)");
   if (hiddenGap < 0) throw bad("--hidden-gap", "must be >= 0 (0 = close when hidden)");
+  sampling.validate();
+  const ImageSize samples = sampling.grid(imageSize).size();
+  if (samples.width > 16384 || samples.height > 16384)
+    throw bad("--pixel-samples", "the sample grid, " + std::to_string(samples.width) + "x" +
+                                     std::to_string(samples.height) +
+                                     ", exceeds 16384 a side; use fewer samples or a smaller size");
 }
 
 int textureSideFor(double projectedPixels, int current, const TextureIntervalsOptions& o) {
@@ -116,6 +122,19 @@ struct TextureIntervalsBuilder::Impl {
   Impl(const Scene& s, int cam, TextureIntervalsOptions o)
       : scene(s), cameraNode(cam), options(o) {}
 
+  // The samples the item buffers hold, and how many make a pixel (s^2): counts of visible
+  // samples are compared with pixel areas times this.
+  SampleGrid grid() const { return options.sampling.grid(options.imageSize); }
+  ItemBufferOptions itemBufferOptions() const {
+    ItemBufferOptions o;
+    o.readDepth = options.itemBufferDepth;
+    return o;
+  }
+  double samplesPerPixel() const {
+    const int s = grid().perAxis;
+    return double(s) * double(s);
+  }
+
   void build() {
     options.validate();
     if (cameraNode < 0 || cameraNode >= int(scene.nodes.size()) ||
@@ -154,7 +173,7 @@ struct TextureIntervalsBuilder::Impl {
     for (int i = 0; i < hierarchy.size(); ++i) nodeObject[i] = objectOf.at(hierarchy.topOf(i).node);
     // The GL context is made here, so that a machine without one fails before any frame; the
     // geometry goes to it with the first addFrame (addFrames' renderers have their own).
-    renderer = std::make_unique<ItemBufferRenderer>(options.imageSize);
+    renderer = std::make_unique<ItemBufferRenderer>(grid(), itemBufferOptions());
     visible.assign(hierarchy.size(), 0);
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
@@ -214,15 +233,16 @@ struct TextureIntervalsBuilder::Impl {
       theta -= h;
     else if (openBelow[i])
       theta += h;
-    bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
+    bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i] * samplesPerPixel();
     // A node seen on fewer pixels than its four children's smallest textures hold (4 minSize^2)
     // keeps one texture: splitting it adds movies, not resolution (partly hidden small triangles, a
     // chair's, would otherwise make most of a scene's movies). But only while its own texture is
     // small too (at most 4 minSize a side): a big patch leaving the frustum, a few pixels left on
     // screen, would keep its whole-area texture, where the children holding those pixels need a
     // sixteenth of it and carry on the movies they had.
-    const bool tiny = double(visible[i]) < 4.0 * options.minSize * options.minSize &&
-                      textureSideFor(area[i], 0, options) <= 4 * options.minSize;
+    const bool tiny =
+        double(visible[i]) < 4.0 * options.minSize * options.minSize * samplesPerPixel() &&
+        textureSideFor(area[i], 0, options) <= 4 * options.minSize;
     if (enough || tiny || hierarchy.isLeaf(i)) {
       chosen.push_back(i);
       return;
@@ -421,9 +441,12 @@ class ItemBufferPipeline {
     std::exception_ptr error;
   };
 
-  ItemBufferPipeline(size_t workers, ImageSize size, const std::vector<ItemObject>& objects,
-                     std::vector<int> frames, View view)
-      : frames_(std::move(frames)), view_(std::move(view)), slots_(workers) {
+  ItemBufferPipeline(size_t workers, SampleGrid size, ItemBufferOptions itemOptions,
+                     const std::vector<ItemObject>& objects, std::vector<int> frames, View view)
+      : itemOptions_(itemOptions),
+        frames_(std::move(frames)),
+        view_(std::move(view)),
+        slots_(workers) {
     try {
       for (size_t k = 0; k < workers; ++k)
         threads_.emplace_back([this, k, size, &objects] { work(k, size, objects); });
@@ -466,12 +489,12 @@ class ItemBufferPipeline {
     for (std::thread& t : threads_) t.join();
   }
 
-  void work(size_t k, ImageSize size, const std::vector<ItemObject>& objects) {
+  void work(size_t k, SampleGrid size, const std::vector<ItemObject>& objects) {
     Slot& s = slots_[k];
     std::unique_ptr<ItemBufferRenderer> renderer;
     std::exception_ptr error;
     try {
-      renderer = std::make_unique<ItemBufferRenderer>(size);
+      renderer = std::make_unique<ItemBufferRenderer>(size, itemOptions_);
       renderer->setGeometry(objects);
     } catch (...) {
       error = std::current_exception();
@@ -505,6 +528,7 @@ class ItemBufferPipeline {
     }
   }
 
+  const ItemBufferOptions itemOptions_;
   const std::vector<int> frames_;
   const View view_;
   std::vector<Slot> slots_;
@@ -528,7 +552,7 @@ void TextureIntervalsBuilder::addFrames(const std::vector<int>& frames, size_t r
     }
     return;
   }
-  ItemBufferPipeline pipeline(std::min(renderers, frames.size()), b.options.imageSize,
+  ItemBufferPipeline pipeline(std::min(renderers, frames.size()), b.grid(), b.itemBufferOptions(),
                               b.itemObjects(), frames, [&b](int f) { return b.frameView(f); });
   for (size_t i = 0; i < frames.size(); ++i) {
     const ItemBufferPipeline::Slot& s = pipeline.take(i);

@@ -93,6 +93,14 @@ struct TextureIntervalsOptions {
   // and then chosen again at the same size continues over them (see above); 0: the paper's
   // rule, every hidden frame closes the movie.
   int hiddenGap = 6;
+  // The samples whose coverage the item buffers decide (sample_grid.h): rad-compose shades
+  // samples of this grid, so every one of them must lie in a movie. The item buffer is the
+  // grid's, visible counts are in samples, and every rule above that counts pixels takes
+  // samples / s^2; projected areas, and so texel density, stay in pixels.
+  PixelSampling sampling = PixelSampling::pixelCentres();
+  // Not a parameter: whether IntervalFrame::itemBuffer carries depth (the caller writes the
+  // buffers); without it the depth target is neither drawn nor read back.
+  bool itemBufferDepth = true;
 
   // Throws rad::Error(kUsage) naming the flag of the first invalid value.
   void validate() const;
@@ -102,8 +110,8 @@ struct TextureIntervalsOptions {
 struct IntervalFrame {
   int frame = 0;
   double time = 0.0;
-  double itemBufferSeconds = 0.0;  // render + readback
-  const ItemBuffer* itemBuffer = nullptr;
+  double itemBufferSeconds = 0.0;          // render + readback
+  const ItemBuffer* itemBuffer = nullptr;  // of options.sampling's grid (sample_grid.h)
   // Per dense node index: visible pixels, projected area of the whole patch (pixels, see
   // above) and the part of it inside the frustum. The areas are computed only where the
   // algorithm needs them (nodes with visible pixels; the frustum area of nodes whose movie

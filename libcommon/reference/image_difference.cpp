@@ -225,20 +225,22 @@ void ErrorFigures::merge(const ErrorFigures& o) {
   emitters.merge(o.emitters);
   if (groups.size() < o.groups.size()) groups.resize(o.groups.size());
   for (size_t g = 0; g < o.groups.size(); ++g) groups[g].merge(o.groups[g]);
+  if (regions.size() < o.regions.size()) regions.resize(o.regions.size());
+  for (size_t g = 0; g < o.regions.size(); ++g) regions[g].merge(o.regions[g]);
 }
 
-ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
-                          const FloatImage* reference2, const EmitterRule& rule,
-                          const std::string& testWhere, const std::string& reference2Where,
-                          const FloatImage* emitterMask, const std::string& maskWhere,
-                          const PixelGroups* groups) {
-  requireSameShape(test, reference, testWhere);
-  if (reference2) requireSameShape(*reference2, reference, reference2Where);
-  if (emitterMask) requireMaskShape(*emitterMask, reference, maskWhere);
-  ErrorFigures f;
-  f.surfaces.twoReferences = f.emitters.twoReferences = reference2 != nullptr;
-  // With two references the emitters are decided from their mean, the same reference as the
-  // mean and the bias, so that both references' pixels fall on the same side.
+EmitterPixels findEmitterPixels(const FloatImage& reference, const FloatImage* reference2,
+                                const EmitterRule& rule, const FloatImage* emitterMask) {
+  const std::size_t pixels = std::size_t(reference.width) * std::size_t(reference.height);
+  EmitterPixels e;
+  e.isEmitter.assign(pixels, 0);
+  if (emitterMask) {
+    e.threshold = std::numeric_limits<double>::quiet_NaN();
+    const std::size_t maskChannels = std::size_t(emitterMask->channelCount());
+    for (std::size_t p = 0; p < pixels; ++p)
+      e.isEmitter[p] = emitterMask->pixels[p * maskChannels] > 0.5f;
+    return e;
+  }
   FloatImage mean;
   if (reference2) {
     mean = reference;
@@ -246,24 +248,50 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
       mean.pixels[i] = 0.5f * (reference.pixels[i] + reference2->pixels[i]);
   }
   const FloatImage& r = reference2 ? mean : reference;
-  f.emitterThreshold =
-      emitterMask ? std::numeric_limits<double>::quiet_NaN() : emitterThreshold(r, rule);
-  const std::size_t maskChannels = emitterMask ? std::size_t(emitterMask->channelCount()) : 0;
+  e.threshold = emitterThreshold(r, rule);
   const std::vector<double> w = luminanceWeights(reference.channels);
   const std::size_t nc = std::size_t(reference.channelCount());
+  for (std::size_t p = 0; p < pixels; ++p)
+    e.isEmitter[p] = pixelLuminance(&r.pixels[p * nc], w) > e.threshold;
+  return e;
+}
+
+namespace {
+
+// Sizes `figures` to the groups' count; throws when the groups are not of the image's size.
+void prepareGroups(const PixelGroups* groups, std::size_t pixels, bool twoReferences,
+                   const std::string& where, std::vector<PixelSetStats>& figures) {
+  if (!groups) return;
+  if (groups->ofPixel.size() != pixels)
+    throw inputError(where, "pixel groups (item buffer) are not of the image's size");
+  figures.resize(size_t(std::max(groups->count, 0)));
+  for (PixelSetStats& g : figures) g.twoReferences = twoReferences;
+}
+
+PixelSetStats* groupOf(const PixelGroups* groups, std::vector<PixelSetStats>& figures,
+                       std::size_t p) {
+  const int g = groups ? groups->ofPixel[p] : -1;
+  return g >= 0 && g < int(figures.size()) ? &figures[size_t(g)] : nullptr;
+}
+
+}  // namespace
+
+ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
+                          const FloatImage* reference2, const EmitterRule& rule,
+                          const std::string& testWhere, const std::string& reference2Where,
+                          const FloatImage* emitterMask, const std::string& maskWhere,
+                          const PixelGroups* groups, const PixelGroups* regions) {
+  requireSameShape(test, reference, testWhere);
+  if (reference2) requireSameShape(*reference2, reference, reference2Where);
+  if (emitterMask) requireMaskShape(*emitterMask, reference, maskWhere);
+  ErrorFigures f;
+  f.surfaces.twoReferences = f.emitters.twoReferences = reference2 != nullptr;
+  const EmitterPixels emitters = findEmitterPixels(reference, reference2, rule, emitterMask);
+  f.emitterThreshold = emitters.threshold;
+  const std::size_t nc = std::size_t(reference.channelCount());
   const std::size_t pixels = std::size_t(reference.width) * std::size_t(reference.height);
-  if (groups) {
-    if (groups->ofPixel.size() != pixels)
-      throw inputError(testWhere, "pixel groups (item buffer) are not of the image's size");
-    f.groups.resize(size_t(std::max(groups->count, 0)));
-    for (PixelSetStats& g : f.groups) g.twoReferences = reference2 != nullptr;
-  }
-  if (groups) {
-    if (groups->ofPixel.size() != pixels)
-      throw inputError(testWhere, "pixel groups (item buffer) are not of the image's size");
-    f.groups.resize(size_t(std::max(groups->count, 0)));
-    for (PixelSetStats& g : f.groups) g.twoReferences = reference2 != nullptr;
-  }
+  prepareGroups(groups, pixels, reference2 != nullptr, testWhere, f.groups);
+  prepareGroups(regions, pixels, reference2 != nullptr, testWhere, f.regions);
   for (std::size_t p = 0; p < pixels; ++p) {
     const std::size_t base = p * nc;
     bool finite = true;
@@ -272,18 +300,17 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
                std::isfinite(reference.pixels[base + c]) &&
                (!reference2 || std::isfinite(reference2->pixels[base + c]));
     if (!finite) continue;
-    const bool emitter = emitterMask ? emitterMask->pixels[p * maskChannels] > 0.5f
-                                     : pixelLuminance(&r.pixels[base], w) > f.emitterThreshold;
+    const bool emitter = emitters.isEmitter[p] != 0;
     PixelSetStats& s = emitter ? f.emitters : f.surfaces;
-    const int g = groups && !emitter ? groups->ofPixel[p] : -1;
-    PixelSetStats* group = g >= 0 && g < int(f.groups.size()) ? &f.groups[size_t(g)] : nullptr;
-    ++s.pixels;
-    if (group) ++group->pixels;
+    PixelSetStats* group = emitter ? nullptr : groupOf(groups, f.groups, p);
+    PixelSetStats* region = emitter ? nullptr : groupOf(regions, f.regions, p);
+    for (PixelSetStats* x : {&s, group, region})
+      if (x) ++x->pixels;
     for (std::size_t c = 0; c < nc; ++c) {
       const double t = test.pixels[base + c], r1 = reference.pixels[base + c];
       const double r2 = reference2 ? double(reference2->pixels[base + c]) : r1;
       const double rm = reference2 ? 0.5 * (r1 + r2) : r1;
-      for (PixelSetStats* x : {&s, group}) {
+      for (PixelSetStats* x : {&s, group, region}) {
         if (!x) continue;
         ++x->samples;
         x->sumReference += rm;
@@ -295,52 +322,6 @@ ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
     }
   }
   return f;
-}
-
-// ---- Sequences -------------------------------------------------------------------------------
-
-SequenceDifference compareSequence(const std::vector<int>& frames,
-                                   const std::function<FrameImages(int frame)>& load,
-                                   double staticTolerance, const EmitterRule& rule) {
-  SequenceDifference result;
-  FloatImage previousTest, previousReference;
-  int previousFrame = 0;
-  bool havePrevious = false;
-  for (int frame : frames) {
-    FrameImages im = load(frame);
-    const bool two = !im.reference2.pixels.empty();
-    const std::string where = "frame " + std::to_string(frame);
-    FrameDifference fd;
-    fd.frame = frame;
-    fd.stats = compareImages(im.test, im.reference, where);
-    const bool masked = !im.emitterMask.pixels.empty();
-    fd.error = measureError(im.test, im.reference, two ? &im.reference2 : nullptr, rule, where,
-                            where + ": second reference", masked ? &im.emitterMask : nullptr,
-                            where + ": emitter mask", im.groups.count > 0 ? &im.groups : nullptr);
-    result.total.merge(fd.stats);
-    result.totalError.merge(fd.error);
-    result.frames.push_back(fd);
-    if (havePrevious && frame == previousFrame + 1)
-      result.flicker.addPair(previousTest, im.test, previousReference, im.reference,
-                             staticTolerance);
-    previousTest = std::move(im.test);
-    previousReference = std::move(im.reference);
-    previousFrame = frame;
-    havePrevious = true;
-  }
-  return result;
-}
-
-SequenceDifference compareSequence(
-    const std::vector<int>& frames,
-    const std::function<std::pair<FloatImage, FloatImage>(int frame)>& load, double staticTolerance,
-    const EmitterRule& rule) {
-  return compareSequence(
-      frames, std::function<FrameImages(int)>([&](int frame) {
-        auto [test, reference] = load(frame);
-        return FrameImages{std::move(test), std::move(reference), FloatImage(), FloatImage(), {}};
-      }),
-      staticTolerance, rule);
 }
 
 }  // namespace rad

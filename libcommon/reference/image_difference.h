@@ -1,6 +1,6 @@
-// Image and frame-sequence error figures (docs/design.md §8, §10): error against a converged
-// path-traced reference and temporal flicker (mean |Δ| between consecutive frames where nothing
-// changes). No file I/O: callers load the images (formats/exr_image.h).
+// Image error figures (docs/design.md §8, §10): error against a converged path-traced reference
+// and temporal flicker (mean |Δ| between consecutive frames where nothing changes). Sequences:
+// sequence_difference.h. No file I/O: callers load the images (formats/exr_image.h).
 //
 // The figure that judges a renderer is ErrorFigures (docs/design.md §10): RMSE / mean and bias over
 // the pixels that are not emitters, with the references' own noise removed when a second
@@ -10,11 +10,10 @@
 // 200 times brighter than the walls reads "1 %" while the walls are 9 % too dark.
 #pragma once
 
-#include <functional>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "libcommon/core/float_image.h"
@@ -102,6 +101,17 @@ struct EmitterRule {
 // The threshold the rule gives for one reference frame: +inf when no pixel is lit (no emitter).
 double emitterThreshold(const FloatImage& reference, const EmitterRule& rule);
 
+// Which pixels of a frame are emitters, as measureError decides: by `emitterMask` (first
+// channel > 0.5) when given, else by the rule applied to the reference, (ref + ref2) / 2 with a
+// second reference so that both references' pixels fall on the same side. `reference2` and
+// `emitterMask` may be null; shapes as measureError checks them.
+struct EmitterPixels {
+  std::vector<uint8_t> isEmitter;                              // row-major, 1: emitter
+  double threshold = std::numeric_limits<double>::infinity();  // the rule's; NaN with a mask
+};
+EmitterPixels findEmitterPixels(const FloatImage& reference, const FloatImage* reference2,
+                                const EmitterRule& rule, const FloatImage* emitterMask);
+
 // Pooled sums over a set of pixels (channels pooled, every sample counted once) from which the
 // figures are formed. With one reference $r = r_1$; with two, $r = (r_1 + r_2) / 2$ is the
 // reference of mean and bias. Sums, so frames merge into an exact pooled total (not a mean of
@@ -140,6 +150,9 @@ struct ErrorFigures {
   // Per pixel group (PixelGroups, e.g. the material seen in an item buffer): its non-emitter
   // pixels, so that a bias can be traced to the surfaces that have it. Empty without groups.
   std::vector<PixelSetStats> groups;
+  // The same per region (edge_pixels.h: edge, interior, background; docs/design.md §10.3), the
+  // figure apart where the image crosses a geometric edge. Empty without regions.
+  std::vector<PixelSetStats> regions;
   double emitterThreshold = std::numeric_limits<double>::infinity();  // one frame's; see rule
   void merge(const ErrorFigures& other);
 };
@@ -155,48 +168,14 @@ struct PixelGroups {
 // (emitterThreshold is then NaN): a mask from the scene (an emitter AOV) is the exact answer
 // that the luminance rule guesses. All images must have the same size, test and references
 // the same channels (throws as requireSameShape, naming testWhere, reference2Where or
-// maskWhere).
+// maskWhere). `groups` and `regions` may be null; each fills its vector of ErrorFigures.
 ErrorFigures measureError(const FloatImage& test, const FloatImage& reference,
                           const FloatImage* reference2, const EmitterRule& rule,
                           const std::string& testWhere = "test image",
                           const std::string& reference2Where = "second reference",
                           const FloatImage* emitterMask = nullptr,
                           const std::string& maskWhere = "emitter mask",
-                          const PixelGroups* groups = nullptr);
-
-// ---- Sequences -------------------------------------------------------------------------------
-
-struct FrameDifference {
-  int frame = 0;
-  DifferenceStats stats;  // test against the (first) reference, every sample
-  ErrorFigures error;     // docs/design.md §10
-};
-
-struct SequenceDifference {
-  std::vector<FrameDifference> frames;  // in the order given
-  DifferenceStats total;                // pooled over all frames
-  ErrorFigures totalError;              // pooled sums over all frames
-  FlickerStats flicker;                 // over pairs of consecutive frame numbers
-};
-
-// One frame's images; reference2 empty (0x0) when there is no second reference, emitterMask
-// empty when the rule decides which pixels are emitters.
-struct FrameImages {
-  FloatImage test, reference, reference2, emitterMask;
-  PixelGroups groups;  // empty (count 0): no per-surface figures
-};
-
-// Compares a sequence frame by frame. `load(frame)` returns the images of one frame number
-// (only two frames are held at a time, so memory is flat in sequence length). `frames` must
-// be ascending; flicker uses the pairs (n, n+1) that are both listed.
-SequenceDifference compareSequence(const std::vector<int>& frames,
-                                   const std::function<FrameImages(int frame)>& load,
-                                   double staticTolerance = 0.0, const EmitterRule& rule = {});
-
-// The same with one reference: `load(frame)` returns {test, reference}.
-SequenceDifference compareSequence(
-    const std::vector<int>& frames,
-    const std::function<std::pair<FloatImage, FloatImage>(int frame)>& load,
-    double staticTolerance = 0.0, const EmitterRule& rule = {});
+                          const PixelGroups* groups = nullptr,
+                          const PixelGroups* regions = nullptr);
 
 }  // namespace rad

@@ -1,6 +1,7 @@
 // libcommon/image_difference: the error and flicker figures of rad-diff on synthetic images
 // whose answers are known exactly.
 #include "libcommon/reference/image_difference.h"
+#include "libcommon/reference/sequence_difference.h"
 
 #include <cmath>
 

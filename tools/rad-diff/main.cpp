@@ -2,7 +2,9 @@
 // "error vs converged reference" and "temporal flicker"; §10, "How error is measured"):
 // RMSE / mean and bias over the non-emitter pixels (emitters apart, a second reference's noise
 // removed with --ref2), then RMSE, relative L2, max abs difference and PSNR over every sample,
-// and the flicker of the test sequence where the reference is static.
+// and the flicker of the test sequence where the reference is static. With an item buffer
+// (--surfaces / --seams ITEMS --scene SCENE): the figure per surface, at edges and inside
+// surfaces (§10.3), the structured error (§10.4) and the seams' steps (§10.5).
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -16,22 +18,27 @@
 
 #include "formats/exr_image.h"
 #include "formats/exr_info.h"
-#include "formats/gltf_scene.h"
-#include "formats/item_buffer_exr.h"
-#include "libcommon/reference/image_difference.h"
+#include "formats/provenance.h"
+#include "libcommon/reference/sequence_difference.h"
 #include "tools/common/tool_main.h"
+#include "tools/rad-diff/geometry_report.h"
+#include "tools/rad-diff/item_surfaces.h"
 
 namespace {
 
 constexpr const char* kTool = "rad-diff";
 namespace fs = std::filesystem;
+using namespace rad::diff;  // this tool's report and item buffers
 
 struct Options {
-  std::string test, reference, reference2, emitterMask, surfaces, scene;
+  std::string test, reference, reference2, emitterMask, surfaces, seams, scene, smoothedError;
   bool json = false;
   std::string channels = "R,G,B";
   double staticTolerance = 0.0;
+  long long seamMinPairs = rad::kSeamMinPairs;
   rad::EmitterRule emitters;
+  int argc = 0;  // the command line, for the provenance of --smoothed-error
+  const char* const* argv = nullptr;
 };
 
 std::vector<std::string> splitChannels(const std::string& spec) {
@@ -57,18 +64,6 @@ std::map<int, std::string> frameFiles(const std::string& dir) {
       files[std::stoi(m[1].str())] = e.path().string();
   }
   return files;
-}
-
-// JSON has no infinity: +inf PSNR (identical images) is written as null, text says "inf".
-nlohmann::json number(double x) {
-  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
-}
-std::string text(double x) {
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  if (std::isnan(x)) return "n/a";
-  std::ostringstream os;
-  os << std::setprecision(6) << x;
-  return os.str();
 }
 
 // One "difference" object: the docs/design.md §10 figures first (over non-emitter pixels, emitters
@@ -136,66 +131,12 @@ rad::FloatImage readEmitterMask(const std::string& path) {
   return rad::readExrImage(path, {channels[0]["name"].get<std::string>()});
 }
 
-// Per-surface figures (--surfaces ITEMS --scene SCENE): each pixel's group is the glTF node and
-// material of the patch rad-intervals' item buffer saw there. Item ids are dense node indices + 1
-// of the regular subdivision (formats/texture_intervals.md): the top-level patches 0..T-1, then
-// four children per node in order, so node j >= T has parent (j - T) / 4.
-struct SurfaceGroups {
-  std::vector<std::string> names;  // per group: "node (material)"
-  const rad::Scene* scene = nullptr;
-  std::vector<int> groupOfTop;  // per top-level patch
-
-  explicit SurfaceGroups(const rad::Scene& s) : scene(&s) {
-    const std::vector<rad::InputPolygon>& tops = s.inputPolygons();
-    std::map<std::pair<int, int>, int> groupOf;  // (mesh node, material)
-    for (const rad::InputPolygon& p : tops) {
-      auto [it, fresh] = groupOf.emplace(std::pair(p.node, p.material), int(names.size()));
-      if (fresh) names.push_back(nameOf(s, p));
-      groupOfTop.push_back(it->second);
-    }
-  }
-
-  // "node (material)", by glTF name where there is one.
-  static std::string nameOf(const rad::Scene& s, const rad::InputPolygon& p) {
-    std::string node =
-        p.node >= 0 && p.node < int(s.nodes.size()) && !s.nodes[size_t(p.node)].name.empty()
-            ? s.nodes[size_t(p.node)].name
-            : "node " + std::to_string(p.node);
-    std::string material =
-        p.material < 0 ? "default"
-        : p.material < int(s.materials.size()) && !s.materials[size_t(p.material)].name.empty()
-            ? s.materials[size_t(p.material)].name
-            : "material " + std::to_string(p.material);
-    return node + " (" + material + ")";
-  }
-
-  rad::PixelGroups of(const std::string& itemsPath, const rad::FloatImage& like) const {
-    const rad::ItemBuffer items = rad::readItemBufferExr(itemsPath);
-    if (items.width != like.width || items.height != like.height)
-      throw rad::inputError(itemsPath, "item buffer is " + std::to_string(items.width) + "x" +
-                                           std::to_string(items.height) + ", the images " +
-                                           std::to_string(like.width) + "x" +
-                                           std::to_string(like.height));
-    const uint64_t T = groupOfTop.size();
-    rad::PixelGroups g;
-    g.count = int(names.size());
-    g.ofPixel.assign(items.id.size(), -1);
-    for (size_t p = 0; p < items.id.size(); ++p) {
-      if (items.id[p] == rad::kNoItem || items.id[p] == 0) continue;
-      uint64_t node = items.id[p] - 1;
-      while (node >= T) node = (node - T) / 4;
-      g.ofPixel[p] = groupOfTop[size_t(node)];
-    }
-    return g;
-  }
-};
-
-nlohmann::json surfacesJson(const rad::ErrorFigures& e, const SurfaceGroups& sg) {
+nlohmann::json surfacesJson(const rad::ErrorFigures& e, const std::vector<std::string>& names) {
   nlohmann::json a = nlohmann::json::array();
   for (size_t g = 0; g < e.groups.size(); ++g) {
     const rad::PixelSetStats& s = e.groups[g];
     if (s.pixels == 0) continue;
-    a.push_back({{"surface", sg.names[g]},
+    a.push_back({{"surface", names[g]},
                  {"pixels", s.pixels},
                  {"mean_reference", s.meanReference()},
                  {"bias", number(s.bias())},
@@ -204,15 +145,15 @@ nlohmann::json surfacesJson(const rad::ErrorFigures& e, const SurfaceGroups& sg)
   return a;
 }
 
-std::string surfacesText(const rad::ErrorFigures& e, const SurfaceGroups& sg) {
+std::string surfacesText(const rad::ErrorFigures& e, const std::vector<std::string>& names) {
   std::ostringstream os;
   os << "  per surface (node and material; non-emitter pixels): pixels, mean(ref), bias, "
         "rmse/mean\n";
   for (size_t g = 0; g < e.groups.size(); ++g) {
     const rad::PixelSetStats& s = e.groups[g];
     if (s.pixels == 0) continue;
-    os << "    " << std::left << std::setw(28) << sg.names[g] << std::right << std::setw(8)
-       << s.pixels << "  " << std::setw(10) << text(s.meanReference()) << "  " << std::setw(10)
+    os << "    " << std::left << std::setw(28) << names[g] << std::right << std::setw(8) << s.pixels
+       << "  " << std::setw(10) << text(s.meanReference()) << "  " << std::setw(10)
        << text(s.bias()) << "  " << text(s.rmseOverMean()) << "\n";
   }
   return os.str();
@@ -226,52 +167,169 @@ std::string legend(const Options& o) {
          "; emitters: " + emitterRuleText(o) + "\n";
 }
 
+// One frame's "difference" object: statsJson, then its regions and structured error when it
+// had an item buffer (else why the structured error is missing).
+nlohmann::json frameJson(const rad::FrameDifference& fd) {
+  nlohmann::json j = statsJson(fd.stats, fd.error, true);
+  if (!fd.error.regions.empty()) j["regions"] = regionsJson(fd.error);
+  if (fd.structured) {
+    j["structured_error"] = structuredJson(*fd.structured);
+  } else {
+    j["structured_error"] = nullptr;
+    j["structured_error_unavailable"] = kStructuredUnavailable;
+  }
+  return j;
+}
+
+// The lines of one frame's geometry figures (regions, structured error), each indented.
+std::string frameGeometryText(const rad::FrameDifference& fd, const std::string& indent) {
+  std::string out;
+  if (!fd.error.regions.empty()) out += indent + regionsText(fd.error) + "\n";
+  if (fd.structured)
+    out += indent + structuredText(*fd.structured) + "\n";
+  else
+    out += indent + "structured error: " + kStructuredUnavailable + "\n";
+  return out;
+}
+
+// The item buffer of --surfaces or --seams (the same one when both are given).
+const std::string& itemsPath(const Options& o) {
+  return o.surfaces.empty() ? o.seams : o.surfaces;
+}
+
+// Writes a frame's smoothed difference image (--smoothed-error) with its provenance
+// (docs/conventions.md §1): this command line, the options and the frame's input files.
+std::function<void(const rad::FloatImage&)> smoothedWriter(const Options& o,
+                                                           const std::string& path,
+                                                           std::vector<std::string> inputs) {
+  return [&o, path, inputs](const rad::FloatImage& image) {
+    rad::Provenance p = rad::makeProvenance(kTool, o.argc, o.argv,
+                                            {{"channels", o.channels},
+                                             {"emitter-rule", emitterRuleText(o)},
+                                             {"box", rad::kStructuredBox},
+                                             {"edge-clearance", rad::kStructuredEdgeClearance}});
+    for (const std::string& input : inputs)
+      if (!input.empty()) p.inputs.push_back({input, rad::hashFile(input), nullptr});
+    rad::writeExrImage(path, image,
+                       {{"rad.provenance", p.toJson().dump()},
+                        {"rad.description",
+                         "structured error (docs/design.md §10.4): 7x7-smoothed luminance "
+                         "error / mean reference luminance, 0 off the measured pixels"}});
+  };
+}
+
 // Two single files.
 void compareFiles(const Options& o, const std::vector<std::string>& channels, nlohmann::json& j,
                   std::ostream& out) {
-  rad::FloatImage test = rad::readExrImage(o.test, channels);
-  rad::FloatImage reference = rad::readExrImage(o.reference, channels);
-  rad::FloatImage reference2;
-  if (!o.reference2.empty()) reference2 = rad::readExrImage(o.reference2, channels);
-  rad::FloatImage mask;
-  if (!o.emitterMask.empty()) mask = readEmitterMask(o.emitterMask);
-  rad::DifferenceStats s = rad::compareImages(test, reference, o.test);
-  std::optional<rad::Scene> scene;
-  std::optional<SurfaceGroups> sg;
-  rad::PixelGroups groups;
-  if (!o.surfaces.empty()) {
-    scene = rad::readGltfScene(o.scene);
-    sg.emplace(*scene);
-    groups = sg->of(o.surfaces, reference);
-  }
-  rad::ErrorFigures e = rad::measureError(
-      test, reference, o.reference2.empty() ? nullptr : &reference2, o.emitters, o.test,
-      o.reference2, o.emitterMask.empty() ? nullptr : &mask, o.emitterMask, sg ? &groups : nullptr);
-  j["size"] = {test.width, test.height};
-  j["difference"] = statsJson(s, e, true);
-  if (sg) j["per_surface"] = surfacesJson(e, *sg);
+  std::optional<ItemSurfaces> items;
+  if (!itemsPath(o).empty()) items.emplace(o.scene);
+  int width = 0, height = 0;
+  const rad::SequenceDifference seq = rad::compareSequence(
+      {0},
+      [&](int) {
+        rad::FrameImages im;
+        im.test = rad::readExrImage(o.test, channels);
+        im.reference = rad::readExrImage(o.reference, channels);
+        if (!o.reference2.empty()) im.reference2 = rad::readExrImage(o.reference2, channels);
+        if (!o.emitterMask.empty()) im.emitterMask = readEmitterMask(o.emitterMask);
+        width = im.test.width;
+        height = im.test.height;
+        im.testWhere = o.test;
+        im.reference2Where = o.reference2;
+        im.maskWhere = o.emitterMask;
+        if (items) {
+          ItemSurfaces::Frame f = items->load(itemsPath(o), im.reference);
+          if (!o.surfaces.empty()) im.groups = std::move(f.groups);
+          im.surfaces = std::move(f.surfaces);
+          if (!o.smoothedError.empty())
+            im.smoothedSink = smoothedWriter(
+                o, o.smoothedError, {o.test, o.reference, o.reference2, itemsPath(o), o.scene});
+        }
+        return im;
+      },
+      0.0, o.emitters);
+  const rad::FrameDifference& fd = seq.frames[0];
+  const rad::ErrorFigures& e = fd.error;
+  j["size"] = {width, height};
+  j["difference"] = frameJson(fd);
+  if (!o.surfaces.empty()) j["per_surface"] = surfacesJson(e, items->names());
+  auto patchName = [&](int p) { return items->patchName(p); };
+  if (!o.seams.empty()) j["seams"] = seamsJson(seq.seams, o.seamMinPairs, patchName, false);
   out << o.test << " vs " << o.reference;
   if (!o.reference2.empty()) out << " and " << o.reference2;
-  out << " (" << test.width << "x" << test.height << ", " << o.channels << "):\n"
+  out << " (" << width << "x" << height << ", " << o.channels << "):\n"
       << legend(o) << "  " << errorText(e);
   if (o.emitterMask.empty()) out << " (emitter threshold " << text(e.emitterThreshold) << ")";
-  out << "\n  every pixel: " << statsText(s, kLongRelative) << "\n";
-  if (sg) out << surfacesText(e, *sg);
+  out << "\n" << frameGeometryText(fd, "  ");
+  out << "  every pixel: " << statsText(fd.stats, kLongRelative) << "\n";
+  if (!o.surfaces.empty()) out << surfacesText(e, items->names());
+  if (!o.seams.empty()) out << seamsText(seq.seams, o.seamMinPairs, patchName, false);
+}
+// The JSON and text of a sequence's figures (compareDirectories); `items` null without an
+// item buffer.
+void reportSequence(const Options& o, const rad::SequenceDifference& seq, int onlyTest,
+                    int onlyReference, const ItemSurfaces* items, nlohmann::json& j,
+                    std::ostream& out) {
+  j["frames_compared"] = seq.frames.size();
+  j["frames_only_in_test"] = onlyTest;
+  j["frames_only_in_reference"] = onlyReference;
+  j["difference"] = statsJson(seq.total, seq.totalError, false);
+  if (items) {
+    j["difference"]["regions"] = regionsJson(seq.totalError);
+    j["difference"]["structured_error"] = structuredSequenceJson(seq.frames);
+  } else {
+    j["difference"]["structured_error"] = nullptr;
+    j["difference"]["structured_error_unavailable"] = kStructuredUnavailable;
+  }
+  if (!o.surfaces.empty()) j["per_surface"] = surfacesJson(seq.totalError, items->names());
+  auto patchName = [&](int p) { return items->patchName(p); };
+  if (!o.seams.empty()) j["seams"] = seamsJson(seq.seams, o.seamMinPairs, patchName, true);
+  j["flicker"] = {{"mean_abs", seq.flicker.mean()},
+                  {"max_abs", seq.flicker.maxAbsChange},
+                  {"static_pixels", seq.flicker.staticPixels},
+                  {"frame_pairs", seq.flicker.framePairs},
+                  {"static_tolerance", o.staticTolerance}};
+  nlohmann::json per = nlohmann::json::array();
+  out << o.test << " vs " << o.reference;
+  if (!o.reference2.empty()) out << " and " << o.reference2;
+  out << ": " << seq.frames.size() << " frame(s) compared";
+  if (onlyTest + onlyReference > 0)
+    out << " (" << onlyTest << " only in test, " << onlyReference << " only in reference)";
+  out << "\n" << legend(o);
+  for (const rad::FrameDifference& fd : seq.frames) {
+    nlohmann::json fj = frameJson(fd);
+    fj["frame"] = fd.frame;
+    per.push_back(fj);
+    out << "  frame " << std::setw(4) << std::setfill('0') << fd.frame << std::setfill(' ') << ": "
+        << errorText(fd.error) << "  |  " << statsText(fd.stats, "relative_l2") << "\n";
+    if (items) out << frameGeometryText(fd, "    ");
+  }
+  j["per_frame"] = per;
+  out << "  all frames (pooled): " << errorText(seq.totalError)
+      << "\n  all frames, every pixel: " << statsText(seq.total, kLongRelative) << "\n";
+  if (items)
+    out << "  all frames, " << regionsText(seq.totalError) << "\n  "
+        << structuredSequenceText(seq.frames) << "\n";
+  else
+    out << "  structured error: " << kStructuredUnavailable << "\n";
+  out << "  flicker: mean |test(n+1)-test(n)| " << text(seq.flicker.mean()) << " (max "
+      << text(seq.flicker.maxAbsChange) << ") over " << seq.flicker.staticPixels
+      << " static pixel(s) in " << seq.flicker.framePairs << " frame pair(s)\n";
+  if (!o.surfaces.empty()) out << surfacesText(seq.totalError, items->names());
+  if (!o.seams.empty()) out << seamsText(seq.seams, o.seamMinPairs, patchName, true);
 }
 
 // Two (or three, with --ref2) frame directories, matched by frame number.
 void compareDirectories(const Options& o, const std::vector<std::string>& channels,
                         nlohmann::json& j, std::ostream& out) {
   std::map<int, std::string> tests = frameFiles(o.test), refs = frameFiles(o.reference);
-  std::map<int, std::string> refs2, masks, items;
+  std::map<int, std::string> refs2, masks, itemFiles;
   if (!o.reference2.empty()) refs2 = frameFiles(o.reference2);
   if (!o.emitterMask.empty()) masks = frameFiles(o.emitterMask);
-  std::optional<rad::Scene> scene;
-  std::optional<SurfaceGroups> sg;
-  if (!o.surfaces.empty()) {
-    items = frameFiles(o.surfaces);
-    scene = rad::readGltfScene(o.scene);
-    sg.emplace(*scene);
+  std::optional<ItemSurfaces> items;
+  if (!itemsPath(o).empty()) {
+    itemFiles = frameFiles(itemsPath(o));
+    items.emplace(o.scene);
   }
   std::vector<int> frames;
   int onlyTest = 0;
@@ -287,60 +345,37 @@ void compareDirectories(const Options& o, const std::vector<std::string>& channe
   for (int f : frames)
     for (const auto& [dir, files] :
          {std::pair(&o.reference2, &refs2), std::pair(&o.emitterMask, &masks),
-          std::pair(&o.surfaces, &items)})
+          std::pair(&itemsPath(o), &itemFiles)})
       if (!dir->empty() && !files->count(f))
         throw rad::inputError(*dir, "no frame " + std::to_string(f) + " (" +
                                         fs::path(refs[f]).filename().string() +
                                         " is in the reference)");
+  if (!o.smoothedError.empty()) fs::create_directories(o.smoothedError);
   rad::SequenceDifference seq = rad::compareSequence(
       frames,
       [&](int f) {
-        rad::FrameImages im{rad::readExrImage(tests[f], channels),
-                            rad::readExrImage(refs[f], channels),
-                            rad::FloatImage(),
-                            rad::FloatImage(),
-                            {}};
+        rad::FrameImages im;
+        im.test = rad::readExrImage(tests[f], channels);
+        im.reference = rad::readExrImage(refs[f], channels);
         rad::requireSameShape(im.test, im.reference, tests[f]);
         if (!o.reference2.empty()) {
           im.reference2 = rad::readExrImage(refs2[f], channels);
           rad::requireSameShape(im.reference2, im.reference, refs2[f]);
         }
         if (!o.emitterMask.empty()) im.emitterMask = readEmitterMask(masks[f]);
-        if (sg) im.groups = sg->of(items[f], im.reference);
+        if (items) {
+          ItemSurfaces::Frame frame = items->load(itemFiles[f], im.reference);
+          if (!o.surfaces.empty()) im.groups = std::move(frame.groups);
+          im.surfaces = std::move(frame.surfaces);
+          if (!o.smoothedError.empty())
+            im.smoothedSink = smoothedWriter(
+                o, (fs::path(o.smoothedError) / fs::path(refs[f]).filename()).string(),
+                {tests[f], refs[f], refs2[f], itemFiles[f], o.scene});
+        }
         return im;
       },
       o.staticTolerance, o.emitters);
-  j["frames_compared"] = frames.size();
-  j["frames_only_in_test"] = onlyTest;
-  j["frames_only_in_reference"] = onlyReference;
-  j["difference"] = statsJson(seq.total, seq.totalError, false);
-  if (sg) j["per_surface"] = surfacesJson(seq.totalError, *sg);
-  j["flicker"] = {{"mean_abs", seq.flicker.mean()},
-                  {"max_abs", seq.flicker.maxAbsChange},
-                  {"static_pixels", seq.flicker.staticPixels},
-                  {"frame_pairs", seq.flicker.framePairs},
-                  {"static_tolerance", o.staticTolerance}};
-  nlohmann::json per = nlohmann::json::array();
-  out << o.test << " vs " << o.reference;
-  if (!o.reference2.empty()) out << " and " << o.reference2;
-  out << ": " << frames.size() << " frame(s) compared";
-  if (onlyTest + onlyReference > 0)
-    out << " (" << onlyTest << " only in test, " << onlyReference << " only in reference)";
-  out << "\n" << legend(o);
-  for (const rad::FrameDifference& fd : seq.frames) {
-    nlohmann::json fj = statsJson(fd.stats, fd.error, true);
-    fj["frame"] = fd.frame;
-    per.push_back(fj);
-    out << "  frame " << std::setw(4) << std::setfill('0') << fd.frame << std::setfill(' ') << ": "
-        << errorText(fd.error) << "  |  " << statsText(fd.stats, "relative_l2") << "\n";
-  }
-  j["per_frame"] = per;
-  out << "  all frames (pooled): " << errorText(seq.totalError)
-      << "\n  all frames, every pixel: " << statsText(seq.total, kLongRelative) << "\n";
-  out << "  flicker: mean |test(n+1)-test(n)| " << text(seq.flicker.mean()) << " (max "
-      << text(seq.flicker.maxAbsChange) << ") over " << seq.flicker.staticPixels
-      << " static pixel(s) in " << seq.flicker.framePairs << " frame pair(s)\n";
-  if (sg) out << surfacesText(seq.totalError, *sg);
+  reportSequence(o, seq, onlyTest, onlyReference, items ? &*items : nullptr, j, out);
 }
 
 int run(const Options& o) {
@@ -348,10 +383,18 @@ int run(const Options& o) {
   if (o.emitters.threshold && !(*o.emitters.threshold >= 0.0))
     throw rad::Error(rad::ExitCode::kUsage, "--emitter-threshold", "must be >= 0");
   std::vector<std::string> inputs = {o.test, o.reference};
-  if (o.surfaces.empty() != o.scene.empty())
-    throw rad::Error(rad::ExitCode::kUsage, o.surfaces.empty() ? "--scene" : "--surfaces",
-                     "--surfaces and --scene go together");
-  for (const std::string& p : {o.reference2, o.emitterMask, o.surfaces, o.scene})
+  if (!o.surfaces.empty() && !o.seams.empty() && o.surfaces != o.seams)
+    throw rad::Error(rad::ExitCode::kUsage, "--seams",
+                     "--surfaces and --seams name one item buffer; given two");
+  if (itemsPath(o).empty() != o.scene.empty())
+    throw rad::Error(
+        rad::ExitCode::kUsage,
+        o.scene.empty() ? (o.surfaces.empty() ? "--seams" : "--surfaces") : "--scene",
+        o.seams.empty() ? "--surfaces and --scene go together" : "--seams and --scene go together");
+  if (!o.smoothedError.empty() && itemsPath(o).empty())
+    throw rad::Error(rad::ExitCode::kUsage, "--smoothed-error",
+                     "needs an item buffer (--surfaces or --seams, with --scene)");
+  for (const std::string& p : {o.reference2, o.emitterMask, itemsPath(o), o.scene})
     if (!p.empty()) inputs.push_back(p);
   for (const std::string& p : inputs)
     if (!fs::exists(p)) throw rad::inputError(p, "cannot open (missing)");
@@ -361,12 +404,15 @@ int run(const Options& o) {
                      "TEST and REFERENCE must both be .exr files or both directories");
   for (const auto& [path, flag] :
        {std::pair(o.reference2, "--ref2"), std::pair(o.emitterMask, "--emitter-mask"),
-        std::pair(o.surfaces, "--surfaces")})
+        std::pair(o.surfaces, "--surfaces"), std::pair(o.seams, "--seams")})
     if (!path.empty() && fs::is_directory(path) != refDir)
       throw rad::Error(rad::ExitCode::kUsage, path,
                        std::string(flag) +
                            " must be of the reference's kind (.exr file or "
                            "directory)");
+  if (!o.smoothedError.empty() && !refDir && fs::is_directory(o.smoothedError))
+    throw rad::Error(rad::ExitCode::kUsage, o.smoothedError,
+                     "--smoothed-error must be of the reference's kind (.exr file or directory)");
   nlohmann::json j;
   j["test"] = o.test;
   j["reference"] = o.reference;
@@ -411,7 +457,24 @@ int main(int argc, char** argv) {
       "||test - ref|| / ||ref|| (normalised by the reference RMS, so dominated by visible\n"
       "emitters), max abs difference, PSNR (peak = max of the reference) and, for sequences, the\n"
       "temporal flicker of the test where the reference does not change. Totals over a sequence\n"
-      "pool the sums of every frame."};
+      "pool the sums of every frame.\n"
+      "\n"
+      "With an item buffer (--surfaces or --seams ITEMS, --scene SCENE; rad-intervals\n"
+      "--item-buffers writes them), patches that are coplanar and of one material count as one\n"
+      "surface, and (docs/design.md §10.3-§10.5):\n"
+      "  regions: the figure over edge pixels (one of the 8 neighbours shows another surface or\n"
+      "    the background, or the pixel is background beside a surface), interior pixels and\n"
+      "    background pixels apart;\n"
+      "  structured error: Y = luminance, e = Y(test) - Y(ref), averaged over the 7x7 box of\n"
+      "    its pixels that are not edges, emitters or background; p95 of |e_box| / mean Y(ref)\n"
+      "    over the pixels >= 3 px from every edge pixel. With --ref2, ref = (ref + ref2) / 2,\n"
+      "    and reference_floor_p95 is the same of e = (Y(ref) - Y(ref2)) / 2: what a perfect\n"
+      "    test would read. Without an item buffer it is not computed (and says so);\n"
+      "  seams (--seams): pixel pairs side by side on two coplanar patches a < b of one\n"
+      "    material, no edge or emitter; per patch pair, step = sum(Y_a - Y_b) / sum((Y_a +\n"
+      "    Y_b) / 2) of the reference, for the test and the reference; over the seams of >=\n"
+      "    --seam-min-pairs pairs, the mean and largest |step| and |excess| = |step(test) -\n"
+      "    step(ref)|, and with --ref2 the references' floor (half their steps' difference)."};
   Options o;
   rad::setUpApp(app, kTool, "rad-diff out/frames ref-seed1/frames --ref2 ref-seed2/frames --json");
   app.add_option("TEST", o.test, "test .exr file or directory of NNNN.exr")->required();
@@ -435,7 +498,21 @@ int main(int argc, char** argv) {
       "item buffer (rad-intervals --item-buffers; a file, or a directory like "
       "REFERENCE) of the frames: adds the figures per surface (glTF node and material) seen, "
       "which say where a bias is; needs --scene");
-  app.add_option("--scene", o.scene, "the scene of --surfaces (its patches and materials)");
+  app.add_option("--seams", o.seams,
+                 "item buffer (as --surfaces; the same one when both are given): adds the "
+                 "luminance steps across seams of coplanar patches of one material; needs "
+                 "--scene");
+  app.add_option("--scene", o.scene,
+                 "the scene of --surfaces / --seams (its patches, planes and materials)");
+  app.add_option("--seam-min-pairs", o.seamMinPairs,
+                 "seams with fewer pixel pairs are left out of the seam summary (their step is "
+                 "mostly the references' noise)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--smoothed-error", o.smoothedError,
+                 "writes the structured error's smoothed difference image (an .exr, or a "
+                 "directory of NNNN.exr like REFERENCE): 7x7-smoothed luminance error / mean, 0 "
+                 "off the measured pixels; needs an item buffer");
   app.add_flag("--json", o.json, "print JSON on stdout instead of text");
   app.add_option("--channels", o.channels,
                  "comma-separated channels to compare (luminance: Rec. 709 when R, G, B are all "
@@ -446,5 +523,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(rad::nonNegativeFinite());
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
+  o.argc = argc;
+  o.argv = argv;
   return rad::runTool(kTool, [&]() { return run(o); });
 }

@@ -1,7 +1,8 @@
 // rad-global: the first pass (paper §3.1, §4.2; docs/design.md §6.1 "rad-global"): space-time
 // hierarchical radiosity over the key times of a frame range, written as global.rlh. The
 // options, key times, min-area default and report are libcommon/radiosity/global_stage.h, the
-// algorithm solveSpaceTime; this main parses, calls and reports. For a render farm (issue 17)
+// driver tools/stages/global_run.h, the algorithm solveSpaceTime; this main parses, calls and
+// reports. For a render farm (issue 17)
 // --window solves a time window's keys into a key window file (solveKeyWindow,
 // formats/key_window.h) and --merge joins such files into the very global.rlh the whole run
 // writes (mergeKeyWindows).
@@ -15,13 +16,11 @@
 #include "formats/atomic_file.h"
 #include "formats/gltf_scene.h"
 #include "formats/key_window.h"
-#include "formats/link_hierarchy.h"
-#include "formats/provenance.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/global_stage.h"
-#include "libcommon/scene/scene_digest.h"
 #include "tools/common/parameter_cli.h"
 #include "tools/common/tool_main.h"
+#include "tools/stages/global_run.h"
 
 namespace {
 
@@ -73,71 +72,6 @@ void addOptions(CLI::App& app, Options& o) {
       ->group(farm);
 }
 
-// The parameters both outputs' provenance records: the options and the digests of the scene's
-// parts the solution depends on (the camera is not one of them).
-nlohmann::json provenanceParameters(const Options& o, const rad::Scene& scene) {
-  nlohmann::json params = o.global.toJson();
-  params["preset"] = o.preset;
-  params[rad::kSceneDigestsKey] =
-      rad::sceneDigests(scene, {rad::ScenePart::kGeometry, rad::ScenePart::kMaterials,
-                                rad::ScenePart::kLights, rad::ScenePart::kAnimation});
-  return params;
-}
-
-// The metadata of both outputs: what ran.
-nlohmann::json runMetadata(const rad::GlobalOptions& g, const rad::FrameRange& frames) {
-  return {{"parameters", g.toJson()},
-          {"first_frame", frames.first},
-          {"last_frame", frames.last},
-          {"coherence", g.spaceTime.coherence}};
-}
-
-// The key-time pass alone, on the --window keys, written as a key window file.
-void writeWindow(const Options& o, const rad::Scene& scene, const rad::FrameRange& frames,
-                 const std::vector<double>& keyTimes, const rad::KeyIndexRange& keys,
-                 rad::GlobalReport& report, int argc, char** argv) {
-  const rad::GlobalOptions& g = o.global;
-  rad::KeyWindow window =
-      rad::solveKeyWindow(scene, keyTimes, keys.first, keys.last, g.spaceTime, &report.solve);
-  rad::Provenance prov = rad::makeProvenance(kTool, argc, argv, provenanceParameters(o, scene));
-  rad::addInput(prov, o.scene);
-  nlohmann::json metadata = runMetadata(g, frames);
-  metadata["window"] = g.window;
-  metadata["run_key_count"] = keyTimes.size();
-  auto tWrite = std::chrono::steady_clock::now();
-  rad::writeKeyWindow(o.output, window, prov, metadata);
-  report.secondsWrite = rad::secondsSince(tWrite);
-}
-
-// The run's global.rlh, solved or merged from key windows. A merge records the whole run's
-// command line (argv without the --merge words), so its bytes are the whole run's.
-void writeHierarchy(const Options& o, const rad::Scene& scene, const rad::FrameRange& frames,
-                    const std::vector<double>& keyTimes, rad::GlobalReport& report, int argc,
-                    char** argv) {
-  const rad::GlobalOptions& g = o.global;
-  const nlohmann::json params = g.toJson();
-  std::vector<std::string> words(argv, argv + argc);
-  rad::GlobalSolution solution;
-  if (g.merge.empty()) {
-    solution = rad::solveSpaceTime(scene, keyTimes, g.spaceTime, &report.solve);
-  } else {
-    auto tRead = std::chrono::steady_clock::now();
-    std::vector<rad::KeyWindow> windows =
-        rad::readKeyWindows(g.merge, scene, params, rad::hashFile(o.scene));
-    report.secondsRead += rad::secondsSince(tRead);
-    solution = rad::mergeKeyWindows(scene, keyTimes, std::move(windows), g.merge, &report.solve);
-    words = rad::argumentsWithoutMerge(argc, argv, g.merge);
-  }
-  std::vector<const char*> args;
-  for (const std::string& w : words) args.push_back(w.c_str());
-  rad::Provenance prov =
-      rad::makeProvenance(kTool, int(args.size()), args.data(), provenanceParameters(o, scene));
-  rad::addInput(prov, o.scene);
-  auto tWrite = std::chrono::steady_clock::now();
-  rad::writeLinkHierarchy(o.output, solution, prov, runMetadata(g, frames));
-  report.secondsWrite = rad::secondsSince(tWrite);
-}
-
 // --print-windows: the --window ranges of a farm run, on one line.
 int printWindows(const rad::FrameRange& frames, int keyStep, int count) {
   const char* sep = "";
@@ -171,10 +105,11 @@ int run(Options o, int argc, char** argv) {
 
   rad::Progress progress(kTool, g.merge.empty() ? long(keys.last - keys.first + 1) : 0);
   g.spaceTime.onKeySolved = [&]() { progress.advance(); };
+  const rad::GlobalRun globalRun{o.scene, o.output, o.preset, g, frames, keyTimes};
   if (g.window.empty())
-    writeHierarchy(o, scene, frames, keyTimes, report, argc, argv);
+    rad::writeGlobalHierarchy(globalRun, scene, report, argc, argv);
   else
-    writeWindow(o, scene, frames, keyTimes, keys, report, argc, argv);
+    rad::writeGlobalWindow(globalRun, scene, keys, report, argc, argv);
   progress.done();
 
   report.secondsTotal = rad::secondsSince(tStart);
