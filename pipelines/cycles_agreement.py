@@ -2,8 +2,8 @@
 """Cycles against rad-reference on one scene, both through the pixel centres (issue 56).
 
 Before Cycles references judge anything, the two renderers must agree where there is nothing
-to judge: this renders SCENE's frame with pipelines/cycles_reference.py --pixel-centres and
-with rad-reference --pixel-centres (two seeds, so rad-diff removes the path tracer's noise),
+to judge: this renders SCENE's frame with pipelines/cycles_reference.py --pixel-filter none and
+with rad-reference --pixel-filter none (two seeds, so rad-diff removes the path tracer's noise),
 then prints rad-diff's figure (docs/design.md §10) of Cycles against them. A wrong emission
 unit shows as a bias, a framing off by a fraction of a pixel or a flipped axis as a large
 RMSE at every edge. By default the scene is pipelines/scenes/make_lit_floor.py's.
@@ -58,16 +58,17 @@ def main():
     for seed in (0, 1):
         d = os.path.join(a.out, "reference-s%d" % seed)
         run([os.path.join(a.bin, "rad-reference"), scene, "-o", d, "--frames", frames, "--size",
-             a.size, "--spp", str(a.spp), "--seed", str(seed), "--pixel-centres"])
+             a.size, "--spp", str(a.spp), "--seed", str(seed), "--pixel-filter", "none"])
         refs.append(d)
     cycles = os.path.join(a.out, "cycles")
     run([sys.executable, os.path.join(HERE, "cycles_reference.py"), scene, "-o", cycles,
-         "--frames", frames, "--size", a.size, "--spp", str(a.cycles_spp), "--pixel-centres",
-         "--bin", a.bin])
+         "--frames", frames, "--size", a.size, "--spp", str(a.cycles_spp), "--pixel-filter",
+         "none", "--bin", a.bin])
     out = run([os.path.join(a.bin, "rad-diff"), cycles, refs[0], "--ref2", refs[1], "--json"])
     total = json.loads(out)["difference"]
     rmse, bias = total["rmse_over_mean"], total["bias"]
-    print("Cycles --pixel-centres (%d spp) against rad-reference --pixel-centres (2 x %d spp), "
+    print("Cycles --pixel-filter none (%d spp) against rad-reference --pixel-filter none "
+          "(2 x %d spp), "
           "%s frame %d at %s: rmse/mean %.2f %%, bias %+.2f %%, the references' noise %.2f %%" %
           (a.cycles_spp, a.spp, os.path.basename(scene), a.frame, a.size, 100 * rmse, 100 * bias,
            100 * total.get("noise_over_mean", float("nan"))))

@@ -27,17 +27,19 @@ frames DIR/NNNN.exr like rad-reference's (RGB float, row 0 = top), which rad-dif
              the importer drops their tangents.
   film       Cycles on the CPU, --spp samples with --seed, no adaptive sampling, no denoiser,
              no clamping, light threshold 0, --max-bounces of every kind, the pixel filter
-             --filter of --filter-width pixels (by default blackman-harris 1.5, Cycles' own
+             --pixel-filter of --filter-width pixels (by default blackman-harris 1.5, Cycles' own
              default), view transform Standard, exposure 0, film not transparent, a black world.
   filter     Blender gives Cycles a box filter 1 px wide whatever its width says (its
              sync.cpp: `filter_type == FILTER_BOX ? 1.0f : filter_width`), so a "box 0.01"
-             render is an area average over each pixel, not the pixel centre: --filter box
-             takes width 1 only. --pixel-centres (blackman-harris 0.01: every sample within
-             0.01 px of the centre) samples as rad-compose and rad-reference --pixel-centres do.
+             render is an area average over each pixel, not the pixel centre: --pixel-filter
+             box takes width 1 only. --pixel-filter none (Cycles' blackman-harris 0.01: every
+             sample within 0.01 px of the centre) samples as rad-compose and rad-reference
+             --pixel-filter none do; --pixel-centres is its older name, as theirs.
 
 usage: cycles_reference.py SCENE -o DIR [--frames A-B|A-BxS|A] [--fps F] [--size WxH]
-                           [--camera NAME] [--spp N] [--seed S] [--pixel-centres |
-                           --filter box|gaussian|blackman-harris --filter-width PX]
+                           [--camera NAME] [--spp N] [--seed S]
+                           [--pixel-filter none|box|gaussian|blackman-harris]
+                           [--filter-width PX]
                            [--max-bounces N] [--threads N]
                            [--blender PATH] [--bin DIR]
 
@@ -75,12 +77,14 @@ def parse_args(argv):
     p.add_argument("--camera", default="", help="camera node (or camera) name; default the first")
     p.add_argument("--spp", type=int, default=1024, help="samples per pixel")
     p.add_argument("--seed", type=int, default=0, help="Cycles' seed")
-    p.add_argument("--filter", choices=sorted(FILTERS), default="blackman-harris",
-                   help="pixel filter (default blackman-harris, Cycles' default)")
+    p.add_argument("--pixel-filter", choices=["none"] + sorted(FILTERS),
+                   default="blackman-harris",
+                   help="pixel filter (default blackman-harris, Cycles' default); none: every "
+                   "sample within 0.01 px of the pixel centre")
     p.add_argument("--filter-width", type=float, default=1.5,
                    help="filter width, pixels (default 1.5; box: 1 only)")
     p.add_argument("--pixel-centres", action="store_true",
-                   help="every sample within 0.01 px of the pixel centre (blackman-harris 0.01)")
+                   help="older name of --pixel-filter none")
     p.add_argument("--max-bounces", type=int, default=64, help="bounces of every kind")
     p.add_argument("--threads", type=int, default=0, help="render threads; 0: all cores")
     p.add_argument("--blender", default="blender", help="the blender executable")
@@ -97,14 +101,19 @@ def parse_args(argv):
     if a.spp < 1 or a.fps < 1 or a.max_bounces < 0 or a.threads < 0:
         p.error("--spp and --fps must be >= 1, --max-bounces and --threads >= 0")
     if a.pixel_centres:
-        if any(x.startswith("--filter") for x in argv):
-            p.error("--pixel-centres sets the filter; it takes no --filter or --filter-width")
+        if any(x.startswith("--pixel-filter") for x in argv):
+            p.error("--pixel-centres is --pixel-filter none; give one of them")
+        a.pixel_filter = "none"
+    if a.pixel_filter == "none":  # Cycles' narrowest filter: samples within 0.01 px
         a.filter, a.filter_width = "blackman-harris", 0.01
+    else:
+        a.filter = a.pixel_filter
     if not 0.01 <= a.filter_width <= 10.0:
         p.error("--filter-width %g; expected in [0.01, 10] (Cycles' range)" % a.filter_width)
     if a.filter == "box" and a.filter_width != 1.0:
-        p.error("--filter box --filter-width %g: Blender renders a box filter 1 px wide "
-                "whatever its width; for pixel centres use --pixel-centres" % a.filter_width)
+        p.error("--pixel-filter box --filter-width %g: Blender renders a box filter 1 px "
+                "wide whatever its width; for pixel centres use --pixel-filter none" %
+                a.filter_width)
     return a
 
 

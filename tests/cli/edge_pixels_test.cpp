@@ -5,7 +5,7 @@
 //   $L(x) = \frac{\rho}{\pi} \pi L_e F(dA_x \to \text{lamp})$
 // with the exact point-to-polygon form factor. The four stages run at the defaults and each
 // floor pixel is compared with L at the point its centre's ray meets (the sampling of
-// rad-compose and rad-reference --pixel-centres). rad-movies bakes texels at their centres
+// rad-compose and rad-reference with --pixel-filter none). rad-movies bakes texels at their centres
 // ((i+.5)/w); the outer half texel at the border lies beyond every texel centre, so the lookup
 // there extrapolates from the last two texels. The camera is turned 7 degrees about its axis so
 // that along the edge the pixel centres fall at every distance from it. Held flat
@@ -128,9 +128,11 @@ class EdgePixels : public ::testing::Test {
   void TearDown() override {
     if (!std::getenv("RAD_KEEP_TEST_DIR")) fs::remove_all(dir);
   }
-  // Runs the four stages at their defaults; the frame's path.
+  // Runs the four stages at their defaults but for the pixel filter: none, one sample through
+  // each pixel centre (rad-compose takes rad-intervals'), which the closed form is evaluated at;
+  // the frame's path.
   std::string render() const {
-    const std::string d = dir.string(), size = " --size 88x60";
+    const std::string d = dir.string(), size = " --size 88x60 --pixel-filter none";
     for (const std::string& cmd :
          {tool("rad-global") + " " + scenePath + " -o " + d + "/global.rlh",
           tool("rad-intervals") + " " + scenePath + " -o " + d + "/intervals.rti" + size,
