@@ -344,9 +344,11 @@ def setup_render(bpy, scene, a):
     r.use_stamp_filename = r.use_stamp_memory = r.use_stamp_hostname = False
     r.use_stamp_marker = r.use_stamp_frame_range = False
     r.use_stamp_note = True  # the command line and what it resolved to, as EXR metadata
-    r.stamp_note_text = "%s %s; Blender %s, Cycles %s filter %g px, %d spp, seed %d, %d bounces" % (
-        TOOL, " ".join(shlex.quote(x) for x in sys.argv[sys.argv.index("--") + 1:]),
-        bpy.app.version_string, FILTERS[a.filter], a.filter_width, a.spp, a.seed, a.max_bounces)
+    command = " ".join(shlex.quote(x) for x in sys.argv[sys.argv.index("--") + 1:])
+    r.stamp_note_text = ("%s %s; Blender %s, Cycles %s filter %g px, %d spp, seed %d, "
+                         "%d bounces" % (TOOL, command, bpy.app.version_string,
+                                         FILTERS[a.filter], a.filter_width, a.spp, a.seed,
+                                         a.max_bounces))
 
 
 def rotation_keys(fcurves):
