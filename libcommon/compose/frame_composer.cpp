@@ -19,17 +19,23 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Bilinear sample with texel centres at ((i+.5)/w, (j+.5)/h) and clamp-to-edge: what GL_LINEAR
-// with GL_CLAMP_TO_EDGE returns (in double, without GL's 8-bit weight quantisation). With a
-// second key `next`, each texel is first blended in float exactly as TextureMovie::textureAt
-// blends the whole texture: (1 - weight) * rgb + weight * next.
-glm::dvec3 sampleClamped(const float* rgb, const float* next, float weight, int w, int h,
-                         glm::dvec2 uv) {
-  double x = std::clamp(uv.x * w - 0.5, 0.0, double(w - 1));
-  double y = std::clamp(uv.y * h - 0.5, 0.0, double(h - 1));
-  int i0 = std::min(int(x), w - 1), j0 = std::min(int(y), h - 1);
-  int i1 = std::min(i0 + 1, w - 1), j1 = std::min(j0 + 1, h - 1);
-  double fx = x - i0, fy = y - j0;
+// Bilinear sample with texel centres at ((i+.5)/w, (j+.5)/h). Inside the texel centres' hull it
+// is what GL_LINEAR returns (in double, without GL's 8-bit weight quantisation); in the half texel
+// between the last centres and the patch's edge the border cell is extended linearly, not clamped
+// to the edge: clamping gave the edge the value half a texel inside, so two patches meeting at an
+// edge each showed their own inner value there and the irradiance stepped by its gradient times
+// a texel across every shared edge (the seams of issue 56; docs/design.md §6.4). Extended values
+// are kept non-negative (a steep shadow edge at the border). With a second key `next`, each texel
+// is first blended in float exactly as TextureMovie::textureAt blends the whole texture:
+// (1 - weight) * rgb + weight * next.
+glm::dvec3 sampleBilinear(const float* rgb, const float* next, float weight, int w, int h,
+                          glm::dvec2 uv) {
+  const double x = uv.x * w - 0.5, y = uv.y * h - 0.5;
+  // The cell of x (the border cell beyond the last centres); a side of one texel is constant.
+  const int i0 = w > 1 ? std::clamp(int(std::floor(x)), 0, w - 2) : 0;
+  const int j0 = h > 1 ? std::clamp(int(std::floor(y)), 0, h - 2) : 0;
+  const int i1 = std::min(i0 + 1, w - 1), j1 = std::min(j0 + 1, h - 1);
+  const double fx = w > 1 ? x - i0 : 0.0, fy = h > 1 ? y - j0 : 0.0;
   const float keep = 1.0f - weight;
   auto at = [&](int i, int j) {
     const size_t o = (size_t(j) * w + i) * 3;
@@ -40,8 +46,9 @@ glm::dvec3 sampleClamped(const float* rgb, const float* next, float weight, int 
                 b = keep * p[2] + weight * q[2];
     return glm::dvec3(r, g, b);
   };
-  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
-         fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
+  const glm::dvec3 v = (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
+                       fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
+  return glm::max(v, glm::dvec3(0.0));
 }
 
 // Bilinear sample of a glTF base colour texture (default sampler: LINEAR, REPEAT). glTF's
@@ -394,7 +401,7 @@ PixelSource FrameComposer::Impl::shadePixel(double t, const std::vector<MovieTex
     // $L = L_e + \frac{\rho(x)}{\pi} H(x)$
     const MovieTexture& mt = movies[size_t(found)];
     glm::dvec3 H =
-        sampleClamped(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width, mt.height, foundUv);
+        sampleBilinear(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width, mt.height, foundUv);
     L = mat.emission + (mat.reflectance * texFactor / kPi) * H;
     source = PixelSource::kMovie;
   } else {

@@ -9,9 +9,9 @@ exporters do, whose shading must be continuous across every shared edge of copla
                     which is a fine regular grid; a 1.3 x 0.04 x 0.04 m emissive tube lamp near
                     the ceiling, a desk under the window, a camera facing the fan wall that
                     slides slowly sideways over 4 s (frames 0-95 at 24 fps).
-  slivers.gltf      a wall whose left part is a fan of slivers from one corner, their far edges
-                    on a geometric ladder (aspect ratios from about 1:1000 to 1:2), beside a
-                    triangle more than 1,000 times the smallest sliver's area; a tube lamp near it.
+  slivers.gltf      a wall fanned from a point of its bottom edge under a tube lamp: slivers whose
+                    top edges are on a geometric ladder (aspect ratios from about 1:1000 to 1:2),
+                    beside a triangle 1,000 times the thinnest sliver's area.
   t-junctions.gltf  a wall split into one big quad beside a grid of small quads, so the grid's
                     vertices on the shared edge are T-junctions of the big quad's edge.
   ngon.gltf         an L-shaped wall and a wall pierced by a window, each one n-gon triangulated
@@ -267,20 +267,21 @@ def fan_wall(W, H, door, window, top_vertices):
     return dedup(ring, tris)
 
 
-def sliver_fan(W, H, first, ratio, last):
-    """A W x H wall: a fan of slivers from corner (0, 0) to the top edge's points at 0, first,
-    first (1 + ratio), ... up to `last` (each gap `ratio` times the one before), then the rest of
-    the wall as two big triangles from the same corner."""
-    tops = [0.0]
+def sliver_fan(W, H, apex, first, ratio, last):
+    """A W x H wall fanned from apex (apex, 0) on its bottom edge: slivers to the top edge's
+    points apex, apex + first, apex + first (1 + ratio), ... up to `last` (each gap `ratio` times
+    the one before), then big triangles from the same apex to the wall's corners. The thinnest
+    sliver is `first` wide at the top and H long; its neighbour on the left, (apex, 0), (apex, H),
+    (0, H), is W apex H / 2 large."""
+    tops = [apex]
     gap = first
     while tops[-1] + gap < last:
         tops.append(tops[-1] + gap)
         gap *= ratio
     tops.append(last)
-    pts = [(0.0, 0.0), (W, 0.0), (W, H)] + [(x, H) for x in reversed(tops)]
-    tris = [(0, 1, 2), (0, 2, 3)]
-    for i in range(3, len(pts) - 1):
-        tris.append((0, i, i + 1))
+    pts = [(apex, 0.0), (W, 0.0), (W, H)] + [(x, H) for x in reversed(tops)] + [(0.0, H),
+                                                                                 (0.0, 0.0)]
+    tris = [(0, i, i + 1) for i in range(1, len(pts) - 1)]
     checked("slivers", pts, tris, W * H)
     return pts, tris
 
@@ -441,7 +442,9 @@ def small_room(name, far_wall, lamp_z=1.9):
 
 
 def slivers():
-    return small_room("slivers", sliver_fan(4.0, 2.5, first=0.0025, ratio=2.0, last=1.5))
+    # u runs from x = W: the fan's apex is under the lamp, its slivers sweep through the bright
+    # spot the lamp makes on the wall.
+    return small_room("slivers", sliver_fan(4.0, 2.5, apex=2.0, first=0.002, ratio=2.0, last=3.4))
 
 
 def t_junctions():
