@@ -25,7 +25,8 @@
 //    round(r^k), r = sizeRatio, and clamped to [minSize, maxSize]. The paper takes powers of
 //    two (r = 2: up to 4 texels per pixel, 2.2 on average over sizes spread evenly in log);
 //    r = sqrt 2 holds the same pixels with at most 2 (1.4 on average), so fewer texels per
-//    frame;
+//    frame. The n^2 texels go to the two sides in the shape of the node's (u,v) map
+//    (TextureShape, below; texture_size.cpp), each side rounded and clamped the same way;
 //  * events (§4.1): a movie opens when its node becomes chosen and closes when the node leaves
 //    the frustum, is hidden, is replaced by an ancestor or descendant (level change), needs
 //    another size, or has lasted maxLength frames; movies open at the end of the window close

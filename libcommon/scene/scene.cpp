@@ -401,6 +401,13 @@ bool tryMerge(const Tri& ti, const Tri& tj, InputPolygon* out) {
       // Coplanar: D within 1e-7 of the quad's size from i's plane.
       if (std::abs(glm::dot(D - A, n)) > 1e-7 * scale) return false;
       if (!convexQuad(v, n)) return false;
+      // A parallelogram only (to 5 % of its size, which keeps measured rectangles such as the
+      // Cornell box's walls and box tops): its bilinear (u,v) map is then the plane homography
+      // of the shadow masks (transmittance.h) to second order in the departure, so each texel's
+      // shadow is taken at the texel's own point. A trapezoid merged from two triangles of a fan
+      // had its shadows displaced over the whole quad (a desk's shadow on a wall 6 cm too low;
+      // issue 56).
+      if (glm::length((A + B) - (D + C)) > 0.05 * scale) return false;
       // The uv map must be one affine map over the quad (else texturing would change).
       glm::dvec2 predicted = affineUv(ti, D);
       double uvScale = 1.0;

@@ -67,5 +67,24 @@ TEST(InputPolygons, ATrianglesMapStartsOppositeItsLongestEdge) {
   EXPECT_EQ(tops[3].local.v[0], glm::dvec3(5, 0, 0));
 }
 
+// Two triangles merge into a quad only when it is a parallelogram (to 5 %): a trapezoid's
+// bilinear (u,v) map is not the plane homography the shadow masks are rendered with
+// (transmittance.h), and a fan's merged trapezoid had its shadows displaced over the whole quad.
+TEST(InputPolygons, OnlyParallelogramsMerge) {
+  Scene s;
+  s.materials.resize(1);
+  const glm::dvec3 a(0, 0, 0), b(4, 0, 0), c(4, 2, 0), d(0, 2, 0), e(3, 2, 0);
+  addTriangles(s, {{a, b, c}, {a, c, d}}, 0);  // a rectangle
+  addTriangles(s, {{a, b, e}, {a, e, d}}, 0);  // a trapezoid
+  // A measured rectangle, one corner 3 mm off (the Cornell box's floor).
+  addTriangles(s, {{a, b, c + glm::dvec3(0.003, 0, 0)}, {a, c + glm::dvec3(0.003, 0, 0), d}}, 0);
+  const std::vector<InputPolygon> tops = s.inputPolygons();
+  ASSERT_EQ(tops.size(), 4u);
+  EXPECT_EQ(tops[0].local.count, 4);
+  EXPECT_EQ(tops[1].local.count, 3);
+  EXPECT_EQ(tops[2].local.count, 3);
+  EXPECT_EQ(tops[3].local.count, 4);
+}
+
 }  // namespace
 }  // namespace rad
