@@ -89,7 +89,7 @@ TEST(SeamSteps, TheGeneratorWritesTheCommittedScenes) {
   fs::remove_all(dir);
 }
 
-// Before the fixes of issue 56 this frame stepped by 1.8 % on average across the fan wall's
+// Before the fixes of issue 56 this frame stepped by 2.3 % on average across the fan wall's
 // edges and by up to 4.5 % (texel borders clamped to the edge, a triangle's texels beyond its
 // long edge filled flat, square textures on long triangles, shadow samples per top).
 TEST(SeamSteps, AFanTriangulatedWallShadesWithoutSteps) {
