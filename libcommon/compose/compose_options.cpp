@@ -33,6 +33,11 @@ const ParameterTable<ComposeOptions>& composeParameters() {
               "shade every sample of every pixel's filter footprint (default: one sample a "
               "pixel where the footprint is one untextured surface, the filter's blur there "
               "taken to second order from the neighbouring centres)");
+    t.addFlag("no-edge-coverage", &O::edgeCoverage, false,
+              "give each sample's cell its sample's radiance where an edge crosses it (default: "
+              "the radiance of each side weighed by the area it covers, from the polygons' "
+              "outlines; the edge is placed to 1/S px without it)",
+              Group::kQuality);
     return t;
   }();
   return table;

@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "libcommon/compose/edge_cells.h"
 #include "libcommon/compose/footprint_filter.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
@@ -215,6 +216,7 @@ struct FrameComposer::Impl {
   PixelSampling sampling;
   SampleGrid grid;                          // sampling.grid(size)
   std::unique_ptr<FootprintFilter> filter;  // null: the pixel centres, unfiltered
+  bool edgeCells = true;                    // weigh the edge cells by coverage (edge_cells.h)
   std::vector<InputPolygon> tops;
   std::vector<int> objectNodes;        // mesh node of each item object
   std::vector<size_t> topObject;       // per top, its item object (index into transforms)
@@ -227,6 +229,7 @@ struct FrameComposer::Impl {
   std::vector<uint8_t> edgeMask;              // refineSilhouettes': samples with another neighbour
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
+  std::vector<size_t> edgeCandidates;  // weighEdgeCells': the edges and their neighbours
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
@@ -238,11 +241,15 @@ struct FrameComposer::Impl {
                           const PrimaryRays& rays, glm::dvec2 pixel, int top, float* rgb) const;
   void composeFiltered(double t, const std::vector<MovieTexture>& movies,
                        const VisibleTops& visible, const ActiveMovies& active,
-                       const PrimaryRays& rays, const std::vector<size_t>& edges,
-                       ComposedFrame& out);
+                       const CameraView& view, const PrimaryRays& rays,
+                       const std::vector<size_t>& edges, ComposedFrame& out);
+  // After the samples are shaded: the filter's edge cells (edge_cells.h), from the samples
+  // whose id differed from a neighbour's before refineSilhouettes and their neighbours.
+  void weighEdgeCells(const VisibleTops& visible, const CameraView& view, const PrimaryRays& rays,
+                      const std::vector<size_t>& edges);
 
   Impl(const Scene& s, const GlobalSolution& g, ImageSize sz, int cam, const PixelSampling& ps,
-       bool everySample)
+       bool everySample, bool edgeCoverage)
       : scene(s),
         solution(g),
         size(sz),
@@ -251,6 +258,7 @@ struct FrameComposer::Impl {
         grid(ps.grid(sz)),
         filter(ps.filter.isNone() ? nullptr
                                   : std::make_unique<FootprintFilter>(ps, sz, everySample)),
+        edgeCells(edgeCoverage),
         tops(s.inputPolygons()),
         renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
@@ -286,8 +294,10 @@ struct FrameComposer::Impl {
 };
 
 FrameComposer::FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size,
-                             int cameraNode, const PixelSampling& sampling, bool everySample)
-    : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode, sampling, everySample)) {}
+                             int cameraNode, const PixelSampling& sampling, bool everySample,
+                             bool edgeCoverage)
+    : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode, sampling, everySample,
+                                   edgeCoverage)) {}
 
 FrameComposer::~FrameComposer() = default;
 
@@ -390,7 +400,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   out.rgb.assign(n * 3, 0.0f);
   out.source.assign(n, PixelSource::kBackground);
   if (m.filter) {
-    m.composeFiltered(t, movies, visible, active, rays, edges, out);
+    m.composeFiltered(t, movies, visible, active, view, rays, edges, out);
     return;
   }
   std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0),
@@ -424,8 +434,8 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
 // surface, as fallen back when one of them fell back, as a movie pixel otherwise.
 void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTexture>& movies,
                                           const VisibleTops& visible, const ActiveMovies& active,
-                                          const PrimaryRays& rays, const std::vector<size_t>& edges,
-                                          ComposedFrame& out) {
+                                          const CameraView& view, const PrimaryRays& rays,
+                                          const std::vector<size_t>& edges, ComposedFrame& out) {
   filter->plan(items.id, edges, texturedItem);
   const std::vector<uint8_t>& needed = filter->needed();
   const int gw = items.width, gh = items.height;
@@ -474,6 +484,7 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
             }
         }
     });
+  if (edgeCells) weighEdgeCells(visible, view, rays, edges);
   static_assert(sizeof(PixelSource) == 1, "sample sources are read as bytes");
   const auto* tags = reinterpret_cast<const uint8_t*>(sampleSource.data());
   std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0);
@@ -495,6 +506,26 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
     out.fallbackPixels += rowFallback[row];
   }
   out.coveredPixels = out.moviePixels + out.fallbackPixels;
+}
+
+void FrameComposer::Impl::weighEdgeCells(const VisibleTops& visible, const CameraView& view,
+                                         const PrimaryRays& rays,
+                                         const std::vector<size_t>& edges) {
+  // A sample that refineSilhouettes changed may now differ from a neighbour that was not an
+  // edge: the neighbours are candidates too (findEdgeCells skips the cells that are not edges).
+  const size_t gw = size_t(items.width), n = items.id.size();
+  edgeCandidates.clear();
+  for (size_t p : edges) {
+    edgeCandidates.push_back(p);
+    if (p % gw > 0) edgeCandidates.push_back(p - 1);
+    if (p % gw + 1 < gw) edgeCandidates.push_back(p + 1);
+    if (p >= gw) edgeCandidates.push_back(p - gw);
+    if (p + gw < n) edgeCandidates.push_back(p + gw);
+  }
+  const EdgeCellInputs in{
+      grid, items.id, filter->needed(), sampleRgb.data(), visible.world, visible.normals,
+      view, rays};
+  filter->setEdgeCells(findEdgeCells(in, edgeCandidates));
 }
 
 // One covered sample at image position `pixel` on top-level patch `top`: its radiance into

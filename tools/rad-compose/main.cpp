@@ -74,6 +74,7 @@ rad::ComposeSequenceOptions resolve(rad::ComposeOptions& o, const rad::Scene& sc
   o.filterWidth = c.sampling.filter.width;
   o.pixelSamples = c.sampling.samplesPerAxis;
   c.everySample = o.everySample;
+  c.edgeCoverage = o.edgeCoverage;
   return c;
 }
 
