@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "libcommon/compose/cell_coverage.h"
+#include "libcommon/core/error.h"
 #include "libcommon/gl/item_buffer.h"
 
 namespace rad {
@@ -54,88 +57,92 @@ double planeDistance(const EdgeCellInputs& in, int t, const glm::dvec3& o, const
   return glm::dot(in.normals[size_t(t)], in.world[size_t(t)].v[0] - o) / denom;
 }
 
+// The edge cell of shaded sample p, into e; false when p is no edge cell, or its other side is
+// not shaded, or the outline's polygon could not be projected.
+bool edgeCellAt(const EdgeCellInputs& in, const std::vector<ProjectedTop>& projected, size_t p,
+                EdgeCell& e) {
+  const ImageSize g = in.grid.size();
+  const int i = int(p % size_t(g.width)), j = int(p / size_t(g.width));
+  const uint32_t a = in.ids[p];
+  const float* La = in.sampleRgb + 3 * p;
+  // The other side: the shaded 4-neighbour of another item with the largest luminance step.
+  size_t q = in.ids.size();
+  double best = -1.0;
+  for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+    if (i + di < 0 || i + di >= g.width || j + dj < 0 || j + dj >= g.height) continue;
+    const size_t r = size_t(j + dj) * g.width + size_t(i + di);
+    if (in.ids[r] == a || !in.shaded[r]) continue;
+    const double step = std::abs(luminanceOf(in.sampleRgb + 3 * r) - luminanceOf(La));
+    if (step > best) best = step, q = r;
+  }
+  if (q == in.ids.size()) return false;
+  const uint32_t b = in.ids[q];
+  const glm::dvec2 centre = in.grid.position(i, j);
+  // Whose outline the boundary is: a's unless b is in front of a's plane at the sample.
+  bool byOther = a == kNoItem;
+  if (a != kNoItem && b != kNoItem) {
+    glm::dvec3 o, d;
+    in.rays.line(centre, o, d);
+    const double sa = planeDistance(in, int(a - 1), o, d), sb = planeDistance(in, int(b - 1), o, d);
+    byOther = sb > 0.0 && sb < sa * (1.0 - 1e-7);
+  }
+  const ProjectedTop& outline = projected[(byOther ? b : a) - 1];
+  if (outline.count == 0) return false;
+  const CellCoverage cov =
+      polygonCellCoverage(outline.v.data(), outline.count, centre, 0.5 / in.grid.perAxis);
+  e.sample = p;
+  if (byOther) {
+    // a has the rest of the cell, whose centroid balances b's about the centre.
+    const double rest = 1.0 - cov.fraction;
+    e.coverage = float(rest);
+    const glm::dvec2 d = rest > 1e-12 ? -cov.fraction * cov.centroid / rest : glm::dvec2(0.0);
+    e.dx = float(d.x), e.dy = float(d.y);
+  } else {
+    e.coverage = float(cov.fraction);
+    e.dx = float(cov.centroid.x), e.dy = float(cov.centroid.y);
+  }
+  const float* Lb = in.sampleRgb + 3 * q;
+  for (int ch = 0; ch < 3; ++ch) e.step[ch] = La[ch] - Lb[ch];
+  return true;
+}
+
 }  // namespace
 
 std::vector<EdgeCell> findEdgeCells(const EdgeCellInputs& in,
-                                    const std::vector<size_t>& candidates) {
+                                    const std::vector<uint8_t>& candidates) {
   const ImageSize g = in.grid.size();
   const size_t n = size_t(g.pixelCount());
-  // Each candidate once, in sample order.
-  std::vector<size_t> cells(candidates);
-  std::sort(cells.begin(), cells.end());
-  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-  while (!cells.empty() && cells.back() >= n) cells.pop_back();
-  // The tops the cells show, projected once.
-  std::vector<ProjectedTop> projected(in.world.size());
+  if (candidates.size() != n)
+    throw Error(ExitCode::kInternal, "compose", "edge candidates are not the sample grid's size");
+  // The shaded candidates, in sample order.
+  std::vector<size_t> cells;
+  for (size_t p = 0; p < n; ++p) {
+    const void* next = std::memchr(&candidates[p], 1, n - p);
+    if (next == nullptr) break;
+    p = size_t(static_cast<const uint8_t*>(next) - candidates.data());
+    if (in.shaded[p]) cells.push_back(p);
+  }
+  // The tops the cells and their neighbours show, projected once.
   std::vector<char> wanted(in.world.size(), 0);
-  for (size_t p : cells)
-    if (in.ids[p] != kNoItem && in.ids[p] - 1 < wanted.size()) wanted[in.ids[p] - 1] = 1;
-  for (size_t p : cells) {  // and their neighbours'
+  for (size_t p : cells) {
     const int i = int(p % size_t(g.width)), j = int(p / size_t(g.width));
-    for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+    for (const auto& [di, dj] : {std::pair{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
       if (i + di < 0 || i + di >= g.width || j + dj < 0 || j + dj >= g.height) continue;
       const uint32_t id = in.ids[size_t(j + dj) * g.width + size_t(i + di)];
       if (id != kNoItem && id - 1 < wanted.size()) wanted[id - 1] = 1;
     }
   }
+  std::vector<ProjectedTop> projected(in.world.size());
   for (size_t t = 0; t < projected.size(); ++t)
     if (wanted[t] && in.world[t].count >= 3)
       projected[t] = projectTop(in.world[t], in.view, in.grid.image);
-  const double half = 0.5 / in.grid.perAxis;
   std::vector<EdgeCell> found(cells.size());
   std::vector<uint8_t> isCell(cells.size(), 0);
-  tbb::parallel_for(size_t(0), cells.size(), [&](size_t c) {
-    const size_t p = cells[c];
-    if (!in.shaded[p]) return;
-    const int i = int(p % size_t(g.width)), j = int(p / size_t(g.width));
-    const uint32_t a = in.ids[p];
-    const float* La = in.sampleRgb + 3 * p;
-    // The other side: the shaded 4-neighbour of another item with the largest luminance step.
-    size_t q = n;
-    double best = -1.0;
-    for (const auto& [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-      if (i + di < 0 || i + di >= g.width || j + dj < 0 || j + dj >= g.height) continue;
-      const size_t r = size_t(j + dj) * g.width + size_t(i + di);
-      if (in.ids[r] == a || !in.shaded[r]) continue;
-      const double step = std::abs(luminanceOf(in.sampleRgb + 3 * r) - luminanceOf(La));
-      if (step > best) best = step, q = r;
-    }
-    if (q == n) return;
-    const uint32_t b = in.ids[q];
-    const glm::dvec2 centre = in.grid.position(i, j);
-    auto coverage = [&](uint32_t item, CellCoverage& cov) {
-      const ProjectedTop& pt = projected[item - 1];
-      if (pt.count == 0) return false;
-      cov = polygonCellCoverage(pt.v.data(), pt.count, centre, half);
-      return true;
-    };
-    // Whose outline the boundary is: a's unless b is in front of a's plane at the sample.
-    bool byOther = a == kNoItem;
-    if (a != kNoItem && b != kNoItem) {
-      glm::dvec3 o, d;
-      in.rays.line(centre, o, d);
-      const double sa = planeDistance(in, int(a - 1), o, d),
-                   sb = planeDistance(in, int(b - 1), o, d);
-      byOther = sb > 0.0 && sb < sa * (1.0 - 1e-7);
-    }
-    CellCoverage cov;
-    if (!coverage(byOther ? b : a, cov)) return;
-    EdgeCell& e = found[c];
-    e.sample = p;
-    if (byOther) {
-      // a has the rest of the cell, whose centroid balances b's about the centre.
-      const double rest = 1.0 - cov.fraction;
-      e.coverage = float(rest);
-      const glm::dvec2 d = rest > 1e-12 ? -cov.fraction * cov.centroid / rest : glm::dvec2(0.0);
-      e.dx = float(d.x), e.dy = float(d.y);
-    } else {
-      e.coverage = float(cov.fraction);
-      e.dx = float(cov.centroid.x), e.dy = float(cov.centroid.y);
-    }
-    const float* Lb = in.sampleRgb + 3 * q;
-    for (int ch = 0; ch < 3; ++ch) e.step[ch] = La[ch] - Lb[ch];
-    isCell[c] = 1;
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 512),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t c = r.begin(); c < r.end(); ++c)
+                        isCell[c] = edgeCellAt(in, projected, cells[c], found[c]);
+                    });
   std::vector<EdgeCell> out;
   for (size_t c = 0; c < cells.size(); ++c)
     if (isCell[c]) out.push_back(found[c]);

@@ -35,9 +35,9 @@ struct EdgeCellInputs {
   const PrimaryRays& rays;
 };
 
-// The edge cells among `candidates` (grid indices, any order, repeats allowed; a cell that is
-// not an edge cell is skipped) in increasing sample order.
+// The edge cells among the samples marked 1 in `candidates` (one byte a grid sample; a sample
+// that is no edge cell is skipped), in increasing sample order.
 std::vector<EdgeCell> findEdgeCells(const EdgeCellInputs& in,
-                                    const std::vector<size_t>& candidates);
+                                    const std::vector<uint8_t>& candidates);
 
 }  // namespace rad

@@ -85,7 +85,6 @@ void FootprintFilter::plan(const std::vector<uint32_t>& ids, const std::vector<s
                            const std::vector<char>& fullItem) {
   const ImageSize g = grid_.size();
   const int w = grid_.image.width, h = grid_.image.height, s = grid_.perAxis;
-  const int mid = (s - 1) / 2, m = grid_.margin;
   if (ids.size() != size_t(g.pixelCount()))
     throw Error(ExitCode::kInternal, "compose", "item buffer is not the sample grid's size");
   if (neighbour_ < 0.0) {
@@ -95,16 +94,10 @@ void FootprintFilter::plan(const std::vector<uint32_t>& ids, const std::vector<s
     // So the pixels within uniformReach_ of an edge sample, and those whose centre is on an item
     // that needs full sampling, are full; the rest are uniform.
     full_.assign(size_t(w) * h, 0);
-    // The pixels c with |i - centre(c)| <= reach: s (c + m) + mid in [i - reach, i + reach].
-    auto span = [&](int i, int n, int& first, int& last) {
-      const int lo = i - uniformReach_ - mid, hi = i + uniformReach_ - mid;
-      first = std::max(0, (lo + s - 1 + s * 1024) / s - 1024 - m);  // ceil(lo / s) - m
-      last = std::min(n - 1, (hi + s * 1024) / s - 1024 - m);       // floor(hi / s) - m
-    };
     for (size_t e : edges) {
       int c0, c1, r0, r1;
-      span(int(e % size_t(g.width)), w, c0, c1);
-      span(int(e / size_t(g.width)), h, r0, r1);
+      pixelSpan(int(e % size_t(g.width)), uniformReach_, w, c0, c1);
+      pixelSpan(int(e / size_t(g.width)), uniformReach_, h, r0, r1);
       for (int row = r0; row <= r1; ++row)
         std::fill_n(full_.begin() + ptrdiff_t(size_t(row) * w + size_t(std::max(c0, 0))),
                     std::max(0, c1 - c0 + 1), uint8_t(1));
@@ -167,6 +160,8 @@ uint8_t FootprintFilter::filterPixel(const float* sampleRgb, const uint8_t* samp
     const size_t first =
         size_t(grid_.centre(row) - reach_) * gw + size_t(grid_.centre(col) - reach_);
     const double* w = taps2_.data();
+    const bool edgeCells =
+        !edgeCells_.empty() && edgeWindow_[size_t(row) * grid_.image.width + col];
     for (size_t l = 0; l < n; ++l) {
       const size_t p = first + l * gw;
       const float* L = sampleRgb + 3 * p;
@@ -177,7 +172,7 @@ uint8_t FootprintFilter::filterPixel(const float* sampleRgb, const uint8_t* samp
         tag = std::max(tag, sampleTag[p + k]);
       }
       // The edge cells of this row of the window (the header's "Edge cells").
-      if (edgeCells_.empty()) continue;
+      if (!edgeCells) continue;
       for (size_t k = 0; k < n; ++k) {
         const int32_t e = edgeCellOf_[p + k];
         if (e < 0) continue;
@@ -209,13 +204,29 @@ uint8_t FootprintFilter::filterPixel(const float* sampleRgb, const uint8_t* samp
   return tag;
 }
 
+void FootprintFilter::pixelSpan(int i, int reach, int n, int& first, int& last) const {
+  // The pixels c with |i - centre(c)| <= reach: s (c + m) + mid in [i - reach, i + reach].
+  const int s = grid_.perAxis, mid = (s - 1) / 2, m = grid_.margin;
+  const int lo = i - reach - mid, hi = i + reach - mid;
+  first = std::max(0, (lo + s - 1 + s * 1024) / s - 1024 - m);  // ceil(lo / s) - m
+  last = std::min(n - 1, (hi + s * 1024) / s - 1024 - m);       // floor(hi / s) - m
+}
+
 void FootprintFilter::setEdgeCells(std::vector<EdgeCell> cells) {
   for (const EdgeCell& c : edgeCells_) edgeCellOf_[c.sample] = -1;
   edgeCells_ = std::move(cells);
+  const int w = grid_.image.width, h = grid_.image.height, gw = grid_.size().width;
+  edgeWindow_.assign(size_t(w) * h, 0);
   for (size_t i = 0; i < edgeCells_.size(); ++i) {
-    if (edgeCells_[i].sample >= edgeCellOf_.size() || edgeCellOf_[edgeCells_[i].sample] >= 0)
+    const size_t p = edgeCells_[i].sample;
+    if (p >= edgeCellOf_.size() || edgeCellOf_[p] >= 0)
       throw Error(ExitCode::kInternal, "compose", "edge cell outside the grid or given twice");
-    edgeCellOf_[edgeCells_[i].sample] = int32_t(i);
+    edgeCellOf_[p] = int32_t(i);
+    int c0, c1, r0, r1;
+    pixelSpan(int(p % size_t(gw)), reach_, w, c0, c1);
+    pixelSpan(int(p / size_t(gw)), reach_, h, r0, r1);
+    for (int row = r0; row <= r1; ++row)
+      for (int col = c0; col <= c1; ++col) edgeWindow_[size_t(row) * w + col] = 1;
   }
 }
 

@@ -111,11 +111,15 @@ class FootprintFilter {
   std::vector<double> taps2_;   // taps_[k] taps_[l], row l major
   std::vector<EdgeCell> edgeCells_;
   std::vector<int32_t> edgeCellOf_;  // per grid sample: index in edgeCells_, or -1
-  int reach_ = 0;                    // K
-  double neighbour_ = 0.0;           // a of the 3 x 3 kernel; < 0: no shortcut
-  int uniformReach_ = 0;             // grid samples max(radius, 1) px from a centre
-  bool interpolate_ = true;          // !everySample
-  std::vector<double> lagrange_;     // per sub-pixel offset k: 3 weights (centres -1, 0, +1)
+  std::vector<uint8_t> edgeWindow_;  // per pixel: its full window holds an edge cell
+  // The image pixels c (clamped to [0, n)) whose centre's grid index is within `reach` of grid
+  // index i, along one axis.
+  void pixelSpan(int i, int reach, int n, int& first, int& last) const;
+  int reach_ = 0;                 // K
+  double neighbour_ = 0.0;        // a of the 3 x 3 kernel; < 0: no shortcut
+  int uniformReach_ = 0;          // grid samples max(radius, 1) px from a centre
+  bool interpolate_ = true;       // !everySample
+  std::vector<double> lagrange_;  // per sub-pixel offset k: 3 weights (centres -1, 0, +1)
   std::vector<uint8_t> needed_, full_;
   std::vector<uint8_t> smoothCentres_;
   std::vector<uint8_t> offCentre_;  // per grid pixel: offCentreNeeded()

@@ -229,7 +229,7 @@ struct FrameComposer::Impl {
   std::vector<uint8_t> edgeMask;              // refineSilhouettes': samples with another neighbour
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
-  std::vector<size_t> edgeCandidates;  // weighEdgeCells': the edges and their neighbours
+  std::vector<uint8_t> edgeCandidates;  // weighEdgeCells': the edges and their neighbours
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
@@ -514,13 +514,13 @@ void FrameComposer::Impl::weighEdgeCells(const VisibleTops& visible, const Camer
   // A sample that refineSilhouettes changed may now differ from a neighbour that was not an
   // edge: the neighbours are candidates too (findEdgeCells skips the cells that are not edges).
   const size_t gw = size_t(items.width), n = items.id.size();
-  edgeCandidates.clear();
+  edgeCandidates.assign(n, 0);
   for (size_t p : edges) {
-    edgeCandidates.push_back(p);
-    if (p % gw > 0) edgeCandidates.push_back(p - 1);
-    if (p % gw + 1 < gw) edgeCandidates.push_back(p + 1);
-    if (p >= gw) edgeCandidates.push_back(p - gw);
-    if (p + gw < n) edgeCandidates.push_back(p + gw);
+    edgeCandidates[p] = 1;
+    if (p % gw > 0) edgeCandidates[p - 1] = 1;
+    if (p % gw + 1 < gw) edgeCandidates[p + 1] = 1;
+    if (p >= gw) edgeCandidates[p - gw] = 1;
+    if (p + gw < n) edgeCandidates[p + gw] = 1;
   }
   const EdgeCellInputs in{
       grid, items.id, filter->needed(), sampleRgb.data(), visible.world, visible.normals,
