@@ -16,9 +16,9 @@ struct CellCoverage {
 };
 
 // The part of the axis-aligned square of half side `half` around `centre` covered by the
-// polygon poly[0..count) (pixel coordinates; convex, either orientation, count <= 5). Exact to
-// rounding (Sutherland-Hodgman clip to the square, then the shoelace area and centroid). A
-// degenerate polygon covers nothing.
+// polygon poly[0..count) (pixel coordinates; convex, either orientation, count <= 12). Exact to
+// rounding: the square clipped by the half-plane of each edge that crosses it, then the
+// shoelace area and centroid. A degenerate polygon covers nothing.
 CellCoverage polygonCellCoverage(const glm::dvec2* poly, int count, glm::dvec2 centre, double half);
 
 }  // namespace rad

@@ -38,6 +38,10 @@ const ParameterTable<ComposeOptions>& composeParameters() {
               "the radiance of each side weighed by the area it covers, from the polygons' "
               "outlines; the edge is placed to 1/S px without it)",
               Group::kQuality);
+    t.add("edge-contrast", &O::edgeContrast,
+          "weigh an edge cell by coverage only where the luminance step across it is at least "
+          "this share of its brighter side (0: every edge cell; smaller: more exact, slower)",
+          ParameterCheck::range(0.0, 1.0), Group::kQuality);
     return t;
   }();
   return table;

@@ -36,9 +36,10 @@ struct ComposeOptions {
   std::optional<PixelFilterType> pixelFilter;
   std::optional<double> filterWidth;
   std::optional<int> pixelSamples;
-  bool everySample = false;  // shade every sample (no shortcut on uniform footprints)
-  bool edgeCoverage = true;  // weigh the cells an edge crosses by coverage (edge_cells.h)
-  std::string report;        // JSON report file; empty: none
+  bool everySample = false;   // shade every sample (no shortcut on uniform footprints)
+  bool edgeCoverage = true;   // weigh the cells an edge crosses by coverage (edge_cells.h)
+  double edgeContrast = 0.1;  // EdgeCellInputs::minContrast
+  std::string report;         // JSON report file; empty: none
 
   // Provenance parameters: composeParameters() under their flags' names, and output. An unset
   // fps or exposure is null.

@@ -76,6 +76,8 @@ bool edgeCellAt(const EdgeCellInputs& in, const std::vector<ProjectedTop>& proje
     if (step > best) best = step, q = r;
   }
   if (q == in.ids.size()) return false;
+  const double Ya = luminanceOf(La), Yb = luminanceOf(in.sampleRgb + 3 * q);
+  if (best < in.minContrast * std::max(Ya, Yb)) return false;
   const uint32_t b = in.ids[q];
   const glm::dvec2 centre = in.grid.position(i, j);
   // Whose outline the boundary is: a's unless b is in front of a's plane at the sample.
@@ -122,20 +124,10 @@ std::vector<EdgeCell> findEdgeCells(const EdgeCellInputs& in,
     p = size_t(static_cast<const uint8_t*>(next) - candidates.data());
     if (in.shaded[p]) cells.push_back(p);
   }
-  // The tops the cells and their neighbours show, projected once.
-  std::vector<char> wanted(in.world.size(), 0);
-  for (size_t p : cells) {
-    const int i = int(p % size_t(g.width)), j = int(p / size_t(g.width));
-    for (const auto& [di, dj] : {std::pair{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-      if (i + di < 0 || i + di >= g.width || j + dj < 0 || j + dj >= g.height) continue;
-      const uint32_t id = in.ids[size_t(j + dj) * g.width + size_t(i + di)];
-      if (id != kNoItem && id - 1 < wanted.size()) wanted[id - 1] = 1;
-    }
-  }
+  // The tops seen (placed at the frame's time), projected once.
   std::vector<ProjectedTop> projected(in.world.size());
   for (size_t t = 0; t < projected.size(); ++t)
-    if (wanted[t] && in.world[t].count >= 3)
-      projected[t] = projectTop(in.world[t], in.view, in.grid.image);
+    if (in.world[t].count >= 3) projected[t] = projectTop(in.world[t], in.view, in.grid.image);
   std::vector<EdgeCell> found(cells.size());
   std::vector<uint8_t> isCell(cells.size(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 512),

@@ -29,10 +29,14 @@ struct EdgeCellInputs {
   const std::vector<uint32_t>& ids;    // per grid sample: top-level index + 1, 0 background
   const std::vector<uint8_t>& shaded;  // per grid sample: 1 where sampleRgb holds its value
   const float* sampleRgb;              // 3 a grid sample
-  const std::vector<Polygon>& world;   // per top, placed at the frame's time (the ones seen)
+  const std::vector<Polygon>& world;   // per top at the frame's time; count 0: not seen
   const std::vector<glm::dvec3>& normals;
   const CameraView& view;
   const PrimaryRays& rays;
+  // A cell whose luminance step is less than this share of its brighter side keeps its
+  // sample's value: the 1/s px placement of a small step is a small error, and most of a
+  // frame's edge cells are seams and creases of little contrast. 0: every edge cell.
+  double minContrast = 0.0;
 };
 
 // The edge cells among the samples marked 1 in `candidates` (one byte a grid sample; a sample

@@ -217,6 +217,7 @@ struct FrameComposer::Impl {
   SampleGrid grid;                          // sampling.grid(size)
   std::unique_ptr<FootprintFilter> filter;  // null: the pixel centres, unfiltered
   bool edgeCells = true;                    // weigh the edge cells by coverage (edge_cells.h)
+  double edgeContrast = 0.0;                // EdgeCellInputs::minContrast
   std::vector<InputPolygon> tops;
   std::vector<int> objectNodes;        // mesh node of each item object
   std::vector<size_t> topObject;       // per top, its item object (index into transforms)
@@ -249,7 +250,7 @@ struct FrameComposer::Impl {
                       const std::vector<size_t>& edges);
 
   Impl(const Scene& s, const GlobalSolution& g, ImageSize sz, int cam, const PixelSampling& ps,
-       bool everySample, bool edgeCoverage)
+       bool everySample, bool edgeCoverage, double minContrast)
       : scene(s),
         solution(g),
         size(sz),
@@ -259,6 +260,7 @@ struct FrameComposer::Impl {
         filter(ps.filter.isNone() ? nullptr
                                   : std::make_unique<FootprintFilter>(ps, sz, everySample)),
         edgeCells(edgeCoverage),
+        edgeContrast(minContrast),
         tops(s.inputPolygons()),
         renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
@@ -295,9 +297,9 @@ struct FrameComposer::Impl {
 
 FrameComposer::FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size,
                              int cameraNode, const PixelSampling& sampling, bool everySample,
-                             bool edgeCoverage)
+                             bool edgeCoverage, double edgeContrast)
     : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode, sampling, everySample,
-                                   edgeCoverage)) {}
+                                   edgeCoverage, edgeContrast)) {}
 
 FrameComposer::~FrameComposer() = default;
 
@@ -327,7 +329,10 @@ CameraView FrameComposer::Impl::renderItems(double t) {
 // off (the Cornell box: the wall behind a box's top edge, much brighter than the box). A pixel
 // whose item differs from a 4-neighbour's casts that ray (Embree, the scene's patches at t) and
 // takes the patch it meets when that patch faces the camera, as the rasterizer's back-face rule
-// would; a pixel whose ray meets nothing, or a back face, keeps its item.
+// would; a pixel whose ray meets nothing, or a back face, keeps its item. A filtered frame whose
+// edge cells are weighed by coverage casts no ray: a cell whose sample is that close to an edge
+// takes each side's share of it from the polygons' outlines (edge_cells.h), whichever item the
+// sample shows, and the item buffer's ids are then rad-intervals' own, so no sample falls back.
 std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
   const int w = items.width, h = items.height;  // the sample grid's (sample_grid.h)
   // Each pair of neighbours compared once (right, below), both marked when they differ; then
@@ -345,7 +350,7 @@ std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const Prima
   std::vector<size_t> edge;
   for (size_t p = 0; p < edgeMask.size(); ++p)
     if (edgeMask[p]) edge.push_back(p);
-  if (edge.empty()) return edge;
+  if (edge.empty() || (filter && edgeCells)) return edge;
   if (!rayScene) {
     const std::vector<double>& k = solution.keyTimes;
     rayScene = std::make_unique<SceneVisibility>(scene, solution.hierarchy, k.front(), k.back());
@@ -524,7 +529,7 @@ void FrameComposer::Impl::weighEdgeCells(const VisibleTops& visible, const Camer
   }
   const EdgeCellInputs in{
       grid, items.id, filter->needed(), sampleRgb.data(), visible.world, visible.normals,
-      view, rays};
+      view, rays,     edgeContrast};
   filter->setEdgeCells(findEdgeCells(in, edgeCandidates));
 }
 

@@ -75,6 +75,7 @@ rad::ComposeSequenceOptions resolve(rad::ComposeOptions& o, const rad::Scene& sc
   o.pixelSamples = c.sampling.samplesPerAxis;
   c.everySample = o.everySample;
   c.edgeCoverage = o.edgeCoverage;
+  c.edgeContrast = o.edgeContrast;
   return c;
 }
 

@@ -36,6 +36,7 @@ struct ComposeSequenceOptions {
   PixelSampling sampling = PixelSampling::pixelCentres();
   bool everySample = false;
   bool edgeCoverage = true;
+  double edgeContrast = 0.0;  // EdgeCellInputs::minContrast
 };
 
 struct ComposeFrameStats {
