@@ -47,6 +47,11 @@ const ParameterTable<ComposeOptions>& composeParameters() {
   return table;
 }
 
+const std::vector<Preset>& composePresets() {
+  static const std::vector<Preset> presets{{"final", {{"edge-contrast", "0"}}}};
+  return presets;
+}
+
 nlohmann::json ComposeOptions::toJson() const {
   nlohmann::json out = composeParameters().toJson(*this);
   out["output"] = output;  // -o

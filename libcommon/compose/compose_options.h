@@ -46,8 +46,10 @@ struct ComposeOptions {
   nlohmann::json toJson() const;
 };
 
-// rad-compose's parameters, declared once (libcommon/core/parameter_table.h). It has no quality
-// preset: the README's recommended settings leave it as shipped.
+// rad-compose's parameters, declared once (libcommon/core/parameter_table.h).
 const ParameterTable<ComposeOptions>& composeParameters();
+// Its quality presets: final weighs every edge cell by coverage (--edge-contrast 0); its grid is
+// the intervals' (their final preset samples more).
+const std::vector<Preset>& composePresets();
 
 }  // namespace rad
