@@ -100,7 +100,8 @@ class FootprintFilter {
   // `sampleTag` (one a grid sample) over the samples read.
   uint8_t filterPixel(const float* sampleRgb, const uint8_t* sampleTag, int col, int row,
                       float* rgb) const;
-  // The grid samples pixel (col, row)'s value reads, as (index, weight > 0) pairs.
+  // The grid samples pixel (col, row)'s value reads, as (index, weight > 0) pairs: the cells'
+  // weights, without the edge cells' terms (setEdgeCells).
   template <class F>
   void forEachSampleOf(int col, int row, F f) const;
 

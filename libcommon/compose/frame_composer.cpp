@@ -230,7 +230,7 @@ struct FrameComposer::Impl {
   std::vector<uint8_t> edgeMask;              // refineSilhouettes': samples with another neighbour
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
-  std::vector<uint8_t> edgeCandidates;  // weighEdgeCells': the edges and their neighbours
+  std::vector<uint8_t> edgeCandidates;  // weighEdgeCells': the edge samples
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
@@ -244,8 +244,8 @@ struct FrameComposer::Impl {
                        const VisibleTops& visible, const ActiveMovies& active,
                        const CameraView& view, const PrimaryRays& rays,
                        const std::vector<size_t>& edges, ComposedFrame& out);
-  // After the samples are shaded: the filter's edge cells (edge_cells.h), from the samples
-  // whose id differed from a neighbour's before refineSilhouettes and their neighbours.
+  // After the samples are shaded: the filter's edge cells (edge_cells.h), among the samples
+  // whose id differs from a neighbour's.
   void weighEdgeCells(const VisibleTops& visible, const CameraView& view, const PrimaryRays& rays,
                       const std::vector<size_t>& edges);
 
@@ -516,17 +516,10 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
 void FrameComposer::Impl::weighEdgeCells(const VisibleTops& visible, const CameraView& view,
                                          const PrimaryRays& rays,
                                          const std::vector<size_t>& edges) {
-  // A sample that refineSilhouettes changed may now differ from a neighbour that was not an
-  // edge: the neighbours are candidates too (findEdgeCells skips the cells that are not edges).
-  const size_t gw = size_t(items.width), n = items.id.size();
-  edgeCandidates.assign(n, 0);
-  for (size_t p : edges) {
-    edgeCandidates[p] = 1;
-    if (p % gw > 0) edgeCandidates[p - 1] = 1;
-    if (p % gw + 1 < gw) edgeCandidates[p + 1] = 1;
-    if (p >= gw) edgeCandidates[p - gw] = 1;
-    if (p + gw < n) edgeCandidates[p + gw] = 1;
-  }
+  // refineSilhouettes cast no ray (edge cells are weighed): `edges` are the samples whose id
+  // differs from a 4-neighbour's, the edge cells' candidates.
+  edgeCandidates.assign(items.id.size(), 0);
+  for (size_t p : edges) edgeCandidates[p] = 1;
   const EdgeCellInputs in{
       grid, items.id, filter->needed(), sampleRgb.data(), visible.world, visible.normals,
       view, rays,     edgeContrast};

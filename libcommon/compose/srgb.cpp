@@ -18,9 +18,7 @@ double srgbEncode(double x) {
 
 namespace {
 
-uint8_t srgbCode(double v) {
-  return uint8_t(std::lround(255.0 * srgbEncode(v)));
-}
+uint8_t srgbCode(double v) { return uint8_t(std::lround(255.0 * srgbEncode(v))); }
 
 uint32_t floatBits(float f) {
   uint32_t u;
@@ -68,8 +66,8 @@ struct SrgbThresholds {
   // couple: near 1 a bucket is 1/128 of the value wide, a code step about twice that).
   uint8_t code(float f) const {
     const uint32_t u = floatBits(f);
-    if (u & 0x80000000u) return 0;  // negative, -0
-    if (u >= kOneBits) return 255;  // 1 and above: t[255] <= 1
+    if (u & 0x80000000u) return 0;         // negative, -0
+    if (u >= kOneBits) return 255;         // 1 and above: t[255] <= 1
     int c = bucketCode[u >> 16];
     while (c < 255 && t[c + 1] <= f) ++c;
     return uint8_t(c);
