@@ -175,6 +175,73 @@ TEST(EdgeCells, LampOutlineIsTheFiltersIntegralAndThePlainGridIsNot) {
   }
 }
 
+// A floor from behind the camera to 20 m ahead under a black sky: its polygon crosses the eye
+// plane, so its outline is the part beyond the near plane, projected (edge_cells.cpp). Its far
+// edge is a horizontal line on the image; each pixel must be the floor's radiance times the
+// filter's weight below that line.
+TEST(EdgeCells, AFloorThroughTheEyePlaneIsClippedAtTheNearPlane) {
+  Scene s;
+  s.path = "floor";
+  Material floor;
+  floor.reflectance = glm::dvec3(kWallRho);
+  s.materials = {floor};
+  Mesh mesh;
+  MeshTriangle t1, t2;
+  const glm::dvec3 q[4] = {{-20, -1, 5}, {20, -1, 5}, {20, -1, -20}, {-20, -1, -20}};
+  t1.p = {q[0], q[1], q[2]};
+  t2.p = {q[0], q[2], q[3]};
+  t1.material = t2.material = 0;
+  mesh.triangles = {t1, t2};
+  Node node;
+  node.mesh = 0;
+  s.meshes.push_back(mesh);
+  s.nodes.push_back(node);
+  Camera lens;
+  lens.name = "cam";
+  lens.yfov = kYfov;
+  lens.znear = 0.01;
+  s.cameras.push_back(lens);
+  Node cam;
+  cam.name = "cam";
+  cam.camera = 0;
+  s.nodes.push_back(cam);
+  ASSERT_EQ(s.inputPolygons().size(), 1u);
+  const GlobalSolution g =
+      test::makeSolution(s, {0.0}, false, [](int, int) { return glm::dvec3(0.0); });
+  const std::vector<float> texel = {float(kWallH.x), float(kWallH.y), float(kWallH.z)};
+  const std::vector<MovieTexture> movies = {{PatchId{0, 1}, 1, 1, texel.data()}};
+  // The far edge's image row: y = -1 at z = -20.
+  const double edgeRow = (1.0 + (1.0 / 20.0) / std::tan(0.5 * kYfov)) * 0.5 * kSize.height;
+  const PixelFilter f;
+  const glm::dvec3 L = kWallRho / kPi * kWallH;
+  for (const bool coverage : {true, false}) {
+    FrameComposer composer(s, g, kSize, s.cameraNode(""), PixelSampling{f, 3}, false, coverage);
+    const ComposedFrame frame = composer.compose(0.0, movies);
+    EXPECT_EQ(frame.fallbackPixels, 0);
+    double worst = 0.0;
+    for (int row = 0; row < kSize.height; ++row) {
+      // The filter's weight below the edge (rows of larger y), by a fine midpoint sum.
+      const int n = 20000;
+      double below = 0.0, all = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const double v = -f.radius() + 2.0 * f.radius() * (i + 0.5) / n, w = f.weight(v);
+        all += w;
+        if (row + 0.5 + v > edgeRow) below += w;
+      }
+      for (int col = 2; col < kSize.width - 2; ++col)
+        for (int c = 0; c < 3; ++c) {
+          const size_t p = size_t(row) * kSize.width + col;
+          worst =
+              std::max(worst, std::abs(frame.rgb[3 * p + size_t(c)] - below / all * L[c]) / L[c]);
+        }
+    }
+    if (coverage)
+      EXPECT_LT(worst, 2.5e-3);
+    else
+      EXPECT_GT(worst, 5e-2);
+  }
+}
+
 TEST(EdgeCells, ThreadsDoNotChangeABit) {
   const LampScene e = lampScene(glm::dvec2(15.37, 9.81), glm::dvec2(7.23, 4.58), 0.35);
   ComposedFrame one, two;
