@@ -3,7 +3,8 @@
 // offsets, straight and rotated. Each pixel must be the filter's integral over the scene's
 // radiance, L_wall + (L_lamp - L_wall) * (the filter's weight over the lamp's outline), to a
 // small share of the step; the plain grid (--no-edge-coverage) places the outline to 1/3 px and
-// misses by a large share of it. Threads must not change a bit.
+// misses by a large share of it. A floor through the eye plane checks the outline clipped at
+// the near plane. Threads must not change a bit.
 #include <algorithm>
 #include <cmath>
 #include <string>
