@@ -20,8 +20,9 @@ BIN   ?= $(call in-repository,build/bin)
 FRAMES  ?=
 FPS     ?= 24
 SIZE    ?= 352x240
-# The stages' quality preset (--preset: draft, default or final; docs/design.md §1). Only
-# rad-global and rad-movies have quality knobs, so only their command lines take it.
+# The stages' quality preset (--preset: draft, default or final; docs/design.md §1). rad-global,
+# rad-intervals (final: 5 x 5 samples a pixel), rad-movies and rad-compose (final: every edge
+# cell weighed by coverage) have quality knobs, so their command lines take it.
 QUALITY ?= default
 
 # The pixel filter of the frames (docs/design.md §6.4): none, box, gaussian or blackman-harris;
@@ -74,10 +75,10 @@ endif
 PRESET_ARG = $(if $(filter-out default,$(QUALITY)),--preset $(QUALITY))
 
 GLOBAL_ARGS    = --frames $(FRAMES) --fps $(FPS) $(PRESET_ARG) $(GLOBAL_FLAGS)
-INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) \
+INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) $(PRESET_ARG) \
                  $(if $(PIXEL_FILTER),--pixel-filter $(PIXEL_FILTER)) $(INTERVALS_FLAGS)
 MOVIES_ARGS    = $(PRESET_ARG) $(MOVIES_FLAGS)
-COMPOSE_ARGS   = --frames $(FRAMES) $(COMPOSE_FLAGS)
+COMPOSE_ARGS   = --frames $(FRAMES) $(PRESET_ARG) $(COMPOSE_FLAGS)
 
 # The stage command lines, written once: the rules run them, `make -f animation.mk
 # stage-commands` prints them (one `STAGE<TAB>command` line each) for bench.py and tradeoff.py,

@@ -58,7 +58,8 @@ KNOBS = [
 # have quality knobs, as the Makefiles' QUALITY does.
 PRESETS = [
     ("draft", {"global": ["--preset", "draft"], "movies": ["--preset", "draft"]}),
-    ("final", {"global": ["--preset", "final"], "movies": ["--preset", "final"]}),
+    ("final", {"global": ["--preset", "final"], "intervals": ["--preset", "final"],
+               "movies": ["--preset", "final"], "compose": ["--preset", "final"]}),
 ]
 TOOLS = {"global": "rad-global", "intervals": "rad-intervals", "movies": "rad-movies",
          "compose": "rad-compose"}

@@ -33,9 +33,23 @@ const ParameterTable<ComposeOptions>& composeParameters() {
               "shade every sample of every pixel's filter footprint (default: one sample a "
               "pixel where the footprint is one untextured surface, the filter's blur there "
               "taken to second order from the neighbouring centres)");
+    t.addFlag("no-edge-coverage", &O::edgeCoverage, false,
+              "give each sample's cell its sample's radiance where an edge crosses it (default: "
+              "the radiance of each side weighed by the area it covers, from the polygons' "
+              "outlines; the edge is placed to 1/S px without it)",
+              Group::kQuality);
+    t.add("edge-contrast", &O::edgeContrast,
+          "weigh an edge cell by coverage only where the luminance step across it is at least "
+          "this share of its brighter side (0: every edge cell; smaller: more exact, slower)",
+          ParameterCheck::range(0.0, 1.0), Group::kQuality);
     return t;
   }();
   return table;
+}
+
+const std::vector<Preset>& composePresets() {
+  static const std::vector<Preset> presets{{"final", {{"edge-contrast", "0"}}}};
+  return presets;
 }
 
 nlohmann::json ComposeOptions::toJson() const {

@@ -36,16 +36,20 @@ struct ComposeOptions {
   std::optional<PixelFilterType> pixelFilter;
   std::optional<double> filterWidth;
   std::optional<int> pixelSamples;
-  bool everySample = false;  // shade every sample (no shortcut on uniform footprints)
-  std::string report;        // JSON report file; empty: none
+  bool everySample = false;   // shade every sample (no shortcut on uniform footprints)
+  bool edgeCoverage = true;   // weigh the cells an edge crosses by coverage (edge_cells.h)
+  double edgeContrast = 0.1;  // EdgeCellInputs::minContrast
+  std::string report;         // JSON report file; empty: none
 
   // Provenance parameters: composeParameters() under their flags' names, and output. An unset
   // fps or exposure is null.
   nlohmann::json toJson() const;
 };
 
-// rad-compose's parameters, declared once (libcommon/core/parameter_table.h). It has no quality
-// preset: the README's recommended settings leave it as shipped.
+// rad-compose's parameters, declared once (libcommon/core/parameter_table.h).
 const ParameterTable<ComposeOptions>& composeParameters();
+// Its quality presets: final weighs every edge cell by coverage (--edge-contrast 0); its grid is
+// the intervals' (their final preset samples more).
+const std::vector<Preset>& composePresets();
 
 }  // namespace rad

@@ -1,10 +1,25 @@
 // rad-compose's pixel filter over the sample grid (docs/design.md §6.4; pixel_filter.h,
 // sample_grid.h): which samples of a frame to shade, and each pixel's value from them.
 //
-// A pixel's value is the filter over the grid samples within its support,
-//   $L_p = \sum_{k,l} f(k/s) f(l/s) L(c_x + k, c_y + l) / \sum_{k,l} f(k/s) f(l/s)$,
+// A pixel's value is the filter over the grid samples within its support, each sample standing
+// for its cell (the square of side 1/s px around it) and weighted by the filter's integral over
+// that cell,
+//   $L_p = \sum_{k,l} W_k W_l L(c_x + k, c_y + l)$, $W_k = \int_{(k-1/2)/s}^{(k+1/2)/s} f /
+//   \sum_j \int_{cell j} f$,
 // |k|, |l| <= radius s, c the pixel centre's sample; background samples count with L = 0, as a
 // black world does in Cycles. That is "full sampling": s^2 shaded samples a pixel.
+//
+// Edge cells. A sample's value stands for its whole cell, so an edge is placed to 1/s px, and
+// the pixels beside an edge of high contrast (a lamp's outline: a hundred times the ceiling) are
+// off by up to a sixth of the step (the quadrature's error, not the shading's). Where an edge
+// crosses a sample's cell, the composer gives the cell as an EdgeCell: the fraction c of it that
+// shows the sample's own surface a, that part's centroid δ, and the step L_a - L_b to the other
+// side's radiance. The cell then weighs L_b by its whole weight and the step by the filter's
+// integral over a's part, to first order in δ:
+//   $\int_{a} f(x) f(y) \approx c (W_k W_l + G_k W_l δ_x + W_k G_l δ_y)$, $G_k = f'(k/s) / s /
+//   \sum_j \int_{cell j} f$,
+// which places the edge exactly for a straight edge up to the filter's curvature over a cell;
+// no sample is added, so rad-intervals' coverage of the grid still holds.
 //
 // Most pixels see one untextured surface over their whole footprint, where the radiance is a
 // smooth field (a texture movie's bilinear irradiance times a constant reflectance). There, to
@@ -35,6 +50,14 @@
 
 namespace rad {
 
+// One sample's cell crossed by an edge (the header's "Edge cells").
+struct EdgeCell {
+  size_t sample = 0;           // grid index
+  float step[3] = {0, 0, 0};   // L_a - L_b: the sample's radiance minus the other side's
+  float coverage = 1.0f;       // c: the fraction of the cell on the sample's side, [0, 1]
+  float dx = 0.0f, dy = 0.0f;  // δ: that part's centroid from the sample, pixels
+};
+
 class FootprintFilter {
  public:
   // `sampling` must not be filter none (the pixel centres need no filter).
@@ -53,6 +76,9 @@ class FootprintFilter {
   const std::vector<uint8_t>& needed() const { return needed_; }
   // Per pixel: 1 where the pixel took full sampling.
   const std::vector<uint8_t>& fullPixels() const { return full_; }
+  // The edge cells the fully sampled pixels weigh by their coverage (each sample at most once;
+  // replaces the previous frame's). Without them every cell holds its sample's value.
+  void setEdgeCells(std::vector<EdgeCell> cells);
 
   // Whether the samples of grid pixel (px, py) (0 <= px < W + 2m: the pixel px - m of the image)
   // that show the item its centre shows are interpolated from the centres around it, rather
@@ -74,14 +100,22 @@ class FootprintFilter {
   // `sampleTag` (one a grid sample) over the samples read.
   uint8_t filterPixel(const float* sampleRgb, const uint8_t* sampleTag, int col, int row,
                       float* rgb) const;
-  // The grid samples pixel (col, row)'s value reads, as (index, weight > 0) pairs.
+  // The grid samples pixel (col, row)'s value reads, as (index, weight > 0) pairs: the cells'
+  // weights, without the edge cells' terms (setEdgeCells).
   template <class F>
   void forEachSampleOf(int col, int row, F f) const;
 
  private:
   SampleGrid grid_;
-  std::vector<double> taps_;      // full sampling: f(k/s) for k = -K..K, normalised to sum 1
-  std::vector<double> taps2_;     // taps_[k] taps_[l], row l major
+  std::vector<double> taps_;    // full sampling: W_k for k = -K..K (sum 1)
+  std::vector<double> slopes_;  // G_k (the header's "Edge cells")
+  std::vector<double> taps2_;   // taps_[k] taps_[l], row l major
+  std::vector<EdgeCell> edgeCells_;
+  std::vector<int32_t> edgeCellOf_;  // per grid sample: index in edgeCells_, or -1
+  std::vector<uint8_t> edgeWindow_;  // per pixel: its full window holds an edge cell
+  // The image pixels c (clamped to [0, n)) whose centre's grid index is within `reach` of grid
+  // index i, along one axis.
+  void pixelSpan(int i, int reach, int n, int& first, int& last) const;
   int reach_ = 0;                 // K
   double neighbour_ = 0.0;        // a of the 3 x 3 kernel; < 0: no shortcut
   int uniformReach_ = 0;          // grid samples max(radius, 1) px from a centre
@@ -89,8 +123,7 @@ class FootprintFilter {
   std::vector<double> lagrange_;  // per sub-pixel offset k: 3 weights (centres -1, 0, +1)
   std::vector<uint8_t> needed_, full_;
   std::vector<uint8_t> smoothCentres_;
-  std::vector<uint8_t> offCentre_;  // per grid pixel: offCentreNeeded()  // per grid pixel: its 3 x
-                                    // 3 centres on one untextured item
+  std::vector<uint8_t> offCentre_;  // per grid pixel: offCentreNeeded()
 };
 
 template <class F>

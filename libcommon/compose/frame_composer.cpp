@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "libcommon/compose/edge_cells.h"
 #include "libcommon/compose/footprint_filter.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
@@ -215,6 +216,8 @@ struct FrameComposer::Impl {
   PixelSampling sampling;
   SampleGrid grid;                          // sampling.grid(size)
   std::unique_ptr<FootprintFilter> filter;  // null: the pixel centres, unfiltered
+  bool edgeCells = true;                    // weigh the edge cells by coverage (edge_cells.h)
+  double edgeContrast = 0.0;                // EdgeCellInputs::minContrast
   std::vector<InputPolygon> tops;
   std::vector<int> objectNodes;        // mesh node of each item object
   std::vector<size_t> topObject;       // per top, its item object (index into transforms)
@@ -227,6 +230,7 @@ struct FrameComposer::Impl {
   std::vector<uint8_t> edgeMask;              // refineSilhouettes': samples with another neighbour
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
+  std::vector<uint8_t> edgeCandidates;  // weighEdgeCells': the edge samples
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
@@ -238,11 +242,15 @@ struct FrameComposer::Impl {
                           const PrimaryRays& rays, glm::dvec2 pixel, int top, float* rgb) const;
   void composeFiltered(double t, const std::vector<MovieTexture>& movies,
                        const VisibleTops& visible, const ActiveMovies& active,
-                       const PrimaryRays& rays, const std::vector<size_t>& edges,
-                       ComposedFrame& out);
+                       const CameraView& view, const PrimaryRays& rays,
+                       const std::vector<size_t>& edges, ComposedFrame& out);
+  // After the samples are shaded: the filter's edge cells (edge_cells.h), among the samples
+  // whose id differs from a neighbour's.
+  void weighEdgeCells(const VisibleTops& visible, const CameraView& view, const PrimaryRays& rays,
+                      const std::vector<size_t>& edges);
 
   Impl(const Scene& s, const GlobalSolution& g, ImageSize sz, int cam, const PixelSampling& ps,
-       bool everySample)
+       bool everySample, bool edgeCoverage, double minContrast)
       : scene(s),
         solution(g),
         size(sz),
@@ -251,6 +259,8 @@ struct FrameComposer::Impl {
         grid(ps.grid(sz)),
         filter(ps.filter.isNone() ? nullptr
                                   : std::make_unique<FootprintFilter>(ps, sz, everySample)),
+        edgeCells(edgeCoverage),
+        edgeContrast(minContrast),
         tops(s.inputPolygons()),
         renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
@@ -286,8 +296,10 @@ struct FrameComposer::Impl {
 };
 
 FrameComposer::FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size,
-                             int cameraNode, const PixelSampling& sampling, bool everySample)
-    : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode, sampling, everySample)) {}
+                             int cameraNode, const PixelSampling& sampling, bool everySample,
+                             bool edgeCoverage, double edgeContrast)
+    : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode, sampling, everySample,
+                                   edgeCoverage, edgeContrast)) {}
 
 FrameComposer::~FrameComposer() = default;
 
@@ -317,7 +329,10 @@ CameraView FrameComposer::Impl::renderItems(double t) {
 // off (the Cornell box: the wall behind a box's top edge, much brighter than the box). A pixel
 // whose item differs from a 4-neighbour's casts that ray (Embree, the scene's patches at t) and
 // takes the patch it meets when that patch faces the camera, as the rasterizer's back-face rule
-// would; a pixel whose ray meets nothing, or a back face, keeps its item.
+// would; a pixel whose ray meets nothing, or a back face, keeps its item. A filtered frame whose
+// edge cells are weighed by coverage casts no ray: a cell whose sample is that close to an edge
+// takes each side's share of it from the polygons' outlines (edge_cells.h), whichever item the
+// sample shows, and the item buffer's ids are then rad-intervals' own, so no sample falls back.
 std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
   const int w = items.width, h = items.height;  // the sample grid's (sample_grid.h)
   // Each pair of neighbours compared once (right, below), both marked when they differ; then
@@ -335,7 +350,7 @@ std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const Prima
   std::vector<size_t> edge;
   for (size_t p = 0; p < edgeMask.size(); ++p)
     if (edgeMask[p]) edge.push_back(p);
-  if (edge.empty()) return edge;
+  if (edge.empty() || (filter && edgeCells)) return edge;
   if (!rayScene) {
     const std::vector<double>& k = solution.keyTimes;
     rayScene = std::make_unique<SceneVisibility>(scene, solution.hierarchy, k.front(), k.back());
@@ -390,7 +405,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   out.rgb.assign(n * 3, 0.0f);
   out.source.assign(n, PixelSource::kBackground);
   if (m.filter) {
-    m.composeFiltered(t, movies, visible, active, rays, edges, out);
+    m.composeFiltered(t, movies, visible, active, view, rays, edges, out);
     return;
   }
   std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0),
@@ -424,8 +439,8 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
 // surface, as fallen back when one of them fell back, as a movie pixel otherwise.
 void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTexture>& movies,
                                           const VisibleTops& visible, const ActiveMovies& active,
-                                          const PrimaryRays& rays, const std::vector<size_t>& edges,
-                                          ComposedFrame& out) {
+                                          const CameraView& view, const PrimaryRays& rays,
+                                          const std::vector<size_t>& edges, ComposedFrame& out) {
   filter->plan(items.id, edges, texturedItem);
   const std::vector<uint8_t>& needed = filter->needed();
   const int gw = items.width, gh = items.height;
@@ -474,6 +489,7 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
             }
         }
     });
+  if (edgeCells) weighEdgeCells(visible, view, rays, edges);
   static_assert(sizeof(PixelSource) == 1, "sample sources are read as bytes");
   const auto* tags = reinterpret_cast<const uint8_t*>(sampleSource.data());
   std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0);
@@ -495,6 +511,19 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
     out.fallbackPixels += rowFallback[row];
   }
   out.coveredPixels = out.moviePixels + out.fallbackPixels;
+}
+
+void FrameComposer::Impl::weighEdgeCells(const VisibleTops& visible, const CameraView& view,
+                                         const PrimaryRays& rays,
+                                         const std::vector<size_t>& edges) {
+  // refineSilhouettes cast no ray (edge cells are weighed): `edges` are the samples whose id
+  // differs from a 4-neighbour's, the edge cells' candidates.
+  edgeCandidates.assign(items.id.size(), 0);
+  for (size_t p : edges) edgeCandidates[p] = 1;
+  const EdgeCellInputs in{
+      grid, items.id, filter->needed(), sampleRgb.data(), visible.world, visible.normals,
+      view, rays,     edgeContrast};
+  filter->setEdgeCells(findEdgeCells(in, edgeCandidates));
 }
 
 // One covered sample at image position `pixel` on top-level patch `top`: its radiance into

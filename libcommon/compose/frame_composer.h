@@ -74,10 +74,12 @@ class FrameComposer {
   // that is not one or a top count that differs.
   // `sampling`: the pixel filter and sample grid (footprint_filter.h); the default is one sample
   // through each pixel centre, unfiltered. everySample: shade every sample of every pixel's
-  // footprint (no shortcut on uniform footprints).
+  // footprint (no shortcut on uniform footprints). edgeCoverage: weigh the cells an edge
+  // crosses by the area each side covers (edge_cells.h); false: each cell holds its sample.
+  // edgeContrast: EdgeCellInputs::minContrast.
   FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size, int cameraNode,
                 const PixelSampling& sampling = PixelSampling::pixelCentres(),
-                bool everySample = false);
+                bool everySample = false, bool edgeCoverage = true, double edgeContrast = 0.0);
   ~FrameComposer();
   FrameComposer(const FrameComposer&) = delete;
   FrameComposer& operator=(const FrameComposer&) = delete;

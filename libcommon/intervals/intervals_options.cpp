@@ -72,6 +72,11 @@ const ParameterTable<IntervalsOptions>& intervalsParameters() {
   return table;
 }
 
+const std::vector<Preset>& intervalsPresets() {
+  static const std::vector<Preset> presets{{"final", {{"pixel-samples", "5"}}}};
+  return presets;
+}
+
 nlohmann::json IntervalsOptions::toJson() const {
   return intervalsParameters().toJson(*this);
 }

@@ -32,8 +32,11 @@ struct IntervalsOptions {
   nlohmann::json toJson() const;
 };
 
-// rad-intervals' parameters, declared once (libcommon/core/parameter_table.h). It has no
-// quality preset: the README's recommended settings leave it as shipped.
+// rad-intervals' parameters, declared once (libcommon/core/parameter_table.h).
 const ParameterTable<IntervalsOptions>& intervalsParameters();
+// Its quality presets: final samples 5 x 5 a pixel (rad-compose takes the intervals' grid), so
+// the edges a cell's coverage cannot resolve alone (three surfaces in one cell, the other
+// side's radiance a cell away) are placed to 1/5 px (docs/design.md §6.4).
+const std::vector<Preset>& intervalsPresets();
 
 }  // namespace rad

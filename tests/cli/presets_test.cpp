@@ -53,11 +53,16 @@ TEST(Presets, FinalDiffersFromDefaultInItsKnobsOnly) {
                                       "near-shooter-levels", "preset"}));
   EXPECT_EQ(movies["min-samples"], 64);
   EXPECT_EQ(movies["gather-partial-share"], 0.001);
-  // Stages the recommended settings leave as shipped take the flag and set nothing.
-  for (const char* t : {"rad-intervals", "rad-compose"})
-    EXPECT_EQ(differences(defaultsOf(tool(t) + " --preset final"), defaultsOf(tool(t))),
-              (std::vector<std::string>{"preset"}))
-        << t;
+  // The final frames sample more (rad-compose takes the intervals' grid) and weigh every edge
+  // cell by coverage.
+  const nlohmann::json intervals = defaultsOf(tool("rad-intervals") + " --preset final");
+  EXPECT_EQ(differences(intervals, defaultsOf(tool("rad-intervals"))),
+            (std::vector<std::string>{"pixel-samples", "preset"}));
+  EXPECT_EQ(intervals["pixel-samples"], 5);
+  const nlohmann::json compose = defaultsOf(tool("rad-compose") + " --preset final");
+  EXPECT_EQ(differences(compose, defaultsOf(tool("rad-compose"))),
+            (std::vector<std::string>{"edge-contrast", "preset"}));
+  EXPECT_EQ(compose["edge-contrast"], 0.0);
 }
 
 TEST(Presets, AnExplicitFlagOverridesThePreset) {

@@ -313,23 +313,22 @@ TEST_F(PipelineSafety, APathStartingWithADashIsAPath) {
       << r.out;
 }
 
-// QUALITY becomes rad-global's and rad-movies' --preset (the stages with quality knobs); without
-// FRAMES the stages cover the scene's animation, as the tools do without --frames.
+// QUALITY becomes every stage's --preset (each has quality knobs: rad-intervals' and
+// rad-compose's since the edge cells); without FRAMES the stages cover the scene's animation, as
+// the tools do without --frames.
 TEST_F(PipelineSafety, QualityAndTheScenesFramesReachTheStages) {
   CommandResult r = runMake({"OUT=/tmp/q", "QUALITY=final", "FPS=12"}, "-s stage-commands");
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  for (const std::string line : {"global\t", "movies\t"}) {
+  for (const std::string line : {"global\t", "intervals\t", "movies\t", "compose\t"}) {
     const size_t at = r.out.find(line);
     ASSERT_NE(at, std::string::npos) << r.out;
     EXPECT_NE(r.out.substr(at, r.out.find('\n', at) - at).find(" --preset final"),
               std::string::npos)
         << r.out;
   }
-  for (const std::string line : {"intervals\t", "compose\t"}) {
-    const size_t at = r.out.find(line);
-    EXPECT_EQ(r.out.substr(at, r.out.find('\n', at) - at).find("--preset"), std::string::npos)
-        << r.out;
-  }
+  CommandResult none = runMake({"OUT=/tmp/q", "FPS=12"}, "-s stage-commands");
+  ASSERT_EQ(none.exitCode, 0) << none.err;
+  EXPECT_EQ(none.out.find("--preset"), std::string::npos) << none.out;
   CommandResult frames =
       runCommand(tool("rad-inspect") + " --default-frames " + kScene + " --fps 12");
   ASSERT_EQ(frames.exitCode, 0) << frames.err;

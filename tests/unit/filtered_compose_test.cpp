@@ -1,8 +1,10 @@
 // rad-compose's pixel filter (libcommon/compose/footprint_filter.h) on a known edge: two flat-lit
 // coplanar walls of radiances A and B meet along a vertical line that crosses a pixel row at a
-// known sub-pixel offset. Each pixel must be the filter over the grid's samples (exactly, as the
-// discrete sum says), which approaches the filter's integral (Cycles' value) as the grid gets
-// finer; --pixel-filter none must be the single-sample frame; threads must not matter.
+// known sub-pixel offset. Each pixel must be the filter's integral (Cycles' value) to a small
+// share of the step with the edge cells weighed by coverage (edge_cells.h), and exactly the
+// discrete sum over the grid's cells without (--no-edge-coverage), which approaches the integral
+// as the grid gets finer; --pixel-filter none must be the single-sample frame; threads must not
+// matter.
 #include <cmath>
 #include <string>
 #include <vector>
@@ -71,20 +73,31 @@ EdgeScene edgeScene() {
   return e;
 }
 
-ComposedFrame composeEdge(const EdgeScene& e, const PixelSampling& sampling, bool every = false) {
-  FrameComposer composer(e.scene, e.solution, kSize, e.scene.cameraNode(""), sampling, every);
+ComposedFrame composeEdge(const EdgeScene& e, const PixelSampling& sampling, bool every = false,
+                          bool edgeCoverage = true) {
+  FrameComposer composer(e.scene, e.solution, kSize, e.scene.cameraNode(""), sampling, every,
+                         edgeCoverage);
   return composer.compose(0.0, e.movies);
 }
 
-// The fraction of the filter's weight left of the edge for pixel `col`: over the grid's samples
-// (the discrete sum compose must give) or over the continuous filter (Cycles' value).
+// The filter's integral over [a, b], by a fine midpoint sum.
+double integral(const PixelFilter& f, double a, double b) {
+  const int n = 2000;
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) sum += f.weight(a + (b - a) * (i + 0.5) / n);
+  return sum * (b - a) / n;
+}
+
+// The fraction of the filter's weight left of the edge for pixel `col`: over the grid's cells,
+// each the filter's integral over its 1/s px and all on its sample's side (the discrete sum
+// compose gives without edge coverage), or over the continuous filter (Cycles' value).
 double leftShareOnGrid(const PixelFilter& f, int s, int col) {
   const int reach = int(std::floor(f.radius() * s + 1e-9));
   double left = 0.0, all = 0.0;
   for (int k = -reach; k <= reach; ++k) {
-    const double x = col + 0.5 + double(k) / s, w = f.weight(double(k) / s);
+    const double v = double(k) / s, w = integral(f, v - 0.5 / s, v + 0.5 / s);
     all += w;
-    if (x < kEdgeColumn) left += w;
+    if (col + 0.5 + v < kEdgeColumn) left += w;
   }
   return left / all;
 }
@@ -105,24 +118,29 @@ glm::dvec3 at(const ComposedFrame& f, int col, int row) {
   return {f.rgb[3 * p], f.rgb[3 * p + 1], f.rgb[3 * p + 2]};
 }
 
-TEST(FilteredCompose, EdgePixelsAreTheFilterOverTheSamplesAndApproachItsIntegral) {
+TEST(FilteredCompose, EdgePixelsAreTheFiltersIntegralAndThePlainGridItsCellSum) {
   const EdgeScene e = edgeScene();
   const glm::dvec3 A = kRho / kPi * kHa, B = kRho / kPi * kHb;
   for (const PixelFilter& f : {PixelFilter{}, PixelFilter{PixelFilterType::kGaussian, 1.5},
                                PixelFilter{PixelFilterType::kBox, 1.0}}) {
     for (int s : {3, 15}) {
       const ComposedFrame frame = composeEdge(e, PixelSampling{f, s});
+      const ComposedFrame plain = composeEdge(e, PixelSampling{f, s}, false, false);
       EXPECT_EQ(frame.fallbackPixels, 0);
       for (int col = 0; col < kSize.width; ++col) {
-        const double share = leftShareOnGrid(f, s, col);
-        const glm::dvec3 want = share * A + (1.0 - share) * B;
+        const double exact = leftShareOfFilter(f, col), share = leftShareOnGrid(f, s, col);
+        const glm::dvec3 want = exact * A + (1.0 - exact) * B;
+        const glm::dvec3 onGrid = share * A + (1.0 - share) * B;
         for (int row : {0, kSize.height / 2, kSize.height - 1})
-          for (int c = 0; c < 3; ++c)
-            ASSERT_NEAR(at(frame, col, row)[c], want[c], 2e-6 * want[c])
+          for (int c = 0; c < 3; ++c) {
+            // Coverage: the integral to the filter's curvature over a cell.
+            ASSERT_NEAR(at(frame, col, row)[c], want[c], 2e-3 * std::abs(A[c] - B[c]))
                 << f.toString() << " s " << s << " pixel " << col << "," << row;
-        // The grid's sum against the filter's integral: its quadrature error bound,
+            ASSERT_NEAR(at(plain, col, row)[c], onGrid[c], 2e-6 * onGrid[c])
+                << f.toString() << " s " << s << " pixel " << col << "," << row;
+          }
+        // The plain grid's sum against the filter's integral: its quadrature error bound,
         // at most the largest normalised weight of one column of samples.
-        const double exact = leftShareOfFilter(f, col);
         EXPECT_NEAR(share, exact, (s == 15 ? 0.04 : 0.2)) << f.toString() << " col " << col;
       }
     }

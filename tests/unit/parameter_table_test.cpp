@@ -75,6 +75,8 @@ void expectPresetsApply(const ParameterTable<O>& table, const std::vector<Preset
 TEST(ParameterTable, PresetsSetParametersTheStageHas) {
   expectPresetsApply(globalParameters(), globalPresets());
   expectPresetsApply(moviesParameters(), moviesPresets());
+  expectPresetsApply(intervalsParameters(), intervalsPresets());
+  expectPresetsApply(composeParameters(), composePresets());
   EXPECT_EQ(findPreset(globalPresets(), "default").values.size(), 0u);
   EXPECT_THROW(findPreset(globalPresets(), "best"), Error);
   GlobalOptions g;

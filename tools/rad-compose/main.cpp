@@ -74,6 +74,8 @@ rad::ComposeSequenceOptions resolve(rad::ComposeOptions& o, const rad::Scene& sc
   o.filterWidth = c.sampling.filter.width;
   o.pixelSamples = c.sampling.samplesPerAxis;
   c.everySample = o.everySample;
+  c.edgeCoverage = o.edgeCoverage;
+  c.edgeContrast = o.edgeContrast;
   return c;
 }
 
@@ -178,10 +180,10 @@ int main(int argc, char** argv) {
   rad::setUpApp(app, kTool,
                 "rad-compose scene.gltf out/global.rlh out/intervals.rti out/movies -o out/frames "
                 "--frames 0-95 --auto-exposure");
-  // A preset sets nothing here (README "Recommended settings"); it is taken so one --preset
-  // goes to every stage, and recorded.
   std::string preset;
-  rad::addPresetOption(app, preset, argc, argv);
+  rad::composeParameters().apply(
+      o,
+      rad::findPreset(rad::composePresets(), rad::addPresetOption(app, preset, argc, argv)).values);
   const std::string common = rad::parameterGroupTitle(rad::ParameterGroup::kCommon);
   app.add_option("SCENE", o.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
   app.add_option("GLOBAL", o.global, "global solution from rad-global (global.rlh)")->required();

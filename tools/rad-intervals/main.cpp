@@ -93,9 +93,9 @@ int main(int argc, char** argv) {
   std::string preset;
   rad::setUpApp(app, kTool,
                 "rad-intervals scene.gltf -o intervals.rti --frames 0-95 --fps 24 --size 352x240");
-  // A preset sets nothing here (README "Recommended settings"); it is taken so one --preset
-  // goes to every stage, and recorded.
-  rad::addPresetOption(app, preset, argc, argv);
+  rad::intervalsParameters().apply(
+      o, rad::findPreset(rad::intervalsPresets(), rad::addPresetOption(app, preset, argc, argv))
+             .values);
   const std::string common = rad::parameterGroupTitle(rad::ParameterGroup::kCommon);
   app.add_option("SCENE", o.scene, "glTF 2.0 scene (.gltf or .glb)")->required();
   app.add_option("-o,--output", o.output, "output intervals file (.rti)")

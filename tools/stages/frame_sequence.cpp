@@ -200,7 +200,7 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
   info.durability = AtomicFile::Durability::kDeferred;
 
   FrameComposer composer(scene, solution, options.size, options.cameraNode, options.sampling,
-                         options.everySample);
+                         options.everySample, options.edgeCoverage, options.edgeContrast);
   MovieCache cache(intervals, options.moviesDir, std::move(headers));
   ComposedFrame frame;
   std::vector<MovieTexture> active;

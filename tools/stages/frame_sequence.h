@@ -31,9 +31,12 @@ struct ComposeSequenceOptions {
   int compression = 0;        // frameCompressionOf(); 0: none
   bool png = true;            // also write NNNN.png
   // The pixel filter and sample grid (libcommon/compose/footprint_filter.h); everySample: no
-  // shortcut on uniform footprints.
+  // shortcut on uniform footprints; edgeCoverage: the cells an edge crosses weighed by the area
+  // each side covers (edge_cells.h).
   PixelSampling sampling = PixelSampling::pixelCentres();
   bool everySample = false;
+  bool edgeCoverage = true;
+  double edgeContrast = 0.0;  // EdgeCellInputs::minContrast
 };
 
 struct ComposeFrameStats {
