@@ -20,6 +20,7 @@
 #include "formats/gltf_scene_file.h"
 #include "formats/gltf_triangles.h"
 #include "libcommon/core/error.h"
+#include "libcommon/scene/gltf_item_label.h"
 
 namespace rad {
 
@@ -333,13 +334,13 @@ Scene Reader::read() {
       fail("required extension " + clipInput(ext) + " is not supported");
   for (size_t i = 0; i < m_.nodes.size(); ++i) {
     if (m_.nodes[i].skin >= 0)
-      fail("node " + std::to_string(i) +
+      fail(gltfItemLabel("node", int(i), m_.nodes[i].name) +
            " has a skin; skinned meshes are not supported (rigid motion only)");
   }
   for (size_t i = 0; i < m_.meshes.size(); ++i)
     for (const tinygltf::Primitive& p : m_.meshes[i].primitives)
       if (!p.targets.empty())
-        fail("mesh " + std::to_string(i) +
+        fail(gltfItemLabel("mesh", int(i), m_.meshes[i].name) +
              " has morph targets; they are not supported (rigid motion only)");
   readNodes(scene);
   scene.meshes.resize(m_.meshes.size());
@@ -364,7 +365,7 @@ void Reader::readNodes(Scene& scene) {
   for (size_t i = 0; i < count; ++i) {
     const tinygltf::Node& g = m_.nodes[i];
     Node& n = scene.nodes[i];
-    const std::string where = "node " + std::to_string(i);
+    const std::string where = gltfItemLabel("node", int(i), g.name);
     n.name = g.name;
     if (g.mesh >= int(m_.meshes.size()))
       fail(where + ": mesh " + std::to_string(g.mesh) + " out of range");
@@ -375,7 +376,7 @@ void Reader::readNodes(Scene& scene) {
     for (int c : g.children) {
       if (c < 0 || c >= int(count)) fail(where + ": child " + std::to_string(c) + " out of range");
       if (scene.nodes[size_t(c)].parent >= 0 || size_t(c) == i)
-        fail(where + ": node " + std::to_string(c) +
+        fail(where + ": " + gltfItemLabel("node", c, m_.nodes[size_t(c)].name) +
              " has more than one parent (glTF §3.5.2: the hierarchy must be a forest)");
       scene.nodes[size_t(c)].parent = int(i);
       n.children.push_back(c);
@@ -418,7 +419,7 @@ void Reader::readNodes(Scene& scene) {
   for (size_t i = 0; i < count; ++i) {
     int k = int(i);
     for (size_t steps = 0; k >= 0; ++steps) {
-      if (steps > count) fail("node " + std::to_string(i) + ": cycle in the node hierarchy");
+      if (steps > count) fail(nodeLabel(scene, int(i)) + ": cycle in the node hierarchy");
       k = scene.nodes[size_t(k)].parent;
     }
   }
@@ -444,7 +445,7 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
   const tinygltf::Mesh& gm = m_.meshes[size_t(meshIndex)];
   for (size_t pi = 0; pi < gm.primitives.size(); ++pi)
     readPrimitive(gm.primitives[pi],
-                  "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(pi),
+                  meshLabel(scene, meshIndex) + " primitive " + std::to_string(pi),
                   scene.meshes[size_t(meshIndex)], scene);
 }
 
@@ -573,9 +574,10 @@ int Reader::material(int index, Scene& scene) {
   auto it = materialMap_.find(index);
   if (it != materialMap_.end()) return it->second;
   const tinygltf::Material& g = m_.materials[size_t(index)];
-  const std::string where = "material " + std::to_string(index);
+  const std::string where = gltfItemLabel("material", index, g.name);
   Material mat;
   mat.name = g.name;
+  mat.gltfIndex = index;
   mat.doubleSided = g.doubleSided;
   const std::vector<double>& bc = g.pbrMetallicRoughness.baseColorFactor;
   if (bc.size() >= 3) {
@@ -622,7 +624,7 @@ int Reader::texture(int index, Scene& scene) {
   auto it = textureMap_.find(index);
   if (it != textureMap_.end()) return it->second;
   const tinygltf::Texture& gt = m_.textures[size_t(index)];
-  const std::string where = "texture " + std::to_string(index);
+  const std::string where = gltfItemLabel("texture", index, gt.name);
   if (gt.source < 0 || gt.source >= int(m_.images.size())) {
     scene.warnings.push_back(where + ": no image source; base colour texture ignored");
     return textureMap_[index] = -1;
@@ -677,7 +679,7 @@ int Reader::texture(int index, Scene& scene) {
 void Reader::readCameras(Scene& scene) {
   for (size_t i = 0; i < m_.cameras.size(); ++i) {
     const tinygltf::Camera& g = m_.cameras[i];
-    const std::string where = "camera " + std::to_string(i);
+    const std::string where = gltfItemLabel("camera", int(i), g.name);
     Camera c;
     c.name = g.name;
     if (g.type == "perspective") {  // glTF §3.10
@@ -718,7 +720,7 @@ void Reader::readAnimations(Scene& scene) {
     for (size_t ci = 0; ci < ga.channels.size(); ++ci) {
       const tinygltf::AnimationChannel& gc = ga.channels[ci];
       const std::string where =
-          "animation " + std::to_string(ai) + " channel " + std::to_string(ci);
+          gltfItemLabel("animation", int(ai), ga.name) + " channel " + std::to_string(ci);
       if (gc.target_node < 0) continue;  // glTF §3.11: no target node -> ignore the channel
       if (gc.target_node >= int(scene.nodes.size())) fail(where + ": target node out of range");
       AnimationChannel ch;
@@ -736,7 +738,7 @@ void Reader::readAnimations(Scene& scene) {
         fail(where + ": unknown target path '" + clipInput(gc.target_path) + "'");
       }
       if (m_.nodes[size_t(ch.node)].matrix.size() == 16)
-        fail(where + ": targets node " + std::to_string(ch.node) +
+        fail(where + ": targets " + nodeLabel(scene, ch.node) +
              " which has a matrix (glTF §3.11 forbids it)");
       if (gc.sampler < 0 || gc.sampler >= int(ga.samplers.size()))
         fail(where + ": sampler out of range");
@@ -788,7 +790,8 @@ void Reader::requireConstantScale(const AnimationChannel& ch, const std::string&
           !cubic || (std::abs(ch.values[3 * k * 3 + c]) <= 1e-6 * std::abs(first) &&
                      std::abs(ch.values[(3 * k + 2) * 3 + c]) <= 1e-6 * std::abs(first));
       if (std::abs(v - first) > 1e-6 * std::max(std::abs(first), std::abs(v)) || !tangentsZero)
-        fail(where + ": animates the scale of node " + std::to_string(ch.node) + " (key " +
+        fail(where + ": animates the scale of " +
+             gltfItemLabel("node", ch.node, m_.nodes[size_t(ch.node)].name) + " (key " +
              std::to_string(k) + ": " + number(v) + ", key 0: " + number(first) +
              "); only rigid motion is supported: a scale channel must hold one value");
     }
@@ -857,7 +860,7 @@ void Reader::checkWorldBounds(const Scene& scene) const {
     const int i = parent.node;
     if (seen[size_t(i)]) continue;
     seen[size_t(i)] = 1;
-    const std::string where = "node " + std::to_string(i);
+    const std::string where = nodeLabel(scene, i);
     const Node& n = scene.nodes[size_t(i)];
     const Frame f{i, parent.offset + parent.scale * reach[size_t(i)].translation,
                   parent.scale * reach[size_t(i)].scale};
@@ -884,7 +887,7 @@ void Reader::requireWorldArea(const Scene& scene, int node, double t) const {
     const double twiceArea = glm::length(glm::cross(a, b));
     const double edge = std::max({glm::length(a), glm::length(b), glm::length(b - a)});
     if (!(twiceArea > 1e-12 * edge * edge) || !std::isfinite(twiceArea))
-      fail("node " + std::to_string(node) + ": its world transform (scale " +
+      fail(nodeLabel(scene, node) + ": its world transform (scale " +
            number(scene.nodes[size_t(node)].scale.x) + " " +
            number(scene.nodes[size_t(node)].scale.y) + " " +
            number(scene.nodes[size_t(node)].scale.z) + " with its parents') flattens triangle " +

@@ -1,5 +1,6 @@
 // Frame composition (paper §3.1 last step). Contracts in frame_composer.h.
 #include "libcommon/compose/frame_composer.h"
+#include "libcommon/scene/gltf_item_label.h"
 
 #include <algorithm>
 #include <cmath>
@@ -254,7 +255,7 @@ struct FrameComposer::Impl {
         tops(s.inputPolygons()),
         renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
-      throw inputError(s.path, "node " + std::to_string(cam) + " is not a camera");
+      throw inputError(s.path, nodeLabel(s, cam) + " is not a camera");
     if (g.hierarchy.topCount() != int(tops.size()))
       throw inputError(s.path, "global solution has " + std::to_string(g.hierarchy.topCount()) +
                                    " top-level patches; the scene has " +

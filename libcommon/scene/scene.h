@@ -41,6 +41,7 @@ struct Texture {
 
 struct Material {
   std::string name;
+  int gltfIndex = -1;  // the material's index in the glTF file (messages name it by both)
   // Diffuse reflectance rho = baseColorFactor.rgb x mean(baseColorTexture), each in
   // [0, kMaxReflectance] when read from a file.
   glm::dvec3 reflectance{1.0};
