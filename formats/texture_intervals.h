@@ -16,7 +16,7 @@ namespace rad {
 
 constexpr const char* kTextureIntervalsKind = "intervals";
 constexpr int kTextureIntervalsMajor = 1;
-constexpr int kTextureIntervalsMinor = 1;
+constexpr int kTextureIntervalsMinor = 2;
 
 // intervals.rti stores libcommon's movie record (libcommon/intervals/movie_extent.h: patch,
 // frames, size, MovieEnd) as it is.

@@ -61,21 +61,6 @@ void TextureIntervalsOptions::validate() const {
                                      ", exceeds 16384 a side; use fewer samples or a smaller size");
 }
 
-int textureSideFor(double projectedPixels, int current, const TextureIntervalsOptions& o) {
-  // At least one texel per covered pixel: n^2 = area x density.
-  double n = std::sqrt(std::max(0.0, projectedPixels) * o.texelDensity);
-  if (current > 0) {
-    double tol = 1.0 + o.resizeTolerance;
-    if (n > current / (o.sizeRatio * tol) && n <= current * tol) return current;
-  }
-  // The first side of the ladder round(r^k), k = 0, 1, ... that holds n texels.
-  long side = 1;
-  for (int k = 1; side < n && side < (1L << 20); ++k)
-    side = std::lround(std::pow(o.sizeRatio, double(k)));
-  side = std::clamp<long>(side, o.minSize, o.maxSize);
-  return int(side);
-}
-
 namespace {
 
 // A frame's camera and the item objects' placement (Impl::frameView), for its item buffer.
@@ -285,8 +270,7 @@ struct TextureIntervalsBuilder::Impl {
     for (HiddenMovie h : hidden) {
       MovieExtent& m = movies[h.movie];
       if (isChosen[h.node]) {
-        if (!reachedMaxLength(m, frame) &&
-            textureSideFor(area[h.node], m.width, options) == m.width) {
+        if (!reachedMaxLength(m, frame) && sizeFor(h.node, sizeOf(m)) == sizeOf(m)) {
           openMovie[h.node] = h.movie;
           m.end = MovieEnd::kWindow;  // open again: ends as an open movie does
           ++continuedOverGaps;
@@ -298,11 +282,18 @@ struct TextureIntervalsBuilder::Impl {
     hidden.swap(still);
   }
 
-  int openNew(int node, int frame, int side) {
+  // The texture size of node i this frame, from `current` (0 x 0: a new movie; TextureShape).
+  TextureSize sizeFor(int i, TextureSize current) const {
+    return textureSizeFor(area[i], textureShapeOf(hierarchy.node(i).local), current, options);
+  }
+  static TextureSize sizeOf(const MovieExtent& m) { return {m.width, m.height}; }
+
+  int openNew(int node, int frame, TextureSize size) {
     MovieExtent m;
     m.patch = hierarchy.node(node).id;
     m.firstFrame = m.lastFrame = frame;
-    m.width = m.height = side;
+    m.width = size.width;
+    m.height = size.height;
     m.end = MovieEnd::kWindow;
     movies.push_back(m);
     openMovie[node] = int(movies.size()) - 1;
@@ -389,17 +380,17 @@ struct TextureIntervalsBuilder::Impl {
       int idx = openMovie[node];
       if (idx >= 0) {
         MovieExtent& m = movies[idx];
-        int side = textureSideFor(area[node], m.width, options);
+        const TextureSize size = sizeFor(node, sizeOf(m));
         const bool full = reachedMaxLength(m, frame);
-        if (!full && side == m.width) {
+        if (!full && size == sizeOf(m)) {
           m.lastFrame = frame;
           chosenMovie[c] = idx;
           continue;
         }
         m.end = full ? MovieEnd::kMaxLength : MovieEnd::kResize;
-        chosenMovie[c] = openNew(node, frame, side);
+        chosenMovie[c] = openNew(node, frame, size);
       } else {
-        chosenMovie[c] = openNew(node, frame, textureSideFor(area[node], 0, options));
+        chosenMovie[c] = openNew(node, frame, sizeFor(node, {}));
       }
     }
     openList = chosen;

@@ -205,6 +205,68 @@ TEST_F(FrameComposerTest, MovieTexelsMapToTheirPatchPoints) {
   }
 }
 
+// Between the last texel centres and the patch's edge (the border half texel) the texture goes
+// on linearly: H = 100 u is reproduced up to u = 0 and u = 1. Clamped to the edge, as GL's
+// CLAMP_TO_EDGE, the border held the value half a texel inside, and two patches meeting at an
+// edge stepped there by the gradient times a texel (issue 56).
+TEST_F(FrameComposerTest, TheBorderHalfTexelContinuesTheTextureLinearly) {
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  std::vector<float> ramp;
+  for (int i = 0; i < 4; ++i) {
+    float h = float(100.0 * (i + 0.5) / 4);
+    ramp.insert(ramp.end(), {h, h, h});
+  }
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  const ComposedFrame f = composer.compose(0.0, {{PatchId{test::kWallTop, 1}, 4, 1, ramp.data()}});
+  ItemBuffer ib = itemBuffer();
+  int checked = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      double u = wallUvAt(*scene, col, row).x;
+      if (u >= 0.5 / 4 && u <= 1 - 0.5 / 4) continue;  // inside: MovieTexelsMapToTheirPatchPoints
+      double want = 0.5 / kPi * 100.0 * u;
+      EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want + 1e-6) << col << "," << row;
+      ++checked;
+    }
+  EXPECT_GT(checked, 10);
+}
+
+// The four children of the wall, each its own 4 x 4 movie of H = 100 u + 50 v at its texels'
+// points, compose into the one linear field: no step where the children's textures meet.
+TEST_F(FrameComposerTest, SiblingMoviesMeetWithoutAStep) {
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  std::vector<std::vector<float>> tex(4);
+  std::vector<MovieTexture> movies;
+  for (int c = 0; c < 4; ++c) {
+    const PatchId child = PatchId{test::kWallTop, 1}.child(c);
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const glm::dvec2 uv = topUvFromNodeUv(child, {(i + 0.5) / 4, (j + 0.5) / 4}, false);
+        const float h = float(100.0 * uv.x + 50.0 * uv.y);
+        tex[size_t(c)].insert(tex[size_t(c)].end(), {h, h, h});
+      }
+    movies.push_back({child, 4, 4, tex[size_t(c)].data()});
+  }
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  const ComposedFrame f = composer.compose(0.0, movies);
+  ItemBuffer ib = itemBuffer();
+  int checked = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      const glm::dvec2 uv = wallUvAt(*scene, col, row);
+      double want = 0.5 / kPi * (100.0 * uv.x + 50.0 * uv.y);
+      EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want + 1e-6) << col << "," << row;
+      ++checked;
+    }
+  EXPECT_GT(checked, 300);
+}
+
 TEST_F(FrameComposerTest, SubPatchMovieCoversItsQuarterAndTheRestFallsBack) {
   auto B = [](int, int) { return glm::dvec3(kPi); };  // fallback L = 1
   GlobalSolution g = test::makeSolution(*scene, {0.0}, false, B);
