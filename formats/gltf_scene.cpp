@@ -17,6 +17,7 @@
 #include <new>
 #include <sstream>
 
+#include "formats/gltf_message_text.h"
 #include "formats/gltf_scene_file.h"
 #include "formats/gltf_triangles.h"
 #include "libcommon/core/error.h"
@@ -57,7 +58,6 @@ class Reader {
   int texture(int index, Scene& scene);
   void readCameras(Scene& scene);
   void readAnimations(Scene& scene);
-  void requireConstantScale(const AnimationChannel& ch, const std::string& where) const;
   void checkWorldBounds(const Scene& scene) const;
   void requireWorldArea(const Scene& scene, int node, double t) const;
 
@@ -69,49 +69,6 @@ class Reader {
   std::map<int, int> textureMap_;   // glTF texture -> Scene::textures
   size_t droppedTriangles_ = 0;
 };
-
-// Quoted input (names, URIs, tinygltf's messages that echo them) is cut at this many bytes:
-// a failed data URI used to be echoed whole, a 12 KB error line.
-constexpr size_t kMaxQuoted = 120;
-
-// `s` cut to `max` bytes (at a UTF-8 character boundary) with "…" appended when cut.
-std::string clipped(const std::string& s, size_t max) {
-  if (s.size() <= max) return s;
-  size_t end = max;
-  while (end > 0 && (static_cast<unsigned char>(s[end]) & 0xC0) == 0x80) --end;
-  return s.substr(0, end) + "…";
-}
-std::string clipInput(const std::string& s) {
-  return clipped(s, kMaxQuoted);
-}
-
-// A library message on one line, every word longer than kMaxQuoted cut (clipInput()), at most
-// 4 x kMaxQuoted bytes in all.
-std::string oneLine(const std::string& text) {
-  std::string out, word;
-  auto flush = [&] {
-    if (word.empty()) return;
-    if (!out.empty()) out += ' ';
-    out += clipInput(word);
-    word.clear();
-  };
-  for (char c : text) {
-    if (c == '\n' || c == '\r' || c == ' ' || c == '\t')
-      flush();
-    else
-      word += c;
-  }
-  flush();
-  return clipped(out, 4 * kMaxQuoted);
-}
-
-// A value in a message: shortest round-trip form ("1e+38", "0.5").
-std::string number(double x) {
-  std::ostringstream os;
-  os.precision(6);
-  os << x;
-  return os.str();
-}
 
 bool allFinite(const std::vector<double>& v) {
   return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
@@ -335,13 +292,13 @@ Scene Reader::read() {
   for (size_t i = 0; i < m_.nodes.size(); ++i) {
     if (m_.nodes[i].skin >= 0)
       fail(gltfItemLabel("node", int(i), m_.nodes[i].name) +
-           " has a skin; skinned meshes are not supported (rigid motion only)");
+           " has a skin; skinned meshes are not supported (a node moves as a whole)");
   }
   for (size_t i = 0; i < m_.meshes.size(); ++i)
     for (const tinygltf::Primitive& p : m_.meshes[i].primitives)
       if (!p.targets.empty())
         fail(gltfItemLabel("mesh", int(i), m_.meshes[i].name) +
-             " has morph targets; they are not supported (rigid motion only)");
+             " has morph targets; they are not supported (a node moves as a whole)");
   readNodes(scene);
   scene.meshes.resize(m_.meshes.size());
   for (size_t i = 0; i < scene.meshes.size(); ++i) scene.meshes[i].name = m_.meshes[i].name;
@@ -490,17 +447,19 @@ std::vector<double> Reader::readPositions(const tinygltf::Primitive& prim,
   return p;
 }
 
-// The base colour texture's TEXCOORD_n; empty without a texture (or, with a warning, without
-// the attribute).
+// The base colour texture's TEXCOORD_n, else the emissive texture's; empty without a texture
+// (or, with a warning, without the attribute).
 std::vector<double> Reader::readTexCoords(const tinygltf::Primitive& prim, const Material* mat,
                                           size_t vertexCount, const std::string& where,
                                           Scene& scene) const {
   std::vector<double> uv;
-  if (!mat || mat->baseColorTexture < 0) return uv;
-  auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(mat->baseColorTexCoord));
+  if (!mat || (mat->baseColorTexture < 0 && mat->emissiveTexture < 0)) return uv;
+  const bool base = mat->baseColorTexture >= 0;  // one set: the base colour's, else emission's
+  const int set = base ? mat->baseColorTexCoord : mat->emissiveTexCoord;
+  auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(set));
   if (tc == prim.attributes.end()) {
-    scene.warnings.push_back(where + ": material has a base colour texture but no TEXCOORD_" +
-                             std::to_string(mat->baseColorTexCoord));
+    scene.warnings.push_back(where + ": material has a" + (base ? " base colour" : "n emissive") +
+                             " texture but no TEXCOORD_" + std::to_string(set));
     return uv;
   }
   // glTF §3.7.2: TEXCOORD is float or normalized unsigned byte/short.
@@ -612,9 +571,10 @@ int Reader::material(int index, Scene& scene) {
              number(kMaxEmission) + " W m^-2 sr^-1");
     }
   }
-  if (g.emissiveTexture.index >= 0)
-    scene.warnings.push_back(where +
-                             ": emissiveTexture ignored (emission is emissiveFactor x strength)");
+  if (g.emissiveTexture.index >= 0 && mat.isEmitter()) {  // L_e x texture (emission_texture.h)
+    mat.emissiveTexture = texture(g.emissiveTexture.index, scene);
+    mat.emissiveTexCoord = std::max(0, g.emissiveTexture.texCoord);
+  }
   scene.materials.push_back(mat);
   return materialMap_[index] = int(scene.materials.size()) - 1;
 }
@@ -770,31 +730,9 @@ void Reader::readAnimations(Scene& scene) {
         fail(where + ": output has " + std::to_string(ch.values.size() / size_t(want)) +
              " elements, expected " + std::to_string(ch.times.size() * per));
       if (!allFinite(ch.values)) fail(where + ": non-finite output value");
-      if (ch.path == AnimationPath::kScale && !options_.allowScaleAnimation)
-        requireConstantScale(ch, where);
       scene.channels.push_back(std::move(ch));
     }
   }
-}
-
-// The scene model is rigid motion (a patch keeps its shape): a scale channel must hold one value
-// (a static scale, within 1e-6 relative) over all its keys, with zero CUBICSPLINE tangents.
-void Reader::requireConstantScale(const AnimationChannel& ch, const std::string& where) const {
-  const size_t keys = ch.times.size();
-  const bool cubic = ch.interpolation == Interpolation::kCubicSpline;
-  auto value = [&](size_t k, size_t c) { return ch.values[((cubic ? 3 * k + 1 : k) * 3) + c]; };
-  for (size_t k = 0; k < keys; ++k)
-    for (size_t c = 0; c < 3; ++c) {
-      const double v = value(k, c), first = value(0, c);
-      const bool tangentsZero =
-          !cubic || (std::abs(ch.values[3 * k * 3 + c]) <= 1e-6 * std::abs(first) &&
-                     std::abs(ch.values[(3 * k + 2) * 3 + c]) <= 1e-6 * std::abs(first));
-      if (std::abs(v - first) > 1e-6 * std::max(std::abs(first), std::abs(v)) || !tangentsZero)
-        fail(where + ": animates the scale of " +
-             gltfItemLabel("node", ch.node, m_.nodes[size_t(ch.node)].name) + " (key " +
-             std::to_string(k) + ": " + number(v) + ", key 0: " + number(first) +
-             "); only rigid motion is supported: a scale channel must hold one value");
-    }
 }
 
 namespace {

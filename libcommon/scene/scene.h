@@ -51,6 +51,10 @@ struct Material {
   bool doubleSided = false;
   int baseColorTexture = -1;  // index into Scene::textures or -1
   int baseColorTexCoord = 0;
+  // emissiveTexture (index into Scene::textures or -1): L_e varies as emission x texture
+  // (libcommon/scene/emission_texture.h).
+  int emissiveTexture = -1;
+  int emissiveTexCoord = 0;
 
   bool isEmitter() const { return emission.x > 0.0 || emission.y > 0.0 || emission.z > 0.0; }
 };

@@ -56,6 +56,19 @@ class GltfBuilder {
     return push("meshes", {{"name", name}, {"primitives", {primitive}}});
   }
 
+  // A LINEAR animation of `path` ("translation", "rotation", "scale") of `node`: key `times`
+  // (seconds) and their values (3 or 4 floats a key).
+  int addAnimation(int node, const std::string& path, const std::vector<float>& times,
+                   const std::vector<float>& values) {
+    const int input = accessor(bytesOf(times), "SCALAR", times.size(), 5126,
+                               {{"min", {times.front()}}, {"max", {times.back()}}});
+    const int output =
+        accessor(bytesOf(values), path == "rotation" ? "VEC4" : "VEC3", times.size(), 5126);
+    return push("animations",
+                {{"samplers", {{{"input", input}, {"output", output}}}},
+                 {"channels", {{{"sampler", 0}, {"target", {{"node", node}, {"path", path}}}}}}});
+  }
+
   // A node of the displayed scene (a root).
   int addNode(const nlohmann::json& node) {
     const int i = push("nodes", node);
