@@ -1,8 +1,9 @@
 // The scene model: what the toolchain sees of an animated glTF 2.0 scene (docs/design.md §4).
 //
 // Units are metres and seconds; time is double everywhere. Geometry is kept in each mesh
-// node's local frame so rigid motion never changes a patch's shape or id; world positions at
-// time t are worldTransform(node, t) applied to the local polygons.
+// node's local frame so motion, rigid or affine (an animated scale), never changes a patch's id
+// or (u,v) map; world positions at time t are worldTransform(node, t) applied to the local
+// polygons, and world normals and areas come from the placed polygons.
 //
 // Animation follows the glTF 2.0 specification exactly (§3.11 "Animations"): TRS channels,
 // STEP / LINEAR / CUBICSPLINE samplers, shortest-arc normalised slerp for rotations, the
