@@ -12,6 +12,7 @@
 #include "formats/gltf_file_access.h"
 #include "formats/gltf_inputs.h"
 #include "formats/gltf_scene.h"
+#include "formats/gltf_scene_file.h"
 #include "formats/inspect_kinds.h"
 #include "formats/pixel_checksum.h"
 #include "formats/provenance.h"
@@ -270,7 +271,9 @@ int main(int argc, char** argv) {
     });
   if (!o.preflight.empty())
     return rad::runTool(kTool, [&]() {
-      rad::requireRenderReadiness(rad::readGltfScene(o.preflight));
+      const rad::Scene scene = rad::readGltfScene(o.preflight);
+      rad::requireRenderReadiness(scene,
+                                  rad::punctualLightsInFile(rad::readGltfSceneFile(o.preflight)));
       std::cout << o.preflight << ": ok\n";
       return 0;
     });
