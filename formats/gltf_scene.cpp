@@ -17,9 +17,11 @@
 #include <new>
 #include <sstream>
 
+#include "formats/gltf_message_text.h"
 #include "formats/gltf_scene_file.h"
 #include "formats/gltf_triangles.h"
 #include "libcommon/core/error.h"
+#include "libcommon/scene/gltf_item_label.h"
 
 namespace rad {
 
@@ -56,7 +58,6 @@ class Reader {
   int texture(int index, Scene& scene);
   void readCameras(Scene& scene);
   void readAnimations(Scene& scene);
-  void requireConstantScale(const AnimationChannel& ch, const std::string& where) const;
   void checkWorldBounds(const Scene& scene) const;
   void requireWorldArea(const Scene& scene, int node, double t) const;
 
@@ -68,49 +69,6 @@ class Reader {
   std::map<int, int> textureMap_;   // glTF texture -> Scene::textures
   size_t droppedTriangles_ = 0;
 };
-
-// Quoted input (names, URIs, tinygltf's messages that echo them) is cut at this many bytes:
-// a failed data URI used to be echoed whole, a 12 KB error line.
-constexpr size_t kMaxQuoted = 120;
-
-// `s` cut to `max` bytes (at a UTF-8 character boundary) with "…" appended when cut.
-std::string clipped(const std::string& s, size_t max) {
-  if (s.size() <= max) return s;
-  size_t end = max;
-  while (end > 0 && (static_cast<unsigned char>(s[end]) & 0xC0) == 0x80) --end;
-  return s.substr(0, end) + "…";
-}
-std::string clipInput(const std::string& s) {
-  return clipped(s, kMaxQuoted);
-}
-
-// A library message on one line, every word longer than kMaxQuoted cut (clipInput()), at most
-// 4 x kMaxQuoted bytes in all.
-std::string oneLine(const std::string& text) {
-  std::string out, word;
-  auto flush = [&] {
-    if (word.empty()) return;
-    if (!out.empty()) out += ' ';
-    out += clipInput(word);
-    word.clear();
-  };
-  for (char c : text) {
-    if (c == '\n' || c == '\r' || c == ' ' || c == '\t')
-      flush();
-    else
-      word += c;
-  }
-  flush();
-  return clipped(out, 4 * kMaxQuoted);
-}
-
-// A value in a message: shortest round-trip form ("1e+38", "0.5").
-std::string number(double x) {
-  std::ostringstream os;
-  os.precision(6);
-  os << x;
-  return os.str();
-}
 
 bool allFinite(const std::vector<double>& v) {
   return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
@@ -333,14 +291,14 @@ Scene Reader::read() {
       fail("required extension " + clipInput(ext) + " is not supported");
   for (size_t i = 0; i < m_.nodes.size(); ++i) {
     if (m_.nodes[i].skin >= 0)
-      fail("node " + std::to_string(i) +
-           " has a skin; skinned meshes are not supported (rigid motion only)");
+      fail(gltfItemLabel("node", int(i), m_.nodes[i].name) +
+           " has a skin; skinned meshes are not supported (a node moves as a whole)");
   }
   for (size_t i = 0; i < m_.meshes.size(); ++i)
     for (const tinygltf::Primitive& p : m_.meshes[i].primitives)
       if (!p.targets.empty())
-        fail("mesh " + std::to_string(i) +
-             " has morph targets; they are not supported (rigid motion only)");
+        fail(gltfItemLabel("mesh", int(i), m_.meshes[i].name) +
+             " has morph targets; they are not supported (a node moves as a whole)");
   readNodes(scene);
   scene.meshes.resize(m_.meshes.size());
   for (size_t i = 0; i < scene.meshes.size(); ++i) scene.meshes[i].name = m_.meshes[i].name;
@@ -364,7 +322,7 @@ void Reader::readNodes(Scene& scene) {
   for (size_t i = 0; i < count; ++i) {
     const tinygltf::Node& g = m_.nodes[i];
     Node& n = scene.nodes[i];
-    const std::string where = "node " + std::to_string(i);
+    const std::string where = gltfItemLabel("node", int(i), g.name);
     n.name = g.name;
     if (g.mesh >= int(m_.meshes.size()))
       fail(where + ": mesh " + std::to_string(g.mesh) + " out of range");
@@ -375,7 +333,7 @@ void Reader::readNodes(Scene& scene) {
     for (int c : g.children) {
       if (c < 0 || c >= int(count)) fail(where + ": child " + std::to_string(c) + " out of range");
       if (scene.nodes[size_t(c)].parent >= 0 || size_t(c) == i)
-        fail(where + ": node " + std::to_string(c) +
+        fail(where + ": " + gltfItemLabel("node", c, m_.nodes[size_t(c)].name) +
              " has more than one parent (glTF §3.5.2: the hierarchy must be a forest)");
       scene.nodes[size_t(c)].parent = int(i);
       n.children.push_back(c);
@@ -418,7 +376,7 @@ void Reader::readNodes(Scene& scene) {
   for (size_t i = 0; i < count; ++i) {
     int k = int(i);
     for (size_t steps = 0; k >= 0; ++steps) {
-      if (steps > count) fail("node " + std::to_string(i) + ": cycle in the node hierarchy");
+      if (steps > count) fail(nodeLabel(scene, int(i)) + ": cycle in the node hierarchy");
       k = scene.nodes[size_t(k)].parent;
     }
   }
@@ -444,7 +402,7 @@ void Reader::readMesh(int meshIndex, Scene& scene) {
   const tinygltf::Mesh& gm = m_.meshes[size_t(meshIndex)];
   for (size_t pi = 0; pi < gm.primitives.size(); ++pi)
     readPrimitive(gm.primitives[pi],
-                  "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(pi),
+                  meshLabel(scene, meshIndex) + " primitive " + std::to_string(pi),
                   scene.meshes[size_t(meshIndex)], scene);
 }
 
@@ -489,17 +447,19 @@ std::vector<double> Reader::readPositions(const tinygltf::Primitive& prim,
   return p;
 }
 
-// The base colour texture's TEXCOORD_n; empty without a texture (or, with a warning, without
-// the attribute).
+// The base colour texture's TEXCOORD_n, else the emissive texture's; empty without a texture
+// (or, with a warning, without the attribute).
 std::vector<double> Reader::readTexCoords(const tinygltf::Primitive& prim, const Material* mat,
                                           size_t vertexCount, const std::string& where,
                                           Scene& scene) const {
   std::vector<double> uv;
-  if (!mat || mat->baseColorTexture < 0) return uv;
-  auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(mat->baseColorTexCoord));
+  if (!mat || (mat->baseColorTexture < 0 && mat->emissiveTexture < 0)) return uv;
+  const bool base = mat->baseColorTexture >= 0;  // one set: the base colour's, else emission's
+  const int set = base ? mat->baseColorTexCoord : mat->emissiveTexCoord;
+  auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(set));
   if (tc == prim.attributes.end()) {
-    scene.warnings.push_back(where + ": material has a base colour texture but no TEXCOORD_" +
-                             std::to_string(mat->baseColorTexCoord));
+    scene.warnings.push_back(where + ": material has a" + (base ? " base colour" : "n emissive") +
+                             " texture but no TEXCOORD_" + std::to_string(set));
     return uv;
   }
   // glTF §3.7.2: TEXCOORD is float or normalized unsigned byte/short.
@@ -573,9 +533,10 @@ int Reader::material(int index, Scene& scene) {
   auto it = materialMap_.find(index);
   if (it != materialMap_.end()) return it->second;
   const tinygltf::Material& g = m_.materials[size_t(index)];
-  const std::string where = "material " + std::to_string(index);
+  const std::string where = gltfItemLabel("material", index, g.name);
   Material mat;
   mat.name = g.name;
+  mat.gltfIndex = index;
   mat.doubleSided = g.doubleSided;
   const std::vector<double>& bc = g.pbrMetallicRoughness.baseColorFactor;
   if (bc.size() >= 3) {
@@ -610,9 +571,10 @@ int Reader::material(int index, Scene& scene) {
              number(kMaxEmission) + " W m^-2 sr^-1");
     }
   }
-  if (g.emissiveTexture.index >= 0)
-    scene.warnings.push_back(where +
-                             ": emissiveTexture ignored (emission is emissiveFactor x strength)");
+  if (g.emissiveTexture.index >= 0 && mat.isEmitter()) {  // L_e x texture (emission_texture.h)
+    mat.emissiveTexture = texture(g.emissiveTexture.index, scene);
+    mat.emissiveTexCoord = std::max(0, g.emissiveTexture.texCoord);
+  }
   scene.materials.push_back(mat);
   return materialMap_[index] = int(scene.materials.size()) - 1;
 }
@@ -622,7 +584,7 @@ int Reader::texture(int index, Scene& scene) {
   auto it = textureMap_.find(index);
   if (it != textureMap_.end()) return it->second;
   const tinygltf::Texture& gt = m_.textures[size_t(index)];
-  const std::string where = "texture " + std::to_string(index);
+  const std::string where = gltfItemLabel("texture", index, gt.name);
   if (gt.source < 0 || gt.source >= int(m_.images.size())) {
     scene.warnings.push_back(where + ": no image source; base colour texture ignored");
     return textureMap_[index] = -1;
@@ -677,7 +639,7 @@ int Reader::texture(int index, Scene& scene) {
 void Reader::readCameras(Scene& scene) {
   for (size_t i = 0; i < m_.cameras.size(); ++i) {
     const tinygltf::Camera& g = m_.cameras[i];
-    const std::string where = "camera " + std::to_string(i);
+    const std::string where = gltfItemLabel("camera", int(i), g.name);
     Camera c;
     c.name = g.name;
     if (g.type == "perspective") {  // glTF §3.10
@@ -718,7 +680,7 @@ void Reader::readAnimations(Scene& scene) {
     for (size_t ci = 0; ci < ga.channels.size(); ++ci) {
       const tinygltf::AnimationChannel& gc = ga.channels[ci];
       const std::string where =
-          "animation " + std::to_string(ai) + " channel " + std::to_string(ci);
+          gltfItemLabel("animation", int(ai), ga.name) + " channel " + std::to_string(ci);
       if (gc.target_node < 0) continue;  // glTF §3.11: no target node -> ignore the channel
       if (gc.target_node >= int(scene.nodes.size())) fail(where + ": target node out of range");
       AnimationChannel ch;
@@ -736,7 +698,7 @@ void Reader::readAnimations(Scene& scene) {
         fail(where + ": unknown target path '" + clipInput(gc.target_path) + "'");
       }
       if (m_.nodes[size_t(ch.node)].matrix.size() == 16)
-        fail(where + ": targets node " + std::to_string(ch.node) +
+        fail(where + ": targets " + nodeLabel(scene, ch.node) +
              " which has a matrix (glTF §3.11 forbids it)");
       if (gc.sampler < 0 || gc.sampler >= int(ga.samplers.size()))
         fail(where + ": sampler out of range");
@@ -768,30 +730,9 @@ void Reader::readAnimations(Scene& scene) {
         fail(where + ": output has " + std::to_string(ch.values.size() / size_t(want)) +
              " elements, expected " + std::to_string(ch.times.size() * per));
       if (!allFinite(ch.values)) fail(where + ": non-finite output value");
-      if (ch.path == AnimationPath::kScale && !options_.allowScaleAnimation)
-        requireConstantScale(ch, where);
       scene.channels.push_back(std::move(ch));
     }
   }
-}
-
-// The scene model is rigid motion (a patch keeps its shape): a scale channel must hold one value
-// (a static scale, within 1e-6 relative) over all its keys, with zero CUBICSPLINE tangents.
-void Reader::requireConstantScale(const AnimationChannel& ch, const std::string& where) const {
-  const size_t keys = ch.times.size();
-  const bool cubic = ch.interpolation == Interpolation::kCubicSpline;
-  auto value = [&](size_t k, size_t c) { return ch.values[((cubic ? 3 * k + 1 : k) * 3) + c]; };
-  for (size_t k = 0; k < keys; ++k)
-    for (size_t c = 0; c < 3; ++c) {
-      const double v = value(k, c), first = value(0, c);
-      const bool tangentsZero =
-          !cubic || (std::abs(ch.values[3 * k * 3 + c]) <= 1e-6 * std::abs(first) &&
-                     std::abs(ch.values[(3 * k + 2) * 3 + c]) <= 1e-6 * std::abs(first));
-      if (std::abs(v - first) > 1e-6 * std::max(std::abs(first), std::abs(v)) || !tangentsZero)
-        fail(where + ": animates the scale of node " + std::to_string(ch.node) + " (key " +
-             std::to_string(k) + ": " + number(v) + ", key 0: " + number(first) +
-             "); only rigid motion is supported: a scale channel must hold one value");
-    }
 }
 
 namespace {
@@ -857,7 +798,7 @@ void Reader::checkWorldBounds(const Scene& scene) const {
     const int i = parent.node;
     if (seen[size_t(i)]) continue;
     seen[size_t(i)] = 1;
-    const std::string where = "node " + std::to_string(i);
+    const std::string where = nodeLabel(scene, i);
     const Node& n = scene.nodes[size_t(i)];
     const Frame f{i, parent.offset + parent.scale * reach[size_t(i)].translation,
                   parent.scale * reach[size_t(i)].scale};
@@ -884,7 +825,7 @@ void Reader::requireWorldArea(const Scene& scene, int node, double t) const {
     const double twiceArea = glm::length(glm::cross(a, b));
     const double edge = std::max({glm::length(a), glm::length(b), glm::length(b - a)});
     if (!(twiceArea > 1e-12 * edge * edge) || !std::isfinite(twiceArea))
-      fail("node " + std::to_string(node) + ": its world transform (scale " +
+      fail(nodeLabel(scene, node) + ": its world transform (scale " +
            number(scene.nodes[size_t(node)].scale.x) + " " +
            number(scene.nodes[size_t(node)].scale.y) + " " +
            number(scene.nodes[size_t(node)].scale.z) + " with its parents') flattens triangle " +

@@ -11,10 +11,6 @@
 namespace rad {
 
 struct GltfReadOptions {
-  // Animated scale is outside the rigid model (patches keep their shape): a scale channel whose
-  // values are not all 1 (within 1e-6) is refused. true only to test glTF's animation semantics
-  // on files that animate scale (no tool sets it).
-  bool allowScaleAnimation = false;
   // An image whose header gives more pixels than this is not decoded: its texture is ignored
   // with a warning (a 450 KB PNG of 12,000^2 pixels decoded to 2.3 GB).
   uint64_t maxTexturePixels = kMaxTexturePixels;
@@ -35,7 +31,7 @@ void setGltfWarningHandler(GltfWarningHandler handler);
 // cameras and TRS animation channels.
 // Throws rad::Error (ExitCode::kBadInput) whose message is `path: what is wrong` for a missing,
 // non-regular (FIFO, device, directory) or malformed file, data out of bounds, non-finite values,
-// and features outside the rigid model (skins, morph targets, animated scale), values beyond the
+// and features outside the affine model (skins, morph targets), values beyond the
 // limits of scene.h (kMaxCoordinate, kMaxEmission) and JSON nested deeper than 256 levels. Never
 // reads outside the loaded buffers; every error message is one line with quoted input cut at 120
 // bytes. Out of memory while reading is rad::Error (ExitCode::kEnvironment) `path: out of memory

@@ -18,8 +18,9 @@ frames DIR/NNNN.exr like rad-reference's (RGB float, row 0 = top), which rad-dif
              buffer and rad-reference) and any other ray is absorbed (black, no emission).
              Cycles alone would shade and light both sides.
   camera     the importer sets yfov as the vertical angle with a vertical sensor fit, which is
-             our projection when the camera has no aspectRatio or the image's (another
-             aspectRatio stretches our frame, which Blender cannot do: refused). Pixel (c, r)'s
+             our projection when the camera has no aspectRatio or the image's. Another
+             aspectRatio is fitted as the tools fit it (camera_projection.h, lensHalfExtents):
+             sensor fit AUTO with the angle of the camera frame's larger side. Pixel (c, r)'s
              centre is (c + 0.5, r + 0.5) in both.
   animation  Blender frame = glTF time x fps (the importer's rule, with render.fps = --fps);
              rotations are slerped between keys as glTF prescribes (the importer's f-curves
@@ -50,6 +51,7 @@ camera, animation), 2 usage, 4 Blender missing or failed.
 """
 import argparse
 import json
+import math
 import os
 import shlex
 import shutil
@@ -209,11 +211,20 @@ def check_scene(doc, a):
             if s.get("interpolation") == "CUBICSPLINE":
                 raise InputError("animation %s: CUBICSPLINE sampler (Blender's importer drops "
                                  "its tangents)" % anim.get("name", "?"))
-    for cam in doc.get("cameras", []):
-        ratio = cam.get("perspective", {}).get("aspectRatio")
-        if ratio and abs(ratio - a.width / a.height) > 1e-6 * ratio:
-            raise InputError("camera %s: aspectRatio %g differs from the image's %dx%d" %
-                             (cam.get("name", "?"), ratio, a.width, a.height))
+
+
+def fit_sensor(camera, doc, a):
+    """A perspective camera whose aspectRatio differs from the image's: Blender's AUTO sensor fit
+    with the field of the camera frame's larger side, as the tools project it (no stretch)."""
+    cams = doc.get("cameras", [])
+    for cam in cams:
+        p = cam.get("perspective", {})
+        ratio = p.get("aspectRatio")
+        if cam.get("name", "") != camera.data.name and len(cams) > 1:
+            continue
+        if ratio and abs(ratio - a.width / a.height) > 1e-6 * (a.width / a.height):
+            camera.data.sensor_fit = "AUTO"
+            camera.data.angle = 2.0 * math.atan(math.tan(0.5 * p["yfov"]) * max(ratio, 1.0))
 
 
 def camera_node_names(doc):
@@ -401,6 +412,7 @@ def render(a):
         if mat.use_nodes and mat.users:
             lambertian_material(mat)
     scene.camera = choose_camera(bpy, doc, a.camera)
+    fit_sensor(scene.camera, doc, a)
     setup_render(bpy, scene, a)
     os.makedirs(a.output, exist_ok=True)
     actions = {o.name: o.animation_data.action for o in bpy.data.objects

@@ -132,10 +132,23 @@ endif
 $(foreach s,$(STAMPS),$(if $(call stamp-differs,$(s)),$(eval $(OUT)/$(s).params: FORCE)))
 endif
 
-$(OUT)/%.params:
-	@err=$$( { mkdir -p $(@D) && printf '%s\n' $(call quote,$(STAMP_$*)) > $@.tmp.$$$$ && \
+# Writes stamp $(1) (scene, global, ...) as the recipe of $(OUT)/$(1).params.
+write-stamp = @err=$$( { mkdir -p $(@D) && printf '%s\n' $(call quote,$(STAMP_$(1))) > $@.tmp.$$$$ && \
 	  mv -f $@.tmp.$$$$ $@; } 2>&1 ) || { rm -f $@.tmp.$$$$ 2>/dev/null; \
-	  echo "$(MAKEFILE_NAME): $@: cannot write the stamp: $${err##*: }" >&2; exit 1; }
+	  echo "$(MAKEFILE_NAME): $@: cannot write the stamp: $${err\#\#*: }" >&2; exit 1; }
+
+$(OUT)/%.params:
+	$(call write-stamp,$*)
+
+# The pre-flight check (docs/design.md §7): the scene's stamp is written only once the scene has
+# a camera and something that emits (rad-inspect --preflight, which reads the file and solves
+# nothing), and every stage depends on that stamp. So a default Blender export (no camera, no
+# lamps) fails before the first stage with one line saying what to export, not after rad-global's
+# solve. It runs whenever the scene's content changes; a scene that fails leaves the stamp as it
+# was, so the next run checks again.
+$(OUT)/scene.params:
+	@$(BIN)/rad-inspect --preflight $(SCENE) >/dev/null
+	$(call write-stamp,scene)
 
 .PHONY: FORCE
 FORCE:

@@ -1,5 +1,8 @@
 // Frame composition (paper §3.1 last step). Contracts in frame_composer.h.
 #include "libcommon/compose/frame_composer.h"
+#include "libcommon/scene/emission_texture.h"
+#include "libcommon/scene/gltf_item_label.h"
+#include "libcommon/scene/texture_sampling.h"
 
 #include <algorithm>
 #include <cmath>
@@ -50,34 +53,6 @@ glm::dvec3 sampleToBorder(const float* rgb, const float* next, float weight, int
   return glm::max((1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
                       fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1)),
                   glm::dvec3(0.0));
-}
-
-// Bilinear sample of a glTF base colour texture (default sampler: LINEAR, REPEAT). glTF's
-// (u,v) = (0,0) is the first texel of the first row of the image (Texture::rgb row 0).
-glm::dvec3 sampleRepeat(const Texture& tex, glm::dvec2 uv) {
-  int w = tex.width, h = tex.height;
-  double x = uv.x * w - 0.5, y = uv.y * h - 0.5;
-  double fx0 = std::floor(x), fy0 = std::floor(y);
-  double fx = x - fx0, fy = y - fy0;
-  auto wrap = [](double i, int n) {
-    long long k = (long long)i % n;
-    return int(k < 0 ? k + n : k);
-  };
-  int i0 = wrap(fx0, w), i1 = wrap(fx0 + 1, w), j0 = wrap(fy0, h), j1 = wrap(fy0 + 1, h);
-  auto at = [&](int i, int j) {
-    const float* p = tex.rgb.data() + (size_t(j) * w + i) * 3;
-    return glm::dvec3(p[0], p[1], p[2]);
-  };
-  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
-         fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
-}
-
-// The attribute map of a polygon's (u,v) parameterisation applied to per-vertex values
-// (patch_hierarchy.h: quads bilinear over v0..v3, triangles affine over v0..v2).
-glm::dvec2 interpolateCorners(const std::array<glm::dvec2, 4>& c, int count, glm::dvec2 uv) {
-  if (count == 3) return c[0] + uv.x * (c[1] - c[0]) + uv.y * (c[2] - c[0]);
-  return (1 - uv.x) * (1 - uv.y) * c[0] + uv.x * (1 - uv.y) * c[1] + uv.x * uv.y * c[2] +
-         (1 - uv.x) * uv.y * c[3];
 }
 
 // Active movie by packed patch id: open addressing with a multiplicative hash. Every covered
@@ -177,8 +152,7 @@ bool textureFactorAt(const Scene& scene, const Material& mat, const InputPolygon
   texFactor = glm::dvec3(1.0);
   if (mat.baseColorTexture < 0 || mat.baseColorTexture >= int(scene.textures.size())) return false;
   const Texture& tex = scene.textures[mat.baseColorTexture];
-  if (!(tex.width > 0 && tex.height > 0 && tex.rgb.size() == size_t(tex.width) * tex.height * 3))
-    return false;
+  if (!hasPixels(tex)) return false;
   glm::dvec2 texUv = interpolateCorners(top.uv, cornerCount, topUv);
   glm::dvec3 c = sampleRepeat(tex, texUv);
   for (int a = 0; a < 3; ++a) texFactor[a] = tex.mean[a] > 0.0 ? c[a] / tex.mean[a] : 0.0;
@@ -223,7 +197,10 @@ struct FrameComposer::Impl {
   std::vector<size_t> topObject;       // per top, its item object (index into transforms)
   std::vector<glm::dmat4> transforms;  // per object, at the current time
   std::vector<Material> materials;     // per top (default material where -1)
-  std::vector<char> texturedItem;      // per item id: the top's material has a base colour texture
+  // Per item id: the top's material has a base colour or an emissive texture (its radiance is
+  // not smooth over the footprint: the filter shades its samples).
+  std::vector<char> texturedItem;
+  std::vector<glm::dvec3> topEmission;  // per top: its mean L_e (meanEmissionOver)
   ItemBufferRenderer renderer;
   ItemBuffer items;                           // of the sample grid
   std::unique_ptr<SceneVisibility> rayScene;  // refineSilhouettes' rays, made on first use
@@ -264,7 +241,7 @@ struct FrameComposer::Impl {
         tops(s.inputPolygons()),
         renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
-      throw inputError(s.path, "node " + std::to_string(cam) + " is not a camera");
+      throw inputError(s.path, nodeLabel(s, cam) + " is not a camera");
     if (g.hierarchy.topCount() != int(tops.size()))
       throw inputError(s.path, "global solution has " + std::to_string(g.hierarchy.topCount()) +
                                    " top-level patches; the scene has " +
@@ -286,9 +263,12 @@ struct FrameComposer::Impl {
       materials.push_back(m >= 0 && m < int(s.materials.size()) ? s.materials[m] : Material{});
     }
     texturedItem.assign(tops.size() + 1, 0);
+    topEmission.resize(tops.size());
     for (size_t i = 0; i < tops.size(); ++i) {
       const int tex = materials[i].baseColorTexture;
-      texturedItem[i + 1] = tex >= 0 && tex < int(s.textures.size());
+      texturedItem[i + 1] =
+          (tex >= 0 && tex < int(s.textures.size())) || hasEmissiveTexture(s, materials[i]);
+      topEmission[i] = meanEmissionOver(s, tops[i]);
     }
     renderer.setGeometry(objects);
     transforms.resize(objects.size());
@@ -539,6 +519,11 @@ PixelSource FrameComposer::Impl::shadeSample(double t, const std::vector<MovieTe
       topUvOfSample(rays, pixel, poly, visible.normals[size_t(top)], visible.uvMaps[size_t(top)]);
   glm::dvec3 texFactor;
   const bool textured = textureFactorAt(scene, mat, tops[top], poly.count, topUv, texFactor);
+  // $L_e(x)$: the emissive texture per sample (emission_texture.h), else the material's.
+  const bool emissiveTextured = hasEmissiveTexture(scene, mat);
+  const glm::dvec3 emitted =
+      emissiveTextured ? emissionAt(scene, mat, interpolateCorners(tops[top].uv, poly.count, topUv))
+                       : mat.emission;
   glm::dvec2 foundUv;
   const int found = deepestMovieAt(active, top, topUv, triangle, foundUv);
 
@@ -549,14 +534,14 @@ PixelSource FrameComposer::Impl::shadeSample(double t, const std::vector<MovieTe
     const MovieTexture& mt = movies[size_t(found)];
     glm::dvec3 H =
         sampleToBorder(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width, mt.height, foundUv);
-    L = mat.emission + (mat.reflectance * texFactor / kPi) * H;
+    L = emitted + (mat.reflectance * texFactor / kPi) * H;
     source = PixelSource::kMovie;
   } else {
     // Fallback: the union leaf's radiosity, $L = B / \pi$.
     int leaf = leafAtTopUv(solution.hierarchy, top, topUv);
     glm::dvec3 B = solution.radiosity(leaf, t);
-    if (textured)
-      L = mat.emission + texFactor * glm::max(B / kPi - mat.emission, glm::dvec3(0.0));
+    if (textured || emissiveTextured)  // B holds the patch's mean emission (emission_texture.h)
+      L = emitted + texFactor * glm::max(B / kPi - topEmission[size_t(top)], glm::dvec3(0.0));
     else
       L = B / kPi;
     source = PixelSource::kFallback;

@@ -40,8 +40,8 @@ struct ItemBuffer {
   float depthAt(int col, int row) const { return depth[size_t(row) * width + col]; }
 };
 
-// Geometry that moves as one rigid body (one glTF mesh node): triangles in the object's local
-// frame, CCW about their front face, and one item id per triangle (ids.size() ==
+// Geometry that moves as one body, rigidly or affinely (one glTF mesh node): triangles in the
+// object's local frame, CCW about their front face, and one item id per triangle (ids.size() ==
 // triangles.size(), ids != kNoItem).
 struct ItemObject {
   std::vector<std::array<glm::dvec3, 3>> triangles;

@@ -1,5 +1,6 @@
 // Texture-movie extents from item buffers. Sources and rules in texture_intervals_builder.h.
 #include "libcommon/intervals/texture_intervals_builder.h"
+#include "libcommon/scene/gltf_item_label.h"
 
 #include <algorithm>
 #include <chrono>
@@ -124,7 +125,7 @@ struct TextureIntervalsBuilder::Impl {
     options.validate();
     if (cameraNode < 0 || cameraNode >= int(scene.nodes.size()) ||
         scene.nodes[cameraNode].camera < 0)
-      throw inputError(scene.path, "node " + std::to_string(cameraNode) + " is not a camera");
+      throw inputError(scene.path, nodeLabel(scene, cameraNode) + " is not a camera");
     hierarchy = PatchHierarchy(scene.inputPolygons());
     // Nodes of the full subdivision: tops x (4^(L+1) - 1) / 3.
     double nodes = hierarchy.topCount() * (std::pow(4.0, options.maxLevel + 1) - 1.0) / 3.0;

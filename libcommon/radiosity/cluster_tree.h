@@ -7,7 +7,7 @@
 // A bounding volume hierarchy over the top-level patches, built once for the whole animation.
 // A cluster never mixes static and moving geometry: the static patches form one sub-tree and
 // each moving mesh node its own, built from its patches in the node's local frame, so that the
-// sub-tree moves rigidly with the node and keeps its shape, its cluster indices and therefore
+// sub-tree moves with the node (rigidly or affinely) and keeps its cluster indices and therefore
 // its links' seeds from key to key. The root joins the sub-trees. A cluster's bounds at a key
 // time come from its patches' world polygons then (ClusterBounds).
 #pragma once

@@ -13,6 +13,7 @@
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/key_time_solver.h"
+#include "libcommon/scene/emission_texture.h"
 
 namespace rad {
 
@@ -24,7 +25,9 @@ std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
     if (m >= 0 && m < int(scene.materials.size())) {
       const Material& mat = scene.materials[size_t(m)];
       out[size_t(t)].reflectance = glm::clamp(mat.reflectance, glm::dvec3(0.0), glm::dvec3(1.0));
-      out[size_t(t)].emission = glm::max(mat.emission, glm::dvec3(0.0)) * M_PI;  // B_e = pi L_e
+      // B_e = pi L_e, L_e the mean over the patch of an emissive texture (emission_texture.h).
+      out[size_t(t)].emission =
+          glm::max(meanEmissionOver(scene, hierarchy.top(t)), glm::dvec3(0.0)) * M_PI;
       out[size_t(t)].doubleSided = mat.doubleSided;
     } else {
       // glTF default material: white (rho 1, kept below 1 as a file's are: the solve needs

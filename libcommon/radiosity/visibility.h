@@ -3,7 +3,7 @@
 // Salzman, Aupperle 1991 (visibility of a link from k jittered ray pairs).
 //
 // Scene layout: all static triangles (world space) live in one child scene whose BVH is built
-// once (high quality) and instanced with the identity transform; each dynamic rigid object is
+// once (high quality) and instanced with the identity transform; each dynamic object is
 // its own child scene (built once, in its local frame) instanced with a transform that the
 // caller sets per key time. Only the small top-level BVH over the instances is rebuilt by
 // commit(). Embree works in single precision: blockers closer than ~1e-6 of the scene's
@@ -60,8 +60,8 @@ class VisibilityScene {
   VisibilityScene(VisibilityScene&&) noexcept;
   VisibilityScene& operator=(VisibilityScene&&) noexcept;
 
-  // Adds a rigid dynamic object (triangles in its local frame); returns its instance id
-  // (0, 1, ...). Its BVH is built here, once. Call commit() before the next query.
+  // Adds a dynamic object (triangles in its local frame, placed by an affine transform); returns
+  // its instance id (0, 1, ...). Its BVH is built here, once. Call commit() before the next query.
   int addInstance(const std::vector<VisibilityTriangle>& localTriangles,
                   const glm::dmat4& objectToWorld = glm::dmat4(1.0));
   // Sets an instance's local-to-world transform (affine). Call commit() before the next query.

@@ -2,6 +2,7 @@
 // hemisphere sampling), §14.5 (path tracing with next-event estimation, Russian roulette);
 // Duff et al. 2017 (orthonormal basis); Embree 3 (Wald et al. 2014).
 #include "libcommon/reference/path_tracer.h"
+#include "libcommon/scene/emission_texture.h"
 
 #include <algorithm>
 #include <array>
@@ -171,7 +172,8 @@ struct PathTracer::Impl {
         if (!surfaces.empty()) surfaces.back().backEmitter = emitter;
         continue;
       }
-      Surface surface{world, n, m.reflectance, m.emission, m.doubleSided};
+      // An emissive texture's mean over the patch, as the lights' list samples it.
+      Surface surface{world, n, m.reflectance, meanEmissionOver(scene, in), m.doubleSided};
       surface.frontEmitter = emitter;
       if (in.normal[0] != glm::dvec3(0.0)) {
         const glm::dmat3 normalMap =

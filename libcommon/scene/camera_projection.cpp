@@ -2,6 +2,7 @@
 // Matrices: Khronos, glTF 2.0 Specification §3.10.3 "Projection Matrices".
 #include "libcommon/scene/camera_projection.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -44,23 +45,45 @@ void validate(const Camera& lens, ImageSize size) {
 // m[col][row].
 glm::dmat4 xywRows(const Camera& lens, ImageSize size) {
   glm::dmat4 m(0.0);
-  if (lens.perspective) {
-    double t = std::tan(0.5 * lens.yfov);
-    m[0][0] = 1.0 / (effectiveAspect(lens, size) * t);
-    m[1][1] = 1.0 / t;
+  const glm::dvec2 half = lensHalfExtents(lens, size);
+  m[0][0] = 1.0 / half.x;
+  m[1][1] = 1.0 / half.y;
+  if (lens.perspective)
     m[2][3] = -1.0;  // w = -z_eye
-  } else {
-    m[0][0] = 1.0 / lens.xmag;
-    m[1][1] = 1.0 / lens.ymag;
+  else
     m[3][3] = 1.0;
-  }
   return m;
 }
 
 }  // namespace
 
+double lensAspect(const Camera& lens) {
+  if (lens.perspective) return lens.aspectRatio;
+  return lens.ymag != 0.0 ? lens.xmag / lens.ymag : 0.0;
+}
+
+bool aspectsAgree(const Camera& lens, ImageSize size) {
+  const double camera = lensAspect(lens);
+  return !(camera > 0.0) || std::abs(camera - size.aspect()) <= 1e-6 * size.aspect();
+}
+
+glm::dvec2 lensHalfExtents(const Camera& lens, ImageSize size) {
+  if (aspectsAgree(lens, size)) {
+    if (!lens.perspective) return {lens.xmag, lens.ymag};
+    const double t = std::tan(0.5 * lens.yfov);
+    return {(lens.aspectRatio > 0.0 ? lens.aspectRatio : size.aspect()) * t, t};
+  }
+  // Sensor fit AUTO: the camera frame's larger side keeps its field, on the image's larger side.
+  const double larger = lens.perspective
+                            ? std::tan(0.5 * lens.yfov) * std::max(lens.aspectRatio, 1.0)
+                            : std::max(lens.xmag, lens.ymag);
+  const double aspect = size.aspect();
+  return aspect >= 1.0 ? glm::dvec2(larger, larger / aspect) : glm::dvec2(larger * aspect, larger);
+}
+
 double effectiveAspect(const Camera& lens, ImageSize size) {
-  return lens.aspectRatio > 0.0 ? lens.aspectRatio : size.aspect();
+  if (aspectsAgree(lens, size)) return lens.aspectRatio > 0.0 ? lens.aspectRatio : size.aspect();
+  return size.aspect();
 }
 
 glm::dmat4 viewMatrix(const CameraView& view) {
@@ -152,15 +175,16 @@ PrimaryRays::PrimaryRays(const CameraView& view, ImageSize size) : view_(view), 
   const glm::dvec3 right(m[0]), up(m[1]), back(m[2]), eye(m[3]);
   origin0_ = eye;
   direction0_ = -back;
+  halfExtents_ = lensHalfExtents(lens, size);
   if (lens.perspective) {
-    halfTan_ = std::tan(0.5 * lens.yfov);
+    halfTan_ = halfExtents_.y;
     aspect_ = effectiveAspect(lens, size);
     // Eye direction (xn aspect t, yn t, -1), as at() builds it before normalising.
     directionX_ = (aspect_ * halfTan_) * right;
     directionY_ = halfTan_ * up;
   } else {
-    originX_ = lens.xmag * right;
-    originY_ = lens.ymag * up;
+    originX_ = halfExtents_.x * right;
+    originY_ = halfExtents_.y * up;
   }
 }
 
@@ -172,16 +196,15 @@ Ray PrimaryRays::at(const glm::dvec2& pixel) const {
   glm::dvec3 originEye, dirEye;
   Ray r;
   if (lens.perspective) {
-    const double t = halfTan_;
     // Inverse of the projection's x, y rows at eye depth 1.
-    dirEye = glm::dvec3(xn * aspect_ * t, yn * t, -1.0);
+    dirEye = glm::dvec3(xn * aspect_ * halfTan_, yn * halfTan_, -1.0);
     originEye = glm::dvec3(0.0);
     double len = glm::length(dirEye);  // ray length per unit of eye depth
     r.tNear = lens.znear * len;
     r.tFar = lens.zfar == 0.0 ? inf : lens.zfar * len;
     dirEye /= len;
   } else {
-    originEye = glm::dvec3(xn * lens.xmag, yn * lens.ymag, 0.0);
+    originEye = glm::dvec3(xn * halfExtents_.x, yn * halfExtents_.y, 0.0);
     dirEye = glm::dvec3(0.0, 0.0, -1.0);
     r.tNear = lens.znear;
     r.tFar = lens.zfar;

@@ -29,9 +29,29 @@ struct ImageSize {
   bool operator!=(const ImageSize& o) const { return !(*this == o); }
 };
 
-// Aspect ratio (width / height) the projection uses: the camera's when it gives one (glTF
-// `aspectRatio`), else the image's. A camera aspect that differs from the image's stretches
-// the picture, as glTF prescribes.
+// The camera's own aspect ratio (width / height): perspective, glTF `aspectRatio` (0 when absent);
+// orthographic, xmag / ymag.
+double lensAspect(const Camera& lens);
+
+// Whether the camera's aspect and the image's agree (within a relative 1e-6: Blender writes
+// `aspectRatio` as a float32 of width / height), or the camera gives none: then the lens is used
+// as written, bit for bit as before sensor fit existed.
+bool aspectsAgree(const Camera& lens, ImageSize size);
+
+// The half extents of the image's field at eye depth 1 (perspective: the tangents of the half
+// field angles) or in metres (orthographic), along the image's x and y. No stage stretches an
+// image: where the aspects agree (aspectsAgree), {aspect tan(yfov/2), tan(yfov/2)} with the
+// camera's aspect (the image's when it gives none), or {xmag, ymag}. Where they differ, Blender's
+// default sensor fit, AUTO, which its glTF exporter assumes (io_scene_gltf2, gather_cameras:
+// the field of the larger side of the render is the camera's angle): the camera's larger side
+// keeps its field, tan(yfov/2) max(aspectRatio, 1) (orthographic max(xmag, ymag)), and it goes
+// to the image's larger side; the other side follows the image's aspect. So a render wider than
+// the camera's frame shows more at the sides or crops top and bottom, never an ellipse for a
+// sphere (docs/design.md §4 "Cameras", formats/gltf_scene.md).
+glm::dvec2 lensHalfExtents(const Camera& lens, ImageSize size);
+
+// Aspect ratio (width / height) of the field the projection uses: the camera's when it gives one
+// and it agrees with the image's, else the image's (sensor fit, lensHalfExtents).
 double effectiveAspect(const Camera& lens, ImageSize size);
 
 // Eye-from-world: inverse of worldFromCamera (rigid inverse, exact to rounding).
@@ -111,7 +131,10 @@ class PrimaryRays {
  private:
   CameraView view_;
   ImageSize size_;
-  double halfTan_ = 0.0, aspect_ = 1.0;  // perspective: tan(yfov/2), effectiveAspect()
+  glm::dvec2 halfExtents_{1.0};  // lensHalfExtents()
+  // Perspective: halfExtents_.y and effectiveAspect(), multiplied per ray in the order they were
+  // before sensor fit, so rays are bit-identical where the aspects agree.
+  double halfTan_ = 0.0, aspect_ = 1.0;
   // line(): origin and direction as affine functions of NDC x, y.
   glm::dvec3 origin0_{0.0}, originX_{0.0}, originY_{0.0};
   glm::dvec3 direction0_{0.0}, directionX_{0.0}, directionY_{0.0};

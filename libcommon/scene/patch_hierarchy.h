@@ -5,8 +5,9 @@
 // patch gets the same id whatever order the hierarchy was refined in; dense node indices are
 // only handles into this object.
 //
-// Geometry stays in the owning mesh node's local frame (see scene.h), so rigid motion moves a
-// patch without changing its shape, its id or its texture parameterisation.
+// Geometry stays in the owning mesh node's local frame (see scene.h), so a node's motion (rigid,
+// or affine with an animated scale) moves a patch without changing its id or its texture
+// parameterisation (an affine map keeps the (u,v) maps and parallelograms).
 #pragma once
 
 #include <cstdint>

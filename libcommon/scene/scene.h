@@ -1,8 +1,9 @@
 // The scene model: what the toolchain sees of an animated glTF 2.0 scene (docs/design.md §4).
 //
 // Units are metres and seconds; time is double everywhere. Geometry is kept in each mesh
-// node's local frame so rigid motion never changes a patch's shape or id; world positions at
-// time t are worldTransform(node, t) applied to the local polygons.
+// node's local frame so motion, rigid or affine (an animated scale), never changes a patch's id
+// or (u,v) map; world positions at time t are worldTransform(node, t) applied to the local
+// polygons, and world normals and areas come from the placed polygons.
 //
 // Animation follows the glTF 2.0 specification exactly (§3.11 "Animations"): TRS channels,
 // STEP / LINEAR / CUBICSPLINE samplers, shortest-arc normalised slerp for rotations, the
@@ -41,6 +42,7 @@ struct Texture {
 
 struct Material {
   std::string name;
+  int gltfIndex = -1;  // the material's index in the glTF file (messages name it by both)
   // Diffuse reflectance rho = baseColorFactor.rgb x mean(baseColorTexture), each in
   // [0, kMaxReflectance] when read from a file.
   glm::dvec3 reflectance{1.0};
@@ -50,6 +52,10 @@ struct Material {
   bool doubleSided = false;
   int baseColorTexture = -1;  // index into Scene::textures or -1
   int baseColorTexCoord = 0;
+  // emissiveTexture (index into Scene::textures or -1): L_e varies as emission x texture
+  // (libcommon/scene/emission_texture.h).
+  int emissiveTexture = -1;
+  int emissiveTexCoord = 0;
 
   bool isEmitter() const { return emission.x > 0.0 || emission.y > 0.0 || emission.z > 0.0; }
 };

@@ -73,7 +73,13 @@ void addMaterials(const Scene& scene, Digest& d) {
 
 void addLights(const Scene& scene, Digest& d) {
   d.integer(int64_t(scene.materials.size()));
-  for (const Material& m : scene.materials) d.vec(m.emission);
+  for (const Material& m : scene.materials) {
+    d.vec(m.emission);
+    // An emissive texture's mean (the first pass's B_e); nothing added without one, so the
+    // digests of scenes without them are unchanged.
+    if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < scene.textures.size())
+      d.vec(scene.textures[size_t(m.emissiveTexture)].mean);
+  }
 }
 
 // `nodes` and their ancestors, ascending.

@@ -1,6 +1,7 @@
 // The scene's list of lights (contract in scene_emitters.h).
 #include "libcommon/scene/scene_emitters.h"
 
+#include "libcommon/scene/emission_texture.h"
 #include "libcommon/scene/emissive_polygon_emitter.h"
 
 namespace rad {
@@ -10,8 +11,8 @@ SceneEmitters::SceneEmitters(const Scene& scene, const std::vector<InputPolygon>
   for (std::size_t t = 0; t < tops.size(); ++t) {
     if (!scene.emits(tops[t])) continue;
     ofTop_[t] = int(emitters_.size());
-    emitters_.push_back(std::make_unique<EmissivePolygonEmitter>(
-        scene, tops[t], int(t), scene.materials[size_t(tops[t].material)].emission));
+    emitters_.push_back(std::make_unique<EmissivePolygonEmitter>(scene, tops[t], int(t),
+                                                                 meanEmissionOver(scene, tops[t])));
   }
 }
 

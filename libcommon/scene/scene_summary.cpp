@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include "libcommon/scene/emission_texture.h"
+
 namespace rad {
 
 namespace {
@@ -12,9 +14,8 @@ nlohmann::json vec3(const glm::dvec3& v) {
 
 glm::dvec3 emittedPower(const Scene& scene, const InputPolygon& polygon, double t) {
   if (polygon.material < 0) return glm::dvec3(0.0);
-  const Material& m = scene.materials[polygon.material];
   double area = polygon.local.transformed(scene.worldTransform(polygon.node, t)).area();
-  return glm::pi<double>() * m.emission * area;
+  return glm::pi<double>() * meanEmissionOver(scene, polygon) * area;
 }
 
 nlohmann::json summarizeScene(const Scene& scene) {

@@ -43,12 +43,9 @@ double wrap(double a) {
 class InterpolationTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    // Its nodes 0, 3 and 4 animate scale, outside the rigid model the tools accept: read with
-    // the option that keeps glTF's animation semantics testable.
-    GltfReadOptions options;
-    options.allowScaleAnimation = true;
-    scene = new Scene(
-        readGltfScene(kExternal + "khronos_InterpolationTest/InterpolationTest.gltf", options));
+    // Its nodes 0, 3 and 4 animate scale: an affine motion the tools render (issue 57).
+    scene =
+        new Scene(readGltfScene(kExternal + "khronos_InterpolationTest/InterpolationTest.gltf"));
   }
   static void TearDownTestSuite() { delete scene; }
   static Scene* scene;
@@ -337,18 +334,7 @@ TEST(External, EveryFileLoads) {
     const std::string ext = e.path().extension().string();
     if (ext != ".gltf" && ext != ".glb") continue;
     ++files;
-    // One documented error: InterpolationTest animates scale (rigid motion only); every other
-    // file loads.
-    if (e.path().filename() == "InterpolationTest.gltf") {
-      try {
-        readGltfScene(e.path().string());
-        ADD_FAILURE() << e.path() << ": animated scale accepted";
-      } catch (const Error& err) {
-        EXPECT_NE(std::string(err.what()).find(": animates the scale of node"), std::string::npos)
-            << err.what();
-      }
-      continue;
-    }
+    // Every file loads (InterpolationTest's animated scale too, issue 57).
     EXPECT_NO_THROW(readGltfScene(e.path().string())) << e.path();
   }
   EXPECT_EQ(files, 7);
@@ -800,14 +786,16 @@ TEST_F(BadInput, PunctualLightsAreCountedAndNoEmitterIsNamed) {
   EXPECT_NO_THROW(requireEmitter(lit));
 }
 
-// The scene model is rigid motion: a scale channel must hold one value.
-TEST_F(BadInput, AnimatedScaleIsRefusedConstantScaleLoads) {
+// An animated scale (squash and stretch) is an affine motion of a dynamic node (issue 57: it was
+// refused); a constant one is a static scale.
+TEST_F(BadInput, AnimatedScaleIsAnAffineMotion) {
   auto scene = [&](float second) {
     const float values[6] = {2, 2, 2, second, 2, 2};
     return write("s.gltf", animatedTriangleGltf("scale", values));
   };
-  expectBadInput(scene(3.0f),
-                 "animation 0 channel 0: animates the scale of node 0 (key 1: 3, key 0: 2)");
+  Scene squash = readGltfScene(scene(3.0f));
+  EXPECT_TRUE(squash.isDynamic(0, 0.0, 1.0));
+  EXPECT_NEAR(scaleX(squash.worldTransform(0, 0.5)), 2.5, 1e-12);
   // A constant scale (2, held by the channel) is a static scale: loads, world area x 4.
   Scene s = readGltfScene(scene(2.0f));
   ASSERT_EQ(s.channels.size(), 1u);

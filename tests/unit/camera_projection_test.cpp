@@ -62,14 +62,68 @@ TEST(CameraProjection, AspectFromImageOrCamera) {
   CameraView v = perspectiveView(0.8);
   EXPECT_DOUBLE_EQ(effectiveAspect(v.lens, size), 2.0);
   EXPECT_NEAR(projectToPixel(v, size, glm::dvec3(2.0 * t * d, 0.0, -d)).pixel.x, 200.0, 1e-9);
-  // An explicit aspect wins (glTF) and stretches the image.
+  // An explicit aspect of the image's: the lens as written.
+  v.lens.aspectRatio = 2.0;
+  EXPECT_NEAR(projectToPixel(v, size, glm::dvec3(2.0 * t * d, 0.0, -d)).pixel.x, 200.0, 1e-9);
+  EXPECT_NEAR(projectToPixel(v, size, glm::dvec3(0.0, t * d, -d)).pixel.y, 0.0, 1e-9);
+  // Another aspect (1) does not stretch: Blender's AUTO sensor fit gives the camera frame's
+  // larger side's field (tan 0.4, either side of a square) to the image's larger side (x), and
+  // the image's aspect sets the other: a square stays square (issue 57).
   v.lens.aspectRatio = 1.0;
   EXPECT_NEAR(projectToPixel(v, size, glm::dvec3(t * d, 0.0, -d)).pixel.x, 200.0, 1e-9);
   EXPECT_NEAR(projectToPixel(v, size, glm::dvec3(-t * d, 0.0, -d)).pixel.x, 0.0, 1e-9);
+  EXPECT_NEAR(projectToPixel(v, size, glm::dvec3(0.0, 0.5 * t * d, -d)).pixel.y, 0.0, 1e-9);
+}
+
+// A sphere's outline stays round whatever the image's aspect against the camera's: equal pixel
+// extents across and up for a ball straight ahead (issue 57: it became an ellipse).
+TEST(CameraProjection, SensorFitNeverStretches) {
+  const double r = 0.3, d = 4.0;
+  for (double cameraAspect : {0.0, 0.5, 1.0, 16.0 / 9.0, 3.0})
+    for (ImageSize size :
+         {ImageSize{160, 90}, ImageSize{90, 160}, ImageSize{120, 120}, ImageSize{300, 100}}) {
+      CameraView v = perspectiveView(0.7, cameraAspect);
+      const auto px = [&](glm::dvec3 p) { return projectToPixel(v, size, p).pixel; };
+      const double across = px({r, 0.0, -d}).x - px({-r, 0.0, -d}).x;
+      const double up = px({0.0, -r, -d}).y - px({0.0, r, -d}).y;
+      EXPECT_NEAR(across, up, 1e-9 * up) << cameraAspect << " " << size.width << "x" << size.height;
+      // The rays agree with the projection.
+      const Ray ray = PrimaryRays(v, size).at(px({r, r, -d}));
+      EXPECT_NEAR(glm::length(glm::cross(ray.direction, glm::normalize(glm::dvec3(r, r, -d)))), 0.0,
+                  1e-12);
+    }
+}
+
+// Which field is kept: the camera frame's larger side's (Blender's AUTO fit), on the image's
+// larger side; bit-identical to the lens as written where the aspects agree.
+TEST(CameraProjection, SensorFitKeepsTheLargerSidesField) {
+  const double t = std::tan(0.35);
+  CameraView wide = perspectiveView(0.7, 2.0);  // horizontal half-tangent 2t
+  EXPECT_NEAR(lensHalfExtents(wide.lens, {100, 100}).x, 2.0 * t, 1e-15);  // crop to a square
+  EXPECT_NEAR(lensHalfExtents(wide.lens, {100, 100}).y, 2.0 * t, 1e-15);
+  EXPECT_NEAR(lensHalfExtents(wide.lens, {50, 100}).y, 2.0 * t, 1e-15);  // portrait: y takes it
+  EXPECT_NEAR(lensHalfExtents(wide.lens, {50, 100}).x, t, 1e-15);
+  CameraView tall = perspectiveView(0.7, 0.5);  // portrait: vertical half-tangent t
+  EXPECT_NEAR(lensHalfExtents(tall.lens, {200, 100}).x, t, 1e-15);
+  EXPECT_NEAR(lensHalfExtents(tall.lens, {200, 100}).y, 0.5 * t, 1e-15);
+  // Agreeing within Blender's float32 aspect: the lens as written, bit for bit.
+  CameraView blender = perspectiveView(0.7, double(float(16.0 / 9.0)));
+  EXPECT_TRUE(aspectsAgree(blender.lens, {1920, 1080}));
+  EXPECT_EQ(lensHalfExtents(blender.lens, {1920, 1080}).x, double(float(16.0 / 9.0)) * t);
+  EXPECT_EQ(lensHalfExtents(blender.lens, {1920, 1080}).y, t);
+  // Orthographic: max(xmag, ymag) on the larger side.
+  Camera ortho;
+  ortho.perspective = false;
+  ortho.xmag = 2.0;
+  ortho.ymag = 1.0;
+  ortho.zfar = 10.0;
+  EXPECT_EQ(lensHalfExtents(ortho, {200, 100}), glm::dvec2(2.0, 1.0));
+  EXPECT_EQ(lensHalfExtents(ortho, {100, 100}), glm::dvec2(2.0, 2.0));
+  EXPECT_EQ(lensHalfExtents(ortho, {100, 200}), glm::dvec2(1.0, 2.0));
 }
 
 TEST(CameraProjection, MatchesGltfFormulas) {
-  ImageSize size{100, 50};
+  ImageSize size{150, 100};  // the camera's aspect: the lens as written
   CameraView v = perspectiveView(0.7, 1.5, 20.0);
   double a = 1.5, y = 0.7, n = 0.1, f = 20.0, t = std::tan(0.5 * y);
   glm::dmat4 p = projectionMatrix(v.lens, size);

@@ -18,6 +18,7 @@
 #include "formats/key_window.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/global_stage.h"
+#include "libcommon/radiosity/solve_cost_warnings.h"
 #include "tools/common/parameter_cli.h"
 #include "tools/common/tool_main.h"
 #include "tools/stages/global_run.h"
@@ -91,6 +92,8 @@ int run(Options o, int argc, char** argv) {
   auto tRead = std::chrono::steady_clock::now();
   rad::Scene scene = rad::readGltfScene(o.scene);
   rad::requireEmitter(scene);  // else the solution is zero and every frame black
+  for (const std::string& w : rad::slowSolveWarnings(scene, g.spaceTime.radiosity.tol))
+    std::cerr << kTool << ": " << o.scene << ": warning: " << w << "\n";
   report.secondsRead = rad::secondsSince(tRead);
   rad::FrameRange frames = given.empty() ? rad::animationFrames(scene, g.fps)
                                          : rad::FrameRange{given.front(), given.back()};

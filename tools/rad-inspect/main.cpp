@@ -12,12 +12,14 @@
 #include "formats/gltf_file_access.h"
 #include "formats/gltf_inputs.h"
 #include "formats/gltf_scene.h"
+#include "formats/gltf_scene_file.h"
 #include "formats/inspect_kinds.h"
 #include "formats/pixel_checksum.h"
 #include "formats/provenance.h"
 #include "formats/texture_movie.h"
 #include "libcommon/radiosity/global_stage.h"
 #include "libcommon/scene/frame_range.h"
+#include "libcommon/scene/render_readiness.h"
 #include "libcommon/scene/scene_summary.h"
 #include "tools/common/tool_main.h"
 
@@ -32,6 +34,7 @@ struct Options {
   std::string array;          // dump one array of a container
   std::string inputs;         // --inputs: the files a scene is made of, with hashes
   std::string defaultFrames;  // --default-frames: the frames a stage covers without --frames
+  std::string preflight;      // --preflight: can the pipeline render this scene at all
   double fps = rad::GlobalOptions{}.fps;  // --fps for --default-frames: the stages' default
 };
 
@@ -245,6 +248,14 @@ int main(int argc, char** argv) {
           ->option_text("SCENE")
           ->excludes(files)
           ->excludes("--inputs");
+  app.add_option("--preflight", o.preflight,
+                 "instead: check that SCENE has a camera and something that emits, before the "
+                 "pipeline's first stage (docs/design.md §7); print 'SCENE: ok' or one line "
+                 "saying what to export, exit 1")
+      ->option_text("SCENE")
+      ->excludes(files)
+      ->excludes("--inputs")
+      ->excludes(defaultFrames);
   app.add_option("--fps", o.fps, "frames per second for --default-frames")
       ->capture_default_str()
       ->check(rad::positiveFinite())
@@ -256,6 +267,14 @@ int main(int argc, char** argv) {
     return rad::runTool(kTool, [&]() {
       std::cout << rad::animationFrames(rad::readGltfScene(o.defaultFrames), o.fps).toString()
                 << "\n";
+      return 0;
+    });
+  if (!o.preflight.empty())
+    return rad::runTool(kTool, [&]() {
+      const rad::Scene scene = rad::readGltfScene(o.preflight);
+      rad::requireRenderReadiness(scene,
+                                  rad::punctualLightsInFile(rad::readGltfSceneFile(o.preflight)));
+      std::cout << o.preflight << ": ok\n";
       return 0;
     });
   if (!o.inputs.empty())
