@@ -2,6 +2,7 @@
 #include "libcommon/scene/scene_emitters.h"
 
 #include "libcommon/scene/emissive_polygon_emitter.h"
+#include "libcommon/scene/punctual_light_emitter.h"
 
 namespace rad {
 
@@ -12,6 +13,13 @@ SceneEmitters::SceneEmitters(const Scene& scene, const std::vector<InputPolygon>
     ofTop_[t] = int(emitters_.size());
     emitters_.push_back(std::make_unique<EmissivePolygonEmitter>(
         scene, tops[t], int(t), scene.materials[size_t(tops[t].material)].emission));
+  }
+  const std::vector<int> lamps = scene.lightNodes();
+  if (lamps.empty()) return;
+  const std::array<glm::dvec3, 2> bounds = animationBounds(scene);
+  for (int node : lamps) {
+    lamps_.push_back(int(emitters_.size()));
+    emitters_.push_back(std::make_unique<PunctualLightEmitter>(scene, node, bounds));
   }
 }
 
