@@ -27,6 +27,7 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "libcommon/movies/lamp_direct_term.h"
 #include "libcommon/movies/movie_geometry.h"
 #include "libcommon/movies/ray_cast_masks.h"
 #include "libcommon/movies/solid_contact.h"
@@ -151,7 +152,10 @@ class MovieBake {
         texels_(geometry.texels()),
         acc_(texels_),
         transmittance_(texels_),
-        texture_(texels_ * 3) {}
+        texture_(texels_ * 3) {
+    if (!emitters.lamps().empty() && visibility)
+      lamps_ = std::make_unique<LampDirectTerm>(emitters, geometry, *visibility, req.patch.top);
+  }
 
   // Texels under a touching solid at key k (a box's foot on the floor, solid_contact.h) are
   // never seen, and gather nothing: ~0. A pixel between such a texel's centre and an exposed
@@ -323,6 +327,7 @@ class MovieBake {
       combine(p, t, f);
     }
     auto clock = SteadyClock::now();
+    if (lamps_) lamps_->add(k, t, acc_);  // the punctual lamps' direct light, per texel
     for (size_t x = 0; x < texels_; ++x)
       for (int c = 0; c < 3; ++c) {
         double v = acc_[x][c];
@@ -491,8 +496,9 @@ class MovieBake {
   FormFactorSpill& spill_;
   const MovieExtent& req_;
   MovieGeometry& geo_;
-  const GoodLinkGather* gather_;  // null: Gouraud
-  SceneVisibility* visibility_;   // null: covered texels are left as they are
+  const GoodLinkGather* gather_;           // null: Gouraud
+  SceneVisibility* visibility_;            // null: covered texels are left as they are
+  std::unique_ptr<LampDirectTerm> lamps_;  // null: the scene has no lamp
   const size_t texels_;
   int saturatedSamples_ = 0;
   std::vector<BadPair> pairs_;
@@ -850,8 +856,12 @@ SceneVisibility* TextureMovieBaker::sceneVisibility() {
 // bounds meet the box around the receiver node and the shooter (the shaft's bounds).
 bool TextureMovieBaker::shadowsMove(const MovieExtent& req,
                                     const std::vector<uint32_t>& badShooters) const {
-  if (badShooters.empty()) return false;
   const double t0 = req.firstFrame / fps_, t1 = req.lastFrame / fps_;
+  const InputPolygon& top = tops_[req.patch.top];
+  if (lampShadowsMove(scene_, tops_, emitters_, top.node,
+                      nodeWorldPolygon(scene_, top, req.patch, t0), t0, t1))
+    return true;
+  if (badShooters.empty()) return false;
   const InputPolygon& receiverTop = tops_[req.patch.top];
   if (scene_.isDynamic(receiverTop.node, t0, t1)) return true;
   std::vector<std::array<glm::dvec3, 2>> swept;
@@ -911,8 +921,9 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     stats_.secondsGood += secondsSince(clock);
   }
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);
-  MovieBake bake(solution_, tops_, emitters_, options_, stats_, gl, *spill, req, geometry,
-                 gather.get(), options_.fillCovered ? sceneVisibility() : nullptr, *blockers_);
+  MovieBake bake(
+      solution_, tops_, emitters_, options_, stats_, gl, *spill, req, geometry, gather.get(),
+      options_.fillCovered || !emitters_.lamps().empty() ? sceneVisibility() : nullptr, *blockers_);
   bake.plan(badShooters);
   sink.begin(movie);
   for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);

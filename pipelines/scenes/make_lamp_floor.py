@@ -9,10 +9,12 @@ camera is orthographic, looking down -Y with image up along -Z, xmag = ymag = HA
 z = HALF (2 (j + 1/2) / H - 1). The floor is a square of side 2 x FLOOR (20 m: "infinite" for
 the lamp at 1 m), reflectance RHO, one quad.
 
-usage: make_lamp_floor.py OUT.gltf [--lamp point|spot|sun] [--move] [--blocker] [--blender]
+usage: make_lamp_floor.py OUT.gltf [--lamp point|spot|sun] [--move] [--blocker] [--move-blocker]
+                          [--blender]
 
-  --move     the lamp moves along +X by 1 m over 2 s (LINEAR), so its shadow moves
-  --blocker  a 0.4 m square board, facing up, 0.5 m above the floor at x in [0.2, 0.6]
+  --move          the lamp moves along +X by 1 m over 2 s (LINEAR), so its shadow moves
+  --blocker       a 0.4 m square board, facing up, 0.5 m above the floor at x in [0.2, 0.6]
+  --move-blocker  the board (implies --blocker) moves along -Z by 1 m over 2 s
   --blender  asset.generator names Blender's exporter, so --light-units auto reads blender units
 
 Lamp: intensity I = 10 cd (colour 1, 0.8, 0.6) at (0, 1, 0) shining down; spot cones 0.3 and
@@ -70,7 +72,7 @@ def qmul(a, b):
 DOWN = [-math.sin(math.pi / 4), 0.0, 0.0, math.cos(math.pi / 4)]  # -Z local -> -Y world
 F = FLOOR
 add_quad("floor", [(-F, 0, -F), (-F, 0, F), (F, 0, F), (F, 0, -F)], 0)
-if "--blocker" in args:
+if "--blocker" in args or "--move-blocker" in args:
     add_quad("blocker", [(0.2, 0.5, -0.2), (0.2, 0.5, 0.2), (0.6, 0.5, 0.2), (0.6, 0.5, -0.2)], 0)
 nodes.append({"name": "camera", "camera": 0, "translation": [0.0, 5.0, 0.0], "rotation": DOWN})
 light = {"name": lamp, "type": "directional" if lamp == "sun" else lamp, "color": [1.0, 0.8, 0.6],
@@ -84,13 +86,20 @@ if lamp == "sun":
     lamp_node["rotation"] = qmul([0.0, 0.0, math.sin(tilt / 2), math.cos(tilt / 2)], DOWN)
 nodes.append(lamp_node)
 animations = []
-if "--move" in args:
+
+
+def move(name, node, start, end):
     t = add_accessor([(0.0,), (2.0,)], "f", "SCALAR", 5126, True)
-    v = add_accessor([(0.0, 1.0, 0.0), (1.0, 1.0, 0.0)], "3f", "VEC3", 5126)
-    animations.append({"name": "lamp-moves",
+    v = add_accessor([start, end], "3f", "VEC3", 5126)
+    animations.append({"name": name,
                        "samplers": [{"input": t, "output": v, "interpolation": "LINEAR"}],
-                       "channels": [{"sampler": 0,
-                                     "target": {"node": len(nodes) - 1, "path": "translation"}}]})
+                       "channels": [{"sampler": 0, "target": {"node": node, "path": "translation"}}]})
+
+
+if "--move" in args:
+    move("lamp-moves", len(nodes) - 1, (0.0, 1.0, 0.0), (1.0, 1.0, 0.0))
+if "--move-blocker" in args:
+    move("board-moves", 1, (0.0, 0.0, 0.0), (0.0, 0.0, -1.0))
 
 generator = ("Khronos glTF Blender I/O v3.4.50" if "--blender" in args
              else "rad pipelines/scenes/make_lamp_floor.py")
