@@ -116,6 +116,7 @@ struct KeySolution {
   std::vector<glm::dvec3> lampIrradiance;
   // The lamps' values computed or taken over at this key, for the next key's coherence.
   LampValueCache lampValues;
+  size_t lampValuesReused = 0;  // of them: taken over (KeySolveInput::reuseLamps)
   // Per dense node: the closure factor of a leaf of this key's tree (1 elsewhere, and when
   // RadiosityOptions::closure is off), for all of its links and for its good ones (shooters
   // that do not emit). Empty without closure.

@@ -47,6 +47,7 @@ size_t KeyTimeSolver::refineLamps() {
   size_t splits = 0;
   while (!work.empty()) {
     std::vector<std::vector<LampValue>> values(work.size());
+    std::vector<int> reused(work.size(), 0);
     tbb::parallel_for(size_t(0), work.size(), [&](size_t j) {
       const int i = work[j];
       const Polygon& world = s_.world[size_t(i)];
@@ -57,6 +58,7 @@ size_t KeyTimeSolver::refineLamps() {
           const auto it = input_.reuseLamps->find(lampValueKey(i, int(l)));
           if (it != input_.reuseLamps->end()) {
             values[j][l] = it->second;
+            ++reused[j];
             continue;
           }
         }
@@ -77,6 +79,7 @@ size_t KeyTimeSolver::refineLamps() {
       lampE_[size_t(i)] = sum;
       lampSpread_[size_t(i)] = spread;
       lampKnown_[size_t(i)] = 1;
+      s_.lampValuesReused += size_t(reused[j]);
       if (!lampWantsSplit(i)) continue;
       splitForLamps(i, next);
       ++splits;

@@ -197,6 +197,8 @@ KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, dou
   kr.linkCapReached = s.linkCapReached;
   kr.clusterLinks = s.clusterLinks;
   kr.clusterLinksReused = s.clusterLinksReused;
+  kr.lampValues = s.lampValues.size();
+  kr.lampValuesReused = s.lampValuesReused;
   kr.secondsLinks = s.secondsLinks;
   kr.secondsSolve = s.secondsSolve;
   for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;

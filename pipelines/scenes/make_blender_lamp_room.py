@@ -15,7 +15,7 @@ export_cameras and export_lights on (both off by default), one embedded .gltf fi
 
 usage: blender -b --factory-startup -P make_blender_lamp_room.py -- OUT.gltf [--blend OUT.blend]
 
-The animation: 48 frames at 24 fps (2 s), the cube sliding 1.5 m along +X.
+The render size is 352x240 (the exported camera's aspectRatio). The animation: 48 frames at 24 fps (2 s), the cube sliding 1.5 m along +X.
 """
 import math
 import sys
@@ -30,6 +30,8 @@ bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 scene.render.fps = 24
 scene.frame_start, scene.frame_end = 0, 47
+# The exporter writes the camera's aspectRatio from the render size: the pipeline's 352x240.
+scene.render.resolution_x, scene.render.resolution_y = 352, 240
 materials = {}
 
 
