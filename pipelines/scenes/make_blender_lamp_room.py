@@ -3,7 +3,7 @@
 
 Issue 57's test scene, as a Blender user makes it: a 4 x 3 x 2.6 m room of boxes (floor,
 ceiling, three walls and a front wall with a wide opening), a table and a chair, a cube that
-moves across the floor, and three lamp objects: a 60 W point lamp 5 cm under the ceiling, a
+moves across the floor, and three lamp objects: a 60 W point lamp 30 cm under the ceiling, a
 150 W spot (45 degrees, blend 0.3) over the table, and a sun of 4 W/m^2 shining in through the
 opening. Lamps are punctual: radius 0 (point, spot) and angle 0 (sun), so Blender's own Cycles
 render is the point-light render the toolchain makes. Materials are Principled BSDFs whose base
@@ -100,7 +100,7 @@ def lamp(name, kind, energy, location, rotation=(0.0, 0.0, 0.0)):
     return data
 
 
-lamp("ceiling-lamp", "POINT", 60.0, (-0.8, -0.2, H - 0.05))
+lamp("ceiling-lamp", "POINT", 60.0, (-0.8, -0.2, H - 0.3))
 spot = lamp("table-spot", "SPOT", 150.0, (0.6, 0.6, 2.2))
 spot.spot_size = math.radians(45.0)
 spot.spot_blend = 0.3
