@@ -175,6 +175,27 @@ TEST_F(PunctualLamps, StaticLampValuesAreKeptAcrossKeyTimes) {
             runCommand(tool("rad-inspect") + " " + g + "-scratch.rlh --array node_radiosity").out);
 }
 
+// A closed box of reflectance rho with a point lamp of I = 1 cd inside (make_lamp_box.py): the
+// walls absorb the lamp's 4 pi I W, so each wall's mean radiosity (by symmetry) is
+// rho 4 pi I / (A (1 - rho)), A = 6 m^2: rad-global's lamp term and interreflection conserve
+// power, within 0.5 %.
+TEST_F(PunctualLamps, ClosedBoxConservesTheLampsPower) {
+  for (const double rho : {0.5, 0.9}) {
+    const std::string s = (dir_ / "box.gltf").string(), g = (dir_ / "box.rlh").string();
+    run("python3 " + std::string(RAD_SOURCE_DIR) + "/pipelines/scenes/make_lamp_box.py " +
+        std::to_string(rho) + " " + s);
+    run(tool("rad-global") + " " + s + " -o " + g);
+    std::istringstream rows(
+        runCommand(tool("rad-inspect") + " " + g + " --array node_radiosity").out);
+    const double expected = rho * 4.0 * kPi / (6.0 * (1.0 - rho));
+    for (int wall = 0; wall < 6; ++wall) {  // the top-level patches come first
+      double r = 0, gr = 0, b = 0;
+      ASSERT_TRUE(rows >> r >> gr >> b) << wall;
+      EXPECT_NEAR(r, expected, 0.005 * expected) << "rho " << rho << " wall " << wall;
+    }
+  }
+}
+
 // A Blender export's lamps are in Blender's units: the same floor written as Blender's exporter
 // would (generator named) renders 683 times darker unless --light-units gltf says otherwise.
 TEST_F(PunctualLamps, BlenderExportIsReadInBlenderUnits) {
