@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "formats/gltf_message_text.h"
+#include "formats/gltf_lights.h"
 #include "formats/gltf_scene_file.h"
 #include "formats/gltf_triangles.h"
 #include "libcommon/core/error.h"
@@ -287,7 +288,7 @@ Scene Reader::read() {
   Scene scene;
   scene.path = path_;
   for (const std::string& ext : m_.extensionsRequired)
-    if (ext != "KHR_materials_emissive_strength")
+    if (ext != "KHR_materials_emissive_strength" && ext != "KHR_lights_punctual")
       fail("required extension " + clipInput(ext) + " is not supported");
   for (size_t i = 0; i < m_.nodes.size(); ++i) {
     if (m_.nodes[i].skin >= 0)
@@ -300,6 +301,7 @@ Scene Reader::read() {
         fail(gltfItemLabel("mesh", int(i), m_.meshes[i].name) +
              " has morph targets; they are not supported (a node moves as a whole)");
   readNodes(scene);
+  readPunctualLights(path_, m_, options_.lightUnits, scene);
   scene.meshes.resize(m_.meshes.size());
   for (size_t i = 0; i < scene.meshes.size(); ++i) scene.meshes[i].name = m_.meshes[i].name;
   std::vector<char> needed(m_.meshes.size(), 0);
@@ -834,19 +836,6 @@ void Reader::requireWorldArea(const Scene& scene, int node, double t) const {
   }
 }
 
-namespace {
-
-// KHR_lights_punctual lights in the file (not supported; counted to say why a scene is dark).
-int punctualLightCount(const tinygltf::Model& model) {
-  auto ext = model.extensions.find("KHR_lights_punctual");
-  if (ext != model.extensions.end() && ext->second.Has("lights") &&
-      ext->second.Get("lights").IsArray())
-    return int(ext->second.Get("lights").ArrayLen());
-  return int(model.lights.size());
-}
-
-}  // namespace
-
 GltfReadOptions& defaultGltfReadOptions() {
   static GltfReadOptions options;
   return options;
@@ -900,7 +889,6 @@ Scene parseAndRead(const std::string& path, const GltfReadOptions& options) {
   }
   Reader reader(path, model, options, hooks);
   Scene scene = reader.read();
-  scene.punctualLights = punctualLightCount(model);
   warn = withoutImageFileWarnings(warn);
   if (!warn.empty()) scene.warnings.push_back("tinygltf: " + oneLine(warn));
   return scene;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "formats/gltf_file_access.h"
+#include "formats/gltf_lights.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {
@@ -14,6 +15,8 @@ struct GltfReadOptions {
   // An image whose header gives more pixels than this is not decoded: its texture is ignored
   // with a warning (a 450 KB PNG of 12,000^2 pixels decoded to 2.3 GB).
   uint64_t maxTexturePixels = kMaxTexturePixels;
+  // The units of KHR_lights_punctual intensities (gltf_lights.h; --light-units).
+  LightUnits lightUnits = LightUnits::kAuto;
 };
 
 // The options readGltfScene(path) uses. Process-wide: the tools set it once from their command

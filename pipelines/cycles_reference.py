@@ -26,6 +26,14 @@ frames DIR/NNNN.exr like rad-reference's (RGB float, row 0 = top), which rad-dif
              rotations are slerped between keys as glTF prescribes (the importer's f-curves
              interpolate quaternion components linearly). CUBICSPLINE samplers are refused:
              the importer drops their tangents.
+  lamps      KHR_lights_punctual lamps (docs/design.md §4 "Lights") are made punctual: radius 0
+             (point, spot) and angle 0 (sun); the importer's default would soften their
+             shadows. The importer reads intensities as Blender's exporter wrote them (its
+             "Standard" mode: cd and lux over 683, x 4 pi for a point or spot's watts), which is
+             the tools' --light-units blender; with --light-units gltf (auto: the tools' rule,
+             by asset.generator) each lamp's energy is multiplied by 683 so that cd and lux are
+             taken as W/sr and W/m^2, as the tools do. A spot is Cycles' (cos x smoothstep
+             profile), which the tools give it in blender units only.
   film       Cycles on the CPU, --spp samples with --seed, no adaptive sampling, no denoiser,
              no clamping, light threshold 0, --max-bounces of every kind, the pixel filter
              --pixel-filter of --filter-width pixels (by default blackman-harris 1.5, Cycles' own
@@ -88,6 +96,8 @@ def parse_args(argv):
     p.add_argument("--pixel-centres", action="store_true",
                    help="older name of --pixel-filter none")
     p.add_argument("--max-bounces", type=int, default=64, help="bounces of every kind")
+    p.add_argument("--light-units", choices=["auto", "gltf", "blender"], default="auto",
+                   help="units of the lamps, as the tools' --light-units (default auto)")
     p.add_argument("--threads", type=int, default=0, help="render threads; 0: all cores")
     p.add_argument("--blender", default="blender", help="the blender executable")
     p.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"),
@@ -396,6 +406,20 @@ def pose_at(bpy, scene, frame):
     bpy.context.view_layer.update()
 
 
+def punctual_lamps(bpy, doc, units):
+    """Radius and angle 0; energies x 683 in gltf units (see the lamps paragraph above)."""
+    if units == "auto":
+        generator = doc.get("asset", {}).get("generator", "")
+        units = "blender" if generator.startswith("Khronos glTF Blender I/O") else "gltf"
+    for light in bpy.data.lights:
+        if light.type == "SUN":
+            light.angle = 0.0
+        else:
+            light.shadow_soft_size = 0.0
+        if units == "gltf":
+            light.energy *= 683.0
+
+
 def render(a):
     import bpy
     doc = gltf_json(a.scene)
@@ -411,6 +435,7 @@ def render(a):
     for mat in bpy.data.materials:
         if mat.use_nodes and mat.users:
             lambertian_material(mat)
+    punctual_lamps(bpy, doc, a.light_units)
     scene.camera = choose_camera(bpy, doc, a.camera)
     fit_sensor(scene.camera, doc, a)
     setup_render(bpy, scene, a)

@@ -27,6 +27,7 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "libcommon/movies/lamp_direct_term.h"
 #include "libcommon/movies/movie_geometry.h"
 #include "libcommon/movies/ray_cast_masks.h"
 #include "libcommon/movies/solid_contact.h"
@@ -162,6 +163,8 @@ class MovieBake {
       for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) beyond_[size_t(j) * w + i] = texelBeyondTriangle(i, j, w, h);
     }
+    if (!emitters.lamps().empty() && visibility)
+      lamps_ = std::make_unique<LampDirectTerm>(emitters, geometry, *visibility, req.patch.top);
   }
 
   // Texels under a touching solid at key k (a box's foot on the floor, solid_contact.h) are
@@ -325,6 +328,7 @@ class MovieBake {
       combine(p, t, f);
     }
     auto clock = SteadyClock::now();
+    if (lamps_) lamps_->add(k, t, acc_);  // the punctual lamps' direct light, per texel
     for (size_t x = 0; x < texels_; ++x)
       for (int c = 0; c < 3; ++c) {
         double v = acc_[x][c];
@@ -494,9 +498,10 @@ class MovieBake {
   FormFactorSpill& spill_;
   const MovieExtent& req_;
   MovieGeometry& geo_;
-  const GoodLinkGather* gather_;  // null: Gouraud
-  SceneVisibility* visibility_;   // null: covered texels are left as they are
-  const uint32_t surface_;        // the receiver top's planar surface: the samples' seed
+  const GoodLinkGather* gather_;           // null: Gouraud
+  SceneVisibility* visibility_;            // null: covered texels are left as they are
+  const uint32_t surface_;                 // the receiver top's planar surface: the samples' seed
+  std::unique_ptr<LampDirectTerm> lamps_;  // null: the scene has no lamp
   const size_t texels_;
   int saturatedSamples_ = 0;
   std::vector<BadPair> pairs_;
@@ -859,8 +864,12 @@ SceneVisibility* TextureMovieBaker::sceneVisibility() {
 // bounds meet the box around the receiver node and the shooter (the shaft's bounds).
 bool TextureMovieBaker::shadowsMove(const MovieExtent& req,
                                     const std::vector<uint32_t>& badShooters) const {
-  if (badShooters.empty()) return false;
   const double t0 = req.firstFrame / fps_, t1 = req.lastFrame / fps_;
+  const InputPolygon& top = tops_[req.patch.top];
+  if (lampShadowsMove(scene_, tops_, emitters_, top.node,
+                      nodeWorldPolygon(scene_, top, req.patch, t0), t0, t1))
+    return true;
+  if (badShooters.empty()) return false;
   const InputPolygon& receiverTop = tops_[req.patch.top];
   if (scene_.isDynamic(receiverTop.node, t0, t1)) return true;
   std::vector<std::array<glm::dvec3, 2>> swept;
@@ -922,8 +931,9 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);
   if (surfaceOfTop_.empty()) surfaceOfTop_ = planarSurfaceOfTops(tops_);
   MovieBake bake(solution_, tops_, emitters_, options_, stats_, gl, *spill, req, geometry,
-                 gather.get(), options_.fillCovered ? sceneVisibility() : nullptr, *blockers_,
-                 surfaceOfTop_[req.patch.top]);
+                 gather.get(),
+                 options_.fillCovered || !emitters_.lamps().empty() ? sceneVisibility() : nullptr,
+                 *blockers_, surfaceOfTop_[req.patch.top]);
   bake.plan(badShooters);
   sink.begin(movie);
   for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);

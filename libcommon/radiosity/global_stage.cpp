@@ -229,6 +229,7 @@ namespace {
 // Sums of the per-key figures.
 struct KeyTotals {
   size_t recomputed = 0, reused = 0, links = 0, visibilityOnly = 0, clusterLinks = 0;
+  size_t lampValues = 0, lampValuesReused = 0;
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
   long iterations = 0;
 };
@@ -241,6 +242,8 @@ KeyTotals totalsOf(const std::vector<KeyTimeReport>& keys) {
     t.visibilityOnly += r.visibilityOnly;
     t.links += r.links;
     t.clusterLinks += r.clusterLinks;
+    t.lampValues += r.lampValues;
+    t.lampValuesReused += r.lampValuesReused;
     t.secondsLinks += r.secondsLinks;
     t.secondsSolve += r.secondsSolve;
     t.secondsCoherence += r.secondsCoherence;
@@ -259,29 +262,34 @@ nlohmann::json GlobalReport::toJson() const {
     keys.push_back(std::move(key));
   }
   const KeyTotals t = totalsOf(solve.keys);
-  return {{"key_times", keys},
-          {"totals",
-           {{"links", t.links},
-            {"cluster_links", t.clusterLinks},
-            {"recomputed", t.recomputed},
-            {"reused", t.reused},
-            {"visibility_only", t.visibilityOnly},
-            {"iterations", t.iterations},
-            {"union_nodes", solve.unionNodes},
-            {"link_rows", solve.linkRows},
-            {"bad_pairs", solve.badPairs},
-            {"keys_at_link_cap", keysAtLinkCap()}}},
-          {"seconds",
-           {{"read", secondsRead},
-            {"setup", solve.secondsSetup},
-            {"links", t.secondsLinks},
-            {"solve", t.secondsSolve},
-            {"coherence", t.secondsCoherence},
-            {"merge", solve.secondsMerge},
-            {"write", secondsWrite},
-            {"total", secondsTotal}}},
-          {"peak_memory_mb", peakMemoryMb},
-          {"coherence", coherence}};
+  nlohmann::json report = {{"key_times", keys},
+                           {"totals",
+                            {{"links", t.links},
+                             {"cluster_links", t.clusterLinks},
+                             {"recomputed", t.recomputed},
+                             {"reused", t.reused},
+                             {"visibility_only", t.visibilityOnly},
+                             {"iterations", t.iterations},
+                             {"union_nodes", solve.unionNodes},
+                             {"link_rows", solve.linkRows},
+                             {"bad_pairs", solve.badPairs},
+                             {"keys_at_link_cap", keysAtLinkCap()}}},
+                           {"seconds",
+                            {{"read", secondsRead},
+                             {"setup", solve.secondsSetup},
+                             {"links", t.secondsLinks},
+                             {"solve", t.secondsSolve},
+                             {"coherence", t.secondsCoherence},
+                             {"merge", solve.secondsMerge},
+                             {"write", secondsWrite},
+                             {"total", secondsTotal}}},
+                           {"peak_memory_mb", peakMemoryMb},
+                           {"coherence", coherence}};
+  if (t.lampValues > 0) {  // a scene with lamps only
+    report["totals"]["lamp_values"] = t.lampValues;
+    report["totals"]["lamp_values_reused"] = t.lampValuesReused;
+  }
+  return report;
 }
 
 size_t GlobalReport::keysAtLinkCap() const {
@@ -320,8 +328,11 @@ std::string GlobalReport::table(const std::string& tool) const {
   out << "  total: " << t.links << " links (and " << t.clusterLinks << " cluster links), "
       << t.recomputed << " recomputed (" << t.visibilityOnly << " of them visibility only), "
       << t.reused << " reused; " << solve.unionNodes << " union nodes, " << solve.linkRows
-      << " link rows, " << solve.badPairs << " bad pairs\n"
-      << "  seconds: links " << t.secondsLinks << ", solve " << t.secondsSolve << ", merge "
+      << " link rows, " << solve.badPairs << " bad pairs\n";
+  if (t.lampValues > 0)
+    out << "  lamps: " << t.lampValues << " direct irradiance values, " << t.lampValuesReused
+        << " of them reused\n";
+  out << "  seconds: links " << t.secondsLinks << ", solve " << t.secondsSolve << ", merge "
       << solve.secondsMerge << ", write " << secondsWrite << ", total " << secondsTotal
       << "; peak memory " << std::setprecision(1) << peakMemoryMb << " MB\n";
   return out.str();

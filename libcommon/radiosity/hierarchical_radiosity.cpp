@@ -45,7 +45,8 @@ glm::dvec3 KeySolution::absorbedPower(const PatchHierarchy& h,
     if (split[i] || !inTree(int(i), h)) continue;
     const SurfaceProperties& s = surfaces[h.node(int(i)).id.top];
     const double e = i < exposure.size() ? exposure[i] : 1.0;
-    sum += e * area[i] * (glm::dvec3(1.0) - s.reflectance) * irradiance[i];
+    const glm::dvec3 lamp = i < lampIrradiance.size() ? lampIrradiance[i] : glm::dvec3(0.0);
+    sum += e * area[i] * (glm::dvec3(1.0) - s.reflectance) * (irradiance[i] + lamp);
   }
   return sum;
 }
@@ -96,6 +97,7 @@ KeySolution KeyTimeSolver::run() {
       refined += refine(unrefinedLinks());
     else
       evaluateNewLinks();
+    refined += refineLamps();
     if (round > 0 && refined == 0) {
       s_.secondsLinks += secondsSince(tl);
       break;
@@ -136,6 +138,9 @@ void KeyTimeSolver::addNewNodes() {
     s_.area.push_back(s_.world.back().area());
     s_.split.push_back(0);
     B_.push_back(n.parent >= 0 ? B_[size_t(n.parent)] : surfaces_[n.id.top].emission);
+    lampE_.push_back(glm::dvec3(0.0));
+    lampSpread_.push_back(0.0);
+    lampKnown_.push_back(0);
   }
 }
 
@@ -155,9 +160,10 @@ void KeyTimeSolver::setThresholds() {
   // finite answer), so only a solve a million times above it is called diverging: at rho x rowsum =
   // 1.002 (the furnace at rho = 0.999) that takes ~7000 sweeps, long before B overflows to Inf and
   // NaN, which the stop rule's std::max would not see.
-  radiosityBound_ =
-      rhoMax < 1.0 ? 1e6 * emissionMax / (1.0 - rhoMax) : std::numeric_limits<double>::infinity();
-  epsAbs_ = opt_.eps * maxComponent(emitted);
+  // A lamp's E has no such bound (I / d^2 near it): with lamps only non-finite B is caught.
+  radiosityBound_ = rhoMax < 1.0 && input_.lamps.empty() ? 1e6 * emissionMax / (1.0 - rhoMax)
+                                                         : std::numeric_limits<double>::infinity();
+  epsAbs_ = opt_.eps * (maxComponent(emitted) + lampPower());
   refineOn_ = opt_.refine && epsAbs_ > 0.0;
   stopChange_ = opt_.tol * std::max(1.0 - rhoMax, 1e-6);
 }
@@ -205,6 +211,12 @@ KeySolution KeyTimeSolver::finish() {
     if (e < 0.0) e = 1.0;  // not in this key's tree
   s_.irradiance = std::move(irr_);
   s_.irradiance.resize(size_t(h_.size()), glm::dvec3(0.0));
+  if (!input_.lamps.empty()) {
+    s_.lampIrradiance.assign(size_t(h_.size()), glm::dvec3(0.0));
+    for (size_t i = 0; i < s_.split.size(); ++i)
+      if (!s_.split[i] && s_.inTree(int(i), h_) && s_.exposure[i] > 0.0)
+        s_.lampIrradiance[i] = lampE_[i] / s_.exposure[i];
+  }
   return std::move(s_);
 }
 

@@ -48,6 +48,7 @@
 
 #include "libcommon/radiosity/cluster_links.h"
 #include "libcommon/radiosity/cluster_tree.h"
+#include "libcommon/radiosity/lamp_irradiance.h"
 #include "libcommon/radiosity/link_records.h"
 #include "libcommon/radiosity/radiosity_options.h"
 #include "libcommon/radiosity/visibility.h"
@@ -98,6 +99,11 @@ struct KeySolveInput {
   // evaluated its cluster links; the few that later rounds make are computed afresh, which
   // gives the values the cache held, and the cache is not held through every round.
   std::function<void()> releaseClusterLinks;
+  // The scene's punctual lamps placed at this key (docs/design.md §4 "Lights"; at most
+  // kMaxLamps), owned by the caller: no patch and no link, a direct irradiance E per receiver
+  // leaf (lamp_irradiance.h) in $B = B_e + \rho (E + H)$, whose variation the oracle refines.
+  std::vector<const PlacedPunctualLight*> lamps;
+  const LampValueCache* reuseLamps = nullptr;  // coherence: lamp values to take over
 };
 
 struct KeySolution {
@@ -105,6 +111,12 @@ struct KeySolution {
   std::vector<char> split;             // per dense node: subdivided in this key's tree
   std::vector<glm::dvec3> radiosity;   // per dense node of this key's tree (area average)
   std::vector<glm::dvec3> irradiance;  // per dense node: H gathered at it and its ancestors
+  // Per dense node: the lamps' direct E at a leaf of this key's tree, over its exposure (0
+  // elsewhere, and without lamps). Not in `irradiance`: the second pass computes it per texel.
+  std::vector<glm::dvec3> lampIrradiance;
+  // The lamps' values computed or taken over at this key, for the next key's coherence.
+  LampValueCache lampValues;
+  size_t lampValuesReused = 0;  // of them: taken over (KeySolveInput::reuseLamps)
   // Per dense node: the closure factor of a leaf of this key's tree (1 elsewhere, and when
   // RadiosityOptions::closure is off), for all of its links and for its good ones (shooters
   // that do not emit). Empty without closure.

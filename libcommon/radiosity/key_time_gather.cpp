@@ -54,7 +54,9 @@ KeyTimeSolver::Pulled KeyTimeSolver::gatherPushPull(int i, const Gathered& down)
                          : s_.closure[size_t(i)] * H.light + goodFactor_[size_t(i)] * H.good);
     irr_[size_t(i)] = irradiance;
     const SurfaceProperties& sp = surfaces_[h_.node(i).id.top];
-    glm::dvec3 b = sp.emission + sp.reflectance * irradiance;
+    // The lamps' direct E (key_time_lamps.cpp), over the exposure as the links' H.
+    const glm::dvec3 lamp = e > 0.0 ? lampE_[size_t(i)] / e : glm::dvec3(0.0);
+    glm::dvec3 b = sp.emission + sp.reflectance * (irradiance + lamp);
     nonFinite_ |= !(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.z));
     maxDelta_ = std::max(maxDelta_, maxComponent(glm::abs(b - B_[size_t(i)])));
     maxB_ = std::max(maxB_, maxComponent(glm::abs(b)));

@@ -76,6 +76,12 @@ class KeyTimeSolver {
   std::vector<LinkIndex> unrefinedLinks() const;
   void computeAccurateFormFactors();
 
+  // The lamps' direct irradiance and its refinement (key_time_lamps.cpp).
+  double lampPower() const;
+  size_t refineLamps();
+  bool lampWantsSplit(int i) const;
+  void splitForLamps(int i, std::vector<int>& next);
+
   // Closure and exposure (key_time_closure.cpp).
   void computeClosure();
   // Whether leaf r is inside a closed room: none of kEscapeRays cosine-distributed rays from
@@ -171,5 +177,10 @@ class KeyTimeSolver {
   std::vector<glm::dvec3> clusterH_;        // per top: irradiance through cluster links
   std::vector<double> clusterRow_;          // per top: its cluster links' form factor sum
   std::vector<FacingPlane> topPlanes_;      // per top at this key (refineClusterLinks)
+  // Per dense node: the lamps' E summed (lampE_), its largest spread over the lamps (a lamp's
+  // own: the oracle's), and whether they are known at this key (refineLamps).
+  std::vector<glm::dvec3> lampE_;
+  std::vector<double> lampSpread_;
+  std::vector<char> lampKnown_;
 };
 }  // namespace rad

@@ -8,20 +8,25 @@
 namespace rad {
 
 nlohmann::json KeyTimeReport::toJson() const {
-  return {{"time", time},
-          {"links", links},
-          {"recomputed", recomputed},
-          {"reused", reused},
-          {"visibility_only", visibilityOnly},
-          {"nodes", nodes},
-          {"iterations", iterations},
-          {"refine_rounds", refineRounds},
-          {"link_cap_reached", linkCapReached},
-          {"cluster_links", clusterLinks},
-          {"cluster_links_reused", clusterLinksReused},
-          {"seconds_links", secondsLinks},
-          {"seconds_solve", secondsSolve},
-          {"seconds_coherence", secondsCoherence}};
+  nlohmann::json j = {{"time", time},
+                      {"links", links},
+                      {"recomputed", recomputed},
+                      {"reused", reused},
+                      {"visibility_only", visibilityOnly},
+                      {"nodes", nodes},
+                      {"iterations", iterations},
+                      {"refine_rounds", refineRounds},
+                      {"link_cap_reached", linkCapReached},
+                      {"cluster_links", clusterLinks},
+                      {"cluster_links_reused", clusterLinksReused},
+                      {"seconds_links", secondsLinks},
+                      {"seconds_solve", secondsSolve},
+                      {"seconds_coherence", secondsCoherence}};
+  if (lampValues > 0) {  // a scene with lamps only: the others' reports stay as they were
+    j["lamp_values"] = lampValues;
+    j["lamp_values_reused"] = lampValuesReused;
+  }
+  return j;
 }
 
 KeyTimeReport KeyTimeReport::fromJson(const nlohmann::json& j) {
@@ -38,6 +43,8 @@ KeyTimeReport KeyTimeReport::fromJson(const nlohmann::json& j) {
   r.linkCapReached = j.value("link_cap_reached", false);
   r.clusterLinks = j.value("cluster_links", size_t(0));
   r.clusterLinksReused = j.value("cluster_links_reused", size_t(0));
+  r.lampValues = j.value("lamp_values", size_t(0));
+  r.lampValuesReused = j.value("lamp_values_reused", size_t(0));
   r.secondsLinks = j.value("seconds_links", 0.0);
   r.secondsSolve = j.value("seconds_solve", 0.0);
   r.secondsCoherence = j.value("seconds_coherence", 0.0);

@@ -30,6 +30,8 @@ struct KeyTimeReport {
   bool linkCapReached = false;    // refinement stopped at the link bound (RadiosityOptions)
   size_t clusterLinks = 0;        // cluster links gathered (clustering)
   size_t clusterLinksReused = 0;  // of them: values taken over from the previous key
+  size_t lampValues = 0;          // (node, lamp) direct irradiance values of the key's leaves
+  size_t lampValuesReused = 0;    // of them: taken over from the previous key
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
 
   // The --report JSON of one key (keys "time", "links", "recomputed", ...; global_stage.h),

@@ -20,6 +20,7 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "libcommon/radiosity/lamp_coherence.h"
 #include "libcommon/radiosity/leaf_vertices.h"
 #include "libcommon/radiosity/link_intervals.h"
 #include "libcommon/radiosity/scene_visibility.h"
@@ -196,6 +197,8 @@ KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, dou
   kr.linkCapReached = s.linkCapReached;
   kr.clusterLinks = s.clusterLinks;
   kr.clusterLinksReused = s.clusterLinksReused;
+  kr.lampValues = s.lampValues.size();
+  kr.lampValuesReused = s.lampValuesReused;
   kr.secondsLinks = s.secondsLinks;
   kr.secondsSolve = s.secondsSolve;
   for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
@@ -282,6 +285,9 @@ class KeyTimePass {
     in.expectedLinks = prev.links.size();
     in.expectedRayPairs = prev.rayPairs.size();
     in.expectedClusterLinks = prev.clusterLinkValues.size();
+    PlacedLamps lamps = placeLamps(*emitters_, t);
+    in.lamps = lamps.lamps;
+    LampValueCache lampCache;
     if (opt_.coherence && k > first_) {
       auto tc = std::chrono::steady_clock::now();
       // The caches hold what the solve takes over of prev's links and cluster links; of prev itself
@@ -309,9 +315,16 @@ class KeyTimePass {
       in.reuseClosed = &closedCache_;
       in.releaseRayPairs = [&] { std::vector<LinkRayPair>().swap(prev.rayPairs); };
       in.releaseClusterLinks = [&] { clusterCache = ClusterLinkCache(); };
+      if (!lamps.lamps.empty()) {
+        lampCache =
+            reusableLampValues(prev, prevLamps_, *emitters_, h_, scene_, keyTimes_[k - 1], t);
+        in.reuseLamps = &lampCache;
+      }
+      LampValueCache().swap(prev.lampValues);
       secondsCoherence = secondsSince(tc);
     }
     KeySolution s = solveKeyTime(h_, surfaces_, in, opt_.radiosity);
+    prevLamps_ = std::move(lamps);
     if (opt_.coherence)
       for (const auto& [id, closed] : s.closedNodes) closedCache_.emplace(id, closed);
     rep_.keys.push_back(keyTimeReportOf(s, h_, t, secondsCoherence));
@@ -359,6 +372,7 @@ class KeyTimePass {
   // The lights among the tops (the light seam): which pairs are the lights' bad pairs. The
   // solve itself treats a polygon light as a patch with B_e (surfaces_).
   std::unique_ptr<SceneEmitters> emitters_;
+  PlacedLamps prevLamps_;  // the lamps of the key solved last (reusableLampValues)
   std::unique_ptr<SceneVisibility> vis_;
   std::vector<KeyRecord> records_;   // per key first..last
   std::vector<uint32_t> nodeCount_;  // per key: h_.size() after its solve

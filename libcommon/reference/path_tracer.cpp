@@ -194,6 +194,14 @@ struct PathTracer::Impl {
       }
       surfaces.push_back(surface);
     }
+    // The punctual lights (delta lights: no surface, never hit), after every polygon light so a
+    // scene without lamps samples exactly as before.
+    for (int lamp : lights->lamps()) {
+      Emitter e{(*lights)[size_t(lamp)].at(t), 0.0, 0.0};
+      if (!e.placed || !(e.placed->samplingWeight() > 0.0)) continue;
+      emitterWeight += e.placed->samplingWeight();
+      emitters.push_back(std::move(e));
+    }
     emitterCdf.clear();
     double sum = 0.0;
     for (Emitter& e : emitters) {
@@ -363,6 +371,7 @@ struct PathTracer::Impl {
     const Emitter& em = emitters[std::min(e, emitters.size() - 1)];
     if (!(em.probability > 0.0)) return glm::dvec3(0.0);
     const glm::dvec3 origin = liftOff(x, geometric);
+    if (em.area == 0.0) return deltaLight(em, origin, n, geometric, surface);
     const EmitterSample sample = em.placed->sample(glm::dvec2(u1, u2));
     const glm::dvec3& y = sample.point;
     const glm::dvec3 d = y - origin;
@@ -380,6 +389,21 @@ struct PathTracer::Impl {
     const double pdfBsdf = cosX / kPi;
     const double weight = pdfLight * pdfLight / (pdfLight * pdfLight + pdfBsdf * pdfBsdf);
     return em.placed->emittedRadiance(y, -w) * (cosX / pdfLight * weight);
+  }
+
+  // A delta light's estimate (emitter.h: no MIS, a continuation never finds it): its unoccluded
+  // irradiance at the receiver, $I \cos\theta / d^2$ or a sun's $E \cos\theta$, if the
+  // segment to its shadowTarget is clear, over the probability of choosing it.
+  glm::dvec3 deltaLight(const Emitter& em, const glm::dvec3& origin, const glm::dvec3& n,
+                        const glm::dvec3& geometric, std::uint32_t surface) const {
+    const glm::dvec3 d = em.placed->shadowTarget(origin) - origin;
+    const double dist = glm::length(d);
+    if (!(dist > 0.0) || glm::dot(geometric, d) <= 0.0) return glm::dvec3(0.0);
+    const glm::dvec3 E = em.placed->irradiance(origin, n);
+    if (maxComponent(E) <= 0.0) return glm::dvec3(0.0);
+    if (occluded(origin, d / dist, dist * (1.0 - kShadowShortening), surface))
+      return glm::dvec3(0.0);
+    return E / em.probability;
   }
 
   // Solid-angle density with which directLight() picks the point at distance `dist` on

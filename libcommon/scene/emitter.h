@@ -69,6 +69,14 @@ class PlacedEmitter {
   virtual glm::dvec3 irradiance(const glm::dvec3& x, const glm::dvec3& n) const = 0;
   // A point on the light from two numbers in [0, 1); deterministic in `u`.
   virtual EmitterSample sample(const glm::dvec2& u) const = 0;
+  // A delta light's (area() == 0) shadow test from receiver `x`: the segment from x to this
+  // point must be clear for x to be lit. The lamp's position for a point or spot; for a sun, x
+  // moved against the light's direction past the scene's bounds (parallel shadows). Unused for
+  // a light with area (its default is sample's point at the centre of [0, 1)^2).
+  virtual glm::dvec3 shadowTarget(const glm::dvec3& x) const {
+    (void)x;
+    return sample(glm::dvec2(0.5)).point;
+  }
 };
 
 // A light of the scene over time.

@@ -534,6 +534,15 @@ std::vector<InputPolygon> Scene::inputPolygons() const {
   return cutAtContacts(*this, std::move(out));
 }
 
+std::vector<int> Scene::lightNodes() const {
+  std::vector<int> out;
+  for (int i : reachableNodes()) {
+    const int l = nodes[size_t(i)].light;
+    if (l >= 0 && l < int(lights.size()) && lights[size_t(l)].emits()) out.push_back(i);
+  }
+  return out;
+}
+
 std::vector<int> Scene::cameraNodes() const {
   std::vector<int> out;
   for (int i : reachableNodes())
@@ -599,11 +608,10 @@ std::string missingEmitterMessage(const Scene& scene) {
       if (t.material >= 0 && t.material < int(scene.materials.size()) &&
           scene.materials[size_t(t.material)].isEmitter())
         return "";
-  std::string what = "no emissive material";
-  if (scene.punctualLights > 0)
-    what += "; " + std::to_string(scene.punctualLights) + " KHR_lights_punctual light" +
-            (scene.punctualLights > 1 ? "s are" : " is") + " not supported";
-  return what + ": give a mesh an emissive material (emissiveFactor) instead";
+  if (!scene.lightNodes().empty()) return "";
+  return std::string("no emissive material and no KHR_lights_punctual light") +
+         (scene.lights.empty() ? "" : " of non-zero intensity on a node of the scene") +
+         ": give a mesh an emissive material (emissiveFactor) or add a lamp";
 }
 
 void requireEmitter(const Scene& scene) {

@@ -84,12 +84,41 @@ struct Camera {
   double zfar = 0.0;  // 0 = infinite (perspective only)
 };
 
+// A punctual light (glTF KHR_lights_punctual), in the light's node frame: at the node's origin,
+// shining down the node's -Z (spot, directional). Its values are in the renderer's radiometric
+// units after the file's units were converted (formats/gltf_scene.md "Lights"; docs/design.md
+// §4 "Lights"): W/sr for a point or spot, W/m^2 for a directional light, on the scale of
+// Material::emission's W/(m^2 sr).
+enum class PunctualLightType { kPoint, kSpot, kDirectional };
+// How a spot's intensity falls off from its axis. kGltf: the extension's recommended smooth
+// falloff, $t^2$ with $t$ = clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1). kCycles:
+// Blender Cycles' spot lamp (its spot_light_attenuation, before Blender 4), what a Blender export
+// looks like in Blender: $\cos a \cdot \mathrm{smoothstep}((\cos a - \cos outer) / s)$ inside the
+// outer cone, $s = (1 - \cos outer) \cdot blend$, blend = 1 - inner / outer (the inverse of the
+// exporter's inner = outer (1 - blend)).
+enum class SpotProfile { kGltf, kCycles };
+
+struct PunctualLight {
+  std::string name;
+  PunctualLightType type = PunctualLightType::kPoint;
+  // colour x intensity: radiant intensity I, W/sr (point, spot: on the axis), or irradiance E,
+  // W/m^2 on a surface facing the light (directional).
+  glm::dvec3 intensity{0.0};
+  double range = 0.0;           // metres; 0: infinite (else the extension's recommended window)
+  double innerConeAngle = 0.0;  // radians, spot only, < outerConeAngle
+  double outerConeAngle = 0.78539816339744830962;  // radians, spot only, in (0, pi/2]
+  SpotProfile profile = SpotProfile::kGltf;
+
+  bool emits() const { return intensity.x > 0.0 || intensity.y > 0.0 || intensity.z > 0.0; }
+};
+
 struct Node {
   std::string name;
   int parent = -1;
   std::vector<int> children;
   int mesh = -1;    // index into Scene::meshes or -1
   int camera = -1;  // index into Scene::cameras or -1
+  int light = -1;   // index into Scene::lights or -1
   // Rest pose (used where no channel animates a property).
   glm::dvec3 translation{0.0};
   glm::dquat rotation{1.0, 0.0, 0.0, 0.0};  // glm order (w, x, y, z)
@@ -146,7 +175,9 @@ class Scene {
   std::vector<Camera> cameras;
   std::vector<AnimationChannel> channels;
   std::vector<std::string> warnings;  // e.g. "dropped 3 zero-area triangles"
-  int punctualLights = 0;  // KHR_lights_punctual lights in the file: not supported, not emitters
+  std::vector<PunctualLight> lights;  // KHR_lights_punctual, placed by Node::light
+  // The units the lights were read in: "gltf" or "blender" (formats/gltf_scene.md "Lights").
+  std::string lightUnits = "gltf";
 
   // Local transform of a node at time t with glTF semantics (T * R * S).
   glm::dmat4 localTransform(int node, double t) const;
@@ -188,6 +219,9 @@ class Scene {
   // Deterministic order: by mesh node, then triangle order.
   std::vector<InputPolygon> inputPolygons() const;
 
+  // Nodes that carry a light that emits and are reachable from roots, in ascending index order.
+  std::vector<int> lightNodes() const;
+
   // Camera nodes reachable from roots, in ascending index order. cameraNode("") is the first;
   // cameraNode(name) matches a node name first, then a camera name; -1 if none.
   std::vector<int> cameraNodes() const;
@@ -195,8 +229,8 @@ class Scene {
   CameraView cameraAt(int node, double t) const;
 };
 
-// Empty when a mesh of the displayed scene has an emitting material; else what is missing, on
-// one line ("no emissive material; 3 KHR_lights_punctual lights are not supported: ...").
+// Empty when a mesh of the displayed scene has an emitting material or a light node of it
+// emits; else what is missing, on one line.
 std::string missingEmitterMessage(const Scene& scene);
 // Throws rad::Error (kBadInput) `path: missingEmitterMessage` when there is no emitter: a tool
 // that computes light would render black frames.

@@ -71,17 +71,6 @@ void addMaterials(const Scene& scene, Digest& d) {
   }
 }
 
-void addLights(const Scene& scene, Digest& d) {
-  d.integer(int64_t(scene.materials.size()));
-  for (const Material& m : scene.materials) {
-    d.vec(m.emission);
-    // An emissive texture's mean (the first pass's B_e); nothing added without one, so the
-    // digests of scenes without them are unchanged.
-    if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < scene.textures.size())
-      d.vec(scene.textures[size_t(m.emissiveTexture)].mean);
-  }
-}
-
 // `nodes` and their ancestors, ascending.
 std::set<int> withAncestors(const Scene& scene, const std::vector<int>& nodes) {
   std::set<int> out;
@@ -110,6 +99,27 @@ void addMotion(const Scene& scene, const std::set<int>& nodes, Digest& d) {
     d.integer(int64_t(c.values.size()));
     for (double v : c.values) d.number(v);
   }
+}
+
+// Emission, and the lamps with their motion (a moving lamp changes the light, not the geometry).
+void addLights(const Scene& scene, Digest& d) {
+  d.integer(int64_t(scene.materials.size()));
+  for (const Material& m : scene.materials) {
+    d.vec(m.emission);
+    // An emissive texture's mean (the first pass's B_e); nothing added without one, so the
+    // digests of scenes without them are unchanged.
+    if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < scene.textures.size())
+      d.vec(scene.textures[size_t(m.emissiveTexture)].mean);
+  }
+  const std::vector<int> lamps = scene.lightNodes();
+  if (lamps.empty()) return;  // a scene without lamps digests as before lamps were read
+  d.integer(int64_t(lamps.size()));
+  for (int n : lamps) {
+    const PunctualLight& l = scene.lights[size_t(scene.nodes[size_t(n)].light)];
+    d.integer(n), d.integer(int64_t(l.type)), d.integer(int64_t(l.profile));
+    d.vec(l.intensity), d.number(l.range), d.number(l.innerConeAngle), d.number(l.outerConeAngle);
+  }
+  addMotion(scene, withAncestors(scene, lamps), d);
 }
 
 void addCamera(const Scene& scene, Digest& d) {

@@ -3,6 +3,7 @@
 
 #include "libcommon/scene/emission_texture.h"
 #include "libcommon/scene/emissive_polygon_emitter.h"
+#include "libcommon/scene/punctual_light_emitter.h"
 
 namespace rad {
 
@@ -13,6 +14,13 @@ SceneEmitters::SceneEmitters(const Scene& scene, const std::vector<InputPolygon>
     ofTop_[t] = int(emitters_.size());
     emitters_.push_back(std::make_unique<EmissivePolygonEmitter>(scene, tops[t], int(t),
                                                                  meanEmissionOver(scene, tops[t])));
+  }
+  const std::vector<int> lamps = scene.lightNodes();
+  if (lamps.empty()) return;
+  const std::array<glm::dvec3, 2> bounds = animationBounds(scene);
+  for (int node : lamps) {
+    lamps_.push_back(int(emitters_.size()));
+    emitters_.push_back(std::make_unique<PunctualLightEmitter>(scene, node, bounds));
   }
 }
 

@@ -15,7 +15,8 @@ class SceneEmitters {
  public:
   // One EmissivePolygonEmitter per polygon of `tops` whose material emits (Scene::emits), in the
   // order of `tops`; Emitter::top() indexes `tops` (Scene::inputPolygons(), or a patch
-  // hierarchy's tops). `scene` must outlive the list; `tops` is copied where needed.
+  // hierarchy's tops). Then one PunctualLightEmitter per Scene::lightNodes(), in node order
+  // (top() -1). `scene` must outlive the list; `tops` is copied where needed.
   SceneEmitters(const Scene& scene, const std::vector<InputPolygon>& tops);
 
   std::size_t size() const { return emitters_.size(); }
@@ -28,10 +29,13 @@ class SceneEmitters {
   }
   // Whether top-level patch `top` is a light.
   bool topEmits(int top) const { return indexOfTop(top) >= 0; }
+  // The indices into this list of the punctual lights (no patch, area 0), ascending.
+  const std::vector<int>& lamps() const { return lamps_; }
 
  private:
   std::vector<std::unique_ptr<Emitter>> emitters_;
   std::vector<int> ofTop_;  // per top: index into emitters_, or -1
+  std::vector<int> lamps_;  // indices of the punctual lights
 };
 
 }  // namespace rad

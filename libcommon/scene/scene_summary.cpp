@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "libcommon/scene/emission_texture.h"
+#include "libcommon/scene/punctual_light_emitter.h"
 
 namespace rad {
 
@@ -17,6 +18,45 @@ glm::dvec3 emittedPower(const Scene& scene, const InputPolygon& polygon, double 
   double area = polygon.local.transformed(scene.worldTransform(polygon.node, t)).area();
   return glm::pi<double>() * meanEmissionOver(scene, polygon) * area;
 }
+
+namespace {
+// The KHR_lights_punctual lights on nodes of the scene, as the stages read them.
+nlohmann::json summarizeLights(const Scene& scene, double t0, double t1) {
+  static const char* kTypes[] = {"point", "spot", "directional"};
+  nlohmann::json lights = nlohmann::json::array();
+  const std::vector<int> nodes = scene.lightNodes();
+  if (nodes.empty()) return lights;
+  const std::array<glm::dvec3, 2> bounds = animationBounds(scene);
+  for (int n : nodes) {
+    const PunctualLightEmitter emitter(scene, n, bounds);
+    const PunctualLight& l = emitter.light();
+    const std::unique_ptr<PlacedEmitter> placed = emitter.at(t0);
+    const auto* p = dynamic_cast<const PlacedPunctualLight*>(placed.get());
+    nlohmann::json j = {
+        {"node", n},
+        {"name", l.name},
+        {"light", scene.nodes[size_t(n)].light},
+        {"type", kTypes[int(l.type)]},
+        {"units", scene.lightUnits},
+        {l.type == PunctualLightType::kDirectional ? "irradiance_w_m2" : "intensity_w_sr",
+         vec3(l.intensity)},
+        {"range", l.range},
+        {"dynamic", emitter.moves(t0, t1)}};
+    if (p) {
+      j["position_at_start"] = vec3(p->position());
+      j["direction_at_start"] = vec3(p->direction());
+      j["power_w"] = vec3(p->power());
+    }
+    if (l.type == PunctualLightType::kSpot) {
+      j["inner_cone"] = l.innerConeAngle;
+      j["outer_cone"] = l.outerConeAngle;
+      j["profile"] = l.profile == SpotProfile::kCycles ? "cycles" : "gltf";
+    }
+    lights.push_back(j);
+  }
+  return lights;
+}
+}  // namespace
 
 nlohmann::json summarizeScene(const Scene& scene) {
   nlohmann::json s;
@@ -56,6 +96,7 @@ nlohmann::json summarizeScene(const Scene& scene) {
                         {"dynamic", scene.isDynamic(n, t0, t1)}});
   }
   s["emitters"] = emitters;
+  s["lights"] = summarizeLights(scene, t0, t1);
 
   nlohmann::json dynamic = nlohmann::json::array();
   for (int n : scene.meshNodes()) {
@@ -81,7 +122,7 @@ nlohmann::json summarizeScene(const Scene& scene) {
 
   nlohmann::json warnings = scene.warnings;
   if (cameras.empty()) warnings.push_back("no camera: rad-intervals and rad-compose need one");
-  if (emitters.empty())
+  if (emitters.empty() && s["lights"].empty())
     warnings.push_back(missingEmitterMessage(scene) + " (rad-global and rad-reference refuse it)");
   s["warnings"] = warnings;
   return s;
@@ -98,6 +139,17 @@ std::string sceneSummaryText(const nlohmann::json& s) {
     os << "  emitter        " << e["name"].get<std::string>() << " (node " << e["node"] << "), "
        << e["patches"] << " patches, power " << e["power_w"].dump() << " W"
        << (e["dynamic"].get<bool>() ? ", moving" : "") << "\n";
+  }
+  for (const auto& l : s["lights"]) {
+    os << "  light          " << l["name"].get<std::string>() << " (node " << l["node"] << "), "
+       << l["type"].get<std::string>() << ", "
+       << (l.contains("irradiance_w_m2") ? "E " + l["irradiance_w_m2"].dump() + " W/m^2"
+                                         : "I " + l["intensity_w_sr"].dump() + " W/sr")
+       << " (" << l["units"].get<std::string>() << " units)";
+    if (l.contains("outer_cone"))
+      os << ", cones " << l["inner_cone"] << " " << l["outer_cone"] << " rad ("
+         << l["profile"].get<std::string>() << ")";
+    os << (l["dynamic"].get<bool>() ? ", moving" : "") << "\n";
   }
   for (const auto& d : s["dynamic_nodes"]) {
     os << "  dynamic        " << d["name"].get<std::string>() << " (node " << d["node"]

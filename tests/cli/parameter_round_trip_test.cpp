@@ -28,6 +28,7 @@ const std::string kScene = RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf
 const std::set<std::string> kPlumbing = {
     "threads",             // results never depend on it (docs/design.md §11)
     "max-texture-pixels",  // the scene reader's bound; the scene digests record what was read
+    "light-units",         // the scene reader's; the lights digest records the lamps as read
     "report",              // the run report's file
     "window",
     "merge",

@@ -768,22 +768,59 @@ TEST_F(BadInput, LongInputIsClippedInMessages) {
   }
 }
 
-// KHR_lights_punctual lights are not emitters: a scene with only those is dark, and says why.
-TEST_F(BadInput, PunctualLightsAreCountedAndNoEmitterIsNamed) {
+// KHR_lights_punctual lights are read (issue 57): a scene with lamps and no emissive surface is
+// lit; the extension may be required; a light without a node lights nothing.
+TEST_F(BadInput, PunctualLightsAreReadAndLightTheScene) {
   write("tri.bin", triangleBin());
   const std::string lights = R"(, "extensionsUsed": ["KHR_lights_punctual"],
-      "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point"}, {"type": "directional"}]}})";
-  const std::string path = write("dark.gltf", triangleGltf(lights));
-  Scene s = readGltfScene(path);
-  EXPECT_EQ(s.punctualLights, 2);
-  EXPECT_EQ(missingEmitterMessage(s),
-            "no emissive material; 2 KHR_lights_punctual lights are not supported: give a mesh an "
-            "emissive material (emissiveFactor) instead");
-  EXPECT_THROW(requireEmitter(s), Error);
-  Scene lit = readGltfScene(
-      write("lit.gltf", withMaterial(triangleGltf(), R"({"emissiveFactor": [1, 1, 1]})")));
+      "extensionsRequired": ["KHR_lights_punctual"],
+      "extensions": {"KHR_lights_punctual": {"lights": [
+        {"type": "point", "color": [1, 0.5, 0.25], "intensity": 4, "range": 3},
+        {"type": "spot", "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}]}})";
+  Scene unplaced = readGltfScene(write("dark.gltf", triangleGltf(lights)));
+  ASSERT_EQ(unplaced.lights.size(), 2u);
+  EXPECT_EQ(unplaced.lights[0].intensity, glm::dvec3(4.0, 2.0, 1.0));
+  EXPECT_EQ(unplaced.lights[0].range, 3.0);
+  EXPECT_EQ(unplaced.lights[1].type, PunctualLightType::kSpot);
+  EXPECT_EQ(unplaced.lights[1].outerConeAngle, 0.5);
+  EXPECT_EQ(unplaced.lightUnits, "gltf");
+  EXPECT_EQ(missingEmitterMessage(unplaced),
+            "no emissive material and no KHR_lights_punctual light of non-zero intensity on a "
+            "node of the scene: give a mesh an emissive material (emissiveFactor) or add a lamp");
+  EXPECT_THROW(requireEmitter(unplaced), Error);
+  const std::string placed =
+      triangleGltf(lights, R"(, "extensions": {"KHR_lights_punctual": {"light": 1}})");
+  Scene lit = readGltfScene(write("lit.gltf", placed));
+  EXPECT_EQ(lit.nodes[0].light, 1);
+  EXPECT_EQ(lit.lightNodes(), std::vector<int>{0});
   EXPECT_EQ(missingEmitterMessage(lit), "");
   EXPECT_NO_THROW(requireEmitter(lit));
+  expectBadInput(write("bad.gltf", triangleGltf(lights, R"(, "extensions":
+                 {"KHR_lights_punctual": {"light": 7}})")),
+                 "node 0: light 7 out of range (2 lights)");
+}
+
+// A Blender export's lamps are in Blender's units (gltf_lights.h): auto reads them by the
+// generator, /683, and its spots take Cycles' profile.
+TEST_F(BadInput, BlenderLampUnitsAreDetected) {
+  write("tri.bin", triangleBin());
+  const std::string lights = R"(, "extensionsUsed": ["KHR_lights_punctual"],
+      "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 683},
+        {"type": "spot", "intensity": 6830, "spot": {"outerConeAngle": 0.5}}]}})";
+  std::string gltf = triangleGltf(lights);
+  gltf.replace(gltf.find("\"asset\": {"), 10,
+               R"("asset": {"generator": "Khronos glTF Blender I/O v3.4.50", )");
+  const std::string path = write("blender.gltf", gltf);
+  Scene s = readGltfScene(path);
+  EXPECT_EQ(s.lightUnits, "blender");
+  EXPECT_DOUBLE_EQ(s.lights[0].intensity.x, 1.0);
+  EXPECT_DOUBLE_EQ(s.lights[1].intensity.x, 10.0);
+  EXPECT_EQ(s.lights[1].profile, SpotProfile::kCycles);
+  GltfReadOptions asGltf;
+  asGltf.lightUnits = LightUnits::kGltf;
+  Scene g = readGltfScene(path, asGltf);
+  EXPECT_EQ(g.lights[0].intensity.x, 683.0);
+  EXPECT_EQ(g.lights[1].profile, SpotProfile::kGltf);
 }
 
 // An animated scale (squash and stretch) is an affine motion of a dynamic node (issue 57: it was

@@ -9,6 +9,18 @@
 namespace rad {
 
 CLI::Option* addSceneReadOptions(CLI::App& app) {
+  // Declared here once, for every tool, so every stage reads a scene's lamps alike; what it
+  // gives is recorded by the scene digests' lights part (the lamps' intensities as read).
+  app.add_option_function<std::string>(
+         "--light-units",
+         [](const std::string& name) {
+           defaultGltfReadOptions().lightUnits = parseLightUnits(name);
+         },
+         "units of KHR_lights_punctual lamps: gltf (cd, lux as W/sr, W/m^2), blender (as "
+         "Blender's exporter wrote them: / 683, Cycles' spot profile), auto (blender when "
+         "asset.generator is Blender's exporter, else gltf)")
+      ->default_str(lightUnitsName(defaultGltfReadOptions().lightUnits))
+      ->check(CLI::IsMember({"auto", "gltf", "blender"}));
   return app
       .add_option("--max-texture-pixels", defaultGltfReadOptions().maxTexturePixels,
                   "a scene's texture with more pixels (read from its header) is ignored with a "

@@ -8,8 +8,9 @@
 
 namespace rad {
 
-// Adds --max-texture-pixels (bound to defaultGltfReadOptions(), which readGltfScene(path) uses).
-// Called by parseCommandLine, so every tool has it.
+// Adds --light-units and --max-texture-pixels (bound to defaultGltfReadOptions(), which
+// readGltfScene(path) uses); returns the latter. Called by parseCommandLine, so every tool has
+// them.
 CLI::Option* addSceneReadOptions(CLI::App& app);
 // Installs a warning handler that prints each warning of each scene read, once per run, as
 // `tool: SCENE: warning: TEXT` on stderr. Called by setUpApp.

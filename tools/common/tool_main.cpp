@@ -112,6 +112,7 @@ void addAdvancedOptions(CLI::App& app) {
       ->check(integerRange(0, kMaxThreads))
       ->group(advanced);
   addSceneReadOptions(app)->group(advanced);  // --max-texture-pixels
+  if (CLI::Option* units = app.get_option_no_throw("--light-units")) units->group(advanced);
 }
 }  // namespace
 
