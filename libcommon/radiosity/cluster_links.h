@@ -14,7 +14,13 @@
 //    top-level patches times the lights, which is quadratic in a hall whose lights grow with
 //    its floor;
 //  * the two bounding spheres come closer than their radii (the point approximation below
-//    does not hold): near geometry ends as patch links;
+//    does not hold): near geometry ends as patch links, unless S holds no emitter and none of
+//    the link's ray pairs (those of V_RS below) gets through: such a link carries nothing and
+//    is dropped, not refined (blocked). Boards of a shelf, boxes in a row: their tops are near
+//    each other by their spheres, and most pairs of them cannot see each other (a board
+//    between); refining every such pair down to top-level patches made their all-pairs links
+//    (issue 58), where the patch links' own oracle never refines a link whose V is 0 either.
+//    A light's links are refined as before: the second pass takes their shadows per texel;
 //  * or its power bound exceeds eps Phi: $\max B_S \, V \, \min(A_R \tilde F, A_S)$ with
 //    $\tilde F = \min(1, A_S / (\pi d_{min}^2))$, d_min the gap between the spheres (Smits et
 //    al. §3's bound on a cluster-to-cluster transfer).
@@ -131,7 +137,7 @@ class ClusterLinks {
   // patches reached go to `patchPairs` (receiver, shooter). Once `budget` new links were made
   // only the links whose shooter holds a light are refined further (down to patch pairs, so
   // that every light keeps its per-texel shadows in the second pass), and `overBudget` is set.
-  // Returns the number of links refined.
+  // Returns the number of links refined or dropped.
   size_t refine(double epsAbs, bool refineAll, size_t budget,
                 std::vector<std::pair<int, int>>& patchPairs, bool& overBudget);
   // About how many links refinement will keep (the previous key's count with a margin): the
@@ -179,7 +185,22 @@ class ClusterLinks {
   // top-level patches through sink.pair(r, s).
   template <class Sink>
   void expand(const ClusterLink& l, Sink& sink) const;
-  bool wantsRefinement(const ClusterLink& l, double epsAbs) const;
+  // What a refinement round does with a link (see the top of this file).
+  enum class Fate : uint8_t { kKeep, kRefine, kDrop };
+  Fate fateOf(const ClusterLink& l, double epsAbs) const;
+  // Ray pair i of the link r <- s, as evaluateLink draws it from the link's seed: a member of
+  // each end drawn among those that may face the other end, a point on each, and the kernel
+  // cos cos / r^2 between them (0 behind either plane).
+  struct RayPair {
+    glm::dvec3 x, y;
+    uint32_t a = 0, b = 0;
+    double kernel = 0;
+  };
+  RayPair rayPair(ClusterRef r, ClusterRef s, int i) const;
+  // Whether none of the link's ray pairs gets through: with some pair of positive kernel, none
+  // of those; else none at all (V_RS = 0 in evaluateLink, from the same pairs). False without
+  // a visibility scene.
+  bool blocked(ClusterRef r, ClusterRef s) const;
   const ClusterBounds& bounds(ClusterRef r) const {
     return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];
   }
