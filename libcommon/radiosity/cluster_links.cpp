@@ -1,6 +1,7 @@
 // Cluster links of one key-time solve (see the header). The figures behind the reasons given here:
 // docs/results.md, "Figures moved out of the radiosity code's comments (issue 55)".
 #include "libcommon/radiosity/cluster_links.h"
+#include "libcommon/radiosity/link_form_factor.h"
 
 #include <algorithm>
 #include <array>
@@ -172,15 +173,11 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
   const ClusterBounds& S = bounds(l.shooter);
   // Near (the centres closer than `separation` times the radii's sum): the point approximation does
   // not hold, so such a link is refined, even one that carries little: accepted with its point
-  // estimate, it moves the frames away from the all-pairs ones. One that carries nothing, whose
-  // rays are all blocked, is dropped (the top of cluster_links.h); a link evaluated before this
-  // round has that V already (the same pairs), a new one casts them here.
+  // estimate, it moves the frames away from the all-pairs ones. One between a few members that
+  // carries nothing (blocked) is dropped (the top of cluster_links.h).
   const double d = glm::length(S.centre() - R.centre());
-  if (!(d > separation_ * (R.radius() + S.radius()))) {
-    if (emitted > 0.0) return Fate::kRefine;
-    const bool none = l.evaluated ? !(l.visibility > 0.0f) : blocked(l.receiver, l.shooter);
-    return none ? Fate::kDrop : Fate::kRefine;
-  }
+  if (!(d > separation_ * (R.radius() + S.radius())))
+    return emitted <= 0.0 && blocked(l.receiver, l.shooter) ? Fate::kDrop : Fate::kRefine;
   // A light's B before the first solve is its emission (the radiosity of the last gather is 0
   // then, and would keep every light link at the first round).
   const double bv = std::max(maxRadiosity(l.shooter), emitted) * l.visibility;
@@ -459,9 +456,8 @@ bool ClusterLinks::mayFace(uint32_t t, const ClusterBounds& box) const {
   return farthest > glm::dot(n, centroid_[t]);
 }
 
-ClusterLinks::RayPair ClusterLinks::rayPair(ClusterRef r, ClusterRef s, int i) const {
+ClusterLinks::RayPair ClusterLinks::rayPair(ClusterRef r, ClusterRef s, int i, int k) const {
   const uint64_t seed = clusterLinkSeed(r, s);
-  const int k = rays_;
   // A shooter holding lights is sampled by emitted power: its light comes from them, and the
   // visibility of its area (a ceiling's, the lights a small part of it) is not that of its light.
   const std::vector<double>& shooterPrefix = emits(s) ? memberPowerPrefix_ : memberAreaPrefix_;
@@ -495,23 +491,45 @@ ClusterLinks::RayPair ClusterLinks::rayPair(ClusterRef r, ClusterRef s, int i) c
 }
 
 bool ClusterLinks::blocked(ClusterRef r, ClusterRef s) const {
-  // evaluateLink leaves V at 1 for ends with one centre.
-  const glm::dvec3 d = bounds(s).centre() - bounds(r).centre();
-  if (!visibility_ || !(glm::dot(d, d) > 0.0)) return false;
-  const int k = rays_;
-  std::array<RayPair, 64> onStack;
-  std::vector<RayPair> onHeap(k > 64 ? size_t(k) : 0);
-  RayPair* pairs = k > 64 ? onHeap.data() : onStack.data();
-  bool anyKernel = false;
-  for (int i = 0; i < k; ++i) {
-    pairs[size_t(i)] = rayPair(r, s, i);
-    anyKernel = anyKernel || pairs[size_t(i)].kernel > 0.0;
-  }
-  for (int i = 0; i < k; ++i) {
-    const RayPair& p = pairs[size_t(i)];
-    if (anyKernel && !(p.kernel > 0.0)) continue;
-    if (!visibility_->occluded(p.x, p.y, p.a, p.b)) return false;
-  }
+  if (!visibility_) return false;
+  // The members of each end whose plane has some of the other end's box in front (the others
+  // see none of it).
+  auto facing = [&](ClusterRef end, ClusterRef other, std::vector<uint32_t>& out) {
+    const ClusterBounds& box = bounds(other);
+    if (!isCluster(end)) {
+      if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
+      return;
+    }
+    const ClusterNode& n = tree_.node(clusterIndex(end));
+    for (uint32_t i = n.first; i < n.first + n.count; ++i)
+      if (mayFace(tree_.members()[i], box)) out.push_back(tree_.members()[i]);
+  };
+  std::vector<uint32_t> a, b;
+  facing(r, s, a);
+  facing(s, r, b);
+  if (a.size() * b.size() > size_t(kTestedMemberPairs)) return false;  // not tested: refined
+  const uint64_t seed = splitMix64(clusterLinkSeed(r, s) ^ 0x626c6f636b6564ull);  // "blocked"
+  for (const uint32_t i : a)
+    for (const uint32_t j : b) {
+      const Polygon &p = world_[i], &q = world_[j];
+      if (!mutuallyFacing(p, facingPlane(p), q, facingPlane(q))) continue;  // they exchange nothing
+      // Points of each in front of the other's plane: every ray between them carries energy.
+      const uint64_t pairSeed = splitMix64(seed ^ (uint64_t(i) << 32 | j));
+      const std::vector<glm::dvec3> x =
+          VisibilityScene::samplePointsInFront(p, q.v[0], normal_[j], rays_, pairSeed);
+      const std::vector<glm::dvec3> y =
+          VisibilityScene::samplePointsInFront(q, p.v[0], normal_[i], rays_, splitMix64(pairSeed));
+      // y's strata in a random order against x's (a Fisher-Yates shuffle): pairing stratum k with
+      // stratum k would test the same few of the stratum pairs every time.
+      std::vector<int> order(static_cast<size_t>(rays_));
+      for (int k = 0; k < rays_; ++k) order[size_t(k)] = k;
+      const uint64_t shuffle = splitMix64(pairSeed ^ 0x73687566666c65ull);
+      for (int k = rays_ - 1; k > 0; --k)
+        std::swap(order[size_t(k)],
+                  order[size_t(std::min(k, int(uniformOpen01(shuffle, uint64_t(k)) * (k + 1))))]);
+      for (int k = 0; k < rays_; ++k)
+        if (!visibility_->occluded(x[size_t(k)], y[size_t(order[size_t(k)])], i, j)) return false;
+    }
   return true;
 }
 
@@ -555,7 +573,7 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
     RayPair* pairs = k > 64 ? onHeap.data() : onStack.data();
     double sumK = 0.0;
     for (int i = 0; i < k; ++i) {
-      pairs[size_t(i)] = rayPair(l.receiver, l.shooter, i);
+      pairs[size_t(i)] = rayPair(l.receiver, l.shooter, i, k);
       sumK += pairs[size_t(i)].kernel;
     }
     // V per facing group of R's members, from the same pairs: one V for a receiver cluster
