@@ -8,7 +8,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <map>
+#include <tuple>
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
@@ -154,6 +158,14 @@ void KeyTimeSolver::setThresholds() {
   // NaN, which the stop rule's std::max would not see.
   radiosityBound_ =
       rhoMax < 1.0 ? 1e6 * emissionMax / (1.0 - rhoMax) : std::numeric_limits<double>::infinity();
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (int t = 0; t < h_.topCount(); ++t)
+    for (int k = 0; k < s_.world[size_t(t)].count; ++k) {
+      lo = glm::min(lo, s_.world[size_t(t)].v[size_t(k)]);
+      hi = glm::max(hi, s_.world[size_t(t)].v[size_t(k)]);
+    }
+  contactDistance_ =
+      h_.topCount() > 0 ? VisibilityScene::kSegmentEpsilon * glm::length(hi - lo) : 0.0;
   epsAbs_ = opt_.eps * maxComponent(emitted);
   refineOn_ = opt_.refine && epsAbs_ > 0.0;
   stopChange_ = opt_.tol * std::max(1.0 - rhoMax, 1e-6);
@@ -176,7 +188,7 @@ KeySolution KeyTimeSolver::finish() {
     s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
   }
   if (clusters_) {  // at the final B, as the merge gathers the patch links
-    clusters_->gather(B_, exposure_, clusterH_);
+    gatherClusterLight();
     s_.topClusterIrradiance = clusterH_;
     s_.clusterLinks = clusters_->size();
     s_.clusterLinksReused = clusters_->reusedCount();
