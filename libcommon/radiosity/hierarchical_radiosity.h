@@ -20,9 +20,12 @@
 //    children's links are evaluated and refined in turn. Refined links are kept (flag
 //    refined) but not gathered;
 //  * accurate pass: leaf links get the accurate unoccluded F (polygonToPolygonFormFactor);
-//  * closure: each leaf's factor c that makes its row sum its own (exact in closed rooms);
-//  * exposure: each node's fraction not covered by a solid standing on it; its links'
-//    irradiance is divided by it, so B is the radiosity of the part that can be seen;
+//  * closure: each leaf's factor c that makes its row sum its own (exact in closed rooms, at
+//    most 1 anywhere);
+//  * exposure: each node's fraction not covered by a solid standing on it or by a surface in
+//    contact with it; its links' irradiance is divided by it, so B is the radiosity of the part
+//    that can be seen (computed for a link's receiver before its visibility, whose pairs from
+//    covered points count as blocked);
 //  * gather + push-pull (HSA'91 §5), Gauss-Seidel over the top-level patches, until the
 //    relative change of B is below tol * (1 - rho_max) (the stop rule of the furnace
 //    reference: a change below tol alone leaves an error of tol / (1 - rho));
