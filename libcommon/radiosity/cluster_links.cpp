@@ -176,8 +176,13 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
   // estimate, it moves the frames away from the all-pairs ones. One between a few members that
   // carries nothing (blocked) is dropped (the top of cluster_links.h).
   const double d = glm::length(S.centre() - R.centre());
-  if (!(d > separation_ * (R.radius() + S.radius())))
-    return emitted <= 0.0 && blocked(l.receiver, l.shooter) ? Fate::kDrop : Fate::kRefine;
+  if (!(d > separation_ * (R.radius() + S.radius()))) {
+    if (emitted > 0.0) return Fate::kRefine;
+    const size_t T = emission_.size();
+    const bool known =
+        reuse_ && reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
+    return known || blocked(l.receiver, l.shooter) ? Fate::kDrop : Fate::kRefine;
+  }
   // A light's B before the first solve is its emission (the radiosity of the last gather is 0
   // then, and would keep every light link at the first round).
   const double bv = std::max(maxRadiosity(l.shooter), emitted) * l.visibility;
@@ -367,6 +372,7 @@ class ClusterLinks::RefineRound {
       current_ = i;
       if (!parallel && made_ + patchPairs_.size() > budget_ + count_) overBudget_ = true;
       if (drops(i, l)) {  // gone, as a refined link is, with no children
+        c_.blocked_.emplace_back(l.receiver, l.shooter);
         if (firstLevel_) changes(l.receiver);
         ++count_;
         continue;
@@ -493,21 +499,34 @@ ClusterLinks::RayPair ClusterLinks::rayPair(ClusterRef r, ClusterRef s, int i, i
 bool ClusterLinks::blocked(ClusterRef r, ClusterRef s) const {
   if (!visibility_) return false;
   // The members of each end whose plane has some of the other end's box in front (the others
-  // see none of it).
-  auto facing = [&](ClusterRef end, ClusterRef other, std::vector<uint32_t>& out) {
+  // see none of it), at most `most` of them (more: the link is not tested).
+  auto facing = [&](ClusterRef end, ClusterRef other, size_t most, std::vector<uint32_t>& out) {
     const ClusterBounds& box = bounds(other);
     if (!isCluster(end)) {
       if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
-      return;
+      return true;
     }
     const ClusterNode& n = tree_.node(clusterIndex(end));
     for (uint32_t i = n.first; i < n.first + n.count; ++i)
-      if (mayFace(tree_.members()[i], box)) out.push_back(tree_.members()[i]);
+      if (mayFace(tree_.members()[i], box)) {
+        if (out.size() == most) return false;
+        out.push_back(tree_.members()[i]);
+      }
+    return true;
   };
   std::vector<uint32_t> a, b;
-  facing(r, s, a);
-  facing(s, r, b);
-  if (a.size() * b.size() > size_t(kTestedMemberPairs)) return false;  // not tested: refined
+  if (!facing(r, s, kTestedMemberPairs, a)) return false;
+  if (a.empty()) return true;  // nothing of r faces s
+  if (!facing(s, r, kTestedMemberPairs / a.size(), b)) return false;
+  // One ray between the centroids of each pair that face each other there first: where the
+  // ends see each other (most near links of an open room), one of them gets through.
+  for (const uint32_t i : a)
+    for (const uint32_t j : b) {
+      const glm::dvec3 d = centroid_[j] - centroid_[i];
+      if (glm::dot(normal_[i], d) > 0.0 && glm::dot(normal_[j], d) < 0.0 &&
+          !visibility_->occluded(centroid_[i], centroid_[j], i, j))
+        return false;
+    }
   const uint64_t seed = splitMix64(clusterLinkSeed(r, s) ^ 0x626c6f636b6564ull);  // "blocked"
   for (const uint32_t i : a)
     for (const uint32_t j : b) {

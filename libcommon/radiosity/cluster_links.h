@@ -114,6 +114,9 @@ struct CachedClusterLink {
 struct ClusterLinkCache {
   PairTable<CachedClusterLink> links;
   std::vector<uint8_t> memberVisibility;  // each cached link's, as ClusterLink::memberVisibility
+  // The near links the previous key dropped as blocked, under the same condition: their rays
+  // meet the same geometry, so the test would say blocked again.
+  PairTable<uint8_t> blocked;
   const CachedClusterLink* find(uint32_t row, uint32_t column) const {
     return links.find(row, column);
   }
@@ -163,6 +166,9 @@ class ClusterLinks {
   // gather weighs them (its row sum's cluster part).
   std::vector<double> rowSums(const std::vector<double>& exposure);
 
+  // The near links dropped as blocked in this key's rounds (receiver, shooter), for the next
+  // key's coherence (ClusterLinkCache::blocked).
+  const std::vector<std::pair<ClusterRef, ClusterRef>>& blockedLinks() const { return blocked_; }
   size_t size() const { return links_.size(); }
   size_t reusedCount() const { return reused_; }
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
@@ -293,6 +299,7 @@ class ClusterLinks {
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;
+  std::vector<std::pair<ClusterRef, ClusterRef>> blocked_;  // blockedLinks()
   // The links' V at their receivers' members (ClusterLink::memberVisibility); a refined link's
   // stay until the key's end.
   std::vector<uint8_t> memberVisibility_;

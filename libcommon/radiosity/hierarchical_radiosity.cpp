@@ -193,6 +193,7 @@ KeySolution KeyTimeSolver::finish() {
     s_.clusterLinks = clusters_->size();
     s_.clusterLinksReused = clusters_->reusedCount();
     s_.clusterBounds = clusters_->clusterBounds();
+    s_.clusterLinksBlocked = clusters_->blockedLinks();
     // Moved out, and the rest of the cluster links (their gather lists) freed here, not when the
     // solver goes: a copy held beside them until then would raise rad-global's peak at the end of
     // each key's solve.
@@ -208,6 +209,7 @@ KeySolution KeyTimeSolver::finish() {
   for (size_t i = 0; i < closed_.size(); ++i)
     if (closed_[i] >= 0 && !moves(h_.node(int(i)).id.top))
       s_.closedNodes.push_back({h_.node(int(i)).id.packed(), closed_[i] != 0});
+  s_.coveredPoints = std::move(coveredPoints_);
   s_.exposure = std::move(exposure_);
   s_.exposure.resize(size_t(h_.size()), 1.0);
   for (double& e : s_.exposure)

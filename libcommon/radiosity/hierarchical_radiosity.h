@@ -85,6 +85,10 @@ struct KeySolveInput {
   // would be held beside it through the key's solve)
   LeafFormFactorCache* reuseLeafFormFactors = nullptr;
   const ClosedNodeCache* reuseClosed = nullptr;  // coherence: closed-room tests
+  // coherence: the previous key's KeySolution::coveredPoints. A link taken over keeps its V only
+  // where its receiver's covered points are the same at this key (a moving object can change
+  // which ray start points are covered), else its rays are cast again.
+  const std::vector<uint64_t>* reuseCoveredPoints = nullptr;
   // Per top-level patch: it moves at some time of the animation. The closure corrects only
   // pairs of patches that never move (empty: none moves).
   std::vector<char> movingTops;
@@ -116,6 +120,9 @@ struct KeySolution {
   // a solid standing on it (see computeExposures in the .cpp); 1 without a visibility scene.
   // Its radiosity and irradiance are those of the exposed part.
   std::vector<double> exposure;
+  // Per dense node exposed at this key: bit k set when its ray start point k (< 64) is covered
+  // (key_time_exposure.cpp); 0 elsewhere.
+  std::vector<uint64_t> coveredPoints;
   // Per dense node: the (top, F(node -> top)) the closure computed or took over at this key.
   std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor;
   // The closed-room tests of static nodes cast or taken over at this key: (node id, closed).
@@ -129,6 +136,8 @@ struct KeySolution {
   // the next key's coherence).
   std::vector<ClusterLink> clusterLinkValues;
   std::vector<uint8_t> clusterMemberVisibility;  // ClusterLink::memberVisibility indexes it
+  // The near cluster links dropped as blocked (cluster_links.h), for the next key's coherence.
+  std::vector<std::pair<ClusterRef, ClusterRef>> clusterLinksBlocked;
   std::vector<ClusterBounds> clusterBounds;
   std::vector<Polygon> world;  // per dense node: world polygon at this key
   std::vector<double> area;    // per dense node: world area

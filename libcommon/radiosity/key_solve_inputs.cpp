@@ -40,22 +40,22 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
                         : polygonBounds(prev.world[size_t(r)]);
   };
   const size_t T = size_t(h.topCount());
+  // Both ends static and no moving node's swept bounds meeting the box around both.
+  auto stays = [&](ClusterRef r, ClusterRef s) {
+    if (!isStatic(r) || !isStatic(s)) return false;
+    const ClusterBounds a = box(r), b = box(s);
+    const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
+    for (const auto& m : swept)
+      if (glm::all(glm::lessThanEqual(m[0], hi)) && glm::all(glm::lessThanEqual(lo, m[1])))
+        return false;
+    return true;
+  };
   // Per link, in parallel, whether it is kept; then the kept ones in link order.
   const std::vector<ClusterLink>& links = prev.clusterLinkValues;
   std::vector<char> kept(links.size());
   tbb::parallel_for(size_t(0), links.size(), [&](size_t i) {
     const ClusterLink& l = links[i];
-    if (!l.evaluated || !isStatic(l.receiver) || !isStatic(l.shooter)) {
-      kept[i] = 0;
-      return;
-    }
-    const ClusterBounds a = box(l.receiver), b = box(l.shooter);
-    const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
-    bool hit = false;
-    for (const auto& s : swept)
-      hit =
-          hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
-    kept[i] = hit ? 0 : 1;
+    kept[i] = l.evaluated && stays(l.receiver, l.shooter) ? 1 : 0;
   });
   std::vector<std::pair<uint32_t, uint32_t>> keys;
   std::vector<CachedClusterLink> values;
@@ -77,6 +77,18 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
     }
   cache.links =
       PairTable<CachedClusterLink>(keys, std::move(values), uint32_t(T + size_t(tree.size())));
+  const auto& blocked = prev.clusterLinksBlocked;
+  std::vector<char> still(blocked.size());
+  tbb::parallel_for(size_t(0), blocked.size(), [&](size_t i) {
+    still[i] = stays(blocked[i].first, blocked[i].second) ? 1 : 0;
+  });
+  std::vector<std::pair<uint32_t, uint32_t>> blockedKeys;
+  for (size_t i = 0; i < blocked.size(); ++i)
+    if (still[i])
+      blockedKeys.emplace_back(clusterLinkEnd(blocked[i].first, T),
+                               clusterLinkEnd(blocked[i].second, T));
+  cache.blocked = PairTable<uint8_t>(blockedKeys, std::vector<uint8_t>(blockedKeys.size(), 1),
+                                     uint32_t(T + size_t(tree.size())));
   return cache;
 }
 

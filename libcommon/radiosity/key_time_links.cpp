@@ -111,7 +111,11 @@ void KeyTimeSolver::evaluateLink(SolverLink& l) const {
       l.estimate = c.estimate;
       l.spreadArea = c.spreadArea;
       l.formFactor = l.estimate;
-      if (c.visibilityValid) {
+      const std::vector<uint64_t>* before = input_.reuseCoveredPoints;
+      const bool sameCover =
+          !before || (size_t(l.receiver) < before->size() &&
+                      (*before)[size_t(l.receiver)] == coveredPoints_[size_t(l.receiver)]);
+      if (c.visibilityValid && sameCover) {
         l.rayVisibility = c.visibility;
         l.openPairs = c.openPairs;
         l.reused = true;
