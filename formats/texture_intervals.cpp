@@ -14,6 +14,11 @@ void writeTextureIntervals(const std::string& path, const TextureIntervals& iv,
   w.metadata()["fps"] = iv.fps;
   w.metadata()["image_width"] = iv.imageWidth;
   w.metadata()["image_height"] = iv.imageHeight;
+  if (!iv.sampling.filter.isNone()) {  // absent: the pixel centres, as in 1.0 files
+    w.metadata()["pixel_filter"] = pixelFilterNames().name(iv.sampling.filter.type);
+    w.metadata()["filter_width"] = iv.sampling.filter.width;
+    w.metadata()["pixel_samples"] = iv.sampling.samplesPerAxis;
+  }
   w.metadata()["close_reasons"] = {"left_frustum", "hidden",     "level_change",
                                    "resize",       "max_length", "window"};
   size_t n = iv.movies.size();
@@ -48,6 +53,19 @@ TextureIntervals readTextureIntervals(const ContainerReader& r) {
     iv.fps = md.at("fps").get<double>();
     iv.imageWidth = md.at("image_width").get<int>();
     iv.imageHeight = md.at("image_height").get<int>();
+    if (md.contains("pixel_filter")) {  // 1.1
+      const std::optional<PixelFilterType> type =
+          pixelFilterNames().find(md.at("pixel_filter").get<std::string>());
+      if (!type) throw inputError(where, "metadata: unknown pixel_filter");
+      iv.sampling.filter.type = *type;
+      iv.sampling.filter.width = md.at("filter_width").get<double>();
+      iv.sampling.samplesPerAxis = md.at("pixel_samples").get<int>();
+      try {
+        iv.sampling.validate();
+      } catch (const Error& e) {
+        throw inputError(where, std::string("metadata: invalid pixel sampling: ") + e.what());
+      }
+    }
   } catch (const nlohmann::json::exception& e) {
     throw inputError(where, std::string("metadata: ") + e.what());
   }

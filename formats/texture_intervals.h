@@ -10,12 +10,13 @@
 
 #include "formats/container.h"
 #include "libcommon/intervals/movie_extent.h"
+#include "libcommon/scene/sample_grid.h"
 
 namespace rad {
 
 constexpr const char* kTextureIntervalsKind = "intervals";
 constexpr int kTextureIntervalsMajor = 1;
-constexpr int kTextureIntervalsMinor = 0;
+constexpr int kTextureIntervalsMinor = 2;
 
 // intervals.rti stores libcommon's movie record (libcommon/intervals/movie_extent.h: patch,
 // frames, size, MovieEnd) as it is.
@@ -24,6 +25,8 @@ struct TextureIntervals {
   int firstFrame = 0, lastFrame = 0;  // the window computed
   double fps = 24.0;
   int imageWidth = 0, imageHeight = 0;
+  // The samples whose coverage the item buffers decided (1.1; a 1.0 file: the pixel centres).
+  PixelSampling sampling = PixelSampling::pixelCentres();
   std::vector<MovieExtent> movies;  // sorted by id (movies[i].movie == i)
   double frameTime(int frame) const { return frame / fps; }
 };

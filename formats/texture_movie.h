@@ -18,7 +18,7 @@
 namespace rad {
 
 constexpr int kTextureMovieMajor = 2;
-constexpr int kTextureMovieMinor = 0;
+constexpr int kTextureMovieMinor = 1;
 
 struct TextureMovie {
   uint32_t movie = 0;  // id in intervals.rti

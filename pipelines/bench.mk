@@ -22,6 +22,12 @@
 #   make -f pipelines/bench.mk furnace [FURNACE_RHO=0.5,0.9,0.99,0.999] [FURNACE_FLAGS="global=--eps 1e-4"]
 #       the closed furnace through the whole pipeline at each rho: frame mean against the exact
 #       L_e / (1 - rho), time and peak memory; out/furnace/
+#   make -f pipelines/bench.mk image [IMAGE_OWN=cornell-moving,...|none] [IMAGE_CORPUS=DIR] [IMAGE_FRAMES=0-24] [IMAGE_EVAL_FRAME=20] [IMAGE_SPP=1024] [IMAGE_PRESETS=default,final]
+#       issue 56's figures per scene at the default and final presets (pipelines/image_figures.py):
+#       RMSE / mean and bias (edges in, emitters out), edge and interior pixels apart, the
+#       structured error and its reference floor, the largest seam step beyond the reference's,
+#       against two rad-reference renders with the frames' filter; IMAGE_CORPUS adds the public
+#       scenes of pipelines/corpus/scenes.py; out/image/image-figures.csv
 #   make -f pipelines/bench.mk fuzz [FUZZ_SECONDS=600] [FUZZ_RUNS=-1]
 #       every reader's libFuzzer harness for FUZZ_SECONDS each, or until FUZZ_RUNS executions
 #       (-1: no bound but the time; the issue's long run: FUZZ_RUNS=1000000 FUZZ_SECONDS=5400)
@@ -53,10 +59,17 @@ FARM_FLAGS ?=
 FURNACE_RHO ?= 0.5,0.9,0.99,0.999
 FURNACE_FLAGS ?=
 
+IMAGE_OWN ?=
+IMAGE_CORPUS ?=
+IMAGE_FRAMES ?= 0-24
+IMAGE_EVAL_FRAME ?= 20
+IMAGE_SPP ?= 1024
+IMAGE_PRESETS ?= default,final
+
 FUZZ_SECONDS ?= 600
 FUZZ_RUNS ?= -1
 
-.PHONY: tables tradeoff furnace contact scale farm-model fuzz
+.PHONY: tables tradeoff furnace contact scale farm-model image fuzz
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -82,6 +95,11 @@ furnace:
 farm-model:
 	python3 pipelines/farm_model.py --bin $(BIN) --scene $(FARM_SCENE) --frames $(FARM_FRAMES) \
 	  --size $(BENCH_SIZE) --nodes $(FARM_NODES) --out out/farm-model $(FARM_FLAGS)
+
+image:
+	python3 pipelines/image_figures.py --bin $(BIN) --frames $(IMAGE_FRAMES) --eval-frame $(IMAGE_EVAL_FRAME) \
+	  --size $(BENCH_SIZE) --spp $(IMAGE_SPP) --presets $(IMAGE_PRESETS) --out out/image \
+	  $(if $(IMAGE_OWN),--own $(IMAGE_OWN)) $(if $(IMAGE_CORPUS),--corpus $(IMAGE_CORPUS))
 
 fuzz:
 	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) bash tests/fuzz/run.sh

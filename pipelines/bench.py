@@ -249,6 +249,22 @@ class ReferenceNoise:
                 "relative_l2": d["relative_l2"]}
 
 
+def reference_filter(flags=None):
+    """rad-reference's pixel-filter arguments for the frames a pipeline makes with `flags` (stage
+    -> extra arguments): the frames' filter is rad-intervals' (rad-compose reads it from
+    intervals.rti), so the reference takes the intervals' --pixel-filter and --filter-width where
+    they are given, and otherwise the default both tools share (blackman-harris 1.5)."""
+    args = list((flags or {}).get("intervals", []))
+    out = []
+    for name in ("--pixel-filter", "--filter-width"):
+        for i, a in enumerate(args):
+            if a == name and i + 1 < len(args):
+                out += [name, args[i + 1]]
+            elif a.startswith(name + "="):
+                out += [name, a.split("=", 1)[1]]
+    return out
+
+
 def reference_difference(bin_dir, scene, out, frame, size, spp, tests, log):
     """The error of each tests[name] frame file against the path-traced references at `frame`
     (ReferenceNoise: RMSE / mean and bias over non-emitters, the references' noise removed); rendered once and kept in
@@ -259,10 +275,10 @@ def reference_difference(bin_dir, scene, out, frame, size, spp, tests, log):
     name = "%04d.exr" % frame
     refs = []
     for seed in (0, 1):
-        d = os.path.join(out, "reference-%d-%dspp-seed%d" % (frame, spp, seed))
+        d = os.path.join(out, "reference-%d-%dspp-filtered-seed%d" % (frame, spp, seed))
         if not os.path.exists(os.path.join(d, name)):
             run([ref, scene, "-o", d, "--frames", "%d-%d" % (frame, frame), "--size", size,
-                 "--spp", str(spp), "--seed", str(seed), "--pixel-centres"], log)
+                 "--spp", str(spp), "--seed", str(seed)] + reference_filter(), log)
         refs.append(os.path.join(d, name))
 
     noise = ReferenceNoise(bin_dir, refs)

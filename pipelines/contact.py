@@ -87,13 +87,15 @@ VARIANTS = [
 def reference(bin_dir, scene, out, seed, size, spp, log):
     """rad-reference of frame 0, rendered again only when the scene or the settings change."""
     with open(scene, "rb") as f:
-        key = "%s %s %d" % (hashlib.sha256(f.read()).hexdigest(), size, spp)
+        key = "%s %s %d %s" % (hashlib.sha256(f.read()).hexdigest(), size, spp,
+                               " ".join(bench.reference_filter()) or "filtered")
     ref = os.path.join(out, "reference-seed%d" % seed)
     stamp = os.path.join(ref, "made-from")
     if os.path.exists(stamp) and open(stamp).read() == key:
         return ref
     bench.run([os.path.join(bin_dir, "rad-reference"), scene, "-o", ref, "--frames", "0-0",
-               "--size", size, "--spp", str(spp), "--seed", str(seed), "--pixel-centres"], log)
+               "--size", size, "--spp", str(spp), "--seed", str(seed)] + bench.reference_filter(),
+              log)
     with open(stamp, "w") as f:
         f.write(key)
     return ref

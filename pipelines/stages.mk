@@ -24,6 +24,13 @@ SIZE    ?= 352x240
 # rad-global and rad-movies have quality knobs, so only their command lines take it.
 QUALITY ?= default
 
+# The pixel filter of the frames (docs/design.md §6.4): none, box, gaussian or blackman-harris;
+# empty: the tools' default, blackman-harris 1.5 px on 3 x 3 samples a pixel, as Blender's. It
+# is rad-intervals' parameter (its item buffers decide the movies' coverage of those samples);
+# rad-compose reads it from intervals.rti, so the two cannot disagree. none: one sample through
+# each pixel centre, the frames before anti-aliasing.
+PIXEL_FILTER ?=
+
 GLOBAL_FLAGS    ?=
 INTERVALS_FLAGS ?=
 MOVIES_FLAGS    ?=
@@ -31,6 +38,9 @@ COMPOSE_FLAGS   ?=
 
 # The calling Makefile's name, for its messages.
 MAKEFILE_NAME := $(notdir $(firstword $(MAKEFILE_LIST)))
+ifneq ($(filter-out none box gaussian blackman-harris,$(PIXEL_FILTER)),)
+$(error $(MAKEFILE_NAME): PIXEL_FILTER=$(PIXEL_FILTER): expected none, box, gaussian or blackman-harris)
+endif
 # $(1) as one shell word, whatever it holds.
 quote = '$(subst ','\'',$(1))'
 
@@ -64,7 +74,8 @@ endif
 PRESET_ARG = $(if $(filter-out default,$(QUALITY)),--preset $(QUALITY))
 
 GLOBAL_ARGS    = --frames $(FRAMES) --fps $(FPS) $(PRESET_ARG) $(GLOBAL_FLAGS)
-INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) $(INTERVALS_FLAGS)
+INTERVALS_ARGS = --frames $(FRAMES) --fps $(FPS) --size $(SIZE) \
+                 $(if $(PIXEL_FILTER),--pixel-filter $(PIXEL_FILTER)) $(INTERVALS_FLAGS)
 MOVIES_ARGS    = $(PRESET_ARG) $(MOVIES_FLAGS)
 COMPOSE_ARGS   = --frames $(FRAMES) $(COMPOSE_FLAGS)
 

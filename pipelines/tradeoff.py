@@ -140,7 +140,8 @@ def main():
                     help="compare only this frame (references of it alone), e.g. one midway "
                          "between key textures, as the README's accuracy table does")
     ap.add_argument("--references", default=None,
-                    help="DIR0,DIR1: two existing rad-reference --pixel-centres renders of "
+                    help="DIR0,DIR1: two existing rad-reference renders with the frames' pixel "
+                         "filter (the default, blackman-harris 1.5) of "
                          "different seeds (same scene, size and frames) instead of rendering them")
     ap.add_argument("--knobs", default=None,
                     help="comma-separated knobs (and presets) to sweep; default: all")
@@ -165,8 +166,8 @@ def main():
     first, last = (int(x) for x in a.frames.split("-"))
     nframes = last - first + 1
 
-    # Pixel-centre samples: rad-compose point-samples pixels, so an antialiased reference would
-    # add an edge-coverage error floor that no accuracy knob moves.
+    # The frames' pixel filter (bench.reference_filter): a reference filtered otherwise would
+    # add an edge error floor that no accuracy knob moves.
     # Named by the scene's content hash, so that a sweep of another scene into the same --out
     # renders its own references instead of taking another scene's.
     with open(a.scene, "rb") as f:
@@ -178,14 +179,14 @@ def main():
             os.path.exists(os.path.join(r, "%04d.exr" % ref_last)) for r in refs)):
         sys.exit("tradeoff: --references: two directories with %04d.exr expected" % ref_last)
     for seed in (0, 1) if not refs else ():
-        ref = os.path.join(a.out, "reference-%s-%s-%s-centres-%dspp-seed%d" % (
+        ref = os.path.join(a.out, "reference-%s-%s-%s-filtered-%dspp-seed%d" % (
             scene_hash, ref_frames, a.size, a.spp, seed))
         if not os.path.exists(os.path.join(ref, "%04d.exr" % ref_last)):
             print("tradeoff: reference, %d spp, seed %d" % (a.spp, seed), file=sys.stderr,
                   flush=True)
             t, _, _ = bench.run([os.path.join(a.bin, "rad-reference"), a.scene, "-o", ref,
                               "--frames", ref_frames, "--fps", "24", "--size", a.size, "--spp",
-                              str(a.spp), "--seed", str(seed), "--pixel-centres"], log)
+                              str(a.spp), "--seed", str(seed)] + bench.reference_filter(), log)
             print("tradeoff: reference took %.1f s" % t, file=sys.stderr)
         refs.append(ref)
     if a.eval_frame is not None:

@@ -1,6 +1,7 @@
 #include "libcommon/compose/compose_options.h"
 
 #include "libcommon/core/shared_parameters.h"
+#include "libcommon/scene/pixel_sampling_parameters.h"
 
 namespace rad {
 
@@ -26,6 +27,12 @@ const ParameterTable<ComposeOptions>& composeParameters() {
         "EXR compression: none, rle, zip, piz (ZIP saves ~7 % of noise-free float "
         "radiance and doubles the compose time)");
     t.addFlag("no-png", &O::noPng, true, "write only the EXR frames", Group::kCommon);
+    addPixelFilterParameters(t, &O::pixelFilter, &O::filterWidth, "the intervals'");
+    addPixelSamplesParameter(t, &O::pixelSamples, "the intervals'");
+    t.addFlag("every-sample", &O::everySample, true,
+              "shade every sample of every pixel's filter footprint (default: one sample a "
+              "pixel where the footprint is one untextured surface, the filter's blur there "
+              "taken to second order from the neighbouring centres)");
     return t;
   }();
   return table;

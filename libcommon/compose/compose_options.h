@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "libcommon/core/parameter_table.h"
+#include "libcommon/scene/pixel_filter.h"
 
 namespace rad {
 
@@ -30,7 +31,13 @@ struct ComposeOptions {
   bool half = false;  // HALF EXR channels
   std::string compression = "none";
   bool noPng = false;
-  std::string report;  // JSON report file; empty: none
+  // Pixel sampling (footprint_filter.h); each empty: intervals.rti's, whose item buffers saw
+  // those samples.
+  std::optional<PixelFilterType> pixelFilter;
+  std::optional<double> filterWidth;
+  std::optional<int> pixelSamples;
+  bool everySample = false;  // shade every sample (no shortcut on uniform footprints)
+  std::string report;        // JSON report file; empty: none
 
   // Provenance parameters: composeParameters() under their flags' names, and output. An unset
   // fps or exposure is null.

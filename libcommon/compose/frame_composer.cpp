@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "libcommon/compose/footprint_filter.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/radiosity/scene_visibility.h"
@@ -19,17 +20,22 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Bilinear sample with texel centres at ((i+.5)/w, (j+.5)/h) and clamp-to-edge: what GL_LINEAR
-// with GL_CLAMP_TO_EDGE returns (in double, without GL's 8-bit weight quantisation). With a
-// second key `next`, each texel is first blended in float exactly as TextureMovie::textureAt
-// blends the whole texture: (1 - weight) * rgb + weight * next.
-glm::dvec3 sampleClamped(const float* rgb, const float* next, float weight, int w, int h,
-                         glm::dvec2 uv) {
-  double x = std::clamp(uv.x * w - 0.5, 0.0, double(w - 1));
-  double y = std::clamp(uv.y * h - 0.5, 0.0, double(h - 1));
-  int i0 = std::min(int(x), w - 1), j0 = std::min(int(y), h - 1);
-  int i1 = std::min(i0 + 1, w - 1), j1 = std::min(j0 + 1, h - 1);
-  double fx = x - i0, fy = y - j0;
+// Bilinear sample of a movie texture, whose texels hold the irradiance at their centres
+// ((i+.5)/w, (j+.5)/h) (rad-movies bakes it there), carried linearly to the patch's border: in
+// the outer half texel, beyond the last centres, each axis extrapolates its two outermost
+// texels instead of holding the last one (GL's CLAMP_TO_EDGE). Irradiance is steepest at
+// borders (concave corners, a floor by a lamp's foot: docs/design.md §6.4), and the held value
+// was the largest error of the pixels along a polygon's edges. A side of one texel is constant;
+// the result is never negative. With a second key `next`, each texel is first blended in float
+// exactly as TextureMovie::textureAt blends the whole texture: (1 - weight) * rgb + weight * next.
+glm::dvec3 sampleToBorder(const float* rgb, const float* next, float weight, int w, int h,
+                          glm::dvec2 uv) {
+  const double x = std::clamp(uv.x * w - 0.5, -0.5, w - 0.5);
+  const double y = std::clamp(uv.y * h - 0.5, -0.5, h - 0.5);
+  const int i0 = std::clamp(int(std::floor(x)), 0, std::max(w - 2, 0));
+  const int j0 = std::clamp(int(std::floor(y)), 0, std::max(h - 2, 0));
+  const int i1 = std::min(i0 + 1, w - 1), j1 = std::min(j0 + 1, h - 1);
+  const double fx = w > 1 ? x - i0 : 0.0, fy = h > 1 ? y - j0 : 0.0;  // in [-.5, 1.5]
   const float keep = 1.0f - weight;
   auto at = [&](int i, int j) {
     const size_t o = (size_t(j) * w + i) * 3;
@@ -40,8 +46,9 @@ glm::dvec3 sampleClamped(const float* rgb, const float* next, float weight, int 
                 b = keep * p[2] + weight * q[2];
     return glm::dvec3(r, g, b);
   };
-  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
-         fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1));
+  return glm::max((1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i1, j0)) +
+                      fy * ((1 - fx) * at(i0, j1) + fx * at(i1, j1)),
+                  glm::dvec3(0.0));
 }
 
 // Bilinear sample of a glTF base colour texture (default sampler: LINEAR, REPEAT). glTF's
@@ -141,12 +148,13 @@ ActiveMovies indexMovies(const std::vector<MovieTexture>& movies, int topCount) 
   return a;
 }
 
-// Top-level (u,v) of the hit point of pixel (col, row)'s centre ray with the patch's plane. (A
-// ray parallel to the plane cannot hit it; its centroid stands in.)
-glm::dvec2 topUvOfPixel(const PrimaryRays& rays, int col, int row, const Polygon& poly,
-                        const glm::dvec3& nrm, const PolygonUvMap& uvMap) {
+// Top-level (u,v) of the hit point of the ray through image position `pixel` (a sample,
+// sample_grid.h) with the patch's plane. (A ray parallel to the plane cannot hit it; its
+// centroid stands in.)
+glm::dvec2 topUvOfSample(const PrimaryRays& rays, glm::dvec2 pixel, const Polygon& poly,
+                         const glm::dvec3& nrm, const PolygonUvMap& uvMap) {
   glm::dvec3 origin, direction;  // direction not unit length: its scale cancels in s
-  rays.line(glm::dvec2(col + 0.5, row + 0.5), origin, direction);
+  rays.line(pixel, origin, direction);
   const double denom = glm::dot(nrm, direction);
   bool onPlane = false;
   glm::dvec3 hit;
@@ -204,25 +212,47 @@ struct FrameComposer::Impl {
   const GlobalSolution& solution;
   ImageSize size;
   int cameraNode;
+  PixelSampling sampling;
+  SampleGrid grid;                          // sampling.grid(size)
+  std::unique_ptr<FootprintFilter> filter;  // null: the pixel centres, unfiltered
   std::vector<InputPolygon> tops;
   std::vector<int> objectNodes;        // mesh node of each item object
   std::vector<size_t> topObject;       // per top, its item object (index into transforms)
   std::vector<glm::dmat4> transforms;  // per object, at the current time
   std::vector<Material> materials;     // per top (default material where -1)
+  std::vector<char> texturedItem;      // per item id: the top's material has a base colour texture
   ItemBufferRenderer renderer;
-  ItemBuffer items;
+  ItemBuffer items;                           // of the sample grid
   std::unique_ptr<SceneVisibility> rayScene;  // refineSilhouettes' rays, made on first use
+  std::vector<uint8_t> edgeMask;              // refineSilhouettes': samples with another neighbour
+  std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
+  std::vector<PixelSource> sampleSource;
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
-  void refineSilhouettes(double t, const PrimaryRays& rays);
+  // Returns the samples it looked at: those whose id differed from a 4-neighbour's.
+  std::vector<size_t> refineSilhouettes(double t, const PrimaryRays& rays);
   void placeVisibleTops(VisibleTops& visible) const;
-  PixelSource shadePixel(double t, const std::vector<MovieTexture>& movies,
-                         const VisibleTops& visible, const ActiveMovies& active,
-                         const PrimaryRays& rays, int col, int row, int top, float* rgb) const;
+  PixelSource shadeSample(double t, const std::vector<MovieTexture>& movies,
+                          const VisibleTops& visible, const ActiveMovies& active,
+                          const PrimaryRays& rays, glm::dvec2 pixel, int top, float* rgb) const;
+  void composeFiltered(double t, const std::vector<MovieTexture>& movies,
+                       const VisibleTops& visible, const ActiveMovies& active,
+                       const PrimaryRays& rays, const std::vector<size_t>& edges,
+                       ComposedFrame& out);
 
-  Impl(const Scene& s, const GlobalSolution& g, ImageSize sz, int cam)
-      : scene(s), solution(g), size(sz), cameraNode(cam), tops(s.inputPolygons()), renderer(sz) {
+  Impl(const Scene& s, const GlobalSolution& g, ImageSize sz, int cam, const PixelSampling& ps,
+       bool everySample)
+      : scene(s),
+        solution(g),
+        size(sz),
+        cameraNode(cam),
+        sampling(ps),
+        grid(ps.grid(sz)),
+        filter(ps.filter.isNone() ? nullptr
+                                  : std::make_unique<FootprintFilter>(ps, sz, everySample)),
+        tops(s.inputPolygons()),
+        renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
       throw inputError(s.path, "node " + std::to_string(cam) + " is not a camera");
     if (g.hierarchy.topCount() != int(tops.size()))
@@ -245,14 +275,19 @@ struct FrameComposer::Impl {
       int m = tops[i].material;
       materials.push_back(m >= 0 && m < int(s.materials.size()) ? s.materials[m] : Material{});
     }
+    texturedItem.assign(tops.size() + 1, 0);
+    for (size_t i = 0; i < tops.size(); ++i) {
+      const int tex = materials[i].baseColorTexture;
+      texturedItem[i + 1] = tex >= 0 && tex < int(s.textures.size());
+    }
     renderer.setGeometry(objects);
     transforms.resize(objects.size());
   }
 };
 
 FrameComposer::FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size,
-                             int cameraNode)
-    : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode)) {}
+                             int cameraNode, const PixelSampling& sampling, bool everySample)
+    : impl_(std::make_unique<Impl>(scene, solution, size, cameraNode, sampling, everySample)) {}
 
 FrameComposer::~FrameComposer() = default;
 
@@ -277,24 +312,30 @@ CameraView FrameComposer::Impl::renderItems(double t) {
 
 // The item buffer's silhouettes decided by the pixel centre's ray. GL rasterizes with a few bits of
 // sub-pixel precision (llvmpipe: 8), so a silhouette edge that passes within ~1/256 pixel of a
-// centre can give the pixel either surface, while rad-reference --pixel-centres (and a renderer's
-// first hit) takes the surface the centre's ray meets first. Such pixels are few but far off (the
-// Cornell box: the wall behind a box's top edge, much brighter than the box). A pixel whose item
-// differs from a 4-neighbour's casts that ray (Embree, the scene's patches at t) and takes the
-// patch it meets when that patch faces the camera, as the rasterizer's back-face rule would; a
-// pixel whose ray meets nothing, or a back face, keeps its item.
-void FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
-  const int w = size.width, h = size.height;
+// centre can give the pixel either surface, while rad-reference --pixel-filter none (and a
+// renderer's first hit) takes the surface the centre's ray meets first. Such pixels are few but far
+// off (the Cornell box: the wall behind a box's top edge, much brighter than the box). A pixel
+// whose item differs from a 4-neighbour's casts that ray (Embree, the scene's patches at t) and
+// takes the patch it meets when that patch faces the camera, as the rasterizer's back-face rule
+// would; a pixel whose ray meets nothing, or a back face, keeps its item.
+std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
+  const int w = items.width, h = items.height;  // the sample grid's (sample_grid.h)
+  // Each pair of neighbours compared once (right, below), both marked when they differ; then
+  // the marked samples in row-major order.
+  edgeMask.assign(items.id.size(), 0);
+  const uint32_t* id = items.id.data();
+  for (int row = 0; row < h; ++row) {
+    const size_t r = size_t(row) * w;
+    for (int col = 0; col + 1 < w; ++col)
+      if (id[r + col] != id[r + col + 1]) edgeMask[r + col] = edgeMask[r + col + 1] = 1;
+    if (row + 1 < h)
+      for (int col = 0; col < w; ++col)
+        if (id[r + col] != id[r + w + col]) edgeMask[r + col] = edgeMask[r + w + col] = 1;
+  }
   std::vector<size_t> edge;
-  for (int row = 0; row < h; ++row)
-    for (int col = 0; col < w; ++col) {
-      const size_t p = size_t(row) * w + col;
-      const uint32_t id = items.id[p];
-      if ((col > 0 && items.id[p - 1] != id) || (col + 1 < w && items.id[p + 1] != id) ||
-          (row > 0 && items.id[p - w] != id) || (row + 1 < h && items.id[p + w] != id))
-        edge.push_back(p);
-    }
-  if (edge.empty()) return;
+  for (size_t p = 0; p < edgeMask.size(); ++p)
+    if (edgeMask[p]) edge.push_back(p);
+  if (edge.empty()) return edge;
   if (!rayScene) {
     const std::vector<double>& k = solution.keyTimes;
     rayScene = std::make_unique<SceneVisibility>(scene, solution.hierarchy, k.front(), k.back());
@@ -304,7 +345,7 @@ void FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
   tbb::parallel_for(size_t(0), edge.size(), [&](size_t e) {
     const size_t p = edge[e];
     decided[e] = items.id[p];
-    const Ray ray = rays.pixelCentre(int(p % size_t(w)), int(p / size_t(w)));
+    const Ray ray = rays.at(grid.position(int(p % size_t(w)), int(p / size_t(w))));
     const uint32_t hit = rayScene->visibility().firstHit(ray.origin, ray.direction);
     if (hit == VisibilityScene::kNoSurface || hit >= uint32_t(tops.size())) return;
     const Polygon world = tops[hit].local.transformed(transforms[topObject[hit]]);
@@ -313,6 +354,7 @@ void FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
     if (glm::dot(world.normal(), ray.direction) < 0.0) decided[e] = hit + 1;
   });
   for (size_t e = 0; e < edge.size(); ++e) items.id[edge[e]] = decided[e];
+  return edge;
 }
 
 void FrameComposer::Impl::placeVisibleTops(VisibleTops& v) const {
@@ -337,7 +379,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   const CameraView view = m.renderItems(t);
   // The frame's primary rays (the lens is validated here, once).
   const PrimaryRays rays(view, size);
-  m.refineSilhouettes(t, rays);
+  const std::vector<size_t> edges = m.refineSilhouettes(t, rays);
   VisibleTops visible;
   m.placeVisibleTops(visible);
   const ActiveMovies active = indexMovies(movies, int(m.tops.size()));
@@ -347,6 +389,10 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   const size_t n = size_t(size.pixelCount());
   out.rgb.assign(n * 3, 0.0f);
   out.source.assign(n, PixelSource::kBackground);
+  if (m.filter) {
+    m.composeFiltered(t, movies, visible, active, rays, edges, out);
+    return;
+  }
   std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0),
       rowCovered(size.height, 0);
 
@@ -358,7 +404,8 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
         if (id == kNoItem) continue;
         ++rowCovered[row];
         const PixelSource source =
-            m.shadePixel(t, movies, visible, active, rays, col, row, int(id - 1), &out.rgb[p * 3]);
+            m.shadeSample(t, movies, visible, active, rays, m.grid.position(col, row), int(id - 1),
+                          &out.rgb[p * 3]);
         out.source[p] = source;
         ++(source == PixelSource::kMovie ? rowMovie : rowFallback)[row];
       }
@@ -372,17 +419,95 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   }
 }
 
-// One covered pixel of top-level patch `top`: its radiance into rgb[0..2], from the deepest
-// active movie containing the point, else from the global solution.
-PixelSource FrameComposer::Impl::shadePixel(double t, const std::vector<MovieTexture>& movies,
-                                            const VisibleTops& visible, const ActiveMovies& active,
-                                            const PrimaryRays& rays, int col, int row, int top,
-                                            float* rgb) const {
+// The filtered frame (footprint_filter.h): the samples the filter reads are shaded, then each
+// pixel is filtered from them. A pixel counts as covered when a sample it reads shows a
+// surface, as fallen back when one of them fell back, as a movie pixel otherwise.
+void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTexture>& movies,
+                                          const VisibleTops& visible, const ActiveMovies& active,
+                                          const PrimaryRays& rays, const std::vector<size_t>& edges,
+                                          ComposedFrame& out) {
+  filter->plan(items.id, edges, texturedItem);
+  const std::vector<uint8_t>& needed = filter->needed();
+  const int gw = items.width, gh = items.height;
+  // Only the needed samples are written and read: no fill of the whole grid.
+  sampleRgb.resize(needed.size() * 3);
+  sampleSource.resize(needed.size());
+  // A sample shaded, or the background's 0.
+  auto shade = [&](int i, int j, size_t p) {
+    const uint32_t id = items.id[p];
+    if (id == kNoItem) {
+      std::fill_n(&sampleRgb[3 * p], 3, 0.0f);
+      sampleSource[p] = PixelSource::kBackground;
+    } else {
+      sampleSource[p] = shadeSample(t, movies, visible, active, rays, grid.position(i, j),
+                                    int(id - 1), &sampleRgb[3 * p]);
+    }
+  };
+  // Two passes over the grid's pixels: the centres and the samples that cannot be interpolated
+  // are shaded, then the others are interpolated from the centres (footprint_filter.h).
+  const int s = grid.perAxis, mid = (s - 1) / 2;
+  const int pw = gw / s, ph = gh / s;
+  for (const bool second : {false, true})
+    tbb::parallel_for(tbb::blocked_range<int>(0, ph), [&](const tbb::blocked_range<int>& r) {
+      for (int py = r.begin(); py < r.end(); ++py)
+        for (int px = 0; px < pw; ++px) {
+          const int ci = px * s + mid, cj = py * s + mid;
+          const size_t centre = size_t(cj) * gw + size_t(ci);
+          if (!filter->offCentreNeeded(px, py)) {  // the centre alone
+            if (!second && needed[centre]) shade(ci, cj, centre);
+            continue;
+          }
+          const bool smooth = filter->smooth(px, py);
+          if (second && !smooth) continue;
+          for (int j = py * s; j < (py + 1) * s; ++j)
+            for (int i = px * s; i < (px + 1) * s; ++i) {
+              const size_t p = size_t(j) * gw + i;
+              if (!needed[p]) continue;
+              const bool interpolated = smooth && p != centre && items.id[p] == items.id[centre];
+              if (interpolated != second) continue;
+              if (interpolated) {
+                filter->interpolate(i, j, sampleRgb.data(), &sampleRgb[3 * p]);
+                sampleSource[p] = sampleSource[centre];
+              } else {
+                shade(i, j, p);
+              }
+            }
+        }
+    });
+  static_assert(sizeof(PixelSource) == 1, "sample sources are read as bytes");
+  const auto* tags = reinterpret_cast<const uint8_t*>(sampleSource.data());
+  std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& r) {
+    for (int row = r.begin(); row < r.end(); ++row)
+      for (int col = 0; col < size.width; ++col) {
+        const size_t p = size_t(row) * size.width + col;
+        // The largest source read: fallback > movie > background.
+        const auto source =
+            PixelSource(filter->filterPixel(sampleRgb.data(), tags, col, row, &out.rgb[3 * p]));
+        out.source[p] = source;
+        if (source != PixelSource::kBackground)
+          ++(source == PixelSource::kMovie ? rowMovie : rowFallback)[row];
+      }
+  });
+  out.moviePixels = out.fallbackPixels = 0;
+  for (int row = 0; row < size.height; ++row) {
+    out.moviePixels += rowMovie[row];
+    out.fallbackPixels += rowFallback[row];
+  }
+  out.coveredPixels = out.moviePixels + out.fallbackPixels;
+}
+
+// One covered sample at image position `pixel` on top-level patch `top`: its radiance into
+// rgb[0..2], from the deepest active movie containing the point, else from the global solution.
+PixelSource FrameComposer::Impl::shadeSample(double t, const std::vector<MovieTexture>& movies,
+                                             const VisibleTops& visible, const ActiveMovies& active,
+                                             const PrimaryRays& rays, glm::dvec2 pixel, int top,
+                                             float* rgb) const {
   const Polygon& poly = visible.world[top];
   const bool triangle = poly.count == 3;
   const Material& mat = materials[top];
   const glm::dvec2 topUv =
-      topUvOfPixel(rays, col, row, poly, visible.normals[size_t(top)], visible.uvMaps[size_t(top)]);
+      topUvOfSample(rays, pixel, poly, visible.normals[size_t(top)], visible.uvMaps[size_t(top)]);
   glm::dvec3 texFactor;
   const bool textured = textureFactorAt(scene, mat, tops[top], poly.count, topUv, texFactor);
   glm::dvec2 foundUv;
@@ -394,7 +519,7 @@ PixelSource FrameComposer::Impl::shadePixel(double t, const std::vector<MovieTex
     // $L = L_e + \frac{\rho(x)}{\pi} H(x)$
     const MovieTexture& mt = movies[size_t(found)];
     glm::dvec3 H =
-        sampleClamped(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width, mt.height, foundUv);
+        sampleToBorder(mt.irradiance, mt.nextIrradiance, mt.weight, mt.width, mt.height, foundUv);
     L = mat.emission + (mat.reflectance * texFactor / kPi) * H;
     source = PixelSource::kMovie;
   } else {

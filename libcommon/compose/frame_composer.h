@@ -4,19 +4,24 @@
 //   $L(x) = L_e + \frac{\rho(x)}{\pi} H(x)$,
 // where rho(x) is the material's reflectance times its base colour texture where present.
 //
-// Visibility is the item buffer's (item_buffer.h): the same renderer, the same projection
-// (camera_projection.h), so a pixel is covered here exactly when rad-intervals saw it covered.
-// Shading is deferred and done on the CPU in double: the ray through each covered pixel's
-// centre is intersected with the visible top-level patch's plane, the hit's top-level (u,v) is
+// Visibility is the item buffer's (item_buffer.h) on the sample grid (sample_grid.h): the same
+// renderer, the same projection (camera_projection.h) and the same samples as rad-intervals', so
+// a sample is covered here exactly when rad-intervals saw it covered. Each pixel is the pixel
+// filter over the samples around it (footprint_filter.h), or with filter none the sample at its
+// centre alone. Shading is deferred and done on the CPU in double: the ray through each shaded
+// sample is intersected with the visible top-level patch's plane, the hit's top-level (u,v) is
 // found by inverting the patch's bilinear/affine map (patch_hierarchy.h), the deepest active
-// movie whose patch node contains that point is sampled bilinearly with clamp-to-edge texel
-// centres at ((i+.5)/w, (j+.5)/h) (exactly GL_LINEAR + CLAMP_TO_EDGE), so non-parallelogram
-// quads are mapped exactly as rad-movies baked them.
+// movie whose patch node contains that point is sampled bilinearly between texel centres at
+// ((i+.5)/w, (j+.5)/h) (GL_LINEAR's), so non-parallelogram quads are mapped exactly as
+// rad-movies baked them; in the outer half texel, up to the patch's border, the two outermost
+// texels of each axis are extrapolated linearly rather than held (GL's CLAMP_TO_EDGE), because
+// irradiance is steepest at borders (issue 56).
 //
-// A covered pixel that no active movie textures falls back to the global solution: the union
+// A covered sample that no active movie textures falls back to the global solution: the union
 // leaf under the point gives $L = B(t)/\pi$ (B already holds the emission, B = B_e + rho H);
 // with a base colour texture the reflected part is modulated, $L = L_e + \frac{tex(x)}{\overline
-// {tex}} (B/\pi - L_e)$. Such pixels are counted so the tool can warn: never silently black.
+// {tex}} (B/\pi - L_e)$. The pixels that read such a sample are counted so the tool can warn:
+// never silently black.
 #pragma once
 
 #include <cstdint>
@@ -25,9 +30,10 @@
 
 #include <glm/glm.hpp>
 
-#include "libcommon/scene/camera_projection.h"
-#include "libcommon/radiosity/global_solution.h"
 #include "libcommon/gl/item_buffer.h"
+#include "libcommon/radiosity/global_solution.h"
+#include "libcommon/scene/camera_projection.h"
+#include "libcommon/scene/sample_grid.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {
@@ -66,7 +72,12 @@ class FrameComposer {
   // are scene.inputPolygons() (readLinkHierarchy checks it). cameraNode: Scene::cameraNode().
   // Throws rad::Error(kEnvironment) when no GL context can be made, kBadInput on a camera node
   // that is not one or a top count that differs.
-  FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size, int cameraNode);
+  // `sampling`: the pixel filter and sample grid (footprint_filter.h); the default is one sample
+  // through each pixel centre, unfiltered. everySample: shade every sample of every pixel's
+  // footprint (no shortcut on uniform footprints).
+  FrameComposer(const Scene& scene, const GlobalSolution& solution, ImageSize size, int cameraNode,
+                const PixelSampling& sampling = PixelSampling::pixelCentres(),
+                bool everySample = false);
   ~FrameComposer();
   FrameComposer(const FrameComposer&) = delete;
   FrameComposer& operator=(const FrameComposer&) = delete;

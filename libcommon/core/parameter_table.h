@@ -162,19 +162,29 @@ class ParameterTable {
     return push(std::move(p));
   }
 
-  // An enum option; JSON and command line: its name in `names`.
+  // An enum option; JSON and command line: its name in `names`. The field may be a
+  // std::optional<E>: unset is JSON null and no command-line text (resolved at run).
   template <class F, class E>
   ParameterTable& addEnum(const std::string& name, F field, const EnumNames<E>& names,
                           const std::string& help,
                           ParameterGroup group = ParameterGroup::kAdvanced) {
+    using T = std::remove_cv_t<std::remove_reference_t<std::invoke_result_t<F, O&>>>;
     Parameter<O> p = base(name, help, group);
     p.choices = names.names();
     p.typeName = "TEXT";
     p.value = [field, names](const O& o) -> nlohmann::json {
-      return names.name(std::invoke(field, const_cast<O&>(o)));
+      const T& v = std::invoke(field, const_cast<O&>(o));
+      if constexpr (detail::IsOptional<T>::value)
+        return v ? nlohmann::json(names.name(*v)) : nlohmann::json();
+      else
+        return names.name(v);
     };
     p.text = [field, names](const O& o) {
-      return std::string(names.name(std::invoke(field, const_cast<O&>(o))));
+      const T& v = std::invoke(field, const_cast<O&>(o));
+      if constexpr (detail::IsOptional<T>::value)
+        return v ? std::string(names.name(*v)) : std::string();
+      else
+        return std::string(names.name(v));
     };
     p.set = [field, names, name](O& o, const std::string& s) {
       std::invoke(field, o) = names.parse(s, "--" + name);

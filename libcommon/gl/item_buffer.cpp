@@ -74,14 +74,15 @@ void ItemObject::addPolygon(const Polygon& polygon, uint32_t id) {
 
 struct ItemBufferRenderer::Impl {
   GlContext context;  // first member: destroyed last, after the GL objects below
-  ImageSize size;
+  SampleGrid grid;    // the image the projection is of, and the samples drawn
+  ImageSize size;     // grid.size(): the buffer's
   ItemBufferOptions options;
   GLuint program = 0, vao = 0, vbo = 0, fbo = 0;
   GLuint idTexture = 0, depthTexture = 0, depthRenderbuffer = 0;
   GLint clipFromLocalLocation = -1, depthFromLocalLocation = -1;
   std::vector<DrawRange> ranges;
 
-  Impl(ImageSize s, ItemBufferOptions o) : size(s), options(o) {
+  Impl(const SampleGrid& g, ItemBufferOptions o) : grid(g), size(g.size()), options(o) {
     GLint maxTexture = 0, maxRenderbuffer = 0, maxViewport[2] = {0, 0};
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxTexture);
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &maxRenderbuffer);
@@ -156,7 +157,14 @@ struct ItemBufferRenderer::Impl {
 };
 
 ItemBufferRenderer::ItemBufferRenderer(ImageSize size, ItemBufferOptions options)
-    : impl_(std::make_unique<Impl>(size, options)) {}
+    : ItemBufferRenderer(SampleGrid{size, 1, 0}, options) {}
+
+ItemBufferRenderer::ItemBufferRenderer(const SampleGrid& grid, ItemBufferOptions options)
+    : impl_(std::make_unique<Impl>(grid, options)) {}
+
+const SampleGrid& ItemBufferRenderer::grid() const {
+  return impl_->grid;
+}
 
 ItemBufferRenderer::~ItemBufferRenderer() = default;
 
@@ -225,10 +233,15 @@ void ItemBufferRenderer::render(const CameraView& view,
   const ImageSize size = m.size;
   // Validates the lens before any GL state changes.
   const glm::dmat4 eyeFromWorld = viewMatrix(view);
-  (void)reversedZProjectionMatrix(view.lens, size);
+  (void)reversedZProjectionMatrix(view.lens, m.grid.image);
 
   m.context.makeCurrent();
   glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
+  // Without readDepth the depth target is not drawn at all (the depth buffer still decides
+  // occlusion): half the colour writes.
+  const GLenum drawBuffers[2] = {
+      GL_COLOR_ATTACHMENT0, m.options.readDepth ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
+  glDrawBuffers(2, drawBuffers);
   glViewport(0, 0, size.width, size.height);
   configureReversedZ();
   glEnable(GL_DEPTH_TEST);
@@ -250,7 +263,7 @@ void ItemBufferRenderer::render(const CameraView& view,
   const GLfloat farDepth[4] = {std::numeric_limits<float>::infinity(), 0, 0, 0};
   const GLfloat clearDepth = 0.0f;  // reversed Z: 0 is infinitely far
   glClearBufferuiv(GL_COLOR, 0, noItem);
-  glClearBufferfv(GL_COLOR, 1, farDepth);
+  if (m.options.readDepth) glClearBufferfv(GL_COLOR, 1, farDepth);
   glClearBufferfv(GL_DEPTH, 0, &clearDepth);
 
   glUseProgram(m.program);
@@ -259,7 +272,10 @@ void ItemBufferRenderer::render(const CameraView& view,
     const DrawRange& r = m.ranges[k];
     if (r.count == 0) continue;
     const glm::dmat4& worldFromLocal = objectTransforms[k];
-    glm::mat4 clip = rasterClipFromLocal(view, size, worldFromLocal);
+    glm::mat4 clip =
+        m.grid.isPixelCentres()
+            ? rasterClipFromLocal(view, size, worldFromLocal)
+            : rasterClipFromLocal(view, m.grid.image, worldFromLocal, m.grid.ndcScale());
     glm::dmat4 eyeFromLocal = eyeFromWorld * worldFromLocal;
     // Row 2 of eyeFromLocal (glm is column-major), negated: depth = -z_eye.
     glm::vec4 depthRow(-eyeFromLocal[0][2], -eyeFromLocal[1][2], -eyeFromLocal[2][2],
@@ -272,17 +288,40 @@ void ItemBufferRenderer::render(const CameraView& view,
   out.width = size.width;
   out.height = size.height;
   out.id.resize(size_t(size.pixelCount()));
-  out.depth.resize(size_t(size.pixelCount()));
+  out.depth.resize(m.options.readDepth ? size_t(size.pixelCount()) : 0);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, size.width, size.height, GL_RED_INTEGER, GL_UNSIGNED_INT, out.id.data());
-  glReadBuffer(GL_COLOR_ATTACHMENT1);
-  glReadPixels(0, 0, size.width, size.height, GL_RED, GL_FLOAT, out.depth.data());
+  if (m.options.readDepth) {
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    glReadPixels(0, 0, size.width, size.height, GL_RED, GL_FLOAT, out.depth.data());
+  }
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   checkGlError("item buffer: render");
   flipRows(out.id, size.width, size.height);
-  flipRows(out.depth, size.width, size.height);
+  if (m.options.readDepth) flipRows(out.depth, size.width, size.height);
+}
+
+ItemBuffer pixelCentreSamples(const ItemBuffer& samples, const SampleGrid& grid) {
+  const ImageSize g = grid.size();
+  if (samples.width != g.width || samples.height != g.height)
+    throw Error(ExitCode::kInternal, "item buffer", "not the sample grid's size");
+  if (grid.isPixelCentres()) return samples;
+  ItemBuffer out;
+  out.width = grid.image.width;
+  out.height = grid.image.height;
+  out.id.resize(size_t(grid.image.pixelCount()));
+  const bool depth = !samples.depth.empty();  // readDepth
+  out.depth.resize(depth ? out.id.size() : 0);
+  for (int row = 0; row < out.height; ++row)
+    for (int col = 0; col < out.width; ++col) {
+      const size_t p = size_t(row) * out.width + col;
+      const size_t q = size_t(grid.centre(row)) * g.width + size_t(grid.centre(col));
+      out.id[p] = samples.id[q];
+      if (depth) out.depth[p] = samples.depth[q];
+    }
+  return out;
 }
 
 ItemBuffer renderItemBuffer(const std::vector<ItemTriangle>& worldTriangles, const CameraView& view,

@@ -18,9 +18,10 @@
 
 #include <glm/glm.hpp>
 
+#include "libcommon/gl/gl_context.h"
 #include "libcommon/scene/camera_projection.h"
 #include "libcommon/scene/geometry.h"
-#include "libcommon/gl/gl_context.h"
+#include "libcommon/scene/sample_grid.h"
 
 namespace rad {
 
@@ -32,7 +33,7 @@ struct ItemBuffer {
   // Row-major, row 0 = top of the image (camera_projection.h's pixel convention).
   std::vector<uint32_t> id;  // kNoItem where nothing is visible
   // Eye-space depth (distance from the eye plane along the view axis, metres) of the visible
-  // surface; +inf where id is kNoItem.
+  // surface; +inf where id is kNoItem. Empty when rendered without ItemBufferOptions::readDepth.
   std::vector<float> depth;
 
   uint32_t idAt(int col, int row) const { return id[size_t(row) * width + col]; }
@@ -55,6 +56,9 @@ struct ItemBufferOptions {
   // One-sided patches: a patch seen from behind is not visible (glTF: CCW front faces).
   // doubleSided materials get a reversed copy of each patch upstream (Scene::inputPolygons).
   bool cullBackFaces = true;
+  // Read the depth target back into ItemBuffer::depth; false leaves depth empty (a caller that
+  // needs only the ids saves the readback).
+  bool readDepth = true;
 };
 
 // Reusable renderer: owns its GL context, FBO, shader and vertex buffer. Geometry is uploaded
@@ -67,11 +71,15 @@ class ItemBufferRenderer {
   // Throws rad::Error(kEnvironment) when no GL context can be made or the size exceeds the
   // driver's limits.
   ItemBufferRenderer(ImageSize size, ItemBufferOptions options = {});
+  // Renders the samples of `grid` (sample_grid.h): a buffer of grid.size(), sample (i, j) at
+  // (i, j), with grid.image's projection. ImageSize `size` above is the grid {size, 1, 0}.
+  ItemBufferRenderer(const SampleGrid& grid, ItemBufferOptions options = {});
   ~ItemBufferRenderer();
   ItemBufferRenderer(const ItemBufferRenderer&) = delete;
   ItemBufferRenderer& operator=(const ItemBufferRenderer&) = delete;
 
-  ImageSize size() const;
+  ImageSize size() const;  // of the buffer: grid().size()
+  const SampleGrid& grid() const;
   const ItemBufferOptions& options() const;
   void setOptions(const ItemBufferOptions& options);
 
@@ -91,6 +99,12 @@ class ItemBufferRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The samples at the pixel centres of `samples`, a buffer of `grid` (grid.size()): an item
+// buffer of grid.image, pixel (col, row) = sample (grid.centre(col), grid.centre(row)), which
+// lies exactly at the pixel's centre (sample_grid.h). The pixel centres' grid gives a copy.
+// Depth is copied where `samples` has it (ItemBufferOptions::readDepth).
+ItemBuffer pixelCentreSamples(const ItemBuffer& samples, const SampleGrid& grid);
 
 // A world-space triangle for the one-shot helper below.
 struct ItemTriangle {

@@ -1,6 +1,7 @@
 #include "libcommon/intervals/intervals_options.h"
 
 #include "libcommon/core/shared_parameters.h"
+#include "libcommon/scene/pixel_sampling_parameters.h"
 
 namespace rad {
 
@@ -61,6 +62,10 @@ const ParameterTable<IntervalsOptions>& intervalsParameters() {
     t.add("item-buffers", &O::itemBuffers,
           "also write each frame's item buffer to DIR/NNNN.exr (UINT id, FLOAT Z)", Check{},
           Group::kCommon);
+    addPixelFilterParameters(
+        t, [](O& o) -> PixelFilterType& { return o.sampling.filter.type; },
+        [](O& o) -> double& { return o.sampling.filter.width; });
+    addPixelSamplesParameter(t, [](O& o) -> int& { return o.sampling.samplesPerAxis; });
     addTextureParameters(t);
     return t;
   }();

@@ -23,6 +23,9 @@ struct IntervalsOptions {
   std::string camera;            // node or camera name; empty: the first camera
   std::string itemBuffers;       // also write each frame's item buffer here; empty: no
   std::string report;            // JSON report file; empty: none
+  // The samples rad-compose will shade (sample_grid.h), copied into build.sampling: Blender's
+  // default filter on a 3 x 3 grid.
+  PixelSampling sampling;
   TextureIntervalsOptions build;
 
   // Provenance parameters: intervalsParameters() under their flags' names.

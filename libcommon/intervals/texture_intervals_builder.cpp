@@ -52,21 +52,12 @@ void TextureIntervalsOptions::validate() const {
   if (!(sizeRatio >= 1.2 && sizeRatio <= 4.0)) throw bad("--size-ratio", "must be in [1.2, 4]");
   if (maxLength < 0) throw bad("--max-length", "must be >= 0 (0 = unlimited)");
   if (hiddenGap < 0) throw bad("--hidden-gap", "must be >= 0 (0 = close when hidden)");
-}
-
-int textureSideFor(double projectedPixels, int current, const TextureIntervalsOptions& o) {
-  // At least one texel per covered pixel: n^2 = area x density.
-  double n = std::sqrt(std::max(0.0, projectedPixels) * o.texelDensity);
-  if (current > 0) {
-    double tol = 1.0 + o.resizeTolerance;
-    if (n > current / (o.sizeRatio * tol) && n <= current * tol) return current;
-  }
-  // The first side of the ladder round(r^k), k = 0, 1, ... that holds n texels.
-  long side = 1;
-  for (int k = 1; side < n && side < (1L << 20); ++k)
-    side = std::lround(std::pow(o.sizeRatio, double(k)));
-  side = std::clamp<long>(side, o.minSize, o.maxSize);
-  return int(side);
+  sampling.validate();
+  const ImageSize samples = sampling.grid(imageSize).size();
+  if (samples.width > 16384 || samples.height > 16384)
+    throw bad("--pixel-samples", "the sample grid, " + std::to_string(samples.width) + "x" +
+                                     std::to_string(samples.height) +
+                                     ", exceeds 16384 a side; use fewer samples or a smaller size");
 }
 
 namespace {
@@ -116,6 +107,19 @@ struct TextureIntervalsBuilder::Impl {
   Impl(const Scene& s, int cam, TextureIntervalsOptions o)
       : scene(s), cameraNode(cam), options(o) {}
 
+  // The samples the item buffers hold, and how many make a pixel (s^2): counts of visible
+  // samples are compared with pixel areas times this.
+  SampleGrid grid() const { return options.sampling.grid(options.imageSize); }
+  ItemBufferOptions itemBufferOptions() const {
+    ItemBufferOptions o;
+    o.readDepth = options.itemBufferDepth;
+    return o;
+  }
+  double samplesPerPixel() const {
+    const int s = grid().perAxis;
+    return double(s) * double(s);
+  }
+
   void build() {
     options.validate();
     if (cameraNode < 0 || cameraNode >= int(scene.nodes.size()) ||
@@ -154,7 +158,7 @@ struct TextureIntervalsBuilder::Impl {
     for (int i = 0; i < hierarchy.size(); ++i) nodeObject[i] = objectOf.at(hierarchy.topOf(i).node);
     // The GL context is made here, so that a machine without one fails before any frame; the
     // geometry goes to it with the first addFrame (addFrames' renderers have their own).
-    renderer = std::make_unique<ItemBufferRenderer>(options.imageSize);
+    renderer = std::make_unique<ItemBufferRenderer>(grid(), itemBufferOptions());
     visible.assign(hierarchy.size(), 0);
     area.assign(hierarchy.size(), 0.0);
     inFrustum.assign(hierarchy.size(), 0.0);
@@ -214,15 +218,16 @@ struct TextureIntervalsBuilder::Impl {
       theta -= h;
     else if (openBelow[i])
       theta += h;
-    bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i];
+    bool enough = area[i] > 0.0 && double(visible[i]) >= theta * area[i] * samplesPerPixel();
     // A node seen on fewer pixels than its four children's smallest textures hold (4 minSize^2)
     // keeps one texture: splitting it adds movies, not resolution (partly hidden small triangles, a
     // chair's, would otherwise make most of a scene's movies). But only while its own texture is
     // small too (at most 4 minSize a side): a big patch leaving the frustum, a few pixels left on
     // screen, would keep its whole-area texture, where the children holding those pixels need a
     // sixteenth of it and carry on the movies they had.
-    const bool tiny = double(visible[i]) < 4.0 * options.minSize * options.minSize &&
-                      textureSideFor(area[i], 0, options) <= 4 * options.minSize;
+    const bool tiny =
+        double(visible[i]) < 4.0 * options.minSize * options.minSize * samplesPerPixel() &&
+        textureSideFor(area[i], 0, options) <= 4 * options.minSize;
     if (enough || tiny || hierarchy.isLeaf(i)) {
       chosen.push_back(i);
       return;
@@ -264,8 +269,7 @@ struct TextureIntervalsBuilder::Impl {
     for (HiddenMovie h : hidden) {
       MovieExtent& m = movies[h.movie];
       if (isChosen[h.node]) {
-        if (!reachedMaxLength(m, frame) &&
-            textureSideFor(area[h.node], m.width, options) == m.width) {
+        if (!reachedMaxLength(m, frame) && sizeFor(h.node, sizeOf(m)) == sizeOf(m)) {
           openMovie[h.node] = h.movie;
           m.end = MovieEnd::kWindow;  // open again: ends as an open movie does
           ++continuedOverGaps;
@@ -277,11 +281,18 @@ struct TextureIntervalsBuilder::Impl {
     hidden.swap(still);
   }
 
-  int openNew(int node, int frame, int side) {
+  // The texture size of node i this frame, from `current` (0 x 0: a new movie; TextureShape).
+  TextureSize sizeFor(int i, TextureSize current) const {
+    return textureSizeFor(area[i], textureShapeOf(hierarchy.node(i).local), current, options);
+  }
+  static TextureSize sizeOf(const MovieExtent& m) { return {m.width, m.height}; }
+
+  int openNew(int node, int frame, TextureSize size) {
     MovieExtent m;
     m.patch = hierarchy.node(node).id;
     m.firstFrame = m.lastFrame = frame;
-    m.width = m.height = side;
+    m.width = size.width;
+    m.height = size.height;
     m.end = MovieEnd::kWindow;
     movies.push_back(m);
     openMovie[node] = int(movies.size()) - 1;
@@ -368,17 +379,17 @@ struct TextureIntervalsBuilder::Impl {
       int idx = openMovie[node];
       if (idx >= 0) {
         MovieExtent& m = movies[idx];
-        int side = textureSideFor(area[node], m.width, options);
+        const TextureSize size = sizeFor(node, sizeOf(m));
         const bool full = reachedMaxLength(m, frame);
-        if (!full && side == m.width) {
+        if (!full && size == sizeOf(m)) {
           m.lastFrame = frame;
           chosenMovie[c] = idx;
           continue;
         }
         m.end = full ? MovieEnd::kMaxLength : MovieEnd::kResize;
-        chosenMovie[c] = openNew(node, frame, side);
+        chosenMovie[c] = openNew(node, frame, size);
       } else {
-        chosenMovie[c] = openNew(node, frame, textureSideFor(area[node], 0, options));
+        chosenMovie[c] = openNew(node, frame, sizeFor(node, {}));
       }
     }
     openList = chosen;
@@ -421,9 +432,12 @@ class ItemBufferPipeline {
     std::exception_ptr error;
   };
 
-  ItemBufferPipeline(size_t workers, ImageSize size, const std::vector<ItemObject>& objects,
-                     std::vector<int> frames, View view)
-      : frames_(std::move(frames)), view_(std::move(view)), slots_(workers) {
+  ItemBufferPipeline(size_t workers, SampleGrid size, ItemBufferOptions itemOptions,
+                     const std::vector<ItemObject>& objects, std::vector<int> frames, View view)
+      : itemOptions_(itemOptions),
+        frames_(std::move(frames)),
+        view_(std::move(view)),
+        slots_(workers) {
     try {
       for (size_t k = 0; k < workers; ++k)
         threads_.emplace_back([this, k, size, &objects] { work(k, size, objects); });
@@ -466,12 +480,12 @@ class ItemBufferPipeline {
     for (std::thread& t : threads_) t.join();
   }
 
-  void work(size_t k, ImageSize size, const std::vector<ItemObject>& objects) {
+  void work(size_t k, SampleGrid size, const std::vector<ItemObject>& objects) {
     Slot& s = slots_[k];
     std::unique_ptr<ItemBufferRenderer> renderer;
     std::exception_ptr error;
     try {
-      renderer = std::make_unique<ItemBufferRenderer>(size);
+      renderer = std::make_unique<ItemBufferRenderer>(size, itemOptions_);
       renderer->setGeometry(objects);
     } catch (...) {
       error = std::current_exception();
@@ -505,6 +519,7 @@ class ItemBufferPipeline {
     }
   }
 
+  const ItemBufferOptions itemOptions_;
   const std::vector<int> frames_;
   const View view_;
   std::vector<Slot> slots_;
@@ -528,7 +543,7 @@ void TextureIntervalsBuilder::addFrames(const std::vector<int>& frames, size_t r
     }
     return;
   }
-  ItemBufferPipeline pipeline(std::min(renderers, frames.size()), b.options.imageSize,
+  ItemBufferPipeline pipeline(std::min(renderers, frames.size()), b.grid(), b.itemBufferOptions(),
                               b.itemObjects(), frames, [&b](int f) { return b.frameView(f); });
   for (size_t i = 0; i < frames.size(); ++i) {
     const ItemBufferPipeline::Slot& s = pipeline.take(i);

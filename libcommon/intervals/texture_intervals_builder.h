@@ -25,7 +25,8 @@
 //    round(r^k), r = sizeRatio, and clamped to [minSize, maxSize]. The paper takes powers of
 //    two (r = 2: up to 4 texels per pixel, 2.2 on average over sizes spread evenly in log);
 //    r = sqrt 2 holds the same pixels with at most 2 (1.4 on average), so fewer texels per
-//    frame;
+//    frame. The n^2 texels go to the two sides in the shape of the node's (u,v) map
+//    (TextureShape, below; texture_size.cpp), each side rounded and clamped the same way;
 //  * events (§4.1): a movie opens when its node becomes chosen and closes when the node leaves
 //    the frustum, is hidden, is replaced by an ancestor or descendant (level change), needs
 //    another size, or has lasted maxLength frames; movies open at the end of the window close
@@ -93,6 +94,14 @@ struct TextureIntervalsOptions {
   // and then chosen again at the same size continues over them (see above); 0: the paper's
   // rule, every hidden frame closes the movie.
   int hiddenGap = 6;
+  // The samples whose coverage the item buffers decide (sample_grid.h): rad-compose shades
+  // samples of this grid, so every one of them must lie in a movie. The item buffer is the
+  // grid's, visible counts are in samples, and every rule above that counts pixels takes
+  // samples / s^2; projected areas, and so texel density, stay in pixels.
+  PixelSampling sampling = PixelSampling::pixelCentres();
+  // Not a parameter: whether IntervalFrame::itemBuffer carries depth (the caller writes the
+  // buffers); without it the depth target is neither drawn nor read back.
+  bool itemBufferDepth = true;
 
   // Throws rad::Error(kUsage) naming the flag of the first invalid value.
   void validate() const;
@@ -102,8 +111,8 @@ struct TextureIntervalsOptions {
 struct IntervalFrame {
   int frame = 0;
   double time = 0.0;
-  double itemBufferSeconds = 0.0;  // render + readback
-  const ItemBuffer* itemBuffer = nullptr;
+  double itemBufferSeconds = 0.0;          // render + readback
+  const ItemBuffer* itemBuffer = nullptr;  // of options.sampling's grid (sample_grid.h)
   // Per dense node index: visible pixels, projected area of the whole patch (pixels, see
   // above) and the part of it inside the frustum. The areas are computed only where the
   // algorithm needs them (nodes with visible pixels; the frustum area of nodes whose movie
@@ -163,8 +172,31 @@ std::vector<MovieExtent> buildTextureIntervals(
     const TextureIntervalsOptions& options,
     const std::function<void(const IntervalFrame&)>& observer = {});
 
-// The size rule above: next size for a movie of current size `current` (0 = new movie) when
-// the projected area is `projectedPixels`.
+// The size rule above for a square texture: next side for a movie of current side `current`
+// (0 = new movie) when the projected area is `projectedPixels`.
 int textureSideFor(double projectedPixels, int current, const TextureIntervalsOptions& options);
+
+// A node's texture is not square where its (u,v) map is not (issue 56): the n^2 texels of the
+// size rule go to the two axes in proportion to the node's edges along u and v, and grow by
+// 1 / sin of the angle between them, so that texels lie as far apart along u as along v, as far
+// as a square's do on a square patch. A square patch's texture is n x n as before; a 4 m x 4 cm
+// tube lamp's face gets its texels along its length, not 1/10 of them; a triangle's texture
+// keeps the half square's budget of a right triangle at v0. `u`, `v`: the factors of n per axis
+// (u v = 1 / sin: a sheared map needs more texels for the same spacing).
+struct TextureShape {
+  double u = 1.0, v = 1.0;
+};
+// Of a node's polygon (its own (u,v) map, patch_hierarchy.h: a triangle's edges v0v1 and v0v2,
+// a quad's mean opposite edges); {1, 1} for a degenerate one.
+TextureShape textureShapeOf(const Polygon& node);
+struct TextureSize {
+  int width = 0, height = 0;  // 0 x 0: none yet
+  bool operator==(const TextureSize& o) const { return width == o.width && height == o.height; }
+};
+// The size rule per axis: each side is the ladder's rung for n x shape.u (n x shape.v) with
+// textureSideFor's hysteresis about the current side (0 = new movie), n = sqrt(projected area x
+// texelDensity).
+TextureSize textureSizeFor(double projectedPixels, TextureShape shape, TextureSize current,
+                           const TextureIntervalsOptions& options);
 
 }  // namespace rad

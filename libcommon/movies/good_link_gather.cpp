@@ -385,7 +385,12 @@ void GoodLinkGather::planVisibility(Link& l, const std::vector<char>& needed) co
     if (needed[size_t(key)] && GlobalSolution::linkActiveAtKey(g, key))
       l.weight[size_t(key)] =
           solution_.exposedRadiosityAtKey(int(l.shooter), key) * cellRatio(l, key);
-  l.seed = linkSeed(h.node(int(g.receiver)).id, h.node(int(l.shooter)).id);
+  // Seeded by the receiver's planar surface and the shooter part, not the link's receiver node:
+  // two coplanar receivers that meet at an edge (a wall's triangles, a node and its neighbour)
+  // cast their rays to the same points and their visibilities agree where they meet (issue 56:
+  // each receiver node's own points made two estimates of one shadow, which stepped there).
+  l.seed = linkSeed(PatchId{byReceiver_.surfaceOfTop[size_t(receiverTop_)], 1u},
+                    h.node(int(l.shooter)).id);
   const double t0 = keyTimes_.front();
   const Polygon shooter = linkWorld(l, t0);
   const std::vector<glm::dvec3> points = pointsInFront(shooter, t0, k, l.seed);

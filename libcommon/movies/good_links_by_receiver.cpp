@@ -7,6 +7,8 @@
 #include <map>
 #include <tuple>
 
+#include "libcommon/scene/planar_surfaces.h"
+
 namespace rad {
 namespace {
 
@@ -34,6 +36,7 @@ GoodLinksByReceiver::GoodLinksByReceiver(const GlobalSolution& s) {
   indexByReceiver(
       s, [](const GlobalLink& l) { return !(l.flags & (kLinkBad | kLinkRefined)); }, start, rows);
   smoothClusterIrradiance(s);
+  surfaceOfTop = planarSurfaceOfTops(s.hierarchy.tops());
 }
 
 void GoodLinksByReceiver::indexAllLinks(const GlobalSolution& s) {

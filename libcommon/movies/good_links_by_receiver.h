@@ -52,6 +52,9 @@ struct GoodLinksByReceiver {
   // steps of one value per tile. A top whose own value lies beyond kClusterBand of its corners'
   // mean keeps it but for the band (keepOwnClusterLight).
   std::vector<glm::vec3> clusterCorners;
+  // Per top, its planar surface (planar_surfaces.h): the seed of the shooter points of the
+  // per-texel visibility, so that coplanar receivers take the same points.
+  std::vector<uint32_t> surfaceOfTop;
 
   // The stores the movies' gathers fill for one another.
   NearShooterStore nearShooters;  // near_shooter_cells.h

@@ -30,10 +30,12 @@
 #include "libcommon/movies/movie_geometry.h"
 #include "libcommon/movies/ray_cast_masks.h"
 #include "libcommon/movies/solid_contact.h"
+#include "libcommon/movies/triangle_texels.h"
 #include "libcommon/radiosity/form_factor.h"
 #include "libcommon/radiosity/shaft.h"
 #include "libcommon/scene/box_tree.h"
 #include "libcommon/scene/frame_range.h"
+#include "libcommon/scene/planar_surfaces.h"
 
 namespace rad {
 namespace {
@@ -135,7 +137,8 @@ class MovieBake {
             const SceneEmitters& emitters, const TextureMovieBakerOptions& options,
             TextureMovieBakerStats& stats, const std::function<OcclusionMaskRenderer&()>& renderer,
             FormFactorSpill& spill, const MovieExtent& req, MovieGeometry& geometry,
-            const GoodLinkGather* gather, SceneVisibility* visibility, const BlockerIndex& blockers)
+            const GoodLinkGather* gather, SceneVisibility* visibility, const BlockerIndex& blockers,
+            uint32_t surface)
       : solution_(solution),
         tops_(tops),
         emitters_(emitters),
@@ -148,10 +151,18 @@ class MovieBake {
         geo_(geometry),
         gather_(gather),
         visibility_(visibility),
+        surface_(surface),
         texels_(geometry.texels()),
         acc_(texels_),
         transmittance_(texels_),
-        texture_(texels_ * 3) {}
+        texture_(texels_ * 3) {
+    if (tops_[req_.patch.top].local.count == 3) {
+      const int w = geo_.width(), h = geo_.height();
+      beyond_.resize(texels_);
+      for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i) beyond_[size_t(j) * w + i] = texelBeyondTriangle(i, j, w, h);
+    }
+  }
 
   // Texels under a touching solid at key k (a box's foot on the floor, solid_contact.h) are
   // never seen, and gather nothing: ~0. A pixel between such a texel's centre and an exposed
@@ -243,18 +254,8 @@ class MovieBake {
   // The texels covered by static solids (staticCovered_; once per movie unless the receiver
   // moves) and the moving nodes whose bounds over the movie meet the receiver (movingNear_).
   void coverStaticTexels(int k, double t, double size) {
-    const int w = geo_.width(), h = geo_.height();
     staticCovered_.assign(texels_, 0);
     coverTexels(visibility_->staticPart(), k, t, size, staticCovered_, nullptr);
-    // A triangle's texture is the half square u + v <= 1 of its (u,v) map; the texels beyond
-    // its long edge lie outside the patch, and those on it (a square texture puts a diagonal of
-    // texel centres exactly on the edge) are half-shadowed by whatever touches the edge there.
-    // A pixel inside near the edge interpolated them (a dark line along the seam of two
-    // triangles). Both are filled as the covered ones are.
-    if (tops_[req_.patch.top].local.count == 3)
-      for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i)
-          if ((i + 0.5) / w + (j + 0.5) / h >= 1.0 - 1e-9) staticCovered_[size_t(j) * w + i] = 1;
     const AxisBox box = boxOf(geo_.receiverWorld(k));
     movingNear_.clear();
     for (int node : movingNodesOf(geo_.scene(), tops_, solution_.keyTimes.front(),
@@ -269,14 +270,15 @@ class MovieBake {
   long fillFromExposedNeighbours() {
     const int w = geo_.width(), h = geo_.height();
     std::vector<char> exposed(texels_);
-    for (size_t x = 0; x < texels_; ++x) exposed[x] = covered_[x] ? 0 : 1;
+    // The texels beyond a triangle are neither read nor filled here (extendBeyondTriangle).
+    for (size_t x = 0; x < texels_; ++x) exposed[x] = covered_[x] || beyond(x) ? 0 : 1;
     long filled = 0;
     for (int ring = 0; ring < 2; ++ring) {
       std::vector<char> next = exposed;
       for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i) {
           const size_t x = size_t(j) * w + i;
-          if (exposed[x]) continue;
+          if (exposed[x] || beyond(x)) continue;
           float sum[3] = {0, 0, 0};
           int n = 0;
           for (int dj = -1; dj <= 1; ++dj)
@@ -331,6 +333,7 @@ class MovieBake {
       }
     stats_.secondsCombine += secondsSince(clock);
     if (options_.fillCovered && visibility_) fillCoveredTexels(k, t);
+    if (!beyond_.empty()) extendBeyondTriangle(texture_, geo_.width(), geo_.height());
     sink.key(size_t(k), texture_);
   }
 
@@ -493,6 +496,7 @@ class MovieBake {
   MovieGeometry& geo_;
   const GoodLinkGather* gather_;  // null: Gouraud
   SceneVisibility* visibility_;   // null: covered texels are left as they are
+  const uint32_t surface_;        // the receiver top's planar surface: the samples' seed
   const size_t texels_;
   int saturatedSamples_ = 0;
   std::vector<BadPair> pairs_;
@@ -505,6 +509,9 @@ class MovieBake {
   std::vector<glm::dvec3> shapedTransmittance_;  // per texel, when shape_ is not empty
   // fillCoveredTexels: under static solids (once per movie), and at the current key.
   std::vector<char> staticCovered_, covered_;
+  // A triangle's texels on or beyond its long edge (triangle_texels.h); empty for a quad.
+  std::vector<char> beyond_;
+  bool beyond(size_t x) const { return !beyond_.empty() && beyond_[x]; }
   std::vector<int> movingNear_;  // moving nodes whose bounds over the movie meet the receiver
 };
 
@@ -579,10 +586,12 @@ void MovieBake::planPair(BadPair& p) {
                                        options_.maxSamples);
   stats_.samples += p.samples;
   if (minSamples < options_.minSamples) ++stats_.weakPairs;
-  // Seeded by the receiver's top-level patch, not the movie's node: the movies of one surface
-  // (a parent's and its children's, neighbours at one level) then take the same sample points
-  // when they take as many, and their kernel-weighted penumbrae meet without a step.
-  const uint32_t seed = mix32(uint64_t(req_.patch.top) * 0x9e3779b97f4a7c15ull ^ S);
+  // Seeded by the receiver's planar surface (planar_surfaces.h), not the movie's node or top: the
+  // movies of one surface (a parent's and its children's, neighbours at one level, a wall's
+  // triangles) then take the same sample points when they take as many, and their
+  // kernel-weighted penumbrae meet without a step (issue 56: per top, two triangles of one wall
+  // made two estimates of one penumbra). A top alone in its plane seeds as it did.
+  const uint32_t seed = mix32(uint64_t(surface_) * 0x9e3779b97f4a7c15ull ^ S);
   p.unitSamples = multiJitteredPoints(p.samples, seed);
   // A subdivided shooter that does not emit: its leaves' radiosity shapes its light (a light's
   // is its emission, uniform; skipping it keeps the lights' pairs as they were, at no cost).
@@ -911,8 +920,10 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     stats_.secondsGood += secondsSince(clock);
   }
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);
+  if (surfaceOfTop_.empty()) surfaceOfTop_ = planarSurfaceOfTops(tops_);
   MovieBake bake(solution_, tops_, emitters_, options_, stats_, gl, *spill, req, geometry,
-                 gather.get(), options_.fillCovered ? sceneVisibility() : nullptr, *blockers_);
+                 gather.get(), options_.fillCovered ? sceneVisibility() : nullptr, *blockers_,
+                 surfaceOfTop_[req.patch.top]);
   bake.plan(badShooters);
   sink.begin(movie);
   for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);

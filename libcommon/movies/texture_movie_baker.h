@@ -234,6 +234,7 @@ class TextureMovieBaker {
   SceneEmitters emitters_;  // the lights among tops_ (the light seam, scene_emitters.h)
   std::unique_ptr<OcclusionMaskRenderer> renderer_;
   std::unique_ptr<BlockerIndex> blockers_;          // made on the first bake
+  std::vector<uint32_t> surfaceOfTop_;              // planar_surfaces.h, on the first bake
   std::unique_ptr<GoodLinksByReceiver> goodLinks_;  // --good-layer gather
   std::unique_ptr<SceneVisibility> visibility_;     // the gather's rays and the covered texels
   SceneVisibility* sceneVisibility();

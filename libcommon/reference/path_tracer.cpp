@@ -521,6 +521,7 @@ FloatImage PathTracer::render(const CameraView& view, ImageSize size,
   std::uint64_t base = splitMix64(options.seed ^ 0x7265666572656E63ull);  // "referenc"
   if (options.decorrelateFrames) base = splitMix64(base ^ splitMix64(std::uint64_t(frame)));
   const PrimaryRays rays(view, size);
+  const PixelFilterSampler filter(options.filter);
   tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& r) {
     for (int row = r.begin(); row < r.end(); ++row) {
       for (int col = 0; col < size.width; ++col) {
@@ -530,17 +531,14 @@ FloatImage PathTracer::render(const CameraView& view, ImageSize size,
         glm::dvec3 sum(0.0);
         for (int s = 0; s < spp; ++s) {
           const std::uint64_t sampleSeed = splitMix64(pixelSeed + std::uint64_t(s) * 2 + 1);
-          // Pixel position: jittered strata for the first strata^2 samples, uniform after.
+          // Offset from the centre: jittered strata for the first strata^2 samples, uniform after,
+          // mapped through the filter's inverse distribution (Cycles' filter table).
           const double jx = uniformOpen01(sampleSeed, 1000001);
           const double jy = uniformOpen01(sampleSeed, 1000002);
-          glm::dvec2 pixel;
-          if (options.pixelCentres) {
-            pixel = glm::dvec2(col + 0.5, row + 0.5);
-          } else if (s < strata * strata) {
-            pixel = glm::dvec2(col + (s % strata + jx) / strata, row + (s / strata + jy) / strata);
-          } else {
-            pixel = glm::dvec2(col + jx, row + jy);
-          }
+          glm::dvec2 u(jx, jy);
+          if (s < strata * strata)
+            u = glm::dvec2((s % strata + jx) / strata, (s / strata + jy) / strata);
+          const glm::dvec2 pixel(col + 0.5 + filter.offset(u.x), row + 0.5 + filter.offset(u.y));
           const Ray ray = rays.at(pixel);
           const glm::dvec3 L = impl_->radiance(ray, sampleSeed, options);
           if (std::isfinite(L.x) && std::isfinite(L.y) && std::isfinite(L.z)) sum += L;

@@ -36,8 +36,9 @@
 
 #include <glm/glm.hpp>
 
-#include "libcommon/scene/camera_projection.h"
 #include "libcommon/core/float_image.h"
+#include "libcommon/scene/camera_projection.h"
+#include "libcommon/scene/pixel_filter.h"
 #include "libcommon/scene/scene.h"
 
 namespace rad {
@@ -51,9 +52,11 @@ struct PathTracerOptions {
   std::uint64_t seed = 0;
   // Mix the frame number into every pixel's seed (independent noise per frame).
   bool decorrelateFrames = false;
-  // Every sample through the pixel centre (no antialiasing): the image then point-samples the
-  // scene exactly as rad-compose does, so a comparison measures shading, not edge coverage.
-  bool pixelCentres = false;
+  // The pixel filter (pixel_filter.h), as Cycles samples it: each sample's offset from the pixel
+  // centre drawn from the filter per axis (the sample's stratum mapped through the filter's
+  // inverse distribution), every sample weighted 1. Filter none: every sample through the
+  // centre (point sampling, as rad-compose --pixel-filter none).
+  PixelFilter filter;
 };
 
 // Mean and spread of a Monte Carlo estimate.

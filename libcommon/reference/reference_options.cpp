@@ -1,6 +1,7 @@
 #include "libcommon/reference/reference_options.h"
 
 #include "libcommon/core/shared_parameters.h"
+#include "libcommon/scene/pixel_sampling_parameters.h"
 
 namespace rad {
 
@@ -10,7 +11,7 @@ PathTracerOptions ReferenceOptions::pathTracer() const {
   options.maxDepth = maxDepth;
   options.seed = seed;
   options.decorrelateFrames = decorrelateFrames;
-  options.pixelCentres = pixelCentres;
+  options.filter = filter;
   return options;
 }
 
@@ -30,8 +31,9 @@ const ParameterTable<ReferenceOptions>& referenceParameters() {
     t.addFlag("decorrelate-frames", &O::decorrelateFrames, true,
               "independent noise per frame (default: the same per-pixel seeds every frame, so "
               "what does not change does not flicker)");
-    t.addFlag("pixel-centres", &O::pixelCentres, true,
-              "every sample through the pixel centre (no antialiasing), as rad-compose samples");
+    addPixelFilterParameters(
+        t, [](O& o) -> PixelFilterType& { return o.filter.type; },
+        [](O& o) -> double& { return o.filter.width; });
     return t;
   }();
   return table;

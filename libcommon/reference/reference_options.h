@@ -28,9 +28,11 @@ struct ReferenceOptions {
   int maxDepth = 64;   // reflections per path
   std::uint64_t seed = 0;
   bool decorrelateFrames = false;
-  bool pixelCentres = false;
+  // The pixel filter, importance-sampled (pixel_filter.h): rad-compose's default, Blender's.
+  // --pixel-centres, the old spelling of --pixel-filter none, is the tool's.
+  PixelFilter filter;
 
-  // The path tracer's options (samples, depth, seed, decorrelation, pixel centres).
+  // The path tracer's options (samples, depth, seed, decorrelation, pixel filter).
   PathTracerOptions pathTracer() const;
   // Provenance parameters: referenceParameters() under their flags' names.
   nlohmann::json toJson() const;

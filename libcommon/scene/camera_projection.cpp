@@ -112,6 +112,15 @@ glm::mat4 rasterClipFromLocal(const CameraView& view, ImageSize size,
   return glm::mat4(reversedZProjectionMatrix(view.lens, size) * viewMatrix(view) * worldFromLocal);
 }
 
+glm::mat4 rasterClipFromLocal(const CameraView& view, ImageSize size,
+                              const glm::dmat4& worldFromLocal, glm::dvec2 ndcScale) {
+  glm::dmat4 scale(1.0);
+  scale[0][0] = ndcScale.x;
+  scale[1][1] = ndcScale.y;
+  return glm::mat4(scale * reversedZProjectionMatrix(view.lens, size) * viewMatrix(view) *
+                   worldFromLocal);
+}
+
 glm::dmat4 clipFromWorld(const CameraView& view, ImageSize size) {
   return projectionMatrix(view.lens, size) * viewMatrix(view);
 }

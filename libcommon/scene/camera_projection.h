@@ -57,6 +57,11 @@ glm::dmat4 reversedZProjectionMatrix(const Camera& lens, ImageSize size);
 // rasteriser (item buffers, rad-compose) uses exactly this so they cover the same pixels.
 glm::mat4 rasterClipFromLocal(const CameraView& view, ImageSize size,
                               const glm::dmat4& worldFromLocal);
+// The same with the clip x and y rows scaled by ndcScale (in double, before the rounding): the
+// image's NDC times ndcScale, for a buffer that holds a margin around the image
+// (sample_grid.h).
+glm::mat4 rasterClipFromLocal(const CameraView& view, ImageSize size,
+                              const glm::dmat4& worldFromLocal, glm::dvec2 ndcScale);
 
 // Clip-from-world with the glTF projection.
 glm::dmat4 clipFromWorld(const CameraView& view, ImageSize size);

@@ -401,6 +401,13 @@ bool tryMerge(const Tri& ti, const Tri& tj, InputPolygon* out) {
       // Coplanar: D within 1e-7 of the quad's size from i's plane.
       if (std::abs(glm::dot(D - A, n)) > 1e-7 * scale) return false;
       if (!convexQuad(v, n)) return false;
+      // A parallelogram only (to 5 % of its size, which keeps measured rectangles such as the
+      // Cornell box's walls and box tops): its bilinear (u,v) map is then the plane homography
+      // of the shadow masks (transmittance.h) to second order in the departure, so each texel's
+      // shadow is taken at the texel's own point. A trapezoid merged from two triangles of a fan
+      // had its shadows displaced over the whole quad (a desk's shadow on a wall 6 cm too low;
+      // issue 56).
+      if (glm::length((A + B) - (D + C)) > 0.05 * scale) return false;
       // The uv map must be one affine map over the quad (else texturing would change).
       glm::dvec2 predicted = affineUv(ti, D);
       double uvScale = 1.0;
@@ -421,6 +428,30 @@ bool tryMerge(const Tri& ti, const Tri& tj, InputPolygon* out) {
 using EdgeKey = std::tuple<double, double, double, double, double, double>;
 EdgeKey edgeKey(const glm::dvec3& a, const glm::dvec3& b) {
   return EdgeKey{a.x, a.y, a.z, b.x, b.y, b.z};
+}
+
+// A triangle's (u,v) map starts at its vertex opposite the longest edge (the widest corner, of
+// largest sine): the texel grid of its texture runs along the two edges there. From a sliver's
+// sharp corner (a fan's apex, where a converter puts v0) both edges run along the sliver and a
+// grid fine enough along its length wastes texels by its aspect ratio (docs/design.md §6.2,
+// issue 56). The rotation keeps the winding; the current v0 is kept unless another corner's
+// opposite edge is longer by more than rounding.
+void rootAtWidestCorner(InputPolygon& p) {
+  if (p.local.count != 3) return;
+  double longest[3];
+  for (int k = 0; k < 3; ++k)
+    longest[k] = glm::length(p.local.v[size_t((k + 2) % 3)] - p.local.v[size_t((k + 1) % 3)]);
+  int root = 0;
+  for (int k = 1; k < 3; ++k)
+    if (longest[k] > longest[root] * (1.0 + 1e-9)) root = k;
+  if (root == 0) return;
+  const InputPolygon q = p;
+  for (int k = 0; k < 3; ++k) {
+    const size_t from = size_t((k + root) % 3);
+    p.local.v[size_t(k)] = q.local.v[from];
+    p.uv[size_t(k)] = q.uv[from];
+    p.normal[size_t(k)] = q.normal[from];
+  }
 }
 
 InputPolygon reversed(const InputPolygon& p) {
@@ -491,6 +522,7 @@ std::vector<InputPolygon> Scene::inputPolygons() const {
           poly.normal[k] = tris[i].normal[k];
         }
         poly.material = tris[i].material;
+        rootAtWidestCorner(poly);
       }
       poly.node = node;
       out.push_back(poly);

@@ -177,8 +177,9 @@ class Scene {
   std::vector<double> sampleTimes(int node, double t0, double t1, int perSegment) const;
 
   // Top-level patches of all mesh nodes: triangles, with coplanar adjacent pairs that form a
-  // convex quad merged; doubleSided materials add a reversed copy. Deterministic order:
-  // by mesh node, then triangle order.
+  // convex parallelogram (to 5 % of its size) merged; a triangle's corners rotated so that v0 is
+  // opposite its longest edge (docs/design.md §4); doubleSided materials add a reversed copy.
+  // Deterministic order: by mesh node, then triangle order.
   std::vector<InputPolygon> inputPolygons() const;
 
   // Camera nodes reachable from roots, in ascending index order. cameraNode("") is the first;

@@ -36,12 +36,20 @@ const std::set<std::string> kPlumbing = {
 
 // Values for the options whose default is unset, or too slow for a test.
 std::map<std::string, nlohmann::json> chosenValues(const fs::path& dir) {
-  return {{"frames", "0-0"},    {"size", "44x30"},
-          {"camera", "camera"}, {"fps", 24.0},
-          {"exposure", 0.5},    {"item-buffers", (dir / "items").string()},
+  return {{"frames", "0-0"},
+          {"size", "44x30"},
+          {"camera", "camera"},
+          {"fps", 24.0},
+          {"exposure", 0.5},
+          {"item-buffers", (dir / "items").string()},
           {"output", nullptr},  // -o: given by the stage's own command line
-          {"spp", 2},           {"max-depth", 2},
-          {"min-area", 1e-3}};  // 0 stands for a value resolved from the scene
+          {"spp", 2},
+          {"max-depth", 2},
+          {"min-area", 1e-3},  // 0 stands for a value resolved from the scene
+          // rad-compose's pixel sampling is unset (the intervals'): the shared default here.
+          {"pixel-filter", "blackman-harris"},
+          {"filter-width", 1.5},
+          {"pixel-samples", 3}};
 }
 
 struct Stage {
@@ -62,7 +70,10 @@ std::vector<Stage> stages(const fs::path& d) {
        s + "/movies/000000.exr",
        {"key-step"}},  // the deprecated spellings of --movie-key-step, --occlusion-merge
       {"rad-compose", inputs + s + "/movies -o " + s + "/frames", s + "/frames/0000.exr", {}},
-      {"rad-reference", kScene + " -o " + s + "/reference", s + "/reference/0000.exr", {"output"}}};
+      {"rad-reference",
+       kScene + " -o " + s + "/reference",
+       s + "/reference/0000.exr",
+       {"output", "pixel-centres"}}};  // the deprecated spelling of --pixel-filter none
 }
 
 // The stage's command line with every option of `defaults` written out; `given` receives the

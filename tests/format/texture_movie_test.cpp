@@ -94,7 +94,7 @@ TEST_F(TextureMovieFormat, RoundTripKeepsEverythingBitExact) {
   EXPECT_EQ(in.header(3).name(), "key0003");
   EXPECT_EQ(in.header(1).findTypedAttribute<Imf::StringAttribute>("rad.patch")->value(), "7/2.1");
   EXPECT_EQ(in.header(0).findTypedAttribute<Imf::StringAttribute>("rad.format")->value(),
-            "texture-movie 2.0");
+            "texture-movie 2.1");
 }
 
 TEST_F(TextureMovieFormat, ConstantMovieAndInterpolation) {
@@ -275,13 +275,14 @@ TEST_F(TextureMovieFormat, NotAMovieAndFutureVersionsAreRefusedByName) {
   TextureMovie m = sampleMovie(2);
   std::string path = dir() + "/m.exr";
   writeTextureMovie(path, m);
-  // Rewrite the version string in place ("texture-movie 2.0" -> "texture-movie 9.0").
+  // Rewrite the version string in place ("texture-movie 2.1" -> "texture-movie 9.0").
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), {});
   size_t pos = 0;
   int replaced = 0;
   while ((pos = bytes.find("texture-movie 2.", pos)) != std::string::npos) {
     bytes[pos + 14] = '9';
+    bytes[pos + 16] = '0';
     ++replaced;
   }
   ASSERT_EQ(replaced, 2);

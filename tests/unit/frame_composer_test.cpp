@@ -170,35 +170,101 @@ TEST_F(FrameComposerTest, FallbackUsesTheUnionLeafUnderThePixel) {
 }
 
 TEST_F(FrameComposerTest, MovieTexelsMapToTheirPatchPoints) {
-  // H = 100 u on a 16x1 texture: texel i centre at u = (i+.5)/16, bilinear between centres
-  // reproduces the linear function exactly; row j = 0 is v = 0, so a 1x16 texture in v checks
+  // H = 100 u on a 4x1 texture: texel i centre at u = (i+.5)/4, bilinear between centres
+  // reproduces the linear function exactly, and so does the lookup in the outer half texel up
+  // to the patch's border, which carries the last two texels on (held flat, clamp-to-edge, it
+  // was off by up to 12 % of the range there); row j = 0 is v = 0, so a 1x4 texture in v checks
   // the other axis.
   GlobalSolution g =
       test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  constexpr int n = 4;
   std::vector<float> ramp;
-  for (int i = 0; i < 16; ++i) {
-    float h = float(100.0 * (i + 0.5) / 16);
+  for (int i = 0; i < n; ++i) {
+    float h = float(100.0 * (i + 0.5) / n);
     ramp.insert(ramp.end(), {h, h, h});
   }
   FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
   for (int axis = 0; axis < 2; ++axis) {
-    MovieTexture mt{PatchId{test::kWallTop, 1}, axis == 0 ? 16 : 1, axis == 0 ? 1 : 16,
-                    ramp.data()};
+    MovieTexture mt{PatchId{test::kWallTop, 1}, axis == 0 ? n : 1, axis == 0 ? 1 : n, ramp.data()};
     ComposedFrame f = composer.compose(0.0, {mt});
     ItemBuffer ib = itemBuffer();
-    int checked = 0;
+    int checked = 0, border = 0;
     for (int row = 0; row < kSize.height; ++row)
       for (int col = 0; col < kSize.width; ++col) {
         size_t p = size_t(row) * kSize.width + col;
         if (ib.id[p] != test::kWallTop + 1) continue;
         double u = wallUvAt(*scene, col, row)[axis];
-        if (u < 0.5 / 16 || u > 1 - 0.5 / 16) continue;  // clamped border texels
         double want = 0.5 / kPi * 100.0 * u;
-        EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want) << col << "," << row << " axis " << axis;
+        EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want + 1e-9)
+            << col << "," << row << " axis " << axis;
         ++checked;
+        border += u < 0.5 / n || u > 1 - 0.5 / n;
       }
     EXPECT_GT(checked, 250);
+    EXPECT_GT(border, 10);
   }
+}
+
+// Between the last texel centres and the patch's edge (the border half texel) the texture goes
+// on linearly: H = 100 u is reproduced up to u = 0 and u = 1. Clamped to the edge, as GL's
+// CLAMP_TO_EDGE, the border held the value half a texel inside, and two patches meeting at an
+// edge stepped there by the gradient times a texel (issue 56).
+TEST_F(FrameComposerTest, TheBorderHalfTexelContinuesTheTextureLinearly) {
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  std::vector<float> ramp;
+  for (int i = 0; i < 4; ++i) {
+    float h = float(100.0 * (i + 0.5) / 4);
+    ramp.insert(ramp.end(), {h, h, h});
+  }
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  const ComposedFrame f = composer.compose(0.0, {{PatchId{test::kWallTop, 1}, 4, 1, ramp.data()}});
+  ItemBuffer ib = itemBuffer();
+  int checked = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      double u = wallUvAt(*scene, col, row).x;
+      if (u >= 0.5 / 4 && u <= 1 - 0.5 / 4) continue;  // inside: MovieTexelsMapToTheirPatchPoints
+      double want = 0.5 / kPi * 100.0 * u;
+      EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want + 1e-6) << col << "," << row;
+      ++checked;
+    }
+  EXPECT_GT(checked, 10);
+}
+
+// The four children of the wall, each its own 4 x 4 movie of H = 100 u + 50 v at its texels'
+// points, compose into the one linear field: no step where the children's textures meet.
+TEST_F(FrameComposerTest, SiblingMoviesMeetWithoutAStep) {
+  GlobalSolution g =
+      test::makeSolution(*scene, {0.0}, false, [](int, int) { return glm::dvec3(0); });
+  std::vector<std::vector<float>> tex(4);
+  std::vector<MovieTexture> movies;
+  for (int c = 0; c < 4; ++c) {
+    const PatchId child = PatchId{test::kWallTop, 1}.child(c);
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const glm::dvec2 uv = topUvFromNodeUv(child, {(i + 0.5) / 4, (j + 0.5) / 4}, false);
+        const float h = float(100.0 * uv.x + 50.0 * uv.y);
+        tex[size_t(c)].insert(tex[size_t(c)].end(), {h, h, h});
+      }
+    movies.push_back({child, 4, 4, tex[size_t(c)].data()});
+  }
+  FrameComposer composer(*scene, g, kSize, scene->cameraNode(""));
+  const ComposedFrame f = composer.compose(0.0, movies);
+  ItemBuffer ib = itemBuffer();
+  int checked = 0;
+  for (int row = 0; row < kSize.height; ++row)
+    for (int col = 0; col < kSize.width; ++col) {
+      size_t p = size_t(row) * kSize.width + col;
+      if (ib.id[p] != test::kWallTop + 1) continue;
+      const glm::dvec2 uv = wallUvAt(*scene, col, row);
+      double want = 0.5 / kPi * (100.0 * uv.x + 50.0 * uv.y);
+      EXPECT_NEAR(pixel(f, p).x, want, 1e-4 * want + 1e-6) << col << "," << row;
+      ++checked;
+    }
+  EXPECT_GT(checked, 300);
 }
 
 TEST_F(FrameComposerTest, SubPatchMovieCoversItsQuarterAndTheRestFallsBack) {

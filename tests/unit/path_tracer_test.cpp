@@ -413,9 +413,10 @@ TEST(PathTracer, DoubleSidedReceiverReflectsOnItsBack) {
 namespace rad {
 namespace {
 
-// --pixel-centres (what rad-compose point-samples): every primary ray goes through its pixel's
-// centre, so a pixel that sees an emitter directly (rho 0: nothing else contributes) is exactly
-// L_e or exactly 0; area sampling instead averages the edge pixels to values in between.
+// --pixel-filter none (what rad-compose --pixel-filter none point-samples): every primary ray goes
+// through its pixel's centre, so a pixel that sees an emitter directly (rho 0: nothing else
+// contributes) is exactly L_e or exactly 0; area sampling instead averages the edge pixels to
+// values in between.
 TEST(PathTracer, PixelCentresPointSampleEdges) {
   const glm::dvec3 le(1.0, 2.0, 3.0);
   // A rectangle facing the camera, its edges at no pixel boundary.
@@ -436,19 +437,89 @@ TEST(PathTracer, PixelCentresPointSampleEdges) {
       }
   };
   int lit, dark, between;
-  o.pixelCentres = true;
+  o.filter = PixelFilter::pixelCentre();
   count(tracer.render(view, {24, 16}, o), lit, dark, between);
   EXPECT_EQ(between, 0);
   EXPECT_GT(lit, 10);
   EXPECT_GT(dark, 10);
   const int litCentres = lit;
-  o.pixelCentres = false;
+  o.filter = PixelFilter{PixelFilterType::kBox, 1.0};
   count(tracer.render(view, {24, 16}, o), lit, dark, between);
   EXPECT_GT(between, 8) << "edge pixels are averaged";
   EXPECT_LT(lit, litCentres);
   std::printf(
       "  emitter seen directly: %d lit pixels at centres; %d partly lit with area samples\n",
       litCentres, between);
+}
+
+// The pixel filter (Cycles' sampling: offsets drawn from the filter, every sample weight 1): an
+// emitter's vertical edge at a known sub-pixel column gives each pixel Le times the filter's
+// share left of the edge, and a flat field stays the field whatever the filter; the same image
+// with 1 or 2 threads.
+TEST(PathTracer, FilteredPixelsAreTheFiltersShareOfAnEdge) {
+  const glm::dvec3 le(1.0, 2.0, 3.0);
+  constexpr int kW = 24, kH = 16;
+  constexpr double kEdge = 11.3;  // image column of the emitter's right edge
+  const double halfTan = std::tan(0.5), aspect = double(kW) / kH;
+  const double x0 = (2.0 * kEdge / kW - 1.0) * aspect * halfTan;  // at depth 1
+  Scene scene = sceneOf({{{{-5, -5, -1}, {x0, -5, -1}, {x0, 5, -1}, {-5, 5, -1}}}},
+                        {material(glm::dvec3(0.0), le)});
+  addCamera(scene, {0, 0, 0}, 1.0);
+  PathTracer tracer(scene, 0.0);
+  const CameraView view = scene.cameraAt(scene.cameraNode(""), 0.0);
+  PathTracerOptions o = unbiasedOptions();
+  o.samplesPerPixel = 1024;  // 32 x 32 strata
+  for (const PixelFilter& f : {PixelFilter{}, PixelFilter{PixelFilterType::kGaussian, 1.5},
+                               PixelFilter{PixelFilterType::kBox, 1.0}}) {
+    o.filter = f;
+    const FloatImage im = tracer.render(view, {kW, kH}, o);
+    for (int col = 0; col < kW; ++col) {
+      // The filter's weight left of the edge, of the pixel centred at col + 1/2.
+      double left = 0.0, all = 0.0;
+      for (int i = 0; i < 20000; ++i) {
+        const double v = -f.radius() + 2.0 * f.radius() * (i + 0.5) / 20000, w = f.weight(v);
+        all += w;
+        if (col + 0.5 + v < kEdge) left += w;
+      }
+      for (int row : {3, 8})
+        EXPECT_NEAR(im.at(col, row, 2), le.z * left / all, 0.01 * le.z)
+            << f.toString() << " pixel " << col;
+    }
+  }
+  // A flat field (the emitter everywhere): every pixel is Le, whatever the filter.
+  Scene flat = sceneOf({{{{-50, -50, -1}, {50, -50, -1}, {50, 50, -1}, {-50, 50, -1}}}},
+                       {material(glm::dvec3(0.0), le)});
+  addCamera(flat, {0, 0, 0}, 1.0);
+  PathTracer flatTracer(flat, 0.0);
+  o.samplesPerPixel = 16;
+  o.filter = PixelFilter{};
+  FloatImage one, two;
+  {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
+    one = flatTracer.render(view, {kW, kH}, o);
+  }
+  {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 2);
+    two = flatTracer.render(view, {kW, kH}, o);
+  }
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(one.at(x, y, c), le[c], 1e-6 * le[c]);
+        EXPECT_EQ(one.at(x, y, c), two.at(x, y, c));
+      }
+  // And the edge image, too, is the same with 1 or 2 threads (a 4-spp render).
+  o.samplesPerPixel = 4;
+  {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
+    one = tracer.render(view, {kW, kH}, o);
+  }
+  {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 2);
+    two = tracer.render(view, {kW, kH}, o);
+  }
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) EXPECT_EQ(one.at(x, y, 2), two.at(x, y, 2));
 }
 
 }  // namespace

@@ -65,6 +65,15 @@ rad::ComposeSequenceOptions resolve(rad::ComposeOptions& o, const rad::Scene& sc
   c.half = o.half;
   c.compression = rad::frameCompressionOf(o.compression);
   c.png = !o.noPng;
+  // The pixel sampling: the intervals' unless given (their item buffers saw its samples).
+  c.sampling.filter.type = o.pixelFilter.value_or(intervals.sampling.filter.type);
+  c.sampling.filter.width = o.filterWidth.value_or(intervals.sampling.filter.width);
+  c.sampling.samplesPerAxis = o.pixelSamples.value_or(intervals.sampling.samplesPerAxis);
+  c.sampling.validate();
+  o.pixelFilter = c.sampling.filter.type;
+  o.filterWidth = c.sampling.filter.width;
+  o.pixelSamples = c.sampling.samplesPerAxis;
+  c.everySample = o.everySample;
   return c;
 }
 
@@ -77,6 +86,13 @@ void warnAboutDifferences(const rad::ComposeSequenceOptions& c, const std::strin
     std::cerr << kTool << ": warning: composing at " << c.size.width << "x" << c.size.height << "; "
               << intervalsPath << " sized the movies for " << intervals.imageWidth << "x"
               << intervals.imageHeight << "\n";
+  // A sample the intervals' item buffers did not see may lie in no movie (then it falls back to
+  // the global solution, and the frame's warning counts it).
+  if (c.size == rad::ImageSize{intervals.imageWidth, intervals.imageHeight} &&
+      !rad::PixelSampling::covers(intervals.sampling.grid(c.size), c.sampling.grid(c.size)))
+    std::cerr << kTool << ": warning: sampling " << c.sampling.toString() << "; " << intervalsPath
+              << " decided the movies' coverage for " << intervals.sampling.toString()
+              << ": samples it did not see may fall back to the global solution\n";
   if (c.fps != intervals.fps)
     std::cerr << kTool << ": warning: --fps " << c.fps << "; " << intervalsPath
               << " was built with " << intervals.fps << " fps\n";

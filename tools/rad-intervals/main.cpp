@@ -45,6 +45,7 @@ int run(const rad::IntervalsOptions& given, const std::string& preset, int argc,
   rad::IntervalsOptions o = given;
   auto [w, h] = rad::parseImageSize(o.size);
   o.build.imageSize = {w, h};
+  o.build.sampling = o.sampling;
   o.build.validate();
   rad::Scene scene = rad::readGltfScene(o.scene);
   int camera = scene.cameraNode(o.camera);

@@ -65,6 +65,16 @@ int main(int argc, char** argv) {
       ->required()
       ->group(rad::parameterGroupTitle(rad::ParameterGroup::kCommon));
   rad::bindParameters(app, rad::referenceParameters(), o);
+  // The old spelling of --pixel-filter none.
+  app.add_flag_callback(
+         "--pixel-centres",
+         [&o] {
+           rad::warnDeprecated(kTool, "--pixel-centres", "--pixel-filter none");
+           o.filter.type = rad::PixelFilterType::kNone;
+         },
+         "deprecated name of --pixel-filter none")
+      ->excludes(app.get_option("--pixel-filter"))
+      ->group("Deprecated");
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o, argc, argv); });
 }

@@ -199,7 +199,8 @@ ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& 
   // and animation.mk removes frames/ before a re-run).
   info.durability = AtomicFile::Durability::kDeferred;
 
-  FrameComposer composer(scene, solution, options.size, options.cameraNode);
+  FrameComposer composer(scene, solution, options.size, options.cameraNode, options.sampling,
+                         options.everySample);
   MovieCache cache(intervals, options.moviesDir, std::move(headers));
   ComposedFrame frame;
   std::vector<MovieTexture> active;

@@ -30,6 +30,10 @@ struct ComposeSequenceOptions {
   bool half = false;          // HALF EXR channels
   int compression = 0;        // frameCompressionOf(); 0: none
   bool png = true;            // also write NNNN.png
+  // The pixel filter and sample grid (libcommon/compose/footprint_filter.h); everySample: no
+  // shortcut on uniform footprints.
+  PixelSampling sampling = PixelSampling::pixelCentres();
+  bool everySample = false;
 };
 
 struct ComposeFrameStats {

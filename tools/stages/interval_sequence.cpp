@@ -25,6 +25,7 @@ TextureIntervals intervalsRecord(const std::vector<MovieExtent>& extents,
   iv.fps = options.fps;
   iv.imageWidth = options.imageSize.width;
   iv.imageHeight = options.imageSize.height;
+  iv.sampling = options.sampling;
   iv.movies = extents;  // one record (MovieExtent): finish() numbers them 0..n-1
   return iv;
 }
@@ -45,7 +46,10 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
 
   IntervalSequence run;
   const auto start = std::chrono::steady_clock::now();
-  TextureIntervalsBuilder builder(scene, cameraNode, options);
+  TextureIntervalsOptions built = options;
+  built.itemBufferDepth = !itemBuffersDir.empty();  // depth only for the files
+  TextureIntervalsBuilder builder(scene, cameraNode, built);
+  const SampleGrid grid = options.sampling.grid(options.imageSize);
   run.setupSeconds = secondsSince(start);
   // Item buffers drawn by one GL context a thread (TextureIntervalsBuilder::addFrames).
   const size_t renderers = std::clamp<size_t>(
@@ -54,14 +58,16 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
       frames, renderers,
       [&](const IntervalFrame& fr) {
         run.itemSeconds.push_back(fr.itemBufferSeconds);
-        const std::vector<uint32_t>& ids = fr.itemBuffer->id;
+        // The pixel centres: what the frame shows (the grid's margin lies outside it), and the
+        // pixel-sized buffer rad-diff --surfaces reads.
+        const ItemBuffer centres = pixelCentreSamples(*fr.itemBuffer, grid);
+        const std::vector<uint32_t>& ids = centres.id;
         if (std::all_of(ids.begin(), ids.end(), [](uint32_t id) { return id == kNoItem; }))
           run.emptyFrames.push_back(fr.frame);
         if (itemBuffersDir.empty()) return;
         char name[32];
         std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
-        writeItemBufferExr(itemBuffersDir + name, *fr.itemBuffer, fr.frame, fr.time,
-                           provenanceJson);
+        writeItemBufferExr(itemBuffersDir + name, centres, fr.frame, fr.time, provenanceJson);
       },
       frameDone);
   const std::vector<MovieExtent> extents = builder.finish();
