@@ -2,6 +2,9 @@
 // buffer makes possible.
 #include "libcommon/reference/sequence_difference.h"
 
+#include <utility>
+#include <vector>
+
 #include "libcommon/core/error.h"
 #include "libcommon/reference/edge_pixels.h"
 
@@ -9,10 +12,23 @@ namespace rad {
 
 namespace {
 
+// What the temporal error (§10.6) keeps of a frame for the next one: its images and which of its
+// pixels are emitters and edges.
+struct KeptFrame {
+  int frame = 0;
+  FloatImage test, reference, reference2;
+  std::vector<uint8_t> emitter, edge;
+  bool hasEdges = false;
+  TemporalFrame view() const {
+    return {&test, &reference, reference2.pixels.empty() ? nullptr : &reference2, &emitter,
+            hasEdges ? &edge : nullptr};
+  }
+};
+
 // The frame's error figure (§10.1), and with surfaces its regions (§10.3), structured error
 // (§10.4) and seams (§10.5), added to `seams`.
 FrameDifference measureFrame(int frame, const FrameImages& im, const EmitterRule& rule,
-                             SeamSteps& seams) {
+                             SeamSteps& seams, KeptFrame& kept) {
   const std::string frameName = "frame " + std::to_string(frame);
   const std::string where = im.testWhere.empty() ? frameName : im.testWhere;
   const std::string where2 =
@@ -27,6 +43,7 @@ FrameDifference measureFrame(int frame, const FrameImages& im, const EmitterRule
   if (im.surfaces.empty()) {
     fd.error = measureError(im.test, im.reference, reference2, rule, where, where2, mask, whereMask,
                             groups);
+    kept.emitter = findEmitterPixels(im.reference, reference2, rule, mask).isEmitter;
     return fd;
   }
   if (im.surfaces.width != im.reference.width || im.surfaces.height != im.reference.height)
@@ -35,13 +52,16 @@ FrameDifference measureFrame(int frame, const FrameImages& im, const EmitterRule
   const PixelGroups regions = edges.regions();
   fd.error = measureError(im.test, im.reference, reference2, rule, where, where2, mask, whereMask,
                           groups, &regions);
-  const EmitterPixels emitters = findEmitterPixels(im.reference, reference2, rule, mask);
+  EmitterPixels emitters = findEmitterPixels(im.reference, reference2, rule, mask);
   FloatImage smoothed;
   fd.structured = measureStructuredError(im.test, im.reference, reference2, emitters.isEmitter,
                                          edges, im.smoothedSink ? &smoothed : nullptr);
   if (im.smoothedSink) im.smoothedSink(smoothed);
   seams.merge(measureSeams(im.test, im.reference, reference2, emitters.isEmitter, im.surfaces,
                            edges, frame));
+  kept.emitter = std::move(emitters.isEmitter);
+  kept.edge = edges.edge;
+  kept.hasEdges = true;
   return fd;
 }
 
@@ -51,22 +71,26 @@ SequenceDifference compareSequence(const std::vector<int>& frames,
                                    const std::function<FrameImages(int frame)>& load,
                                    double staticTolerance, const EmitterRule& rule) {
   SequenceDifference result;
-  FloatImage previousTest, previousReference;
-  int previousFrame = 0;
+  KeptFrame previous, current;
   bool havePrevious = false;
   for (int frame : frames) {
     FrameImages im = load(frame);
     result.haveSurfaces = result.haveSurfaces || !im.surfaces.empty();
-    FrameDifference fd = measureFrame(frame, im, rule, result.seams);
+    current = KeptFrame{};
+    FrameDifference fd = measureFrame(frame, im, rule, result.seams, current);
     result.total.merge(fd.stats);
     result.totalError.merge(fd.error);
     result.frames.push_back(std::move(fd));
-    if (havePrevious && frame == previousFrame + 1)
-      result.flicker.addPair(previousTest, im.test, previousReference, im.reference,
+    current.frame = frame;
+    current.test = std::move(im.test);
+    current.reference = std::move(im.reference);
+    current.reference2 = std::move(im.reference2);
+    if (havePrevious && frame == previous.frame + 1) {
+      result.flicker.addPair(previous.test, current.test, previous.reference, current.reference,
                              staticTolerance);
-    previousTest = std::move(im.test);
-    previousReference = std::move(im.reference);
-    previousFrame = frame;
+      result.temporal.addPair(previous.view(), current.view());
+    }
+    std::swap(previous, current);
     havePrevious = true;
   }
   return result;

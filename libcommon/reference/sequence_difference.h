@@ -14,6 +14,7 @@
 #include "libcommon/reference/image_difference.h"
 #include "libcommon/reference/seam_steps.h"
 #include "libcommon/reference/structured_error.h"
+#include "libcommon/reference/temporal_error.h"
 
 namespace rad {
 
@@ -29,6 +30,7 @@ struct SequenceDifference {
   DifferenceStats total;                // pooled over all frames
   ErrorFigures totalError;              // pooled sums over all frames
   FlickerStats flicker;                 // over pairs of consecutive frame numbers
+  TemporalError temporal;               // over the same pairs (§10.6)
   SeamSteps seams;                      // pooled over the frames with surfaces, by patch pair
   bool haveSurfaces = false;            // some frame had surfaces
 };
@@ -49,7 +51,7 @@ struct FrameImages {
 
 // Compares a sequence frame by frame. `load(frame)` returns the images of one frame number
 // (only two frames are held at a time, so memory is flat in sequence length). `frames` must
-// be ascending; flicker uses the pairs (n, n+1) that are both listed.
+// be ascending; flicker and the temporal error use the pairs (n, n+1) that are both listed.
 SequenceDifference compareSequence(const std::vector<int>& frames,
                                    const std::function<FrameImages(int frame)>& load,
                                    double staticTolerance = 0.0, const EmitterRule& rule = {});

@@ -265,6 +265,32 @@ void compareFiles(const Options& o, const std::vector<std::string>& channels, nl
   if (!o.surfaces.empty()) out << surfacesText(e, items->names());
   if (!o.seams.empty()) out << seamsText(seq.seams, o.seamMinPairs, patchName, false);
 }
+// The temporal error of docs/design.md §10.6, over all non-emitting pixels and, with an item
+// buffer, over edge and interior pixels apart.
+nlohmann::json temporalJson(const rad::TemporalError& t) {
+  auto sums = [](const rad::TemporalSums& s) {
+    return nlohmann::json{{"rmse_over_mean", s.rmseOverMean()},
+                          {"raw_rmse_over_mean", s.rawRmseOverMean()},
+                          {"samples", s.samples}};
+  };
+  nlohmann::json j = {{"frame_pairs", t.framePairs}, {"all", sums(t.all)}};
+  if (t.haveEdges) {
+    j["edge"] = sums(t.edge);
+    j["interior"] = sums(t.interior);
+  }
+  return j;
+}
+std::string temporalText(const rad::TemporalError& t) {
+  std::ostringstream s;
+  s << "  temporal error (change n -> n+1 against the reference's, rmse/mean): "
+    << text(t.all.rmseOverMean());
+  if (t.haveEdges)
+    s << "; edge " << text(t.edge.rmseOverMean()) << ", interior "
+      << text(t.interior.rmseOverMean());
+  s << " over " << t.framePairs << " frame pair(s)\n";
+  return s.str();
+}
+
 // The JSON and text of a sequence's figures (compareDirectories); `items` null without an
 // item buffer.
 void reportSequence(const Options& o, const rad::SequenceDifference& seq, int onlyTest,
@@ -289,6 +315,7 @@ void reportSequence(const Options& o, const rad::SequenceDifference& seq, int on
                   {"static_pixels", seq.flicker.staticPixels},
                   {"frame_pairs", seq.flicker.framePairs},
                   {"static_tolerance", o.staticTolerance}};
+  j["temporal"] = temporalJson(seq.temporal);
   nlohmann::json per = nlohmann::json::array();
   out << o.test << " vs " << o.reference;
   if (!o.reference2.empty()) out << " and " << o.reference2;
@@ -314,7 +341,8 @@ void reportSequence(const Options& o, const rad::SequenceDifference& seq, int on
     out << "  structured error: " << kStructuredUnavailable << "\n";
   out << "  flicker: mean |test(n+1)-test(n)| " << text(seq.flicker.mean()) << " (max "
       << text(seq.flicker.maxAbsChange) << ") over " << seq.flicker.staticPixels
-      << " static pixel(s) in " << seq.flicker.framePairs << " frame pair(s)\n";
+      << " static pixel(s) in " << seq.flicker.framePairs << " frame pair(s)\n"
+      << temporalText(seq.temporal);
   if (!o.surfaces.empty()) out << surfacesText(seq.totalError, items->names());
   if (!o.seams.empty()) out << seamsText(seq.seams, o.seamMinPairs, patchName, true);
 }
@@ -457,7 +485,10 @@ int main(int argc, char** argv) {
       "||test - ref|| / ||ref|| (normalised by the reference RMS, so dominated by visible\n"
       "emitters), max abs difference, PSNR (peak = max of the reference) and, for sequences, the\n"
       "temporal flicker of the test where the reference does not change. Totals over a sequence\n"
-      "pool the sums of every frame.\n"
+      "pool the sums of every frame. A sequence also gets the temporal error (§10.6): the RMS of\n"
+      "(t(n+1) - t(n)) - (r(n+1) - r(n)) over non-emitters, over the mean reference (with --ref2\n"
+      "the references' change noise removed), at edge and interior pixels apart with an item\n"
+      "buffer: an aliased edge that crawls under a moving camera reads high at edges.\n"
       "\n"
       "With an item buffer (--surfaces or --seams ITEMS, --scene SCENE; rad-intervals\n"
       "--item-buffers writes them), patches that are coplanar and of one material count as one\n"
