@@ -179,9 +179,11 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
   if (!(d > separation_ * (R.radius() + S.radius()))) {
     if (emitted > 0.0) return Fate::kRefine;
     const size_t T = emission_.size();
-    const bool known =
-        reuse_ && reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T));
-    return known || blocked(l.receiver, l.shooter) ? Fate::kDrop : Fate::kRefine;
+    const uint8_t* known =
+        reuse_ ? reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))
+               : nullptr;
+    const bool isBlocked = known ? *known != 0 : blocked(l.receiver, l.shooter);
+    return isBlocked ? Fate::kDrop : Fate::kRefineNear;
   }
   // A light's B before the first solve is its emission (the radiosity of the last gather is 0
   // then, and would keep every light link at the first round).
@@ -285,7 +287,8 @@ class ClusterLinks::RefineRound {
   }
 
   bool refines(size_t i, const ClusterLink& l) const {
-    return l.receiver == l.shooter || refineAll_ || fate_[i] == Fate::kRefine;
+    return l.receiver == l.shooter || refineAll_ || fate_[i] == Fate::kRefine ||
+           fate_[i] == Fate::kRefineNear;
   }
   bool drops(size_t i, const ClusterLink& l) const {
     return l.receiver != l.shooter && !refineAll_ && fate_[i] == Fate::kDrop;
@@ -372,7 +375,7 @@ class ClusterLinks::RefineRound {
       current_ = i;
       if (!parallel && made_ + patchPairs_.size() > budget_ + count_) overBudget_ = true;
       if (drops(i, l)) {  // gone, as a refined link is, with no children
-        c_.blocked_.emplace_back(l.receiver, l.shooter);
+        c_.nearTests_.push_back({l.receiver, l.shooter, 1});
         if (firstLevel_) changes(l.receiver);
         ++count_;
         continue;
@@ -386,6 +389,8 @@ class ClusterLinks::RefineRound {
         continue;
       }
       if (!parallel) c_.expand(l, append);
+      if (!refineAll_ && l.receiver != l.shooter && fate_[i] == Fate::kRefineNear)
+        c_.nearTests_.push_back({l.receiver, l.shooter, 0});
       if (firstLevel_) changes(l.receiver);
       ++count_;
     }

@@ -111,11 +111,19 @@ struct CachedClusterLink {
 };
 // The cluster links the next key time may take over, and their members' own V (one byte a
 // member of a cluster receiver, as ClusterLinks keeps them).
+// A near cluster link without a light tested for being blocked (ClusterLinks::blocked): dropped
+// when blocked, else refined.
+struct NearLinkTest {
+  ClusterRef receiver, shooter;
+  uint8_t blocked;
+};
+
 struct ClusterLinkCache {
   PairTable<CachedClusterLink> links;
   std::vector<uint8_t> memberVisibility;  // each cached link's, as ClusterLink::memberVisibility
-  // The near links the previous key dropped as blocked, under the same condition: their rays
-  // meet the same geometry, so the test would say blocked again.
+  // The near links the previous key tested for being blocked (ClusterLinks::nearTests), under
+  // the same condition: their rays meet the same geometry, so the test would give the same
+  // answer. Value 1: blocked (dropped), 0: not (refined).
   PairTable<uint8_t> blocked;
   const CachedClusterLink* find(uint32_t row, uint32_t column) const {
     return links.find(row, column);
@@ -166,9 +174,9 @@ class ClusterLinks {
   // gather weighs them (its row sum's cluster part).
   std::vector<double> rowSums(const std::vector<double>& exposure);
 
-  // The near links dropped as blocked in this key's rounds (receiver, shooter), for the next
+  // The near links tested for being blocked in this key's rounds, with the answer, for the next
   // key's coherence (ClusterLinkCache::blocked).
-  const std::vector<std::pair<ClusterRef, ClusterRef>>& blockedLinks() const { return blocked_; }
+  const std::vector<NearLinkTest>& nearTests() const { return nearTests_; }
   size_t size() const { return links_.size(); }
   size_t reusedCount() const { return reused_; }
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
@@ -193,7 +201,8 @@ class ClusterLinks {
   template <class Sink>
   void expand(const ClusterLink& l, Sink& sink) const;
   // What a refinement round does with a link (see the top of this file).
-  enum class Fate : uint8_t { kKeep, kRefine, kDrop };
+  // kRefineNear: a near link tested and not blocked, refined (recorded in nearTests_).
+  enum class Fate : uint8_t { kKeep, kRefine, kRefineNear, kDrop };
   Fate fateOf(const ClusterLink& l, double epsAbs) const;
   // Ray pair i of the link r <- s, as evaluateLink draws it from the link's seed: a member of
   // each end drawn among those that may face the other end, a point on each, and the kernel
@@ -299,7 +308,7 @@ class ClusterLinks {
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;
-  std::vector<std::pair<ClusterRef, ClusterRef>> blocked_;  // blockedLinks()
+  std::vector<NearLinkTest> nearTests_;  // nearTests()
   // The links' V at their receivers' members (ClusterLink::memberVisibility); a refined link's
   // stay until the key's end.
   std::vector<uint8_t> memberVisibility_;

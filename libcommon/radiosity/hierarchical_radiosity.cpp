@@ -193,7 +193,7 @@ KeySolution KeyTimeSolver::finish() {
     s_.clusterLinks = clusters_->size();
     s_.clusterLinksReused = clusters_->reusedCount();
     s_.clusterBounds = clusters_->clusterBounds();
-    s_.clusterLinksBlocked = clusters_->blockedLinks();
+    s_.clusterNearTests = clusters_->nearTests();
     // Moved out, and the rest of the cluster links (their gather lists) freed here, not when the
     // solver goes: a copy held beside them until then would raise rad-global's peak at the end of
     // each key's solve.

@@ -136,8 +136,9 @@ struct KeySolution {
   // the next key's coherence).
   std::vector<ClusterLink> clusterLinkValues;
   std::vector<uint8_t> clusterMemberVisibility;  // ClusterLink::memberVisibility indexes it
-  // The near cluster links dropped as blocked (cluster_links.h), for the next key's coherence.
-  std::vector<std::pair<ClusterRef, ClusterRef>> clusterLinksBlocked;
+  // The near cluster links tested for being blocked, with the answer (cluster_links.h), for
+  // the next key's coherence.
+  std::vector<NearLinkTest> clusterNearTests;
   std::vector<ClusterBounds> clusterBounds;
   std::vector<Polygon> world;  // per dense node: world polygon at this key
   std::vector<double> area;    // per dense node: world area

@@ -77,18 +77,21 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
     }
   cache.links =
       PairTable<CachedClusterLink>(keys, std::move(values), uint32_t(T + size_t(tree.size())));
-  const auto& blocked = prev.clusterLinksBlocked;
-  std::vector<char> still(blocked.size());
-  tbb::parallel_for(size_t(0), blocked.size(), [&](size_t i) {
-    still[i] = stays(blocked[i].first, blocked[i].second) ? 1 : 0;
+  const std::vector<NearLinkTest>& tests = prev.clusterNearTests;
+  std::vector<char> still(tests.size());
+  tbb::parallel_for(size_t(0), tests.size(), [&](size_t i) {
+    still[i] = stays(tests[i].receiver, tests[i].shooter) ? 1 : 0;
   });
-  std::vector<std::pair<uint32_t, uint32_t>> blockedKeys;
-  for (size_t i = 0; i < blocked.size(); ++i)
-    if (still[i])
-      blockedKeys.emplace_back(clusterLinkEnd(blocked[i].first, T),
-                               clusterLinkEnd(blocked[i].second, T));
-  cache.blocked = PairTable<uint8_t>(blockedKeys, std::vector<uint8_t>(blockedKeys.size(), 1),
-                                     uint32_t(T + size_t(tree.size())));
+  std::vector<std::pair<uint32_t, uint32_t>> testKeys;
+  std::vector<uint8_t> answers;
+  for (size_t i = 0; i < tests.size(); ++i)
+    if (still[i]) {
+      testKeys.emplace_back(clusterLinkEnd(tests[i].receiver, T),
+                            clusterLinkEnd(tests[i].shooter, T));
+      answers.push_back(tests[i].blocked);
+    }
+  cache.blocked =
+      PairTable<uint8_t>(testKeys, std::move(answers), uint32_t(T + size_t(tree.size())));
   return cache;
 }
 

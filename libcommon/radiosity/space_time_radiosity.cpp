@@ -302,7 +302,7 @@ class KeyTimePass {
       }
       std::vector<ClusterLink>().swap(prev.clusterLinkValues);
       std::vector<uint8_t>().swap(prev.clusterMemberVisibility);
-      std::vector<std::pair<ClusterRef, ClusterRef>>().swap(prev.clusterLinksBlocked);
+      std::vector<NearLinkTest>().swap(prev.clusterNearTests);
       // The closure integrates only pairs of patches that never move (KeySolveInput::
       // movingTops), so every leaf-to-top form factor prev kept stays valid; the union
       // hierarchy's dense node numbering is the same at every key. The solve takes them over.
