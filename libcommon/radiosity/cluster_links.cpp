@@ -1,6 +1,7 @@
 // Cluster links of one key-time solve (see the header). The figures behind the reasons given here:
 // docs/results.md, "Figures moved out of the radiosity code's comments (issue 55)".
 #include "libcommon/radiosity/cluster_links.h"
+#include "libcommon/radiosity/link_form_factor.h"
 
 #include <algorithm>
 #include <array>
@@ -162,25 +163,34 @@ void ClusterLinks::expand(const ClusterLink& l, Sink& sink) const {
     splitReceiver ? pairOrLink(c, l.shooter) : pairOrLink(l.receiver, c);
 }
 
-bool ClusterLinks::wantsRefinement(const ClusterLink& l, double epsAbs) const {
+ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) const {
   const double emitted = emission(l.shooter);
   if (emitted > 0.0) {
-    if (!(lightShare_ > 0.0)) return true;
+    if (!(lightShare_ > 0.0)) return Fate::kRefine;
     epsAbs *= lightShare_;
   }
   const ClusterBounds& R = bounds(l.receiver);
   const ClusterBounds& S = bounds(l.shooter);
   // Near (the centres closer than `separation` times the radii's sum): the point approximation does
-  // not hold, so such a link is always refined, even one that carries little: accepted with its
-  // point estimate, it moves the frames away from the all-pairs ones.
+  // not hold, so such a link is refined, even one that carries little: accepted with its point
+  // estimate, it moves the frames away from the all-pairs ones. One between a few members that
+  // carries nothing (blocked) is dropped (the top of cluster_links.h).
   const double d = glm::length(S.centre() - R.centre());
-  if (!(d > separation_ * (R.radius() + S.radius()))) return true;
+  if (!(d > separation_ * (R.radius() + S.radius()))) {
+    if (emitted > 0.0) return Fate::kRefine;
+    const size_t T = emission_.size();
+    const uint8_t* known =
+        reuse_ ? reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))
+               : nullptr;
+    const bool isBlocked = known ? *known != 0 : blocked(l.receiver, l.shooter);
+    return isBlocked ? Fate::kDrop : Fate::kRefineNear;
+  }
   // A light's B before the first solve is its emission (the radiosity of the last gather is 0
   // then, and would keep every light link at the first round).
   const double bv = std::max(maxRadiosity(l.shooter), emitted) * l.visibility;
   const double gap = d - R.radius() - S.radius();
   const double f = std::min(1.0, S.area / (M_PI * gap * gap));
-  return bv * std::min(R.area * f, S.area) > epsAbs;
+  return bv * std::min(R.area * f, S.area) > epsAbs ? Fate::kRefine : Fate::kKeep;
 }
 
 // One call of ClusterLinks::refine, level by level: `work_` holds one level's links, their
@@ -277,7 +287,11 @@ class ClusterLinks::RefineRound {
   }
 
   bool refines(size_t i, const ClusterLink& l) const {
-    return l.receiver == l.shooter || refineAll_ || wants_[i];
+    return l.receiver == l.shooter || refineAll_ || fate_[i] == Fate::kRefine ||
+           fate_[i] == Fate::kRefineNear;
+  }
+  bool drops(size_t i, const ClusterLink& l) const {
+    return l.receiver != l.shooter && !refineAll_ && fate_[i] == Fate::kDrop;
   }
 
   // One level: the tests, the children (in parallel where the link bound allows), then the
@@ -296,11 +310,11 @@ class ClusterLinks::RefineRound {
   // the same.
   template <class LinkAt>
   void testLevel(size_t size, LinkAt& linkAt) {
-    wants_.assign(refineAll_ ? 0 : size, 0);
+    fate_.assign(refineAll_ ? 0 : size, Fate::kKeep);
     if (!refineAll_)
       tbb::parallel_for(size_t(0), size, [&](size_t i) {
         const ClusterLink l = linkAt(i);
-        wants_[i] = l.receiver != l.shooter && c_.wantsRefinement(l, epsAbs_);
+        fate_[i] = l.receiver != l.shooter ? c_.fateOf(l, epsAbs_) : Fate::kRefine;
       });
   }
 
@@ -360,6 +374,12 @@ class ClusterLinks::RefineRound {
       const ClusterLink l = linkAt(i);
       current_ = i;
       if (!parallel && made_ + patchPairs_.size() > budget_ + count_) overBudget_ = true;
+      if (drops(i, l)) {  // gone, as a refined link is, with no children
+        c_.nearTests_.push_back({l.receiver, l.shooter, 1});
+        if (firstLevel_) changes(l.receiver);
+        ++count_;
+        continue;
+      }
       if (overBudget_ && !c_.emits(l.shooter)) {
         keep(l);
         continue;
@@ -369,6 +389,8 @@ class ClusterLinks::RefineRound {
         continue;
       }
       if (!parallel) c_.expand(l, append);
+      if (!refineAll_ && l.receiver != l.shooter && fate_[i] == Fate::kRefineNear)
+        c_.nearTests_.push_back({l.receiver, l.shooter, 0});
       if (firstLevel_) changes(l.receiver);
       ++count_;
     }
@@ -390,7 +412,7 @@ class ClusterLinks::RefineRound {
   size_t current_ = 0;  // the first level's index of the link at hand
   std::vector<LinkEnds> work_;
   size_t made_ = 0, count_ = 0;
-  std::vector<char> wants_;  // per link of the level: wantsRefinement (empty: refineAll_)
+  std::vector<Fate> fate_;  // per link of the level: fateOf (empty: refineAll_)
 };
 
 size_t ClusterLinks::refine(double epsAbs, bool refineAll, size_t budget,
@@ -445,6 +467,96 @@ bool ClusterLinks::mayFace(uint32_t t, const ClusterBounds& box) const {
   return farthest > glm::dot(n, centroid_[t]);
 }
 
+ClusterLinks::RayPair ClusterLinks::rayPair(ClusterRef r, ClusterRef s, int i, int k) const {
+  const uint64_t seed = clusterLinkSeed(r, s);
+  // A shooter holding lights is sampled by emitted power: its light comes from them, and the
+  // visibility of its area (a ceiling's, the lights a small part of it) is not that of its light.
+  const std::vector<double>& shooterPrefix = emits(s) ? memberPowerPrefix_ : memberAreaPrefix_;
+  // Each end's member is drawn among those that may face the other end (its plane has some of
+  // the other's bounding box in front): a pair with a member facing away has kernel 0 and
+  // counts for nothing, and with a cluster's six facing groups most area-uniform pairs had
+  // been such (two boxes: 1 of 36). Up to kFacingTries draws, by area (power) as before among
+  // the members that face; V = open kernel / kernel is the same quantity over them, from more
+  // pairs.
+  auto pickFacing = [&](ClusterRef ref, ClusterRef other, int side,
+                        const std::vector<double>& prefix) -> uint32_t {
+    return drawFacingMember(ref, bounds(other), prefix, [&](int t) {
+      return uniformOpen01(seed, t == 0 ? uint64_t(i) * 6 + uint64_t(side)
+                                        : uint64_t(k) * 6 +
+                                              (uint64_t(i) * kFacingTries + uint64_t(t)) * 2 +
+                                              uint64_t(side));
+    });
+  };
+  const uint64_t c = uint64_t(i) * 6;
+  RayPair p;
+  p.a = pickFacing(r, s, 0, memberAreaPrefix_);
+  p.b = pickFacing(s, r, 1, shooterPrefix);
+  p.x = pointOnPolygon(world_[p.a], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
+  p.y = pointOnPolygon(world_[p.b], uniformOpen01(seed, c + 4), uniformOpen01(seed, c + 5));
+  const glm::dvec3 xy = p.y - p.x;
+  const double len2 = glm::dot(xy, xy);
+  p.kernel = len2 > 0.0 ? std::max(0.0, glm::dot(world_[p.a].normal(), xy)) *
+                              std::max(0.0, -glm::dot(world_[p.b].normal(), xy)) / (len2 * len2)
+                        : 0.0;
+  return p;
+}
+
+bool ClusterLinks::blocked(ClusterRef r, ClusterRef s) const {
+  if (!visibility_) return false;
+  // The members of each end whose plane has some of the other end's box in front (the others
+  // see none of it), at most `most` of them (more: the link is not tested).
+  auto facing = [&](ClusterRef end, ClusterRef other, size_t most, std::vector<uint32_t>& out) {
+    const ClusterBounds& box = bounds(other);
+    if (!isCluster(end)) {
+      if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
+      return true;
+    }
+    const ClusterNode& n = tree_.node(clusterIndex(end));
+    for (uint32_t i = n.first; i < n.first + n.count; ++i)
+      if (mayFace(tree_.members()[i], box)) {
+        if (out.size() == most) return false;
+        out.push_back(tree_.members()[i]);
+      }
+    return true;
+  };
+  std::vector<uint32_t> a, b;
+  if (!facing(r, s, kTestedMemberPairs, a)) return false;
+  if (a.empty()) return true;  // nothing of r faces s
+  if (!facing(s, r, kTestedMemberPairs / a.size(), b)) return false;
+  // One ray between the centroids of each pair that face each other there first: where the
+  // ends see each other (most near links of an open room), one of them gets through.
+  for (const uint32_t i : a)
+    for (const uint32_t j : b) {
+      const glm::dvec3 d = centroid_[j] - centroid_[i];
+      if (glm::dot(normal_[i], d) > 0.0 && glm::dot(normal_[j], d) < 0.0 &&
+          !visibility_->occluded(centroid_[i], centroid_[j], i, j))
+        return false;
+    }
+  const uint64_t seed = splitMix64(clusterLinkSeed(r, s) ^ 0x626c6f636b6564ull);  // "blocked"
+  for (const uint32_t i : a)
+    for (const uint32_t j : b) {
+      const Polygon &p = world_[i], &q = world_[j];
+      if (!mutuallyFacing(p, facingPlane(p), q, facingPlane(q))) continue;  // they exchange nothing
+      // Points of each in front of the other's plane: every ray between them carries energy.
+      const uint64_t pairSeed = splitMix64(seed ^ (uint64_t(i) << 32 | j));
+      const std::vector<glm::dvec3> x =
+          VisibilityScene::samplePointsInFront(p, q.v[0], normal_[j], rays_, pairSeed);
+      const std::vector<glm::dvec3> y =
+          VisibilityScene::samplePointsInFront(q, p.v[0], normal_[i], rays_, splitMix64(pairSeed));
+      // y's strata in a random order against x's (a Fisher-Yates shuffle): pairing stratum k with
+      // stratum k would test the same few of the stratum pairs every time.
+      std::vector<int> order(static_cast<size_t>(rays_));
+      for (int k = 0; k < rays_; ++k) order[size_t(k)] = k;
+      const uint64_t shuffle = splitMix64(pairSeed ^ 0x73687566666c65ull);
+      for (int k = rays_ - 1; k > 0; --k)
+        std::swap(order[size_t(k)],
+                  order[size_t(std::min(k, int(uniformOpen01(shuffle, uint64_t(k)) * (k + 1))))]);
+      for (int k = 0; k < rays_; ++k)
+        if (!visibility_->occluded(x[size_t(k)], y[size_t(order[size_t(k)])], i, j)) return false;
+    }
+  return true;
+}
+
 void ClusterLinks::evaluateLink(ClusterLink& l) {
   l.evaluated = true;
   if (reuse_) {  // the values recomputing would give (static ends, no moving object near)
@@ -475,53 +587,18 @@ void ClusterLinks::evaluateLink(ClusterLink& l) {
   // V: k ray pairs between area-uniform points of R's and S's patches, kernel-weighted.
   double v = 1.0;
   if (visibility_) {
-    const uint64_t seed = clusterLinkSeed(l.receiver, l.shooter);
-    // A shooter holding lights is sampled by emitted power: its light comes from them, and the
-    // visibility of its area (a ceiling's, the lights a small part of it) is not that of its light.
-    const std::vector<double>& shooterPrefix =
-        emits(l.shooter) ? memberPowerPrefix_ : memberAreaPrefix_;
     // The pairs first, then the rays: where some pair's kernel is positive, V = open kernel /
     // kernel, and the rays of pairs whose kernel is 0 (facing away: a chair's back, a desk's
     // underside) count for nothing, so they are not cast. Only when every kernel is 0 does V
     // fall back to the open rays' share, and then every ray is cast.
-    struct RayPair {
-      glm::dvec3 x, y;
-      uint32_t a, b;
-      double kernel;
-    };
     const int k = rays_;
     std::array<RayPair, 64> onStack;
     std::vector<RayPair> onHeap(k > 64 ? size_t(k) : 0);
     RayPair* pairs = k > 64 ? onHeap.data() : onStack.data();
-    // Each end's member is drawn among those that may face the other end (its plane has some of
-    // the other's bounding box in front): a pair with a member facing away has kernel 0 and
-    // counts for nothing, and with a cluster's six facing groups most area-uniform pairs had
-    // been such (two boxes: 1 of 36). Up to kFacingTries draws, by area (power) as before among
-    // the members that face; V = open kernel / kernel is the same quantity over them, from more
-    // pairs.
-    auto pickFacing = [&](ClusterRef ref, ClusterRef other, int i, int side,
-                          const std::vector<double>& prefix) -> uint32_t {
-      return drawFacingMember(ref, bounds(other), prefix, [&](int t) {
-        return uniformOpen01(seed, t == 0 ? uint64_t(i) * 6 + uint64_t(side)
-                                          : uint64_t(k) * 6 +
-                                                (uint64_t(i) * kFacingTries + uint64_t(t)) * 2 +
-                                                uint64_t(side));
-      });
-    };
     double sumK = 0.0;
     for (int i = 0; i < k; ++i) {
-      const uint64_t c = uint64_t(i) * 6;
-      RayPair& p = pairs[size_t(i)];
-      p.a = pickFacing(l.receiver, l.shooter, i, 0, memberAreaPrefix_);
-      p.b = pickFacing(l.shooter, l.receiver, i, 1, shooterPrefix);
-      p.x = pointOnPolygon(world_[p.a], uniformOpen01(seed, c + 2), uniformOpen01(seed, c + 3));
-      p.y = pointOnPolygon(world_[p.b], uniformOpen01(seed, c + 4), uniformOpen01(seed, c + 5));
-      const glm::dvec3 xy = p.y - p.x;
-      const double len2 = glm::dot(xy, xy);
-      p.kernel = len2 > 0.0 ? std::max(0.0, glm::dot(world_[p.a].normal(), xy)) *
-                                  std::max(0.0, -glm::dot(world_[p.b].normal(), xy)) / (len2 * len2)
-                            : 0.0;
-      sumK += p.kernel;
+      pairs[size_t(i)] = rayPair(l.receiver, l.shooter, i, k);
+      sumK += pairs[size_t(i)].kernel;
     }
     // V per facing group of R's members, from the same pairs: one V for a receiver cluster
     // spreads the light its open members see over its occluded ones (a chair's seat under a

@@ -8,7 +8,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <map>
+#include <tuple>
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
@@ -163,6 +167,14 @@ void KeyTimeSolver::setThresholds() {
   // A lamp's E has no such bound (I / d^2 near it): with lamps only non-finite B is caught.
   radiosityBound_ = rhoMax < 1.0 && input_.lamps.empty() ? 1e6 * emissionMax / (1.0 - rhoMax)
                                                          : std::numeric_limits<double>::infinity();
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+  for (int t = 0; t < h_.topCount(); ++t)
+    for (int k = 0; k < s_.world[size_t(t)].count; ++k) {
+      lo = glm::min(lo, s_.world[size_t(t)].v[size_t(k)]);
+      hi = glm::max(hi, s_.world[size_t(t)].v[size_t(k)]);
+    }
+  contactDistance_ =
+      h_.topCount() > 0 ? VisibilityScene::kSegmentEpsilon * glm::length(hi - lo) : 0.0;
   epsAbs_ = opt_.eps * (maxComponent(emitted) + lampPower());
   refineOn_ = opt_.refine && epsAbs_ > 0.0;
   stopChange_ = opt_.tol * std::max(1.0 - rhoMax, 1e-6);
@@ -185,11 +197,12 @@ KeySolution KeyTimeSolver::finish() {
     s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
   }
   if (clusters_) {  // at the final B, as the merge gathers the patch links
-    clusters_->gather(B_, exposure_, clusterH_);
+    gatherClusterLight();
     s_.topClusterIrradiance = clusterH_;
     s_.clusterLinks = clusters_->size();
     s_.clusterLinksReused = clusters_->reusedCount();
     s_.clusterBounds = clusters_->clusterBounds();
+    s_.clusterNearTests = clusters_->nearTests();
     // Moved out, and the rest of the cluster links (their gather lists) freed here, not when the
     // solver goes: a copy held beside them until then would raise rad-global's peak at the end of
     // each key's solve.
@@ -205,6 +218,7 @@ KeySolution KeyTimeSolver::finish() {
   for (size_t i = 0; i < closed_.size(); ++i)
     if (closed_[i] >= 0 && !moves(h_.node(int(i)).id.top))
       s_.closedNodes.push_back({h_.node(int(i)).id.packed(), closed_[i] != 0});
+  s_.coveredPoints = std::move(coveredPoints_);
   s_.exposure = std::move(exposure_);
   s_.exposure.resize(size_t(h_.size()), 1.0);
   for (double& e : s_.exposure)

@@ -20,9 +20,12 @@
 //    children's links are evaluated and refined in turn. Refined links are kept (flag
 //    refined) but not gathered;
 //  * accurate pass: leaf links get the accurate unoccluded F (polygonToPolygonFormFactor);
-//  * closure: each leaf's factor c that makes its row sum its own (exact in closed rooms);
-//  * exposure: each node's fraction not covered by a solid standing on it; its links'
-//    irradiance is divided by it, so B is the radiosity of the part that can be seen;
+//  * closure: each leaf's factor c that makes its row sum its own (exact in closed rooms, at
+//    most 1 anywhere);
+//  * exposure: each node's fraction not covered by a solid standing on it or by a surface in
+//    contact with it; its links' irradiance is divided by it, so B is the radiosity of the part
+//    that can be seen (computed for a link's receiver before its visibility, whose pairs from
+//    covered points count as blocked);
 //  * gather + push-pull (HSA'91 §5), Gauss-Seidel over the top-level patches, until the
 //    relative change of B is below tol * (1 - rho_max) (the stop rule of the furnace
 //    reference: a change below tol alone leaves an error of tol / (1 - rho));
@@ -83,6 +86,10 @@ struct KeySolveInput {
   // would be held beside it through the key's solve)
   LeafFormFactorCache* reuseLeafFormFactors = nullptr;
   const ClosedNodeCache* reuseClosed = nullptr;  // coherence: closed-room tests
+  // coherence: the previous key's KeySolution::coveredPoints. A link taken over keeps its V only
+  // where its receiver's covered points are the same at this key (a moving object can change
+  // which ray start points are covered), else its rays are cast again.
+  const std::vector<uint64_t>* reuseCoveredPoints = nullptr;
   // Per top-level patch: it moves at some time of the animation. The closure corrects only
   // pairs of patches that never move (empty: none moves).
   std::vector<char> movingTops;
@@ -125,6 +132,9 @@ struct KeySolution {
   // a solid standing on it (see computeExposures in the .cpp); 1 without a visibility scene.
   // Its radiosity and irradiance are those of the exposed part.
   std::vector<double> exposure;
+  // Per dense node exposed at this key: bit k set when its ray start point k (< 64) is covered
+  // (key_time_exposure.cpp); 0 elsewhere.
+  std::vector<uint64_t> coveredPoints;
   // Per dense node: the (top, F(node -> top)) the closure computed or took over at this key.
   std::vector<std::vector<std::pair<uint32_t, double>>> leafTopFormFactor;
   // The closed-room tests of static nodes cast or taken over at this key: (node id, closed).
@@ -138,6 +148,9 @@ struct KeySolution {
   // the next key's coherence).
   std::vector<ClusterLink> clusterLinkValues;
   std::vector<uint8_t> clusterMemberVisibility;  // ClusterLink::memberVisibility indexes it
+  // The near cluster links tested for being blocked, with the answer (cluster_links.h), for
+  // the next key's coherence.
+  std::vector<NearLinkTest> clusterNearTests;
   std::vector<ClusterBounds> clusterBounds;
   std::vector<Polygon> world;  // per dense node: world polygon at this key
   std::vector<double> area;    // per dense node: world area

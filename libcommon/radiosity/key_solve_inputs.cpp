@@ -40,22 +40,22 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
                         : polygonBounds(prev.world[size_t(r)]);
   };
   const size_t T = size_t(h.topCount());
+  // Both ends static and no moving node's swept bounds meeting the box around both.
+  auto stays = [&](ClusterRef r, ClusterRef s) {
+    if (!isStatic(r) || !isStatic(s)) return false;
+    const ClusterBounds a = box(r), b = box(s);
+    const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
+    for (const auto& m : swept)
+      if (glm::all(glm::lessThanEqual(m[0], hi)) && glm::all(glm::lessThanEqual(lo, m[1])))
+        return false;
+    return true;
+  };
   // Per link, in parallel, whether it is kept; then the kept ones in link order.
   const std::vector<ClusterLink>& links = prev.clusterLinkValues;
   std::vector<char> kept(links.size());
   tbb::parallel_for(size_t(0), links.size(), [&](size_t i) {
     const ClusterLink& l = links[i];
-    if (!l.evaluated || !isStatic(l.receiver) || !isStatic(l.shooter)) {
-      kept[i] = 0;
-      return;
-    }
-    const ClusterBounds a = box(l.receiver), b = box(l.shooter);
-    const glm::dvec3 lo = glm::min(a.lo, b.lo), hi = glm::max(a.hi, b.hi);
-    bool hit = false;
-    for (const auto& s : swept)
-      hit =
-          hit || (glm::all(glm::lessThanEqual(s[0], hi)) && glm::all(glm::lessThanEqual(lo, s[1])));
-    kept[i] = hit ? 0 : 1;
+    kept[i] = l.evaluated && stays(l.receiver, l.shooter) ? 1 : 0;
   });
   std::vector<std::pair<uint32_t, uint32_t>> keys;
   std::vector<CachedClusterLink> values;
@@ -77,6 +77,21 @@ ClusterLinkCache reusableClusterLinks(const KeySolution& prev, const ClusterTree
     }
   cache.links =
       PairTable<CachedClusterLink>(keys, std::move(values), uint32_t(T + size_t(tree.size())));
+  const std::vector<NearLinkTest>& tests = prev.clusterNearTests;
+  std::vector<char> still(tests.size());
+  tbb::parallel_for(size_t(0), tests.size(), [&](size_t i) {
+    still[i] = stays(tests[i].receiver, tests[i].shooter) ? 1 : 0;
+  });
+  std::vector<std::pair<uint32_t, uint32_t>> testKeys;
+  std::vector<uint8_t> answers;
+  for (size_t i = 0; i < tests.size(); ++i)
+    if (still[i]) {
+      testKeys.emplace_back(clusterLinkEnd(tests[i].receiver, T),
+                            clusterLinkEnd(tests[i].shooter, T));
+      answers.push_back(tests[i].blocked);
+    }
+  cache.blocked =
+      PairTable<uint8_t>(testKeys, std::move(answers), uint32_t(T + size_t(tree.size())));
   return cache;
 }
 

@@ -1,5 +1,5 @@
-// The key-time solver's closure (each leaf's own row sum, exact in closed rooms) and exposure
-// (a patch's covered part left out). See key_time_solver.h.
+// The key-time solver's closure (each leaf's own row sum, exact in closed rooms). See
+// key_time_solver.h.
 // The figures behind the reasons given here: docs/results.md, "Figures moved out of the radiosity
 // code's comments (issue 55)".
 #include "libcommon/radiosity/key_time_solver.h"
@@ -12,28 +12,13 @@
 #include <tbb/parallel_sort.h>
 
 #include "libcommon/core/error.h"
+#include "libcommon/radiosity/cosine_rays.h"
 #include "libcommon/radiosity/pair_table.h"
 #include "libcommon/radiosity/visibility.h"
 
 namespace rad {
 
 namespace {
-
-// Cosine-distributed directions about a node's normal (Malley's method), the k-th from two
-// counter-based numbers of `seed`: the exposure's rays and the closed-room test's.
-struct CosineRays {
-  glm::dvec3 normal, t, b;
-  explicit CosineRays(const glm::dvec3& n) : normal(n) {
-    t = std::abs(n.x) > 0.5 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
-    t = glm::normalize(glm::cross(t, n));
-    b = glm::cross(n, t);
-  }
-  glm::dvec3 operator()(uint64_t seed, size_t k) const {
-    const double u = uniformOpen01(seed, 2 * k), v = uniformOpen01(seed, 2 * k + 1);
-    const double r = std::sqrt(u), phi = 2.0 * M_PI * v;
-    return r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1.0 - u) * normal;
-  }
-};
 
 struct TopShare {  // one top-level shooter's links in a leaf's chain
   uint32_t top = 0;
@@ -194,7 +179,7 @@ void KeyTimeSolver::closeLeaf(int r) {
   // The good-link irradiance rad-movies interpolates (Gouraud layer) takes the good share's
   // ratio as one factor.
   if (averaged.y > 0.0) s_.goodClosure[size_t(r)] = own.y / averaged.y;
-  if (opt_.closedRooms) closeRoomRow(r);
+  closeRow(r);
 }
 
 // A leaf's replaced tops' excess irradiance (topExcess_), (emitting shooters, the others).
@@ -209,6 +194,14 @@ std::pair<glm::dvec3, glm::dvec3> KeyTimeSolver::excessIrradiance(int r) const {
   return H;
 }
 
+// A leaf's row sum, the sum of the form factors it gathers through, is at most 1: what it sees is
+// at most its whole hemisphere. The estimates exceed that: by the hierarchy's averaging (a leaf
+// gathers through its ancestors' links their view, and their visibility), which the solve has
+// always carried, and far more where geometry is wrong for the estimates (surfaces in contact, a
+// cluster link kept at the link bound with its point form factor where its ends are near). A row
+// at or above 1 / rho makes the solve diverge (issue 58: --no-closed-rooms on the RenderPark
+// office), so such a row is brought down to 1, in an open scene too.
+//
 // A leaf inside a closed room sees the scene's surfaces and nothing else, so the row sum of its
 // exposed part is exactly 1, occluded links included. An occluded link's visibility is a ratio
 // estimate from a few ray pairs, and its error does not cancel within one receiver: a closed
@@ -217,8 +210,12 @@ std::pair<glm::dvec3, glm::dvec3> KeyTimeSolver::excessIrradiance(int r) const {
 // shooters keep the closure above (mostly unoccluded, and recomputed per texel by the second pass);
 // the others' factor fills the row to 1, each node's links counted over its exposure as the gather
 // divides them. Where every shooter emits (the furnace), or the others' share cannot take the
-// difference, the whole row is scaled.
-void KeyTimeSolver::closeRoomRow(int r) {
+// difference, the whole row is scaled, but raised at most kMaxRowFill times: a row far below 1
+// lacks links (those the link bound cut off, those whose rays all missed), and filling it from the
+// few it has would gather their shooters many times over (a cubby's side gathered its lamp 130
+// times, a floor patch at the link bound its few shooters 2.5e6 times: frames up to 7 times too
+// bright, issue 58); it stays darker than 1 instead.
+void KeyTimeSolver::closeRow(int r) {
   if (!(exposure_[size_t(r)] > 0.0)) return;
   glm::dvec2 coef(0.0);  // (emitting shooters, the others), the replaced tops' excess included
   for (int a = r; a >= 0; a = h_.node(a).parent) {
@@ -229,70 +226,31 @@ void KeyTimeSolver::closeRoomRow(int r) {
   }
   for (const auto& [k, c] : topExcess_[size_t(r)])
     (shooterEmits_[k] ? coef.x : coef.y) += c * s_.links[k].fv();
-  if (!(coef.x + coef.y > 0.0) || !closedAt(r)) return;
-  // The cluster links' share (gathered at the top, over its exposure) is taken as it is.
+  if (!(coef.x + coef.y > 0.0)) return;
+  // The cluster links' share (gathered at the top, over its exposure, at most 1:
+  // gatherClusterLight) is taken as it is.
   const uint32_t top = h_.node(r).id.top;
-  const double cluster = clusterRow_.empty() ? 0.0 : clusterRow_[top];
-  if (!(cluster < 1.0)) return;
+  const double cluster = clusterRow_.empty() ? 0.0 : std::min(clusterRow_[top], 1.0);
+  const double patches = s_.closure[size_t(r)] * coef.x + goodFactor_[size_t(r)] * coef.y;
+  const bool closed = opt_.closedRooms && closedAt(r);
+  const double rho = maxComponent(surfaces_[top].reflectance);
+  if (!closed && (!((cluster + patches) * rho >= 1.0))) return;
   const double good =
       coef.y > 0.0 ? (1.0 - cluster - s_.closure[size_t(r)] * coef.x) / coef.y : 0.0;
-  if (good > 0.5 && good < 2.0) {
+  // The others' factor fills the row (closed) or brings it down (open): the emitting shooters'
+  // links, whose light the second pass recomputes per texel, keep theirs (a ceiling leaf above
+  // a lamp gathers its ancestors' view of the room beside the lamp's own light; scaling the lamp
+  // down with it darkened the ceiling the room is lit from).
+  if (closed ? good > 0.5 && good < 2.0 : coef.y > 0.0 && good >= 0.0) {
     goodFactor_[size_t(r)] = good;
-  } else {
-    s_.closure[size_t(r)] = (1.0 - cluster) / (coef.x + coef.y);
-    goodFactor_[size_t(r)] = s_.closure[size_t(r)];
+    s_.goodClosure[size_t(r)] = closed ? good : s_.goodClosure[size_t(r)] * good;
+    return;
   }
-  s_.goodClosure[size_t(r)] = goodFactor_[size_t(r)];
-}
-
-// Exposure (the darkening at contacts): a box standing on the floor covers part of the floor's
-// patches, whose links' shadow rays then start under the box and are blocked, so the area-averaged
-// H and B of a patch straddling the box's footprint mix the lit part with the dark covered one; the
-// camera sees only the lit part, and the ceiling and walls that gather from that patch see only its
-// lit part too, so the mix darkens every surface of a room with boxes on its floor. A node's
-// exposure e is the fraction of its ray start points (samplePoints, the same for all its links)
-// that are not covered: a point is covered when a cosine-distributed ray from it first meets the
-// back of a one-sided surface (the inside of a solid, the back of a wall). The gather divides a
-// node's links' irradiance by e, so B and H are those of the exposed part (the covered points'
-// pairs are exactly the ones removed), and a parent pulls its children's B weighted by exposed
-// area.
-void KeyTimeSolver::computeExposures() {
-  const size_t N = size_t(h_.size());
-  exposure_.resize(N, -1.0);
-  std::vector<int> todo;
-  for (size_t i = 0; i < N; ++i)
-    if (exposure_[i] < 0.0 && s_.inTree(int(i), h_)) todo.push_back(int(i));
-  tbb::parallel_for(size_t(0), todo.size(),
-                    [&](size_t k) { exposure_[size_t(todo[k])] = exposureOf(todo[k]); });
-}
-
-double KeyTimeSolver::exposureOf(int i) const {
-  if (!input_.visibility) return 1.0;
-  const PatchNode& n = h_.node(i);
-  const Polygon& P = s_.world[size_t(i)];
-  const glm::dvec3 normal = P.normal();
-  if (normal == glm::dvec3(0.0)) return 1.0;
-  const CosineRays direction(normal);
-  const std::vector<glm::dvec3> points =
-      VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(n.id));
-  const uint64_t seed = splitMix64(receiverSeed(n.id));
-  const double size = polygonSize(P);
-  // Undecided rays (a front and a back at one distance: a partition flush with the ceiling,
-  // a sheet of two back-to-back patches) go with the majority of the decided ones.
-  int exposed = 0, inside = 0, undecided = 0;
-  for (size_t k = 0; k < points.size(); ++k) {
-    const glm::dvec3 d = direction(seed, k) * size;  // firstHit's tnear is relative to |d|
-    const RayStart r = rayStart(*input_.visibility, points[k], d, n.id.top, [&](uint32_t hit) {
-      return hit < uint32_t(h_.topCount()) && !surfaces_[hit].doubleSided &&
-             glm::dot(s_.world[hit].normal(), d) > 0.0;
-    });
-    (r == RayStart::kOutside ? exposed : r == RayStart::kInside ? inside : undecided) += 1;
-  }
-  if (inside > exposed)
-    inside += undecided;
-  else
-    exposed += undecided;
-  return points.empty() ? 1.0 : double(exposed) / double(points.size());
+  double scale = (1.0 - cluster) / patches;
+  if (closed) scale = std::min(scale, kMaxRowFill);
+  s_.closure[size_t(r)] *= scale;
+  goodFactor_[size_t(r)] *= scale;
+  s_.goodClosure[size_t(r)] = closed ? goodFactor_[size_t(r)] : s_.goodClosure[size_t(r)] * scale;
 }
 
 }  // namespace rad

@@ -82,6 +82,16 @@ KeyTimeSolver::Pulled KeyTimeSolver::gatherPushPull(int i, const Gathered& down)
   return {B_[size_t(i)] * sum.area, sum.area};
 }
 
+// The irradiance each top gathers through cluster links, with a cluster row above 1 scaled down
+// to 1 (closeRow's reason): near cluster links kept at the link bound, each a point form factor
+// of the shooter's facing groups, summed past 1 on the tops beside them.
+void KeyTimeSolver::gatherClusterLight() {
+  clusters_->gather(B_, exposure_, clusterH_);
+  if (!opt_.closure) return;
+  for (size_t t = 0; t < clusterH_.size() && t < clusterRow_.size(); ++t)
+    if (clusterRow_[t] > 1.0) clusterH_[t] /= clusterRow_[t];
+}
+
 void KeyTimeSolver::buildSweepLists() {
   sweepCoefficient_.resize(adj_.size());
   tbb::parallel_for(size_t(0), adj_.size(), [&](size_t k) {
@@ -102,7 +112,7 @@ void KeyTimeSolver::solve() {
     maxDelta_ = maxB_ = 0;
     // Cluster links gather from the B of the sweep before (Jacobi for them, Gauss-Seidel
     // for the patch links).
-    if (clusters_) clusters_->gather(B_, exposure_, clusterH_);
+    if (clusters_) gatherClusterLight();
     for (int t = 0; t < h_.topCount(); ++t) {
       Gathered top;
       if (clusters_) top.cluster = clusterH_[size_t(t)];

@@ -83,6 +83,7 @@ void KeyTimeSolver::measureShooterRanges() {
 // since the last call, in parallel (each link writes only itself).
 void KeyTimeSolver::evaluateNewLinks() {
   size_t begin = evaluated_, end = s_.links.size();
+  exposeReceivers(begin, end);  // their covered points' pairs count as blocked
   tbb::parallel_for(begin, end, [&](size_t li) { evaluateLink(s_.links[li]); });
   evaluated_ = end;
 }
@@ -94,11 +95,11 @@ void KeyTimeSolver::evaluateLink(SolverLink& l) const {
   const Polygon& Q = s_.world[size_t(l.shooter)];
   auto shadowRays = [&] {
     l.openPairs = ~uint64_t(0);
-    return input_.visibility
-               ? input_.visibility->visibilityFrom(
-                     VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)), P.normal(), Q,
-                     linkSeed(r.id, q.id), r.id.top, q.id.top, &l.openPairs)
-               : 1.0;
+    return input_.visibility ? input_.visibility->visibilityFrom(
+                                   VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)),
+                                   P.normal(), Q, linkSeed(r.id, q.id), r.id.top, q.id.top,
+                                   &l.openPairs, coveredPoints_[size_t(l.receiver)])
+                             : 1.0;
   };
   if (input_.reuse) {
     const uint32_t known = input_.reuse->indexOf(uint32_t(l.receiver), uint32_t(l.shooter));
@@ -110,7 +111,11 @@ void KeyTimeSolver::evaluateLink(SolverLink& l) const {
       l.estimate = c.estimate;
       l.spreadArea = c.spreadArea;
       l.formFactor = l.estimate;
-      if (c.visibilityValid) {
+      const std::vector<uint64_t>* before = input_.reuseCoveredPoints;
+      const bool sameCover =
+          !before || (size_t(l.receiver) < before->size() &&
+                      (*before)[size_t(l.receiver)] == coveredPoints_[size_t(l.receiver)]);
+      if (c.visibilityValid && sameCover) {
         l.rayVisibility = c.visibility;
         l.openPairs = c.openPairs;
         l.reused = true;
@@ -268,7 +273,8 @@ void KeyTimeSolver::weightLinkVisibility(SolverLink& l) const {
   double seen = -1.0;
   const double v = input_.visibility->weightedVisibilityFrom(
       VisibilityScene::samplePoints(P, opt_.rays, receiverSeed(r.id)), P.normal(), Q,
-      linkSeed(r.id, q.id), r.id.top, q.id.top, &l.openPairs, radiosityAt, nullptr, &seen);
+      linkSeed(r.id, q.id), r.id.top, q.id.top, &l.openPairs, radiosityAt, nullptr, &seen,
+      coveredPoints_[size_t(l.receiver)]);
   setWeightedVisibility(l, v, seen);
 }
 

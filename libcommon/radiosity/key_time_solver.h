@@ -5,7 +5,8 @@
 //    thresholds and the solution handed back (finish);
 //  * key_time_links.cpp: link (cluster links' refinement), evaluate, refine, the accurate pass
 //    and the radiosity-weighted visibility;
-//  * key_time_closure.cpp: closure (each leaf's own row sum) and exposure;
+//  * key_time_closure.cpp: closure (each leaf's own row sum);
+//  * key_time_exposure.cpp: exposure (which ray start points are covered);
 //  * key_time_gather.cpp: gather + push-pull, the Gauss-Seidel sweeps.
 // Nothing outside libcommon/radiosity includes this file; the contract is solveKeyTime's.
 #pragma once
@@ -101,12 +102,24 @@ class KeyTimeSolver {
   void closeLeaf(int r);
 
   std::pair<glm::dvec3, glm::dvec3> excessIrradiance(int r) const;
-  void closeRoomRow(int r);
+  // A leaf's row: at most 1, and exactly 1 inside a closed room (key_time_closure.cpp).
+  void closeRow(int r);
+  // How many times a closed room's row may be raised to reach 1 (closeRow).
+  static constexpr double kMaxRowFill = 2.0;
+  // Exposure (key_time_exposure.cpp): exposure_ and coveredPoints_ of every node of this key's
+  // tree not yet exposed, of the receivers of links [begin, end), of node i.
   void computeExposures();
-  double exposureOf(int i) const;
+  void exposeReceivers(size_t begin, size_t end);
+  void expose(int i);
+  bool inContact(const glm::dvec3& x, const glm::dvec3& normal, uint32_t top) const;
+  // Heights within this share of a point's coordinates are on its plane (rounding); normals whose
+  // cosine is below minus this face each other (a milliradian, contact_cuts.h's parallel).
+  static constexpr double kContactRounding = 1e-6;
+  static constexpr double kContactParallel = 0.9999995;
 
   // Gather + push-pull, the Gauss-Seidel sweeps (key_time_gather.cpp).
   void buildGatherLists();
+  void gatherClusterLight();
 
   // What a node gives its parent's pull: its exposed area e A and e A B.
   struct Pulled {
@@ -151,7 +164,14 @@ class KeyTimeSolver {
   std::vector<size_t> adjStart_;
   std::vector<LinkIndex> adj_;
   std::vector<glm::dvec3> irr_;   // per dense node: H gathered at it and its ancestors
-  std::vector<double> exposure_;  // per dense node: exposureOf once computed, else < 0
+  std::vector<double> exposure_;  // per dense node: its exposure once exposed, else < 0
+  // Per dense node, once exposed: bit k set when its sample point k (< 64) is covered; the pairs
+  // of its links from those points count as blocked (key_time_exposure.cpp).
+  std::vector<uint64_t> coveredPoints_;
+  // How near a surface in front of a point puts the point in a contact gap (inContact): the part
+  // of a shadow ray the visibility skips at each end, kSegmentEpsilon of its length, for the
+  // longest link (the diagonal of the tops' bounds at this key).
+  double contactDistance_ = 0;
   // Per dense node: the closure factor of a leaf's links to shooters that do not emit (its
   // closure factor, or the closed-room one).
   std::vector<double> goodFactor_;

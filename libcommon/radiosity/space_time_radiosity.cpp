@@ -308,11 +308,13 @@ class KeyTimePass {
       }
       std::vector<ClusterLink>().swap(prev.clusterLinkValues);
       std::vector<uint8_t>().swap(prev.clusterMemberVisibility);
+      std::vector<NearLinkTest>().swap(prev.clusterNearTests);
       // The closure integrates only pairs of patches that never move (KeySolveInput::
       // movingTops), so every leaf-to-top form factor prev kept stays valid; the union
       // hierarchy's dense node numbering is the same at every key. The solve takes them over.
       in.reuseLeafFormFactors = &prev.leafTopFormFactor;
       in.reuseClosed = &closedCache_;
+      in.reuseCoveredPoints = &prev.coveredPoints;
       in.releaseRayPairs = [&] { std::vector<LinkRayPair>().swap(prev.rayPairs); };
       in.releaseClusterLinks = [&] { clusterCache = ClusterLinkCache(); };
       if (!lamps.lamps.empty()) {

@@ -482,16 +482,17 @@ struct PairTally {
 double VisibilityScene::visibilityFrom(const std::vector<glm::dvec3>& aPoints,
                                        const glm::dvec3& aNormal, const Polygon& b,
                                        std::uint64_t seed, std::uint32_t ignoreA,
-                                       std::uint32_t ignoreB, std::uint64_t* openPairs) const {
+                                       std::uint32_t ignoreB, std::uint64_t* openPairs,
+                                       std::uint64_t blockedPairs) const {
   return weightedVisibilityFrom(aPoints, aNormal, b, seed, ignoreA, ignoreB, nullptr, nullptr,
-                                openPairs);
+                                openPairs, nullptr, blockedPairs);
 }
 
 double VisibilityScene::weightedVisibilityFrom(
     const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal, const Polygon& b,
     std::uint64_t seed, std::uint32_t ignoreA, std::uint32_t ignoreB,
     const std::uint64_t* knownOpenPairs, const std::function<double(const glm::dvec3&)>& weightAtB,
-    std::uint64_t* openPairs, double* kernelMeanWeight) const {
+    std::uint64_t* openPairs, double* kernelMeanWeight, std::uint64_t blockedPairs) const {
   const int k = int(aPoints.size());
   if (k == 0) return 1.0;
   const std::vector<glm::dvec3> bPoints = pairedPoints(b, k, seed);
@@ -503,8 +504,11 @@ double VisibilityScene::weightedVisibilityFrom(
     const glm::dvec3 pa = aPoints[size_t(i)], pb = bPoints[size_t(i)];
     const int bit = i % kMaxRecordedPairs;
     if (!known && bit == 0)  // the next (up to) 64 pairs' segments, in packets
-      chunk = openSegments(&aPoints[size_t(i)], 1, &bPoints[size_t(i)], k - i, ignoreA, ignoreB);
-    const bool isOpen = known ? ((*knownOpenPairs >> i) & 1u) != 0 : ((chunk >> bit) & 1u) != 0;
+      chunk = openSegments(&aPoints[size_t(i)], 1, &bPoints[size_t(i)], k - i, ignoreA, ignoreB,
+                           i == 0 ? ~blockedPairs : ~std::uint64_t(0));
+    const bool blocked = i < kMaxRecordedPairs && ((blockedPairs >> i) & 1u) != 0;
+    const bool isOpen =
+        !blocked && (known ? ((*knownOpenPairs >> i) & 1u) != 0 : ((chunk >> bit) & 1u) != 0);
     if (isOpen && i < kMaxRecordedPairs) open |= std::uint64_t(1) << i;
     tally.add(isOpen, pairKernel(pa, aNormal, pb, bNormal),
               weightAtB ? std::max(0.0, weightAtB(pb)) : 1.0);

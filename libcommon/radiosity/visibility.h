@@ -90,10 +90,12 @@ class VisibilityScene {
   // count lets pairs that exchange no energy (behind either plane) decide the link's
   // visibility. When no sample pair has K > 0, the area-uniform fraction.
   // `openPairs`, when given, receives bit i set for each unoccluded pair i < kMaxRecordedPairs.
+  // The pairs i < kMaxRecordedPairs whose bit is set in `blockedPairs` count as occluded and cast
+  // no ray (a's covered points: rad-global's exposure).
   double visibilityFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
                         const Polygon& b, std::uint64_t seed, std::uint32_t ignoreA = kNoSurface,
-                        std::uint32_t ignoreB = kNoSurface,
-                        std::uint64_t* openPairs = nullptr) const;
+                        std::uint32_t ignoreB = kNoSurface, std::uint64_t* openPairs = nullptr,
+                        std::uint64_t blockedPairs = 0) const;
   // visibilityFrom with each pair's kernel also weighted by weightAtB(its point on b):
   //   $V_w = \sum_i K_i w(y_i) v_i / \sum_i K_i w(y_i)$.
   // With w = the shooter's radiosity this is the share of the power leaving b towards a that
@@ -102,12 +104,14 @@ class VisibilityScene {
   // the same arguments) spares the rays when k <= kMaxRecordedPairs. A null weightAtB: w = 1.
   // kernelMeanWeight, when given, receives $\sum_i K_i w(y_i) / \sum_i K_i$ over all pairs, open
   // or not (the shooter's radiosity as the receiver sees it; -1 when no pair carries energy).
+  // `blockedPairs` as visibilityFrom's.
   double weightedVisibilityFrom(const std::vector<glm::dvec3>& aPoints, const glm::dvec3& aNormal,
                                 const Polygon& b, std::uint64_t seed, std::uint32_t ignoreA,
                                 std::uint32_t ignoreB, const std::uint64_t* knownOpenPairs,
                                 const std::function<double(const glm::dvec3&)>& weightAtB,
                                 std::uint64_t* openPairs = nullptr,
-                                double* kernelMeanWeight = nullptr) const;
+                                double* kernelMeanWeight = nullptr,
+                                std::uint64_t blockedPairs = 0) const;
   static constexpr int kMaxRecordedPairs = 64;
   // The pairs weightedVisibilityFrom makes from the same arguments: b's points (bPoints[i]
   // paired with aPoints[i]) and each pair's kernel K_i. For a caller that weights the same
