@@ -211,7 +211,12 @@ struct PathTracer::Impl {
     }
     if (!emitterCdf.empty()) emitterCdf.back() = 1.0;
     if (!(sceneSize > 0.0)) sceneSize = 1.0;
+    buildBvh();
+  }
 
+  // The BVH of `surfaces`, each polygon a fan of triangles (0, k, k+1); polygonOf and fanIndex
+  // map a hit triangle back to its polygon.
+  void buildBvh() {
     if (bvh) rtcReleaseScene(bvh);
     bvh = rtcNewScene(device);
     check("rtcNewScene");
