@@ -213,14 +213,4 @@ GltfSceneFile readGltfSceneFile(const std::string& path, bool requireJson) {
   return f;
 }
 
-int punctualLightsInFile(const GltfSceneFile& file) {
-  if (!file.document.is_object()) return 0;
-  const auto ext = file.document.find("extensions");
-  if (ext == file.document.end() || !ext->is_object()) return 0;
-  const auto lights = ext->find("KHR_lights_punctual");
-  if (lights == ext->end() || !lights->is_object()) return 0;
-  const auto list = lights->find("lights");
-  return list != lights->end() && list->is_array() ? int(list->size()) : 0;
-}
-
 }  // namespace rad

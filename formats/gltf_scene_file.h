@@ -31,8 +31,4 @@ struct GltfSceneFile {
 // `requireJson`, which refuses them as `invalid gltf: ...`.
 GltfSceneFile readGltfSceneFile(const std::string& path, bool requireJson = false);
 
-// The KHR_lights_punctual lights the file lists (its `extensions.KHR_lights_punctual.lights`),
-// whether or not the reader supports or reads them; 0 without the extension or a document.
-int punctualLightsInFile(const GltfSceneFile& file);
-
 }  // namespace rad

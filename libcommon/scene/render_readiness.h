@@ -12,15 +12,14 @@
 namespace rad {
 
 // What the scene lacks for the pipeline, one sentence each that says what to export (empty: it
-// can be rendered). An emitter is a mesh of the displayed scene with an emissive material
-// (missingEmitterMessage), or one of the `lightsInFile` KHR_lights_punctual lights the file lists
-// (counted from the file, whether or not the reader supports lights: the stage that cannot use
-// them says so itself). A camera is any camera node of the displayed scene. No solve: it takes
-// the time of reading the file.
-std::vector<std::string> renderReadinessProblems(const Scene& scene, int lightsInFile);
+// can be rendered). Something emits as the stages see it (missingEmitterMessage: a mesh of the
+// displayed scene with an emissive material, or a KHR_lights_punctual lamp on one of its nodes).
+// A camera is any camera node of the displayed scene. No solve: it takes the time of reading the
+// file.
+std::vector<std::string> renderReadinessProblems(const Scene& scene);
 
 // Throws rad::Error (kBadInput) `path: problem; problem` when renderReadinessProblems is not
 // empty.
-void requireRenderReadiness(const Scene& scene, int lightsInFile);
+void requireRenderReadiness(const Scene& scene);
 
 }  // namespace rad

@@ -66,13 +66,18 @@ class Gltf:
 
     def mesh(self, name, quads, material):
         """quads: lists of 3 or 4 corners, CCW seen from the front."""
-        verts, idx = [], []
+        verts, tris = [], []
         for q in quads:
             base = len(verts)
             verts.extend(q)
-            idx.extend([base, base + 1, base + 2])
+            tris.append((base, base + 1, base + 2))
             if len(q) == 4:
-                idx.extend([base, base + 2, base + 3])
+                tris.append((base, base + 2, base + 3))
+        return self.indexed_mesh(name, verts, tris, material)
+
+    def indexed_mesh(self, name, verts, tris, material):
+        """verts: 3D points; tris: index triples, CCW seen from the front (shared vertices)."""
+        idx = [i for t in tris for i in t]
         pv = self.view(b"".join(struct.pack("<3f", *v) for v in verts), 34962)
         iv = self.view(b"".join(struct.pack("<H", i) for i in idx), 34963)
         lo = [f32(min(v[k] for v in verts)) for k in range(3)]

@@ -25,12 +25,12 @@ deterministic, so regenerated files are byte-identical.
 usage: make_seam_scenes.py OUTDIR [NAME ...]     (no NAME: every scene)
 """
 import argparse
-import base64
-import json
 import math
 import os
-import struct
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import make_paper_scenes as paper  # noqa: E402
 
 FPS = 24.0
 WHITE, FLOOR, WOOD, LIGHT = range(4)
@@ -42,111 +42,14 @@ MATERIALS = [
 ]
 
 
-def f32(x):
-    return struct.unpack("<f", struct.pack("<f", x))[0]
-
-
-class Gltf:
-    def __init__(self, name):
-        self.name = name
-        self.buffer = bytearray()
-        self.views, self.accessors, self.meshes, self.nodes = [], [], [], []
-        self.samplers, self.channels = [], []
-        self.cameras = []
-
-    def view(self, data, target=None):
-        while len(self.buffer) % 4:
-            self.buffer.append(0)
-        v = {"buffer": 0, "byteOffset": len(self.buffer), "byteLength": len(data)}
-        if target:
-            v["target"] = target
-        self.views.append(v)
-        self.buffer.extend(data)
-        return len(self.views) - 1
+class Gltf(paper.Gltf):
+    """make_paper_scenes' glTF writer with this file's materials; meshes are indexed."""
 
     def mesh(self, name, verts, tris, material):
-        """verts: 3D points; tris: index triples, CCW seen from the front (shared vertices)."""
-        pv = self.view(b"".join(struct.pack("<3f", *v) for v in verts), 34962)
-        iv = self.view(b"".join(struct.pack("<H", i) for t in tris for i in t), 34963)
-        lo = [f32(min(v[k] for v in verts)) for k in range(3)]
-        hi = [f32(max(v[k] for v in verts)) for k in range(3)]
-        self.accessors.append({"bufferView": pv, "componentType": 5126, "count": len(verts),
-                               "type": "VEC3", "min": lo, "max": hi})
-        self.accessors.append({"bufferView": iv, "componentType": 5123, "count": 3 * len(tris),
-                               "type": "SCALAR"})
-        n = len(self.accessors)
-        self.meshes.append({"name": name, "primitives": [
-            {"attributes": {"POSITION": n - 2}, "indices": n - 1, "material": material}]})
-        return len(self.meshes) - 1
-
-    def node(self, name, mesh=None, translation=None, rotation=None, camera=None):
-        n = {"name": name}
-        if mesh is not None:
-            n["mesh"] = mesh
-        if camera is not None:
-            n["camera"] = camera
-        if translation is not None:
-            n["translation"] = [float(x) for x in translation]
-        if rotation is not None:
-            n["rotation"] = [float(x) for x in rotation]
-        self.nodes.append(n)
-        return len(self.nodes) - 1
-
-    def floats(self, values, kind):
-        v = self.view(b"".join(struct.pack("<f", x) for x in values))
-        n = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[kind]
-        a = {"bufferView": v, "componentType": 5126, "count": len(values) // n, "type": kind}
-        if kind == "SCALAR":
-            a["min"], a["max"] = [f32(min(values))], [f32(max(values))]
-        self.accessors.append(a)
-        return len(self.accessors) - 1
-
-    def animate(self, node, path, times, values):
-        """values: one tuple per key time (3 for translation, 4 for rotation x y z w)."""
-        t = self.floats(times, "SCALAR")
-        o = self.floats([c for v in values for c in v], "VEC3" if path == "translation" else "VEC4")
-        self.samplers.append({"input": t, "output": o, "interpolation": "LINEAR"})
-        self.channels.append({"sampler": len(self.samplers) - 1,
-                              "target": {"node": node, "path": path}})
-        self.nodes[node][path] = [float(x) for x in values[0]]
-
-    def camera(self, yfov):
-        self.cameras.append({"name": "camera", "type": "perspective",
-                             "perspective": {"yfov": yfov, "znear": 0.02, "zfar": 50.0}})
-        return len(self.cameras) - 1
+        return self.indexed_mesh(name, verts, tris, material)
 
     def write(self, path, light_strength):
-        mats = []
-        for name, rgb, emission in MATERIALS:
-            m = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(rgb) + [1.0],
-                                                        "metallicFactor": 0.0,
-                                                        "roughnessFactor": 1.0}}
-            if emission:
-                m["emissiveFactor"] = list(emission)
-                m["extensions"] = {"KHR_materials_emissive_strength":
-                                   {"emissiveStrength": light_strength}}
-            mats.append(m)
-        g = {
-            "asset": {"version": "2.0", "generator": "rad pipelines/scenes/make_seam_scenes.py"},
-            "extensionsUsed": ["KHR_materials_emissive_strength"],
-            "scene": 0,
-            "scenes": [{"name": self.name, "nodes": list(range(len(self.nodes)))}],
-            "nodes": self.nodes,
-            "meshes": self.meshes,
-            "materials": mats,
-            "cameras": self.cameras,
-            "accessors": self.accessors,
-            "bufferViews": self.views,
-            "buffers": [{"byteLength": len(self.buffer),
-                         "uri": "data:application/octet-stream;base64," +
-                                base64.b64encode(bytes(self.buffer)).decode()}],
-        }
-        if self.channels:
-            g["animations"] = [{"name": "motion", "samplers": self.samplers,
-                                "channels": self.channels}]
-        with open(path, "w") as f:
-            json.dump(g, f, indent=1)
-            f.write("\n")
+        super().write(path, light_strength, MATERIALS)
 
 
 # --- tessellations (2D, in a wall's plane) --------------------------------------------------
@@ -321,16 +224,7 @@ def pierced_wall(W, H, window):
 
 def box(x0, y0, z0, x1, y1, z1, bottom=True):
     """Axis-aligned box, faces outwards, as (verts, tris)."""
-    q = [
-        [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)],  # +y
-        [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)],  # +z
-        [(x1, y0, z0), (x0, y0, z0), (x0, y1, z0), (x1, y1, z0)],  # -z
-        [(x1, y0, z1), (x1, y0, z0), (x1, y1, z0), (x1, y1, z1)],  # +x
-        [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)],  # -x
-    ]
-    if bottom:
-        q.append([(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)])  # -y
-    return quads(q)
+    return quads(paper.box(x0, y0, z0, x1, y1, z1, bottom))
 
 
 def quads(qs):
