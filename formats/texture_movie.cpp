@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <regex>
+#include <tuple>
 #include <utility>
 
 #include <OpenEXR/ImfChannelList.h>
@@ -94,7 +95,20 @@ std::string textureMoviePath(const std::string& dir, uint32_t id) {
   return dir + name;
 }
 
+std::string textureMoviePiecePath(const std::string& dir, uint32_t id, int index) {
+  char name[48];
+  std::snprintf(name, sizeof name, "/%06u.piece-%04d.exr", id, index);
+  return dir + name;
+}
+
 namespace {
+
+std::string formatVersion(const TextureMoviePiece& piece) {
+  return piece.isPiece() ? "texture-movie-piece " + std::to_string(kTextureMoviePieceMajor) + "." +
+                               std::to_string(kTextureMoviePieceMinor)
+                         : "texture-movie " + std::to_string(kTextureMovieMajor) + "." +
+                               std::to_string(kTextureMovieMinor);
+}
 
 // The part headers of a movie with the given keys (key frames/times of the parts).
 std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<int>& keyFrames,
@@ -114,9 +128,7 @@ std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<i
     std::snprintf(name, sizeof name, "key%04zu", k);
     h.setName(name);
     h.setType(Imf::SCANLINEIMAGE);
-    h.insert("rad.format",
-             Imf::StringAttribute("texture-movie " + std::to_string(kTextureMovieMajor) + "." +
-                                  std::to_string(kTextureMovieMinor)));
+    h.insert("rad.format", Imf::StringAttribute(formatVersion(m.piece)));
     h.insert("rad.movie", Imf::IntAttribute(int(m.movie)));
     h.insert("rad.patch", Imf::StringAttribute(m.patch.toString()));
     h.insert("rad.patchPacked", Imf::StringAttribute(std::to_string(m.patch.packed())));
@@ -128,6 +140,13 @@ std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<i
     h.insert("rad.keyFrame", Imf::IntAttribute(keyFrames[k]));
     h.insert("rad.keyTime", Imf::DoubleAttribute(keyTimes[k]));
     h.insert("rad.units", Imf::StringAttribute("irradiance W/m^2"));
+    if (m.piece.isPiece()) {  // texture_movie_piece.md
+      h.insert("rad.pieceIndex", Imf::IntAttribute(m.piece.index));
+      h.insert("rad.pieceCount", Imf::IntAttribute(m.piece.count));
+      h.insert("rad.pieceFirstKey", Imf::IntAttribute(m.piece.firstKey));
+      h.insert("rad.pieceKeys", Imf::IntAttribute(m.piece.keys));
+      h.insert("rad.movieKeyCount", Imf::IntAttribute(m.piece.movieKeys));
+    }
     if (k == 0 && !m.provenanceJson.empty())
       h.insert("rad.provenance", Imf::StringAttribute(m.provenanceJson));
     // The pixels are not known yet when the headers are written (keys stream in): a
@@ -163,6 +182,7 @@ TextureMovieWriter::TextureMovieWriter(std::string path, const TextureMovie& mov
   meta_.keyFrames = movie.keyFrames;
   meta_.keyTimes = movie.keyTimes;
   meta_.provenanceJson = movie.provenanceJson;
+  meta_.piece = movie.piece;
   if (meta_.keyFrames.empty() || meta_.keyFrames.size() != meta_.keyTimes.size())
     throw Error(ExitCode::kInternal, path_, "texture movie keys, times and frames differ");
   if (meta_.width < 1 || meta_.height < 1)
@@ -357,11 +377,57 @@ class PartAttributes {
   const std::string& path_;
 };
 
+// rad.format names what the reader expects (`kind`) in a version it reads. A piece read where a
+// whole movie is expected (or the reverse) is refused by name: rad-compose must never take the
+// first keys of a movie for the movie.
+void checkFormatVersion(const PartAttributes& h, const std::string& fmt, MovieFileKind kind,
+                        const std::string& path) {
+  const std::string piecePrefix = "texture-movie-piece ", wholePrefix = "texture-movie ";
+  const bool isPiece = fmt.rfind(piecePrefix, 0) == 0;
+  if (!isPiece && fmt.rfind(wholePrefix, 0) != 0) throw inputError(path, "not a texture movie");
+  if (isPiece && kind == MovieFileKind::kWhole)
+    throw inputError(path, "a piece of texture movie " + std::to_string(h.integer("rad.movie")) +
+                               " (" + fmt +
+                               "), not a whole movie: rad-movies --merge-pieces "
+                               "joins the pieces into the movie");
+  if (!isPiece && kind == MovieFileKind::kPiece)
+    throw inputError(path, "a whole texture movie, not a piece of one (texture-movie-piece)");
+  const std::string version = fmt.substr(isPiece ? piecePrefix.size() : wholePrefix.size());
+  const int major = std::atoi(version.c_str());
+  const int supported = isPiece ? kTextureMoviePieceMajor : kTextureMovieMajor;
+  if (!isPiece && major < kTextureMovieMajor)
+    throw inputError(path, "texture-movie version " + version +
+                               " is no longer read (its pixels carry no checksum): re-run "
+                               "rad-movies");
+  if (major != supported)
+    throw inputError(path, fmt.substr(0, fmt.find(' ')) + " version " + version + ", expected " +
+                               std::to_string(supported) + ".x");
+}
+
+// A piece's place in its movie (texture_movie_piece.md), checked against the file's `parts`.
+TextureMoviePiece pieceOf(const PartAttributes& h, int parts, const std::string& path,
+                          const std::string& part) {
+  TextureMoviePiece p;
+  p.index = h.integer("rad.pieceIndex");
+  p.count = h.integer("rad.pieceCount");
+  p.firstKey = h.integer("rad.pieceFirstKey");
+  p.keys = h.integer("rad.pieceKeys");
+  p.movieKeys = h.integer("rad.movieKeyCount");
+  if (p.count < 1 || p.index < 0 || p.index >= p.count || p.firstKey < 0 || p.keys < 1 ||
+      p.movieKeys < 1 || int64_t(p.firstKey) + p.keys > p.movieKeys ||
+      (parts != p.keys && parts != 1))
+    throw inputError(path, part + ": piece " + std::to_string(p.index) + " of " +
+                               std::to_string(p.count) + ", keys " + std::to_string(p.firstKey) +
+                               "+" + std::to_string(p.keys) + " of " + std::to_string(p.movieKeys) +
+                               " in " + std::to_string(parts) + " parts: inconsistent");
+  return p;
+}
+
 // Every part's header checked and the movie's metadata filled in (keys left empty), from a core
 // context: OpenEXR's C++ reader, which this replaces, builds every part's Header (a map of
 // allocated attributes) and reads the chunk tables, where the core context parses the headers
 // alone.
-TextureMovie readHeaders(exr_const_context_t ctx, const std::string& path) {
+TextureMovie readHeaders(exr_const_context_t ctx, const std::string& path, MovieFileKind kind) {
   TextureMovie m;
   int parts = 0;
   if (exr_get_count(ctx, &parts) != EXR_ERR_SUCCESS || parts < 1)
@@ -370,15 +436,16 @@ TextureMovie readHeaders(exr_const_context_t ctx, const std::string& path) {
     const PartAttributes h(ctx, k, path);
     const std::string part = "part " + std::to_string(k);
     const std::string fmt = h.string("rad.format");
-    if (fmt.rfind("texture-movie ", 0) != 0) throw inputError(path, "not a texture movie");
-    int major = std::atoi(fmt.c_str() + 14);
-    if (major < kTextureMovieMajor)
-      throw inputError(path, "texture-movie version " + fmt.substr(14) +
-                                 " is no longer read (its pixels carry no checksum): re-run "
-                                 "rad-movies");
-    if (major != kTextureMovieMajor)
-      throw inputError(path, "texture-movie version " + fmt.substr(14) + ", expected " +
-                                 std::to_string(kTextureMovieMajor) + ".x");
+    checkFormatVersion(h, fmt, kind, path);
+    if (kind == MovieFileKind::kPiece) {
+      const TextureMoviePiece piece = pieceOf(h, parts, path, part);
+      if (k > 0 &&
+          std::tie(piece.index, piece.count, piece.firstKey, piece.keys, piece.movieKeys) !=
+              std::tie(m.piece.index, m.piece.count, m.piece.firstKey, m.piece.keys,
+                       m.piece.movieKeys))
+        throw inputError(path, part + ": piece attributes differ from part 0's");
+      m.piece = piece;
+    }
     const std::optional<std::string> stored = h.optionalString(kPixelChecksumAttribute);
     m.keyChecksums.push_back(requiredPixelChecksum(stored ? &*stored : nullptr, path, part));
     exr_attr_box2i_t dw;
@@ -452,10 +519,10 @@ TextureMovie readTextureMovie(const std::string& path) {
   return stream.movie();
 }
 
-TextureMovie readTextureMovieHeaders(const std::string& path) {
+TextureMovie readTextureMovieHeaders(const std::string& path, MovieFileKind kind) {
   return readingExr(path, [&] {
     scanExrFile(path);
-    return readHeaders(CoreExrFile(path).ctx, path);
+    return readHeaders(CoreExrFile(path).ctx, path, kind);
   });
 }
 
@@ -531,10 +598,11 @@ struct TextureMovieStream::Reader {
   }
 };
 
-TextureMovieStream::TextureMovieStream(std::string path) : path_(std::move(path)) {
+TextureMovieStream::TextureMovieStream(std::string path, MovieFileKind kind)
+    : path_(std::move(path)) {
   readingExr(path_, [&] { return scanExrFile(path_); });
   open();
-  movie_ = readHeaders(reader_->ctx, path_);
+  movie_ = readHeaders(reader_->ctx, path_, kind);
   movie_.keys.assign(movie_.keyTimes.size(), {});
 }
 

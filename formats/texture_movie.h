@@ -19,6 +19,22 @@ namespace rad {
 
 constexpr int kTextureMovieMajor = 2;
 constexpr int kTextureMovieMinor = 1;
+// A piece of a movie (formats/texture_movie_piece.md) has a format of its own, so that no reader
+// of whole movies takes one for a whole movie.
+constexpr int kTextureMoviePieceMajor = 1;
+constexpr int kTextureMoviePieceMinor = 0;
+
+// Which keys of its movie a file holds. A render farm task may bake a long movie's keys as
+// pieces of consecutive keys (rad-movies --piece-keys), each its own file, and one merge joins
+// them into the whole movie, byte for byte the movie one task bakes (--merge-pieces;
+// docs/design.md §6.3). count == 0: the whole movie.
+struct TextureMoviePiece {
+  int index = 0, count = 0;  // piece `index` of `count`
+  int firstKey = 0;          // the movie's index of the piece's first key
+  int keys = 0;              // keys the piece covers (its parts: these, or 1 when all are equal)
+  int movieKeys = 0;         // keys of the whole movie
+  bool isPiece() const { return count > 0; }
+};
 
 struct TextureMovie {
   uint32_t movie = 0;  // id in intervals.rti
@@ -35,6 +51,9 @@ struct TextureMovie {
   // Read from the file: each part's rad.pixelChecksum (formats/pixel_checksum.h), which the
   // readers verify against the pixels they decode. Writers compute their own.
   std::vector<uint64_t> keyChecksums;
+  // A piece's place in its movie (keyFrames, keyTimes and keys are then the piece's); a whole
+  // movie's count is 0.
+  TextureMoviePiece piece;
 
   bool constant() const { return keys.size() == 1; }
   // Irradiance texture at time t: linear between the two key textures around t (held before
@@ -54,6 +73,8 @@ TextureMovie textureMovieOf(const MovieExtent& extent, std::string provenanceJso
 
 // Path of movie `id` in `dir`: dir/000042.exr.
 std::string textureMoviePath(const std::string& dir, uint32_t id);
+// Path of piece `index` of movie `id` in `dir`: dir/000042.piece-0003.exr.
+std::string textureMoviePiecePath(const std::string& dir, uint32_t id, int index);
 
 // Atomic write (temporary + rename). Throws rad::outputError(path, ...). The movie is written
 // as given (no constant detection); a thin wrapper over TextureMovieWriter.
@@ -103,11 +124,16 @@ class TextureMovieWriter {
   struct File;                       // AtomicFile + OpenEXR multi-part output
   std::unique_ptr<File> file_;
 };
+// What a reader expects a file to be: a whole movie, or a piece of one. Each refuses the other
+// by name (a piece is never read as a whole movie).
+enum class MovieFileKind { kWhole, kPiece };
+
 // Reads and validates (part count, sizes, attributes, pixel checksums, finite values). Throws
 // rad::inputError(path, ...), never crashes on a truncated or corrupted file.
 TextureMovie readTextureMovie(const std::string& path);
 // The metadata alone (keys empty), every part's header checked as readTextureMovie checks it.
-TextureMovie readTextureMovieHeaders(const std::string& path);
+TextureMovie readTextureMovieHeaders(const std::string& path,
+                                     MovieFileKind kind = MovieFileKind::kWhole);
 
 // A movie read as it plays: every part's header is read and checked at construction, the
 // pixels of a key only when textureAt needs them, and at most the two keys around the current
@@ -117,7 +143,7 @@ class TextureMovieStream {
  public:
   // Checks every part's header (a checksum present in each) and opens the file for reading (it
   // stays open until destruction); throws rad::inputError(path, ...).
-  explicit TextureMovieStream(std::string path);
+  explicit TextureMovieStream(std::string path, MovieFileKind kind = MovieFileKind::kWhole);
   // The same with the headers already read and checked (readTextureMovieHeaders of `path`):
   // only the part count is checked against the file opened.
   TextureMovieStream(std::string path, TextureMovie headers);

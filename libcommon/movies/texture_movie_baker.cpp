@@ -888,7 +888,7 @@ bool TextureMovieBaker::shadowsMove(const MovieExtent& req,
   return false;
 }
 
-BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
+void TextureMovieBaker::checkExtent(const MovieExtent& req) const {
   const std::string where = "movie " + std::to_string(req.movie);
   if (req.patch.top >= tops_.size())
     throw inputError(where, "patch " + req.patch.toString() + " names top-level patch " +
@@ -900,9 +900,11 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     throw inputError(where, "texture " + std::to_string(req.width) + "x" +
                                 std::to_string(req.height) + "; expected 1..16384 each way");
   if (req.firstFrame > req.lastFrame) throw inputError(where, "first frame after last frame");
-  const std::vector<uint32_t> badShooters = solution_.badShooters(req.patch.top);
-  checkRequest(req, badShooters.size());
+}
 
+BakedMovie TextureMovieBaker::keyPlan(const MovieExtent& req) const {
+  checkExtent(req);
+  const std::vector<uint32_t> badShooters = solution_.badShooters(req.patch.top);
   BakedMovie movie;
   movie.keyStep = options_.keyStep;
   if (options_.movingShadowKeyStep > 0 && options_.movingShadowKeyStep < options_.keyStep &&
@@ -910,6 +912,20 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
     movie.keyStep = options_.movingShadowKeyStep;
   movie.keyFrames = keyFrames(req.firstFrame, req.lastFrame, movie.keyStep);
   for (int f : movie.keyFrames) movie.keyTimes.push_back(f / fps_);
+  return movie;
+}
+
+BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink, MovieKeyRange keys) {
+  const auto planStart = SteadyClock::now();
+  BakedMovie movie = keyPlan(req);
+  const std::vector<uint32_t> badShooters = solution_.badShooters(req.patch.top);
+  checkRequest(req, badShooters.size());
+  const int movieKeys = int(movie.keyFrames.size());
+  const int firstKey = keys.first, endKey = keys.count < 0 ? movieKeys : keys.first + keys.count;
+  if (firstKey < 0 || firstKey >= endKey || endKey > movieKeys)
+    throw Error(ExitCode::kUsage, "movie " + std::to_string(req.movie),
+                "keys " + std::to_string(firstKey) + "+" + std::to_string(keys.count) +
+                    " outside its " + std::to_string(movieKeys) + " keys");
 
   // Planning (everything that does not depend on the key), then the keys one by one.
   MovieGeometry geometry(scene_, tops_, req, movie.keyTimes);
@@ -935,8 +951,9 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink) {
                  options_.fillCovered || !emitters_.lamps().empty() ? sceneVisibility() : nullptr,
                  *blockers_, surfaceOfTop_[req.patch.top]);
   bake.plan(badShooters);
+  movie.secondsPlan = secondsSince(planStart);
   sink.begin(movie);
-  for (int k = 0; k < geometry.keys(); ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);
+  for (int k = firstKey; k < endKey; ++k) bake.bakeKey(k, movie.keyTimes[size_t(k)], sink);
   const size_t stored = sink.finish();
 
   if (renderer_) {

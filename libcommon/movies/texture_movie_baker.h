@@ -143,6 +143,15 @@ struct BakedMovie {
   std::vector<double> keyTimes;
   std::vector<std::vector<float>> keys;
   int keyStep = 0;  // the key step used
+  // Seconds of the movie's planning (everything before its first key: texel points, the good
+  // layer's links, the bad pairs' form factors and static shadows), which every piece of a movie
+  // pays again (pipelines/farm_model.py splits a movie's time with it).
+  double secondsPlan = 0.0;
+};
+
+// Keys [first, first + count) of a movie: what one bake() call bakes. count < 0: to the last.
+struct MovieKeyRange {
+  int first = 0, count = -1;
 };
 
 // Receives one movie's key textures in key order as they are baked (only one key texture is
@@ -197,11 +206,22 @@ class TextureMovieBaker {
                     TextureMovieBakerOptions options, TextureMovieBakerBackends backends = {});
   ~TextureMovieBaker();
 
+  // The movie's key frames, times and step (no key baked): keyFrames(first, last, step) with
+  // the moving-shadow step where the movie's shadows move. Throws as bake() does for a bad
+  // request.
+  BakedMovie keyPlan(const MovieExtent& request) const;
+
   // Bakes one movie, streaming its keys to `sink`. Throws rad::inputError("movie N", ...) when
   // the request names a patch outside the scene or a bad size, an environment Error when the
   // movie's working memory exceeds maxTextureMemoryMiB. Creates the GL context on first need
   // (a scene without bad pairs never touches GL).
-  BakedMovie bake(const MovieExtent& request, BakedKeySink& sink);
+  //
+  // `keys`: only these keys are baked and handed to the sink (sink.begin still gets the whole
+  // movie's plan, and key(k) the movie's index k). The planning is the whole movie's, so each
+  // key comes out bit-identical to the same key of the whole bake; a piece pays the planning
+  // (and with it the static shadows of paper §5) again. Throws a usage Error for keys outside
+  // the movie.
+  BakedMovie bake(const MovieExtent& request, BakedKeySink& sink, MovieKeyRange keys = {});
   // The same with the keys collected in memory (K keys alive; for tests and small movies). A
   // movie whose keys are all bit-equal keeps one key when coherence is on.
   BakedMovie bake(const MovieExtent& request);
@@ -242,7 +262,9 @@ class TextureMovieBaker {
 
   OcclusionMaskRenderer& renderer();
   bool shadowsMove(const MovieExtent& request, const std::vector<uint32_t>& badShooters) const;
-  // Throws for a request bake() cannot do (see bake).
+  // Throws for a request bake() cannot do (see bake): a bad patch, size or frames.
+  void checkExtent(const MovieExtent& request) const;
+  // Throws when the movie's working memory exceeds the budget.
   void checkRequest(const MovieExtent& request, size_t badShooters) const;
 };
 

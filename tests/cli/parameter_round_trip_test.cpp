@@ -33,6 +33,8 @@ const std::set<std::string> kPlumbing = {
     "window",
     "merge",
     "print-windows",  // rad-global's render farm: same bytes either way
+    "piece-keys",
+    "merge-pieces",  // rad-movies' render farm: the merged movies are the one task's bytes
 };
 
 // Values for the options whose default is unset, or too slow for a test.

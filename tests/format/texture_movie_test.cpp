@@ -436,3 +436,66 @@ TEST_F(TextureMovieFormat, StreamingWriterLeavesNothingBehindOnFailure) {
 
 }  // namespace
 }  // namespace rad
+
+namespace rad {
+namespace {
+
+// A piece of a movie (texture_movie_piece.md): its own format name, its place in the movie
+// round-trips, a piece reader takes it, and a whole-movie reader (rad-compose's, rad-inspect's)
+// refuses it by name, as the piece reader refuses a whole movie.
+TEST_F(TextureMovieFormat, PieceRoundTripsAndIsNeverReadAsAWholeMovie) {
+  TextureMovie whole = sampleMovie(5);
+  TextureMovie piece = whole;
+  piece.piece = TextureMoviePiece{1, 2, 2, 3, 5};  // keys 2, 3, 4 of 5
+  piece.keyFrames.erase(piece.keyFrames.begin(), piece.keyFrames.begin() + 2);
+  piece.keyTimes.erase(piece.keyTimes.begin(), piece.keyTimes.begin() + 2);
+  piece.keys.erase(piece.keys.begin(), piece.keys.begin() + 2);
+  const std::string path = textureMoviePiecePath(dir(), piece.movie, 1);
+  EXPECT_EQ(fs::path(path).filename(), "000042.piece-0001.exr");
+  writeTextureMovie(path, piece);
+
+  TextureMovieStream stream(path, MovieFileKind::kPiece);
+  const TextureMovie& r = stream.movie();
+  EXPECT_EQ(r.piece.index, 1);
+  EXPECT_EQ(r.piece.count, 2);
+  EXPECT_EQ(r.piece.firstKey, 2);
+  EXPECT_EQ(r.piece.keys, 3);
+  EXPECT_EQ(r.piece.movieKeys, 5);
+  EXPECT_EQ(r.keyFrames, piece.keyFrames);
+  EXPECT_EQ(stream.key(2), piece.keys[2]);
+  Imf::MultiPartInputFile in(path.c_str());
+  EXPECT_EQ(in.header(0).findTypedAttribute<Imf::StringAttribute>("rad.format")->value(),
+            "texture-movie-piece 1.0");
+
+  const std::string e = errorOf(path);
+  EXPECT_EQ(e, path +
+                   ": a piece of texture movie 42 (texture-movie-piece 1.0), not a whole movie: "
+                   "rad-movies --merge-pieces joins the pieces into the movie");
+  EXPECT_THROW(readTextureMovieHeaders(path), Error);
+  const std::string wholePath = textureMoviePath(dir(), whole.movie);
+  writeTextureMovie(wholePath, whole);
+  try {
+    TextureMovieStream wrong(wholePath, MovieFileKind::kPiece);
+    ADD_FAILURE() << "a whole movie read as a piece";
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("not a piece"), std::string::npos) << err.what();
+  }
+}
+
+// A constant piece (all its keys equal) is stored with one part, and its attributes still say
+// how many keys it covers.
+TEST_F(TextureMovieFormat, ConstantPieceKeepsOneKeyAndItsKeyCount) {
+  TextureMovie piece = sampleMovie(4);
+  piece.piece = TextureMoviePiece{0, 3, 0, 4, 10};
+  const std::string path = textureMoviePiecePath(dir(), piece.movie, 0);
+  TextureMovieWriter writer(path, piece, true);
+  for (size_t k = 0; k < 4; ++k) writer.writeKey(k, piece.keys[0]);
+  EXPECT_EQ(writer.commit(), 1u);
+  TextureMovie r = readTextureMovieHeaders(path, MovieFileKind::kPiece);
+  EXPECT_EQ(r.keyFrames.size(), 1u);
+  EXPECT_EQ(r.piece.keys, 4);
+  EXPECT_EQ(r.piece.movieKeys, 10);
+}
+
+}  // namespace
+}  // namespace rad

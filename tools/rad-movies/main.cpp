@@ -20,6 +20,7 @@
 #include "tools/common/made_from_scene.h"
 #include "tools/common/parameter_cli.h"
 #include "tools/common/tool_main.h"
+#include "tools/stages/movie_pieces.h"
 #include "tools/stages/movie_sequence.h"
 
 namespace {
@@ -31,6 +32,8 @@ struct Options {
   rad::TextureMovieBakerOptions baker;  // bound to the flags; its toJson() is the provenance
   std::string preset;                   // --preset, recorded beside the values it set
   std::string shard = "0/1";
+  int pieceKeys = 0;    // --piece-keys: render farm pieces (tools/stages/movie_pieces.h)
+  int mergePieces = 0;  // --merge-pieces: join the pieces of that size instead of baking
   std::string report;
 };
 
@@ -58,6 +61,27 @@ void addDeprecatedOptions(CLI::App& app, rad::TextureMovieBakerOptions& b) {
     else
       opt->check(rad::validatorOf(p->check, p->typeName));
   }
+}
+
+// --merge-pieces: the pieces of --piece-keys tasks joined into their movies (movie_pieces.h).
+int mergePieces(const Options& o, const rad::TextureMovieBaker& baker,
+                const rad::TextureIntervals& intervals, const rad::Provenance& provenance,
+                const nlohmann::json& parameters, rad::SteadyClock::time_point start) {
+  const rad::MoviePieceMergeReport merged =
+      rad::mergeMoviePieces(baker, intervals, o.outDir, o.mergePieces, provenance);
+  if (!o.report.empty()) {
+    nlohmann::json report;
+    report["tool"] = kTool;
+    report["merge_pieces"] = o.mergePieces;
+    report["movies_merged"] = merged.moviesMerged;
+    report["pieces_read"] = merged.piecesRead;
+    report["parameters"] = parameters;
+    report["seconds"]["merge"] = merged.seconds;
+    report["seconds"]["total"] = rad::secondsSince(start);
+    report["peak_memory_mb"] = rad::peakMemoryMb();
+    rad::writeTextFile(o.report, report.dump(1) + "\n");
+  }
+  return 0;
 }
 
 int run(Options o, int argc, char** argv) {
@@ -89,7 +113,14 @@ int run(Options o, int argc, char** argv) {
   parameters[rad::kSceneDigestsKey] =
       rad::sceneDigests(scene, {rad::ScenePart::kGeometry, rad::ScenePart::kMaterials,
                                 rad::ScenePart::kLights, rad::ScenePart::kAnimation});
-  rad::Provenance provenance = rad::makeProvenance(kTool, argc, argv, parameters);
+  // A merge records the command line without --merge-pieces: the whole bake's, byte for byte.
+  const std::vector<std::string> words = o.mergePieces > 0
+                                             ? rad::argumentsWithoutMergePieces(argc, argv)
+                                             : std::vector<std::string>(argv, argv + argc);
+  std::vector<const char*> args;
+  for (const std::string& w : words) args.push_back(w.c_str());
+  rad::Provenance provenance =
+      rad::makeProvenance(kTool, int(args.size()), args.data(), parameters);
   rad::addInput(provenance, o.scene);
   provenance.inputs.push_back(std::move(globalInput));
   provenance.inputs.push_back(std::move(intervalsInput));
@@ -97,9 +128,11 @@ int run(Options o, int argc, char** argv) {
   rad::TextureMovieBakerBackends backends;
   backends.formFactorSpill = rad::formFactorScratchFiles();
   rad::TextureMovieBaker baker(scene, solution, intervals.fps, o.baker, backends);
-  rad::Progress progress(kTool, long(rad::shardMovies(intervals, shard).size()));
+  if (o.mergePieces > 0) return mergePieces(o, baker, intervals, provenance, parameters, start);
+  const std::vector<rad::MovieWork> work = rad::shardWork(intervals, shard, o.pieceKeys, baker);
+  rad::Progress progress(kTool, long(work.size()));
   const rad::MovieSequenceReport written = rad::bakeMovieSequence(
-      baker, intervals, {o.intervals, o.outDir, shard}, provenance, [&] { progress.advance(); });
+      baker, work, {o.intervals, o.outDir}, provenance, [&] { progress.advance(); });
   progress.done();
   const rad::TextureMovieBakerStats& stats = baker.stats();
   for (const std::string& w : stats.warnings) std::cerr << kTool << ": warning: " << w << "\n";
@@ -114,7 +147,21 @@ int run(Options o, int argc, char** argv) {
     report["seconds"]["read"] = secondsRead;
     report["seconds"]["write"] = written.secondsWrite;
     report["seconds"]["total"] = rad::secondsSince(start);
-    report["movie_seconds"] = written.movieSeconds;  // [[movie id, seconds], ...]
+    // [[movie id, seconds], ...] of the whole movies, and of each movie or piece baked its keys
+    // and planning seconds (pipelines/farm_model.py cuts movies into pieces with them).
+    nlohmann::json movieSeconds = nlohmann::json::array(), work = nlohmann::json::array();
+    for (const rad::MovieWorkSeconds& w : written.workSeconds) {
+      if (w.piece < 0) movieSeconds.push_back({w.movie, w.seconds});
+      work.push_back({{"movie", w.movie},
+                      {"piece", w.piece},
+                      {"keys", w.keys},
+                      {"seconds", w.seconds},
+                      {"seconds_plan", w.secondsPlan}});
+    }
+    report["movie_seconds"] = movieSeconds;
+    report["work_seconds"] = work;
+    report["pieces_baked"] = written.piecesBaked;
+    report["piece_keys"] = o.pieceKeys;
     report["peak_memory_mb"] = rad::peakMemoryMb();
     rad::writeTextFile(o.report, report.dump(1) + "\n");
   }
@@ -148,6 +195,25 @@ int main(int argc, char** argv) {
       ->group(common);
   app.add_option("--report", o.report, "write timings and counts as JSON to this file")
       ->group(common);
+  // The render farm (issue 58): a long movie's keys in pieces side by side, then one merge.
+  const std::string farm = "Render farm";
+  auto* pieces = app.add_option("--piece-keys", o.pieceKeys,
+                                "render farm: bake a movie of more than K keys as pieces of at "
+                                "most K keys, piece p of movie m in shard (m + p) % n, each to "
+                                "its own piece file (NNNNNN.piece-PPPP.exr) for --merge-pieces; "
+                                "each piece plans the movie again (its static shadows too)")
+                     ->type_name("K")
+                     ->check(rad::nonNegativeInteger())
+                     ->capture_default_str()
+                     ->group(farm);
+  app.add_option("--merge-pieces", o.mergePieces,
+                 "render farm: instead of baking, join the pieces that --piece-keys K runs of this "
+                 "same command line wrote into their movies: the same bytes as the run without "
+                 "--merge-pieces, provenance included")
+      ->type_name("K")
+      ->check(rad::positiveInteger())
+      ->excludes(pieces)
+      ->group(farm);
   addDeprecatedOptions(app, b);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;
   return rad::runTool(kTool, [&]() { return run(o, argc, argv); });

@@ -18,6 +18,7 @@
 #include "formats/texture_movie.h"
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "tools/stages/movie_pieces.h"
 
 namespace rad {
 namespace {
@@ -29,7 +30,8 @@ class MovieFileSink : public BakedKeySink {
   MovieFileSink(bool collapse, double& secondsWrite)
       : collapse_(collapse), secondsWrite_(secondsWrite) {}
 
-  // The movie the next bake() streams: its metadata (keys come from the baker) and file.
+  // The movie the next bake() streams: its metadata (keys come from the baker) and file; for a
+  // piece, its place in the movie (meta.piece), whose keys alone the file holds.
   void start(TextureMovie meta, std::string path) {
     meta_ = std::move(meta);
     path_ = std::move(path);
@@ -39,15 +41,19 @@ class MovieFileSink : public BakedKeySink {
 
   void begin(const BakedMovie& plan) override {
     auto t = SteadyClock::now();
-    meta_.keyFrames = plan.keyFrames;
-    meta_.keyTimes = plan.keyTimes;
+    first_ = meta_.piece.isPiece() ? size_t(meta_.piece.firstKey) : 0;
+    const size_t keys = meta_.piece.isPiece() ? size_t(meta_.piece.keys) : plan.keyFrames.size();
+    meta_.keyFrames.assign(plan.keyFrames.begin() + long(first_),
+                           plan.keyFrames.begin() + long(first_ + keys));
+    meta_.keyTimes.assign(plan.keyTimes.begin() + long(first_),
+                          plan.keyTimes.begin() + long(first_ + keys));
     writer_ = std::make_unique<TextureMovieWriter>(path_, meta_, collapse_,
                                                    AtomicFile::Durability::kDeferred);
     secondsWrite_ += secondsSince(t);
   }
   void key(size_t k, const std::vector<float>& texture) override {
     auto t = SteadyClock::now();
-    writer_->writeKey(k, texture);
+    writer_->writeKey(k - first_, texture);
     secondsWrite_ += secondsSince(t);
   }
   size_t finish() override {
@@ -62,6 +68,7 @@ class MovieFileSink : public BakedKeySink {
   bool collapse_;
   double& secondsWrite_;
   TextureMovie meta_;
+  size_t first_ = 0;  // the movie's index of the file's first key
   std::string path_;
   std::unique_ptr<TextureMovieWriter> writer_;
 };
@@ -77,14 +84,25 @@ MovieShard MovieShard::parse(const std::string& s) {
   return {i, n};
 }
 
-std::vector<const MovieExtent*> shardMovies(const TextureIntervals& intervals, MovieShard shard) {
-  std::vector<const MovieExtent*> mine;
-  for (const MovieExtent& m : intervals.movies)
-    if (shard.contains(m.movie)) mine.push_back(&m);
+std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard, int pieceKeys,
+                                 const TextureMovieBaker& baker) {
+  std::vector<MovieWork> mine;
+  for (const MovieExtent& m : intervals.movies) {
+    if (pieceKeys <= 0) {
+      if (shard.contains(m.movie)) mine.push_back({&m, TextureMoviePiece{}});
+      continue;
+    }
+    const std::vector<TextureMoviePiece> pieces =
+        moviePieces(int(baker.keyPlan(m).keyFrames.size()), pieceKeys);
+    for (const TextureMoviePiece& p : pieces)
+      if (shard.contains(m.movie + uint32_t(p.index)))
+        mine.push_back({&m, pieces.size() > 1 ? p : TextureMoviePiece{}});
+  }
   return mine;
 }
 
-MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureIntervals& intervals,
+MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker,
+                                      const std::vector<MovieWork>& movies,
                                       const MovieSequenceOptions& options,
                                       const Provenance& provenance,
                                       const std::function<void()>& progress) {
@@ -94,7 +112,6 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     throw outputError(options.moviesDir, "cannot create the movie directory" +
                                              (ec ? ": " + ec.message() : std::string()));
   const std::string provenanceJson = provenance.toJson().dump();
-  const std::vector<const MovieExtent*> movies = shardMovies(intervals, options.shard);
 
   // One worker per allowed thread (--threads), each baking whole movies with its own baker: a big
   // scene's movies are mostly a few texels, too small for the per-texel loops inside a movie to
@@ -110,7 +127,7 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     std::string rendererName;
   };
   std::vector<Worker> done(workers);
-  std::vector<double> movieSeconds(movies.size(), -1.0);
+  std::vector<MovieWorkSeconds> movieSeconds(movies.size());
   std::atomic<size_t> next{0};
   std::atomic<bool> stop{false};
   std::mutex mutex;  // progress and the first failure
@@ -125,14 +142,22 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     // again.
     tbb::task_arena alone(1);
     for (size_t i; !stop && (i = next++) < movies.size();) {
-      const MovieExtent& m = *movies[i];
+      const MovieExtent& m = *movies[i].movie;
+      const TextureMoviePiece& piece = movies[i].piece;
       const auto movieStart = SteadyClock::now();
+      BakedMovie baked;
       try {
-        sink.start(textureMovieOf(m, provenanceJson), textureMoviePath(options.moviesDir, m.movie));
+        TextureMovie meta = textureMovieOf(m, provenanceJson);
+        meta.piece = piece;
+        sink.start(std::move(meta),
+                   piece.isPiece() ? textureMoviePiecePath(options.moviesDir, m.movie, piece.index)
+                                   : textureMoviePath(options.moviesDir, m.movie));
+        const MovieKeyRange keys =
+            piece.isPiece() ? MovieKeyRange{piece.firstKey, piece.keys} : MovieKeyRange{};
         if (workers > 1 && i + workers < movies.size())
-          alone.execute([&] { mine.bake(m, sink); });
+          alone.execute([&] { baked = mine.bake(m, sink, keys); });
         else
-          mine.bake(m, sink);
+          baked = mine.bake(m, sink, keys);
       } catch (...) {
         sink.discard();
         std::lock_guard<std::mutex> lock(mutex);
@@ -140,7 +165,9 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
         stop = true;
         return;
       }
-      movieSeconds[i] = secondsSince(movieStart);
+      movieSeconds[i] = {m.movie, piece.isPiece() ? piece.index : -1,
+                         piece.isPiece() ? piece.keys : int(baked.keyFrames.size()),
+                         secondsSince(movieStart), baked.secondsPlan};
       if (progress) {
         std::lock_guard<std::mutex> lock(mutex);
         progress();
@@ -194,8 +221,8 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureInt
     }
   }
   for (size_t i = 0; i < movies.size(); ++i) {
-    ++report.moviesBaked;
-    report.movieSeconds.emplace_back(movies[i]->movie, movieSeconds[i]);
+    ++(movies[i].piece.isPiece() ? report.piecesBaked : report.moviesBaked);
+    report.workSeconds.push_back(movieSeconds[i]);
   }
   // One sync for all movies (AtomicFile::Durability::kDeferred) before the tool reports
   // success: Make's movies/.done stamp follows our exit status.

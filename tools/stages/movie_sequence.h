@@ -15,6 +15,7 @@
 
 #include "formats/provenance.h"
 #include "formats/texture_intervals.h"
+#include "formats/texture_movie.h"
 #include "libcommon/movies/texture_movie_baker.h"
 
 namespace rad {
@@ -30,31 +31,51 @@ struct MovieShard {
 struct MovieSequenceOptions {
   std::string intervalsPath;  // named in the error of a bad movie
   std::string moviesDir;      // created if missing
-  MovieShard shard;
+};
+
+// One unit of a shard's work: a whole movie, or one piece of one (piece.count == 0: whole).
+struct MovieWork {
+  const MovieExtent* movie = nullptr;
+  TextureMoviePiece piece;
+};
+
+// What one unit cost: the farm model (pipelines/farm_model.py) re-splits a run's movies into any
+// number of shards and pieces from these.
+struct MovieWorkSeconds {
+  uint32_t movie = 0;
+  int piece = -1;            // -1: the whole movie
+  int keys = 0;              // keys baked
+  double seconds = 0.0;      // to plan, bake and write it
+  double secondsPlan = 0.0;  // of which planning (BakedMovie::secondsPlan)
 };
 
 struct MovieSequenceReport {
-  long moviesBaked = 0;
+  long moviesBaked = 0, piecesBaked = 0;
   double secondsWrite = 0.0;  // movie files: open, write, commit, and the final sync
-  // Per movie baked, in id order: (movie id, seconds to bake and write it). The farm model
-  // (pipelines/farm_model.py) re-splits a run's movies into any number of shards from these.
-  std::vector<std::pair<uint32_t, double>> movieSeconds;
+  std::vector<MovieWorkSeconds> workSeconds;  // per unit baked, in work order
   std::string rendererName;  // the first worker's that rendered a mask ("" when none did)
 };
 
-// The movies of `shard`, in id order.
-std::vector<const MovieExtent*> shardMovies(const TextureIntervals& intervals, MovieShard shard);
+// The work of `shard`, in id order. --piece-keys K (render farm, docs/design.md §6.3): a movie
+// of more than K keys is baked as pieces of at most K consecutive keys (movie_pieces.h), each
+// written as a piece file for --merge-pieces to join; 0: whole movies. In id order (and piece order
+// within a movie). Without pieces, the movies with id % n == i. With pieces (pieceKeys > 0), piece
+// p of movie m is the shard's when (m + p) % n == i: a whole movie is piece 0 of 1, so it goes
+// where it went without pieces, and a long movie's pieces go to consecutive shards. `baker` gives
+// each movie's key count (TextureMovieBaker::keyPlan).
+std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard, int pieceKeys,
+                                 const TextureMovieBaker& baker);
 
-// Bakes and writes every movie of the shard with as many workers as TBB's allowed parallelism
-// (the tools' --threads): `baker` and baker.sibling()s, whose stats are added to `baker`'s at
-// the end. `progress` is called after each movie, from one worker at a time. A movie
-// whose keys are all equal is stored with one key when the baker's coherence is on. Throws
+// Bakes and writes every movie and piece of `work` (shardWork) with as many workers as TBB's
+// allowed parallelism (the tools' --threads): `baker` and baker.sibling()s, whose stats are added
+// to `baker`'s at the end. `progress` is called after each movie, from one worker at a time. A
+// movie whose keys are all equal is stored with one key when the baker's coherence is on. Throws
 // rad::inputError(intervalsPath, ...) for a movie the baker refuses as bad input,
 // rad::outputError when MOVIES_DIR or a movie cannot be written, and passes the baker's other
 // errors on (kEnvironment for the memory budget); a movie that fails leaves no file, the
 // workers stop after their current movie, and of the movies that failed, the lowest id's
 // error is thrown.
-MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const TextureIntervals& intervals,
+MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker, const std::vector<MovieWork>& work,
                                       const MovieSequenceOptions& options,
                                       const Provenance& provenance,
                                       const std::function<void()>& progress = {});

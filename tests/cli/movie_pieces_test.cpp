@@ -1,0 +1,147 @@
+// rad-movies' render-farm pieces (issue 58; tools/stages/movie_pieces.h) on the bundled scene
+// through the real tools: movies cut into pieces of keys by --piece-keys tasks and joined by
+// --merge-pieces are the one-task bake's files byte for byte; a piece is never read as a movie
+// (rad-compose refuses it by name); the merge refuses a piece of another run and a missing piece.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <map>
+#include <regex>
+#include <set>
+
+#include "formats/texture_movie.h"
+#include "tests/cli/cli_util.h"
+
+namespace fs = std::filesystem;
+
+namespace rad::test {
+namespace {
+
+const std::string kScene = RAD_SOURCE_DIR "/pipelines/scenes/cornell-moving.gltf";
+// Frames 0-11 with a key every 2 frames (every frame where shadows move): movies of 7 or 12
+// keys, cut into pieces of at most 3.
+const std::string kFrames = "--frames 0-11";
+const std::string kMovieFlags = "--movie-key-step 2 --moving-shadow-key-step 1 --threads 2";
+
+class MoviePiecesCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::path(::testing::TempDir()) /
+                        ("rad_movie_pieces_" + std::to_string(::getpid())));
+    fs::remove_all(*dir_);
+    fs::create_directories(*dir_);
+    const std::string d = dir_->string();
+    CommandResult g = runCommand(tool("rad-global") + " " + kScene + " -o " + d +
+                                 "/global.rlh --preset draft " + kFrames);
+    ASSERT_EQ(g.exitCode, 0) << g.err;
+    CommandResult i = runCommand(tool("rad-intervals") + " " + kScene + " -o " + d +
+                                 "/intervals.rti --size 88x60 " + kFrames);
+    ASSERT_EQ(i.exitCode, 0) << i.err;
+    // The one-task bake, moved aside: the pieces are baked into the same -o (the provenance
+    // records it).
+    CommandResult m = runCommand(movies(""));
+    ASSERT_EQ(m.exitCode, 0) << m.err;
+    fs::rename(d + "/movies", d + "/whole");
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static std::string movies(const std::string& extra, const std::string& out = "movies") {
+    const std::string d = dir_->string();
+    return tool("rad-movies") + " " + kScene + " " + d + "/global.rlh " + d + "/intervals.rti -o " +
+           d + "/" + out + " " + kMovieFlags + " " + extra;
+  }
+  static std::string path(const std::string& name) { return (*dir_ / name).string(); }
+  // The files of a folder by name: their bytes.
+  static std::map<std::string, std::string> files(const std::string& folder) {
+    std::map<std::string, std::string> out;
+    for (const auto& e : fs::directory_iterator(folder))
+      out[e.path().filename().string()] = readWholeFile(e.path().string());
+    return out;
+  }
+  static fs::path* dir_;
+};
+fs::path* MoviePiecesCli::dir_ = nullptr;
+
+const std::regex kPieceName("([0-9]{6})\\.piece-[0-9]{4}\\.exr");
+
+TEST_F(MoviePiecesCli, PiecesMergedAreTheOneTaskBakeByteForByte) {
+  for (int s = 0; s < 3; ++s) {
+    CommandResult r = runCommand(movies("--piece-keys 3 --shard " + std::to_string(s) + "/3"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  // The movies cut into pieces (their pieces only, no movie file yet).
+  std::set<std::string> split;
+  for (const auto& [name, bytes] : files(path("movies"))) {
+    std::smatch match;
+    if (std::regex_match(name, match, kPieceName)) split.insert(match[1].str() + ".exr");
+  }
+  ASSERT_GE(split.size(), 2u) << "the scene's movies are longer than 3 keys";
+  for (const std::string& name : split) EXPECT_FALSE(fs::exists(path("movies/" + name))) << name;
+
+  CommandResult merge = runCommand(movies("--merge-pieces 3"));
+  ASSERT_EQ(merge.exitCode, 0) << merge.err;
+  const std::map<std::string, std::string> whole = files(path("whole")),
+                                           merged = files(path("movies"));
+  ASSERT_EQ(merged.size(), whole.size()) << "no piece left, every movie there";
+  for (const auto& [name, bytes] : whole) {
+    ASSERT_TRUE(merged.count(name)) << name;
+    if (split.count(name)) {
+      EXPECT_TRUE(merged.at(name) == bytes)
+          << name << ": merged pieces differ from the one-task bake";
+    } else {  // a movie of one piece, baked whole by its shard (whose --shard it records)
+      EXPECT_EQ(readTextureMovie(path("movies/" + name)).keys,
+                readTextureMovie(path("whole/" + name)).keys)
+          << name;
+    }
+  }
+}
+
+TEST_F(MoviePiecesCli, APieceIsNeverTakenForAMovie) {
+  CommandResult r = runCommand(movies("--piece-keys 3", "unmerged"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  // A piece put where a movie is expected: rad-compose refuses it by name, on one line.
+  std::string piece;
+  for (const auto& e : fs::directory_iterator(path("unmerged")))
+    if (std::regex_match(e.path().filename().string(), kPieceName)) piece = e.path().string();
+  ASSERT_FALSE(piece.empty());
+  const std::string id = fs::path(piece).filename().string().substr(0, 6);
+  fs::create_directories(path("forged"));
+  for (const auto& e : fs::directory_iterator(path("whole")))
+    fs::copy_file(e.path(), path("forged") / e.path().filename());
+  fs::copy_file(piece, path("forged/" + id + ".exr"), fs::copy_options::overwrite_existing);
+  const std::string d = dir_->string();
+  CommandResult c = runCommand(tool("rad-compose") + " " + kScene + " " + d + "/global.rlh " + d +
+                               "/intervals.rti " + d + "/forged -o " + d + "/frames --frames 0-1");
+  EXPECT_EQ(c.exitCode, 1) << c.err;
+  EXPECT_NE(c.err.find("a piece of texture movie"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("--merge-pieces"), std::string::npos) << c.err;
+}
+
+TEST_F(MoviePiecesCli, MergeRefusesForeignAndMissingPieces) {
+  // Pieces baked with another parameter: the merge names it and writes nothing.
+  CommandResult r = runCommand(movies("--piece-keys 3 --min-samples 8", "foreign"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  CommandResult m = runCommand(movies("--merge-pieces 3", "foreign"));
+  EXPECT_EQ(m.exitCode, 1) << m.err;
+  EXPECT_EQ(countLines(m.err), 1) << m.err;
+  EXPECT_NE(m.err.find("--min-samples 8"), std::string::npos) << m.err;
+  // A missing piece: named, and its movie not written.
+  r = runCommand(movies("--piece-keys 3", "missing"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::string piece;
+  for (const auto& e : fs::directory_iterator(path("missing")))
+    if (std::regex_match(e.path().filename().string(), kPieceName)) piece = e.path().string();
+  ASSERT_FALSE(piece.empty());
+  fs::remove(piece);
+  m = runCommand(movies("--merge-pieces 3", "missing"));
+  EXPECT_EQ(m.exitCode, 1) << m.err;
+  EXPECT_NE(m.err.find(fs::path(piece).filename().string()), std::string::npos) << m.err;
+  const std::string id = fs::path(piece).filename().string().substr(0, 6);
+  EXPECT_FALSE(fs::exists(path("missing/" + id + ".exr"))) << "a movie made without its piece";
+}
+
+}  // namespace
+}  // namespace rad::test
