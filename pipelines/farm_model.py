@@ -13,19 +13,31 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
                         W = min(N x C, keys) windows, each paying a from-scratch first key
                         (key 0's time) and the rest coherent, then the merge)
   movies                movie i in shard i % SHARDS; each shard pays the fixed cost once;
-                        shards are list-scheduled on the N x C cores (longest first)
+                        shards are list-scheduled on the N x C cores (longest first).
+                        With --piece-keys K (slurm.mk's MOVIE_PIECE_KEYS, issue 58), a movie of
+                        n > K keys is P = ceil(n / K) pieces, every movie's pieces dealt to
+                        the shards in order, each paying the movie's planning (its report's
+                        seconds_plan) and its share of the movie's key time; then one merge
+                        task (the fixed cost and, per merged movie, reading and writing its keys
+                        at the run's write rate) and one more stage boundary
   compose               SHARDS contiguous chunks of frames, each paying the fixed cost once
-  mp4 + contact sheet   one task each, side by side
+  mp4 + contact sheet   one task each, side by side; with --video-segments (slurm.mk, issue 58)
+                        each compose chunk also encodes its frames as a segment (the one-core
+                        mp4 encode's time per frame) and the mp4 task only concatenates them
+                        (-c copy); the contact sheet decodes its eight frames. The three are
+                        timed on the run's frames, one core each (video-seconds.json)
   + one scheduling latency per stage boundary (--latency, seconds; measured on the local
     cluster: tests/slurm/cluster.sh)
 
 The serial part is what no number of nodes shortens, the critical path on unlimited nodes: the
 longer of global and intervals (or, windowed, the slowest window and the merge), the fixed cost
-of one movies and one compose task (scene loading), the longest single movie and frame (a piece
-is not split), ffmpeg and the latencies. The one-core time over it bounds the speed-up.
+of one movies and one compose task (scene loading), the longest single movie (with pieces: the
+longest piece, and the merge) and frame, ffmpeg and the latencies. The one-core time over it
+bounds the speed-up.
 
 usage: farm_model.py --scene SCENE [--frames 0-95] [--size 352x240] [--nodes 1,4,16,64]
-                     [--cores N] [--latency 1.0] [--global-windows] [--bin DIR] [--out DIR]
+                     [--cores N] [--latency 1.0] [--global-windows] [--piece-keys K]
+                     [--video-segments] [--bin DIR] [--out DIR]
        farm_model.py --from DIR ...   (model an earlier one-core run in DIR, without running)
        farm_model.py --self-test      (the model's arithmetic on made-up pieces)
 """
@@ -74,6 +86,43 @@ def measure(args):
     return wall
 
 
+def time_video(run_dir):
+    """One core's seconds of the run's mp4 (one encode), its contact sheet, and the mp4 as
+    segments of 4 chunks joined by `encode.sh concat` (the join alone): video-seconds.json."""
+    path = os.path.join(run_dir, "video-seconds.json")
+    if os.path.exists(path):
+        return load(path)
+    frames_dir = os.path.join(run_dir, "frames")
+    numbers = sorted(int(n[:-4]) for n in os.listdir(frames_dir) if n.endswith(".png"))
+    if not numbers:
+        fail("%s: no frames to time the encodes on" % frames_dir)
+    first, last = numbers[0], numbers[-1]
+    encode = os.path.join(HERE, "encode.sh")
+    scratch = os.path.join(run_dir, "video-timing")
+    os.makedirs(scratch, exist_ok=True)
+
+    def timed(*args):
+        t0 = time.monotonic()
+        if subprocess.run(["taskset", "-c", "0", encode] + list(args)).returncode != 0:
+            fail("encode.sh %s failed" % args[0])
+        return time.monotonic() - t0
+    frames = "%d-%d" % (first, last)
+    out = {"mp4": timed("mp4", frames_dir, frames, "24", os.path.join(scratch, "one.mp4")),
+           "contact": timed("contact", frames_dir, frames, "24", os.path.join(scratch, "c.png"))}
+    n = last - first + 1
+    chunks = ["%d-%d" % (first + n * j // 4, first + n * (j + 1) // 4 - 1) for j in range(4)]
+    for c in chunks:
+        timed("segment", frames_dir, c, "24", os.path.join(frames_dir, "segment-%s.mp4" % c))
+    out["concat"] = timed("concat", frames_dir, ",".join(chunks), "24",
+                          os.path.join(scratch, "cat.mp4"))
+    for c in chunks:
+        os.remove(os.path.join(frames_dir, "segment-%s.mp4" % c))
+    shutil.rmtree(scratch, ignore_errors=True)
+    with open(path, "w") as f:
+        json.dump(out, f)
+    return out
+
+
 def pieces(run_dir):
     """The one-core run's pieces: seconds of each stage part."""
     g = load(os.path.join(run_dir, "global-report.json"))
@@ -84,14 +133,20 @@ def pieces(run_dir):
         fail("%s: no movie_seconds (made by an older rad-movies)" % os.path.join(run_dir, "movies-report.json"))
     keys = [k["seconds_links"] + k["seconds_solve"] + k.get("seconds_coherence", 0.0) for k in g["key_times"]]
     movies = [(int(mid), s) for mid, s in m["movie_seconds"]]
-    frames = [f["seconds"] for f in c["frames"]]
+    # Per movie: its keys and planning seconds (rad-movies' work_seconds; older reports have none,
+    # and their movies cannot be cut: one key, no planning).
+    plans = {int(w["movie"]): (int(w["keys"]), float(w["seconds_plan"]))
+             for w in m.get("work_seconds", []) if w.get("piece", -1) < 0}
     p = {
         "global": g["seconds"]["total"],
         "global_fixed": g["seconds"]["total"] - sum(keys),
         "keys": keys,
         "intervals": i["total_seconds"],
         "movies": movies,
+        "movie_plans": {mid: plans.get(mid, (1, 0.0)) for mid, _ in movies},
         "movies_fixed": m["seconds"]["total"] - sum(s for _, s in movies),
+        # Writing the movies, per key: what a merge pays per key it reads and writes again.
+        "write_per_key": m["seconds"].get("write", 0.0) / max(1, m.get("keys", 1)),
         "frames": frames,
         "compose_fixed": c["seconds"] - sum(frames),
     }
@@ -124,38 +179,73 @@ def global_seconds(p, slots, windows):
     return slowest + merge
 
 
-def model(p, nodes, cores, latency, windows):
+def movie_pieces(p, piece_keys):
+    """(movie id, piece index, seconds) of every piece, and the merge task's seconds (0: no
+    merge). A movie of n > K keys is ceil(n / K) pieces, as rad-movies --piece-keys cuts it, each
+    paying the movie's planning and its share of the key time (tools/stages/movie_pieces.h)."""
+    out, merged_keys = [], 0
+    for mid, s in p["movies"]:
+        keys, plan = p.get("movie_plans", {}).get(mid, (1, 0.0))
+        count = (keys + piece_keys - 1) // piece_keys if piece_keys > 0 and keys > piece_keys else 1
+        if count == 1:
+            out.append((mid, 0, s))
+            continue
+        merged_keys += keys
+        for j in range(count):
+            n = keys * (j + 1) // count - keys * j // count
+            out.append((mid, j, plan + (s - plan) * n / keys))
+    write = p.get("write_per_key", 0.0)
+    merge = p["movies_fixed"] + 2.0 * write * merged_keys if merged_keys else 0.0
+    return out, merge
+
+
+def video_path(p, segments):
+    """The encodes after the frames: both whole encodes (the run's remainder), or with segments
+    the longer of the concatenation and the contact sheet (side by side)."""
+    if not segments:
+        return p["video"]
+    v = p["video_parts"]
+    return max(v["concat"], v["contact"])
+
+
+def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False):
     slots = nodes * cores
     shards = slots
     movie_shards = [0.0] * shards
-    for mid, s in p["movies"]:
-        movie_shards[mid % shards] += s
+    pieces, merge = movie_pieces(p, piece_keys)
+    for u, (mid, _, s) in enumerate(pieces):  # rad-movies' shardWork: pieces dealt in order
+        movie_shards[(u if piece_keys > 0 else mid) % shards] += s
     movie_tasks = [p["movies_fixed"] + s for s in movie_shards if s > 0.0]
     n = len(p["frames"])
     chunks = min(shards, n)
+    encode = p["video_parts"]["mp4"] / n if segments else 0.0  # a segment's encode, per frame
     compose_tasks = [p["compose_fixed"] + sum(p["frames"][n * j // chunks:n * (j + 1) // chunks])
-                     for j in range(chunks)]
+                     + encode * (n * (j + 1) // chunks - n * j // chunks) for j in range(chunks)]
     g = global_seconds(p, slots, windows)
     path = {
         "global || intervals": max(g, p["intervals"]),
         "movies": makespan(movie_tasks, slots),
+        "movie merge": merge,
         "compose": makespan(compose_tasks, slots),
-        "mp4 + contact sheet": p["video"],
-        "scheduling": 4 * latency,
+        "mp4 + contact sheet": video_path(p, segments),
+        "scheduling": (5 if merge else 4) * latency,
     }
     return path, sum(path.values())
 
 
-def serial_part(p, latency, windows):
+def serial_part(p, latency, windows, piece_keys=0, segments=False):
     """The critical path with unlimited nodes: what no number of nodes shortens."""
     g = global_seconds(p, len(p["keys"]), windows)
+    pieces, merge = movie_pieces(p, piece_keys)
+    encode = p["video_parts"]["mp4"] / len(p["frames"]) if segments else 0.0
     return {
         "global || intervals": max(g, p["intervals"]),
         "scene loading": p["movies_fixed"] + p["compose_fixed"],
-        "longest movie": max(s for _, s in p["movies"]),
-        "longest frame": max(p["frames"]),
-        "ffmpeg": p["video"],
-        "scheduling": 4 * latency,
+        "longest movie": max(s for _, _, s in pieces),
+        "movie merge": merge,
+        "longest frame": max(p["frames"]) + encode,
+        "ffmpeg": video_path(p, segments),
+        "scheduling": (5 if merge else 4) * latency,
     }
 
 
@@ -182,6 +272,30 @@ def self_test():
     check("movies on 16 cores: the longest movie", path["movies"], 0.5 + 3.0)
     serial = serial_part(p, 0.0, False)
     check("serial part", sum(serial.values()), 10.0 + 0.6 + 3.0 + 0.25 + 2.0)
+    # Pieces (issue 58): movie 3 (3 s, 6 keys, 1 s of planning) in pieces of at most 2 keys is
+    # 3 pieces of 1 + 2/3 s each, the 4th to 6th pieces dealt: shards 3, 0, 1;
+    # the merge reads and writes its 6 keys at 0.1 s per key, after the fixed 0.5 s.
+    p["movie_plans"] = {0: (2, 0.5), 1: (2, 0.5), 2: (2, 0.5), 3: (6, 1.0)}
+    p["write_per_key"] = 0.05
+    pieces, merge = movie_pieces(p, 2)
+    check("three pieces of movie 3", len([x for x in pieces if x[0] == 3]), 3)
+    check("a piece: planning + a third of the keys", pieces[3][2], 1.0 + 2.0 / 3.0)
+    check("the merge", merge, 0.5 + 0.6)
+    check("no pieces: no merge", movie_pieces(p, 0)[1], 0.0)
+    path, wall = model(p, 2, 2, 1.0, False, 2)
+    check("movies on 4 shards: shard 0 holds movie 0 and a piece of movie 3",
+          path["movies"], 0.5 + 1.0 + 1.0 + 2.0 / 3.0)
+    check("a stage more", path["scheduling"], 5.0)
+    serial = serial_part(p, 0.0, False, 2)
+    check("serial: the longest piece",
+          serial["longest movie"], 1.0 + 2.0 / 3.0)
+    check("serial merge", serial["movie merge"], 1.1)
+    # Segments: each chunk of two frames encodes them (1 s for 4 frames: 0.5 s a chunk); then
+    # the longer of the join (0.25 s) and the contact sheet (0.5 s).
+    p["video_parts"] = {"mp4": 1.0, "contact": 0.5, "concat": 0.25}
+    path, wall = model(p, 1, 2, 1.0, False, 0, True)
+    check("compose chunks encode their segments", path["compose"], 0.1 + 0.5 + 0.5)
+    check("the join or the contact sheet", path["mp4 + contact sheet"], 0.5)
     print("farm_model.py: self-test passed")
     return 0
 
@@ -195,6 +309,10 @@ def main():
     ap.add_argument("--cores", type=int, default=os.cpu_count() or 2)
     ap.add_argument("--latency", type=float, default=1.0)
     ap.add_argument("--global-windows", action="store_true")
+    ap.add_argument("--video-segments", action="store_true",
+                    help="the mp4 as segments encoded by the compose tasks, then joined (slurm.mk)")
+    ap.add_argument("--piece-keys", type=int, default=0,
+                    help="movies in pieces of at most K keys (slurm.mk's MOVIE_PIECE_KEYS); 0: whole")
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "farm-model"))
     ap.add_argument("--from", dest="from_dir")
@@ -212,21 +330,29 @@ def main():
         measure(args)
         run_dir = args.out
     p = pieces(run_dir)
+    if args.video_segments:
+        p["video_parts"] = time_video(run_dir)
     one_core = p["wall"]
     print("farm model of %s: one core %.1f s (global %.1f, intervals %.1f, %d movies %.1f + %.2f fixed, "
-          "%d frames %.1f + %.2f fixed, ffmpeg %.1f); %d cores per node, %.1f s latency per stage%s"
+          "%d frames %.1f + %.2f fixed, ffmpeg %.1f); %d cores per node, %.1f s latency per stage%s%s%s"
           % (run_dir, one_core, p["global"], p["intervals"], len(p["movies"]),
              sum(s for _, s in p["movies"]), p["movies_fixed"], len(p["frames"]), sum(p["frames"]),
              p["compose_fixed"], p["video"], args.cores, args.latency,
-             ", rad-global in time windows" if args.global_windows else ""))
+             ", rad-global in time windows" if args.global_windows else "",
+             ", movies in pieces of at most %d keys" % args.piece_keys if args.piece_keys else "",
+             ", the mp4 in segments (encode %.1f, join %.1f, contact sheet %.1f)"
+             % (p["video_parts"]["mp4"], p["video_parts"]["concat"], p["video_parts"]["contact"])
+             if args.video_segments else ""))
     rows = []
     print("%6s %9s %9s  %s" % ("nodes", "wall s", "speed-up", "critical path (s)"))
     for nodes in [int(x) for x in args.nodes.split(",")]:
-        path, wall = model(p, nodes, args.cores, args.latency, args.global_windows)
+        path, wall = model(p, nodes, args.cores, args.latency, args.global_windows,
+                           args.piece_keys, args.video_segments)
         rows.append({"nodes": nodes, "wall": wall, "path": path})
         print("%6d %9.1f %8.1fx  %s" % (nodes, wall, one_core / wall,
                                         ", ".join("%s %.1f" % kv for kv in path.items())))
-    serial = serial_part(p, args.latency, args.global_windows)
+    serial = serial_part(p, args.latency, args.global_windows, args.piece_keys,
+                         args.video_segments)
     total = sum(serial.values())
     print("serial part (the critical path on unlimited nodes): %.1f s = %.1f %% of the one-core "
           "time, so the speed-up is at most %.1fx: %s"

@@ -10,9 +10,15 @@
 #                                    as an array over W time windows of FRAMES (`--window`) and
 #                                    a merge job (`--merge`), whose global.rlh is the one job's,
 #                                    byte for byte
-#   rad-movies                       an array over `--shard i/SHARDS`
-#   rad-compose                      an array over SHARDS contiguous chunks of FRAMES
-#   the mp4 and the contact sheet    one job each
+#   rad-movies                       an array over `--shard i/SHARDS`; with MOVIE_PIECE_KEYS=K
+#                                    (the default), a movie of more than K keys is baked as
+#                                    pieces of at most K keys spread over the shards
+#                                    (`--piece-keys`), and a merge job (`--merge-pieces`) joins
+#                                    them into the movies one task bakes, byte for byte
+#   rad-compose                      an array over SHARDS contiguous chunks of FRAMES, each
+#                                    also encoding its frames as a segment of the mp4
+#   the mp4 and the contact sheet    one job each; the mp4 joins the segments (-c copy,
+#                                    encode.sh concat), so no task encodes every frame
 # Every task logs to OUT/logs/STAGE_TASK.log. A split stage's pieces stamp themselves
 # (OUT/movies/.shard-I-of-N, OUT/frames/.chunk-I-of-N) and its done-stamp is written by a job
 # that runs only when every piece succeeded, so a re-run after a failure or a killed task
@@ -29,11 +35,19 @@ include $(HERE)stages.mk
 
 SHARDS         ?= 4
 GLOBAL_WINDOWS ?= 1
+# Keys per movie piece (rad-movies --piece-keys; 0: whole movies, no merge job). Each piece plans
+# its movie again, so a smaller piece cuts the longest task and adds planning (docs/results.md,
+# "Farm tasks finer than one movie").
+MOVIE_PIECE_KEYS ?= 8
 PARTITION    ?=
 WAIT         ?= 0
 SBATCH_FLAGS ?=
 
 LOGS = $(OUT)/logs
+comma := ,
+space := $(subst ,, )
+# The mp4's segment of the frames $(1) (FIRST-LAST), encoded by the compose task that made them.
+SEGMENT_CMD = $(PIPELINES)encode.sh segment $(OUT)/frames $(1) $(FPS) $(OUT)/frames/segment-$(1).mp4
 JOBS = $(OUT)/slurm-jobs
 
 # This run's submissions (STAGE JOBID TASKS per line): dependencies and WAIT=1 read them.
@@ -107,27 +121,39 @@ endif
 $(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-intervals
 	@$(call submit,intervals,,,$(INTERVALS_CMD))
 
+# The shards' stamps name the piece size (.pshardK-I-of-N), so that pieces of another size are
+# never merged: slurm-pieces.sh empties the folder when the stamps are of another kind.
+MOVIES_SHARD_KIND := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)),pshard$(MOVIE_PIECE_KEYS),shard)
+MOVIES_PIECE_ARGS := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)), --piece-keys $(MOVIE_PIECE_KEYS))
+
+# The shards, then (with pieces) the merge, which writes the done-stamp; without pieces a job that
+# only stamps. A re-run after a failed merge merges again (a merged movie's pieces are gone).
 $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
 	@rm -f $@ && \
-	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies shard $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies $(MOVIES_SHARD_KIND) $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,movies,$$missing,global global-merge intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS)) \
-	    && touch $(OUT)/movies/.shard-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)) && \
+	  $(call submit,movies,$$missing,global global-merge intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS))$(MOVIES_PIECE_ARGS) \
+	    && touch $(OUT)/movies/.$(MOVIES_SHARD_KIND)-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)); \
+	fi && \
+	if [ -n "$(MOVIES_PIECE_ARGS)" ]; then \
+	  $(call submit,movies-merge,,global global-merge intervals movies,$(call MOVIES_MERGE_CMD,$(MOVIE_PIECE_KEYS)) && touch $@); \
+	elif [ -n "$$missing" ]; then \
 	  $(call submit,movies-done,,movies,touch $@); \
 	else touch $@; fi
 
 $(OUT)/frames/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
 	@rm -f $@ && \
-	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals movies" $^) && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals movies movies-merge" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,compose,$$missing,global global-merge intervals movies,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
-	    $(call COMPOSE_CHUNK_CMD,$$1) && touch $(OUT)/frames/.chunk-$$SLURM_ARRAY_TASK_ID-of-$(CHUNK_COUNT)) && \
+	  $(call submit,compose,$$missing,global global-merge intervals movies movies-merge,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
+	    $(call COMPOSE_CHUNK_CMD,$$1) && $(call SEGMENT_CMD,$$1) && \
+	    touch $(OUT)/frames/.chunk-$$SLURM_ARRAY_TASK_ID-of-$(CHUNK_COUNT)) && \
 	  $(call submit,frames-done,,compose,touch $@); \
 	else touch $@; fi
 
 $(OUT)/movie.mp4: $(OUT)/frames/.done
-	@$(call submit,mp4,,compose,$(MP4_CMD))
+	@$(call submit,mp4,,compose,$(PIPELINES)encode.sh concat $(OUT)/frames $(subst $(space),$(comma),$(strip $(CHUNKS))) $(FPS) $(OUT)/movie.mp4)
 
 $(OUT)/contact-sheet.png: $(OUT)/frames/.done
 	@$(call submit,contact-sheet,,compose,$(CONTACT_CMD))

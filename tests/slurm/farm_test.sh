@@ -5,7 +5,10 @@
 #   1. with rad-global in 3 time windows and a merge (GLOBAL_WINDOWS=3), global.rlh is the single
 #      run's byte for byte, and every frame's pixels (EXR and PNG) are bit-identical to
 #      animation.mk's (the frame files differ only in their provenance, which records each
-#      task's own command line and paths);
+#      task's own command line and paths); the movies of more than MOVIE_PIECE_KEYS=4 keys were
+#      baked in pieces and merged (issue 58), and every output (global.rlh, intervals.rti, movies,
+#      frames) is animation.mk's (pipelines/same_outputs.py); the mp4 joined from the compose
+#      tasks' segments holds every frame;
 #   2. a movies task killed mid-run makes WAIT fail with one line naming the stage, the task and
 #      its log; the dependent jobs are cancelled; nothing downstream is marked done; the re-run
 #      submits only the killed shard and ends with the same frames;
@@ -62,8 +65,19 @@ same_frames() {
 
 # 1. A whole run, rad-global in 3 time windows and their merge.
 make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 GLOBAL_WINDOWS=3 WAIT=1 \
-  2>"$work/farm.err" || fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
+  MOVIE_PIECE_KEYS=4 2>"$work/farm.err" || fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
 same_frames "$work/local" "$work/farm"
+grep -q "slurm.mk: movies-merge submitted" "$work/farm.err" || fail "no merge of movie pieces submitted"
+merged=$(grep -o '"movies_merged": [0-9]*' "$work/farm/movies-report.json" | grep -o '[0-9]*$')
+[ "${merged:-0}" -gt 0 ] || fail "no movie was baked in pieces (movies-report.json: ${merged:-none})"
+if ls "$work/farm/movies" | grep -q piece; then fail "movie pieces left after the merge"; fi
+python3 pipelines/same_outputs.py "$work/local" "$work/farm" >"$work/same.out" ||
+  fail "slurm.mk's outputs differ from animation.mk's: $(cat "$work/same.out")"
+echo "farm_test: $merged movies baked in pieces and merged; $(tail -1 "$work/same.out")"
+# The mp4 joined from the compose tasks' segments holds every frame, at FPS.
+probe=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,r_frame_rate \
+  -of csv=p=0 "$work/farm/movie.mp4")
+[ "$probe" = "24/1,24" ] || fail "movie.mp4 from segments: $probe (expected 24/1,24: 24 frames at 24 fps)"
 # The merged global.rlh is the one rad-global writes in one piece, byte for byte (provenance
 # included: the merge records the single run's command line, which names this OUT).
 global_cmd=$(make -s -f pipelines/animation.mk "${common[@]}" "OUT=$work/farm" stage-commands |
@@ -82,11 +96,11 @@ done
 echo "farm_test: 24 frames through slurm.mk (SHARDS=4) have animation.mk's pixels"
 
 # 3. Up to date: nothing is submitted.
-make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 WAIT=1 2>"$work/again.err" ||
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 MOVIE_PIECE_KEYS=4 WAIT=1 2>"$work/again.err" ||
   fail "the up-to-date re-run failed"
 if grep -q submitted "$work/again.err"; then fail "an up-to-date run submitted: $(cat "$work/again.err")"; fi
 # A parameter change submits what animation.mk would re-run: COMPOSE_FLAGS, only the frames on.
-make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 COMPOSE_FLAGS="--exposure 0.5" WAIT=1 \
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 MOVIE_PIECE_KEYS=4 COMPOSE_FLAGS="--exposure 0.5" WAIT=1 \
   2>"$work/change.err" || fail "the re-run with other COMPOSE_FLAGS failed"
 stages=$(sed -n 's/^slurm.mk: \([a-z0-9-]*\) submitted:.*/\1/p' "$work/change.err" | tr '\n' ' ')
 [ "$stages" = "compose frames-done mp4 contact-sheet " ] ||

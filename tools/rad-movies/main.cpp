@@ -155,6 +155,8 @@ int run(Options o, int argc, char** argv) {
       work.push_back({{"movie", w.movie},
                       {"piece", w.piece},
                       {"keys", w.keys},
+                      {"movie_keys", w.movieKeys},
+                      {"texels", w.texels},
                       {"seconds", w.seconds},
                       {"seconds_plan", w.secondsPlan}});
     }
@@ -197,15 +199,16 @@ int main(int argc, char** argv) {
       ->group(common);
   // The render farm (issue 58): a long movie's keys in pieces side by side, then one merge.
   const std::string farm = "Render farm";
-  auto* pieces = app.add_option("--piece-keys", o.pieceKeys,
-                                "render farm: bake a movie of more than K keys as pieces of at "
-                                "most K keys, piece p of movie m in shard (m + p) % n, each to "
-                                "its own piece file (NNNNNN.piece-PPPP.exr) for --merge-pieces; "
-                                "each piece plans the movie again (its static shadows too)")
-                     ->type_name("K")
-                     ->check(rad::nonNegativeInteger())
-                     ->capture_default_str()
-                     ->group(farm);
+  auto* pieces =
+      app.add_option("--piece-keys", o.pieceKeys,
+                     "render farm: bake a movie of more than K keys as pieces of at "
+                     "most K keys, every movie's pieces dealt to the shards in order, each to "
+                     "its own piece file (NNNNNN.piece-PPPP.exr) for --merge-pieces; "
+                     "each piece plans the movie again (its static shadows too)")
+          ->type_name("K")
+          ->check(rad::nonNegativeInteger())
+          ->capture_default_str()
+          ->group(farm);
   app.add_option("--merge-pieces", o.mergePieces,
                  "render farm: instead of baking, join the pieces that --piece-keys K runs of this "
                  "same command line wrote into their movies: the same bytes as the run without "

@@ -87,6 +87,7 @@ MovieShard MovieShard::parse(const std::string& s) {
 std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard, int pieceKeys,
                                  const TextureMovieBaker& baker) {
   std::vector<MovieWork> mine;
+  uint32_t unit = 0;  // the index of a piece among every movie's pieces
   for (const MovieExtent& m : intervals.movies) {
     if (pieceKeys <= 0) {
       if (shard.contains(m.movie)) mine.push_back({&m, TextureMoviePiece{}});
@@ -95,8 +96,7 @@ std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard s
     const std::vector<TextureMoviePiece> pieces =
         moviePieces(int(baker.keyPlan(m).keyFrames.size()), pieceKeys);
     for (const TextureMoviePiece& p : pieces)
-      if (shard.contains(m.movie + uint32_t(p.index)))
-        mine.push_back({&m, pieces.size() > 1 ? p : TextureMoviePiece{}});
+      if (shard.contains(unit++)) mine.push_back({&m, pieces.size() > 1 ? p : TextureMoviePiece{}});
   }
   return mine;
 }
@@ -165,9 +165,13 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker,
         stop = true;
         return;
       }
-      movieSeconds[i] = {m.movie, piece.isPiece() ? piece.index : -1,
+      movieSeconds[i] = {m.movie,
+                         piece.isPiece() ? piece.index : -1,
                          piece.isPiece() ? piece.keys : int(baked.keyFrames.size()),
-                         secondsSince(movieStart), baked.secondsPlan};
+                         int(baked.keyFrames.size()),
+                         long(m.width) * long(m.height),
+                         secondsSince(movieStart),
+                         baked.secondsPlan};
       if (progress) {
         std::lock_guard<std::mutex> lock(mutex);
         progress();

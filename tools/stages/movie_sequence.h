@@ -45,6 +45,8 @@ struct MovieWorkSeconds {
   uint32_t movie = 0;
   int piece = -1;            // -1: the whole movie
   int keys = 0;              // keys baked
+  int movieKeys = 0;         // keys of the whole movie
+  long texels = 0;           // of the movie's texture
   double seconds = 0.0;      // to plan, bake and write it
   double secondsPlan = 0.0;  // of which planning (BakedMovie::secondsPlan)
 };
@@ -56,13 +58,15 @@ struct MovieSequenceReport {
   std::string rendererName;  // the first worker's that rendered a mask ("" when none did)
 };
 
-// The work of `shard`, in id order. --piece-keys K (render farm, docs/design.md §6.3): a movie
-// of more than K keys is baked as pieces of at most K consecutive keys (movie_pieces.h), each
-// written as a piece file for --merge-pieces to join; 0: whole movies. In id order (and piece order
-// within a movie). Without pieces, the movies with id % n == i. With pieces (pieceKeys > 0), piece
-// p of movie m is the shard's when (m + p) % n == i: a whole movie is piece 0 of 1, so it goes
-// where it went without pieces, and a long movie's pieces go to consecutive shards. `baker` gives
-// each movie's key count (TextureMovieBaker::keyPlan).
+// The work of `shard`, in id order (and piece order within a movie). --piece-keys K (render
+// farm, docs/design.md §6.3): a movie of more than K keys is baked as pieces of at most K
+// consecutive keys (movie_pieces.h), each written as a piece file for --merge-pieces to join;
+// 0: whole movies. Without pieces, the movies with id % n == i. With pieces, every movie's
+// pieces (a movie of at most K keys is one piece, its whole movie) are dealt to the shards in
+// id and piece order: the u-th is shard u % n's, so a long movie's pieces go to consecutive
+// shards. A piece's cost is not known before it is baked (the texels' cost varies by far more
+// than their count), so no schedule by cost is attempted. Every task computes the same list
+// from the inputs alone (`baker` gives each movie's key count, keyPlan).
 std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard, int pieceKeys,
                                  const TextureMovieBaker& baker);
 
