@@ -18,8 +18,8 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
                         n > K keys is P = ceil(n / K) pieces, every movie's pieces dealt to
                         the shards in order, each paying the movie's planning (its report's
                         seconds_plan) and its share of the movie's key time; then one merge
-                        task (the fixed cost and, per merged movie, reading and writing its keys
-                        at the run's write rate) and one more stage boundary
+                        task (the fixed cost and, per merged movie, reading and writing its
+                        bytes at the run's write rate) and one more stage boundary
   compose               SHARDS contiguous chunks of frames, each paying the fixed cost once
   mp4 + contact sheet   one task each, side by side; with --video-segments (slurm.mk, issue 58)
                         each compose chunk also encodes its frames as a segment (the one-core
@@ -137,6 +137,11 @@ def pieces(run_dir):
     # and their movies cannot be cut: one key, no planning).
     plans = {int(w["movie"]): (int(w["keys"]), float(w["seconds_plan"]))
              for w in m.get("work_seconds", []) if w.get("piece", -1) < 0}
+    frames = [f["seconds"] for f in c["frames"]]
+    movie_bytes = {}
+    for mid, _ in movies:
+        path = os.path.join(run_dir, "movies", "%06d.exr" % mid)
+        movie_bytes[mid] = os.path.getsize(path) if os.path.exists(path) else 0
     p = {
         "global": g["seconds"]["total"],
         "global_fixed": g["seconds"]["total"] - sum(keys),
@@ -145,8 +150,10 @@ def pieces(run_dir):
         "movies": movies,
         "movie_plans": {mid: plans.get(mid, (1, 0.0)) for mid, _ in movies},
         "movies_fixed": m["seconds"]["total"] - sum(s for _, s in movies),
-        # Writing the movies, per key: what a merge pays per key it reads and writes again.
-        "write_per_key": m["seconds"].get("write", 0.0) / max(1, m.get("keys", 1)),
+        # Each movie's bytes, and the seconds of writing a byte: a merge reads a cut movie's
+        # pieces and writes the movie (a constant movie's pieces are one key each).
+        "movie_bytes": movie_bytes,
+        "write_per_byte": m["seconds"].get("write", 0.0) / max(1, sum(movie_bytes.values())),
         "frames": frames,
         "compose_fixed": c["seconds"] - sum(frames),
     }
@@ -183,19 +190,19 @@ def movie_pieces(p, piece_keys):
     """(movie id, piece index, seconds) of every piece, and the merge task's seconds (0: no
     merge). A movie of n > K keys is ceil(n / K) pieces, as rad-movies --piece-keys cuts it, each
     paying the movie's planning and its share of the key time (tools/stages/movie_pieces.h)."""
-    out, merged_keys = [], 0
+    out, merged_bytes = [], 0
     for mid, s in p["movies"]:
         keys, plan = p.get("movie_plans", {}).get(mid, (1, 0.0))
         count = (keys + piece_keys - 1) // piece_keys if piece_keys > 0 and keys > piece_keys else 1
         if count == 1:
             out.append((mid, 0, s))
             continue
-        merged_keys += keys
+        merged_bytes += p.get("movie_bytes", {}).get(mid, 0)
         for j in range(count):
             n = keys * (j + 1) // count - keys * j // count
             out.append((mid, j, plan + (s - plan) * n / keys))
-    write = p.get("write_per_key", 0.0)
-    merge = p["movies_fixed"] + 2.0 * write * merged_keys if merged_keys else 0.0
+    cut = sum(1 for _, j, _ in out if j == 1)  # movies of more than one piece
+    merge = p["movies_fixed"] + 2.0 * p.get("write_per_byte", 0.0) * merged_bytes if cut else 0.0
     return out, merge
 
 
@@ -274,9 +281,10 @@ def self_test():
     check("serial part", sum(serial.values()), 10.0 + 0.6 + 3.0 + 0.25 + 2.0)
     # Pieces (issue 58): movie 3 (3 s, 6 keys, 1 s of planning) in pieces of at most 2 keys is
     # 3 pieces of 1 + 2/3 s each, the 4th to 6th pieces dealt: shards 3, 0, 1;
-    # the merge reads and writes its 6 keys at 0.1 s per key, after the fixed 0.5 s.
+    # the merge reads and writes its 600 bytes at 0.0005 s a byte, after the fixed 0.5 s.
     p["movie_plans"] = {0: (2, 0.5), 1: (2, 0.5), 2: (2, 0.5), 3: (6, 1.0)}
-    p["write_per_key"] = 0.05
+    p["movie_bytes"] = {0: 100, 1: 100, 2: 100, 3: 600}
+    p["write_per_byte"] = 0.0005
     pieces, merge = movie_pieces(p, 2)
     check("three pieces of movie 3", len([x for x in pieces if x[0] == 3]), 3)
     check("a piece: planning + a third of the keys", pieces[3][2], 1.0 + 2.0 / 3.0)

@@ -13,8 +13,9 @@
 #   rad-movies                       an array over `--shard i/SHARDS`; with MOVIE_PIECE_KEYS=K
 #                                    (the default), a movie of more than K keys is baked as
 #                                    pieces of at most K keys spread over the shards
-#                                    (`--piece-keys`), and a merge job (`--merge-pieces`) joins
-#                                    them into the movies one task bakes, byte for byte
+#                                    (`--piece-keys`), and an array of merges (`--merge-pieces`,
+#                                    by `--shard i/SHARDS` of the movies) joins them into the
+#                                    movies one task bakes, byte for byte
 #   rad-compose                      an array over SHARDS contiguous chunks of FRAMES, each
 #                                    also encoding its frames as a segment of the mp4
 #   the mp4 and the contact sheet    one job each; the mp4 joins the segments (-c copy,
@@ -125,9 +126,11 @@ $(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-int
 # never merged: slurm-pieces.sh empties the folder when the stamps are of another kind.
 MOVIES_SHARD_KIND := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)),pshard$(MOVIE_PIECE_KEYS),shard)
 MOVIES_PIECE_ARGS := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)), --piece-keys $(MOVIE_PIECE_KEYS))
+SHARD_INDICES := $(shell seq -s, 0 $$(($(SHARDS) - 1)))
 
-# The shards, then (with pieces) the merge, which writes the done-stamp; without pieces a job that
-# only stamps. A re-run after a failed merge merges again (a merged movie's pieces are gone).
+# The shards, then (with pieces) the merges, one per shard of the movies (id % SHARDS), side by
+# side, then a job that stamps. A re-run after a failed merge merges again (a merged movie's pieces
+# are gone, and its merge takes it as done).
 $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
 	@rm -f $@ && \
 	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies $(MOVIES_SHARD_KIND) $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
@@ -136,7 +139,8 @@ $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti 
 	    && touch $(OUT)/movies/.$(MOVIES_SHARD_KIND)-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)); \
 	fi && \
 	if [ -n "$(MOVIES_PIECE_ARGS)" ]; then \
-	  $(call submit,movies-merge,,global global-merge intervals movies,$(call MOVIES_MERGE_CMD,$(MOVIE_PIECE_KEYS)) && touch $@); \
+	  $(call submit,movies-merge,$(SHARD_INDICES),global global-merge intervals movies,$(call MOVIES_MERGE_CMD,$(MOVIE_PIECE_KEYS),$${SLURM_ARRAY_TASK_ID}/$(SHARDS))) && \
+	  $(call submit,movies-done,,movies-merge,touch $@); \
 	elif [ -n "$$missing" ]; then \
 	  $(call submit,movies-done,,movies,touch $@); \
 	else touch $@; fi

@@ -94,9 +94,10 @@ COMPOSE_CMD   = $(call COMPOSE_RUN,$(COMPOSE_ARGS),$(OUT)/compose-report.json)
 GLOBAL_WINDOW_CMD = $(call GLOBAL_RUN,$(2),$(2:.rkw=-report.json)) --window $(1)
 GLOBAL_MERGE_CMD  = $(GLOBAL_CMD) --merge $(1)
 MOVIES_SHARD_CMD  = $(call MOVIES_RUN,$(OUT)/movies-report-$(1)of$(2).json) --shard $(1)/$(2)
-# The merge of the movie pieces of at most $(1) keys the shards baked (--piece-keys): it writes
-# what MOVIES_CMD writes, byte for byte (it is MOVIES_CMD plus --merge-pieces).
-MOVIES_MERGE_CMD  = $(MOVIES_CMD) --merge-pieces $(1)
+# The merge of the movie pieces of at most $(1) keys the shards baked (--piece-keys), of the
+# movies of shard $(2) (i/n): it writes what MOVIES_CMD writes, byte for byte (it is MOVIES_CMD
+# plus --merge-pieces and --shard, which the movies' provenance leaves out).
+MOVIES_MERGE_CMD  = $(MOVIES_CMD) --merge-pieces $(1) --shard $(2)
 COMPOSE_CHUNK_CMD = $(call COMPOSE_RUN,--frames $(1) $(COMPOSE_FLAGS),$(OUT)/compose-report-$(1).json)
 GLOBAL_RUN  = $(strip $(BIN)/rad-global $(SCENE) -o $(1) $(GLOBAL_ARGS) --report $(2))
 MOVIES_RUN  = $(strip $(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti -o $(OUT)/movies \

@@ -1,6 +1,7 @@
 // rad-movies' render-farm pieces (issue 58; tools/stages/movie_pieces.h) on the bundled scene
 // through the real tools: movies cut into pieces of keys by --piece-keys tasks and joined by
-// --merge-pieces are the one-task bake's files byte for byte; a piece is never read as a movie
+// --merge-pieces (two merges, each of half the movies) are the one-task bake's files byte for
+// byte; a piece is never read as a movie
 // (rad-compose refuses it by name); the merge refuses a piece of another run and a missing piece.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -81,8 +82,13 @@ TEST_F(MoviePiecesCli, PiecesMergedAreTheOneTaskBakeByteForByte) {
   ASSERT_GE(split.size(), 2u) << "the scene's movies are longer than 3 keys";
   for (const std::string& name : split) EXPECT_FALSE(fs::exists(path("movies/" + name))) << name;
 
-  CommandResult merge = runCommand(movies("--merge-pieces 3"));
-  ASSERT_EQ(merge.exitCode, 0) << merge.err;
+  // Two merges side by side, each of its share of the movies (slurm.mk's array): their movies
+  // record the one-task command line, without --merge-pieces and --shard.
+  for (int s = 0; s < 2; ++s) {
+    CommandResult merge =
+        runCommand(movies("--merge-pieces 3 --shard " + std::to_string(s) + "/2"));
+    ASSERT_EQ(merge.exitCode, 0) << merge.err;
+  }
   const std::map<std::string, std::string> whole = files(path("whole")),
                                            merged = files(path("movies"));
   ASSERT_EQ(merged.size(), whole.size()) << "no piece left, every movie there";

@@ -67,12 +67,15 @@ void addDeprecatedOptions(CLI::App& app, rad::TextureMovieBakerOptions& b) {
 int mergePieces(const Options& o, const rad::TextureMovieBaker& baker,
                 const rad::TextureIntervals& intervals, const rad::Provenance& provenance,
                 const nlohmann::json& parameters, rad::SteadyClock::time_point start) {
-  const rad::MoviePieceMergeReport merged =
-      rad::mergeMoviePieces(baker, intervals, o.outDir, o.mergePieces, provenance);
+  const rad::MoviePieceMergeReport merged = rad::mergeMoviePieces(
+      baker, intervals, o.outDir, o.mergePieces, provenance, rad::MovieShard::parse(o.shard));
+  std::cerr << kTool << ": merged " << merged.moviesMerged << " movies from " << merged.piecesRead
+            << " pieces\n";
   if (!o.report.empty()) {
     nlohmann::json report;
     report["tool"] = kTool;
     report["merge_pieces"] = o.mergePieces;
+    report["shard"] = o.shard;
     report["movies_merged"] = merged.moviesMerged;
     report["pieces_read"] = merged.piecesRead;
     report["parameters"] = parameters;
@@ -108,7 +111,8 @@ int run(Options o, int argc, char** argv) {
 
   nlohmann::json parameters = o.baker.toJson();
   parameters["preset"] = o.preset;
-  parameters["shard"] = o.shard;
+  // A merge's movies are the one-task bake's, whichever share of them it merges.
+  parameters["shard"] = o.mergePieces > 0 ? std::string("0/1") : o.shard;
   parameters["output"] = o.outDir;
   parameters[rad::kSceneDigestsKey] =
       rad::sceneDigests(scene, {rad::ScenePart::kGeometry, rad::ScenePart::kMaterials,
@@ -211,8 +215,8 @@ int main(int argc, char** argv) {
           ->group(farm);
   app.add_option("--merge-pieces", o.mergePieces,
                  "render farm: instead of baking, join the pieces that --piece-keys K runs of this "
-                 "same command line wrote into their movies: the same bytes as the run without "
-                 "--merge-pieces, provenance included")
+                 "same command line wrote into their movies (with --shard i/n, those with id % n "
+                 "== i): the same bytes as the run without --merge-pieces, provenance included")
       ->type_name("K")
       ->check(rad::positiveInteger())
       ->excludes(pieces)

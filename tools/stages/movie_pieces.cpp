@@ -29,11 +29,11 @@ std::vector<std::string> argumentsWithoutMergePieces(int argc, const char* const
   std::vector<std::string> words;
   for (int i = 0; i < argc; ++i) {
     const std::string w = argv[i];
-    if (w == "--merge-pieces") {
+    if (w == "--merge-pieces" || w == "--shard") {
       ++i;  // and its value
       continue;
     }
-    if (w.rfind("--merge-pieces=", 0) == 0) continue;
+    if (w.rfind("--merge-pieces=", 0) == 0 || w.rfind("--shard=", 0) == 0) continue;
     words.push_back(w);
   }
   return words;
@@ -85,7 +85,7 @@ void requirePieceOf(const std::string& path, const TextureMovie& piece, const Mo
 MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
                                        const TextureIntervals& intervals,
                                        const std::string& moviesDir, int pieceKeys,
-                                       const Provenance& provenance) {
+                                       const Provenance& provenance, MovieShard shard) {
   const auto start = SteadyClock::now();
   const std::string provenanceJson = provenance.toJson().dump();
   MoviePieceMergeReport report;
@@ -99,6 +99,7 @@ MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
   };
   std::vector<Split> todo;
   for (const MovieExtent& m : intervals.movies) {
+    if (!shard.contains(m.movie)) continue;
     BakedMovie plan = baker.keyPlan(m);
     std::vector<TextureMoviePiece> pieces = moviePieces(int(plan.keyFrames.size()), pieceKeys);
     if (pieces.size() < 2) continue;

@@ -15,6 +15,7 @@
 #include "formats/texture_intervals.h"
 #include "formats/texture_movie.h"
 #include "libcommon/movies/texture_movie_baker.h"
+#include "tools/stages/movie_sequence.h"
 
 namespace rad {
 
@@ -23,8 +24,8 @@ namespace rad {
 // pieceKeys <= 0 or keys <= pieceKeys: one piece (count 1), the whole movie.
 std::vector<TextureMoviePiece> moviePieces(int keys, int pieceKeys);
 
-// The command line of a --merge-pieces run without `--merge-pieces K` (or `--merge-pieces=K`):
-// the provenance the merged movies record, the whole bake's.
+// The command line of a --merge-pieces run without `--merge-pieces K` and `--shard i/n` (or
+// their `=` forms): the provenance the merged movies record, the whole bake's.
 std::vector<std::string> argumentsWithoutMergePieces(int argc, const char* const* argv);
 
 struct MoviePieceMergeReport {
@@ -32,16 +33,17 @@ struct MoviePieceMergeReport {
   double seconds = 0.0;
 };
 
-// Joins the pieces of every movie of `intervals` that --piece-keys `pieceKeys` cut into more than
-// one piece: reads MOVIES_DIR/MMMMMM.piece-PPPP.exr for every piece (each checked against the
-// movie's key plan from `baker` and against `provenance`: made with the same parameters, --shard
-// aside, and from the same inputs), writes MOVIES_DIR/MMMMMM.exr (provenance: `provenance`)
-// and removes the pieces. Movies of one piece were written whole by their task and are left as
-// they are. Throws rad::inputError(piece path, ...) for a missing, damaged or foreign piece
-// (no movie of it is written) and rad::outputError when a movie cannot be written.
+// Joins the pieces of every movie of `intervals` of `shard` (id % n == i, so that merges run side
+// by side) that --piece-keys `pieceKeys` cut into more than one piece: reads
+// MOVIES_DIR/MMMMMM.piece-PPPP.exr for every piece (each checked against the movie's key plan from
+// `baker` and against `provenance`: made with the same parameters, --shard aside, and from the same
+// inputs), writes MOVIES_DIR/MMMMMM.exr (provenance: `provenance`) and removes the pieces. Movies
+// of one piece were written whole by their task and are left as they are. Throws
+// rad::inputError(piece path, ...) for a missing, damaged or foreign piece (no movie of it is
+// written) and rad::outputError when a movie cannot be written.
 MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
                                        const TextureIntervals& intervals,
                                        const std::string& moviesDir, int pieceKeys,
-                                       const Provenance& provenance);
+                                       const Provenance& provenance, MovieShard shard);
 
 }  // namespace rad
