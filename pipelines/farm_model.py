@@ -17,17 +17,18 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
                         With --piece-keys K (slurm.mk's MOVIE_PIECE_KEYS, issue 58), a movie of
                         n > K keys is P = ceil(n / K) pieces, every movie's pieces dealt to
                         the shards in order, each paying the movie's planning (its report's
-                        seconds_plan) and its share of the movie's key time; then one merge
-                        task (the fixed cost and, per merged movie, reading and writing its
-                        bytes at the run's write rate) and one more stage boundary
+                        seconds_plan) and its share of the movie's key time; then the merges,
+                        movie m in task m % SHARDS (the fixed cost and, per movie cut, reading
+                        and writing its bytes at the run's write rate), one more stage boundary
   compose               SHARDS contiguous chunks of frames, each paying the fixed cost once
   mp4 + contact sheet   one task each, side by side; with --video-segments (slurm.mk, issue 58)
                         each compose chunk also encodes its frames as a segment (the one-core
                         mp4 encode's time per frame) and the mp4 task only concatenates them
                         (-c copy); the contact sheet decodes its eight frames. The three are
                         timed on the run's frames, one core each (video-seconds.json)
-  + one scheduling latency per stage boundary (--latency, seconds; measured on the local
-    cluster: tests/slurm/cluster.sh)
+  + one scheduling latency per stage on the critical path (--latency, seconds; measured on the
+    local cluster: tests/slurm/cluster.sh): global (and its merge when windowed), movies (and
+    their merges with pieces), compose, the mp4
 
 The serial part is what no number of nodes shortens, the critical path on unlimited nodes: the
 longer of global and intervals (or, windowed, the slowest window and the merge), the fixed cost
@@ -187,23 +188,34 @@ def global_seconds(p, slots, windows):
 
 
 def movie_pieces(p, piece_keys):
-    """(movie id, piece index, seconds) of every piece, and the merge task's seconds (0: no
-    merge). A movie of n > K keys is ceil(n / K) pieces, as rad-movies --piece-keys cuts it, each
-    paying the movie's planning and its share of the key time (tools/stages/movie_pieces.h)."""
-    out, merged_bytes = [], 0
+    """(movie id, piece index, seconds) of every piece, and {movie id: seconds to merge it} of
+    the movies cut. A movie of n > K keys is ceil(n / K) pieces, as rad-movies --piece-keys cuts
+    it, each paying the movie's planning and its share of the key time
+    (tools/stages/movie_pieces.h); its merge reads its pieces and writes it: twice its bytes at
+    the run's write rate."""
+    out, merges = [], {}
     for mid, s in p["movies"]:
         keys, plan = p.get("movie_plans", {}).get(mid, (1, 0.0))
         count = (keys + piece_keys - 1) // piece_keys if piece_keys > 0 and keys > piece_keys else 1
         if count == 1:
             out.append((mid, 0, s))
             continue
-        merged_bytes += p.get("movie_bytes", {}).get(mid, 0)
+        merges[mid] = 2.0 * p.get("write_per_byte", 0.0) * p.get("movie_bytes", {}).get(mid, 0)
         for j in range(count):
             n = keys * (j + 1) // count - keys * j // count
             out.append((mid, j, plan + (s - plan) * n / keys))
-    cut = sum(1 for _, j, _ in out if j == 1)  # movies of more than one piece
-    merge = p["movies_fixed"] + 2.0 * p.get("write_per_byte", 0.0) * merged_bytes if cut else 0.0
-    return out, merge
+    return out, merges
+
+
+def merge_seconds(p, merges, shards):
+    """The merges side by side, as slurm.mk runs them: movie m in merge task m % shards, each
+    task paying the fixed cost once (0: no movie cut, no merge)."""
+    if not merges:
+        return 0.0
+    tasks = [0.0] * shards
+    for mid, s in merges.items():
+        tasks[mid % shards] += s
+    return p["movies_fixed"] + max(tasks)
 
 
 def video_path(p, segments):
@@ -219,7 +231,8 @@ def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False):
     slots = nodes * cores
     shards = slots
     movie_shards = [0.0] * shards
-    pieces, merge = movie_pieces(p, piece_keys)
+    pieces, merges = movie_pieces(p, piece_keys)
+    merge = merge_seconds(p, merges, shards)
     for u, (mid, _, s) in enumerate(pieces):  # rad-movies' shardWork: pieces dealt in order
         movie_shards[(u if piece_keys > 0 else mid) % shards] += s
     movie_tasks = [p["movies_fixed"] + s for s in movie_shards if s > 0.0]
@@ -235,15 +248,22 @@ def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False):
         "movie merge": merge,
         "compose": makespan(compose_tasks, slots),
         "mp4 + contact sheet": video_path(p, segments),
-        "scheduling": (5 if merge else 4) * latency,
+        "scheduling": stage_boundaries(windows and slots > 1, merge) * latency,
     }
     return path, sum(path.values())
+
+
+def stage_boundaries(global_windows, movie_merge):
+    """The stages on the critical path, each started after one scheduling latency: global (and its
+    merge, when in windows), movies (and their merges), compose, the mp4."""
+    return 4 + (1 if global_windows else 0) + (1 if movie_merge else 0)
 
 
 def serial_part(p, latency, windows, piece_keys=0, segments=False):
     """The critical path with unlimited nodes: what no number of nodes shortens."""
     g = global_seconds(p, len(p["keys"]), windows)
-    pieces, merge = movie_pieces(p, piece_keys)
+    pieces, merges = movie_pieces(p, piece_keys)
+    merge = merge_seconds(p, merges, max(1, len(merges)))
     encode = p["video_parts"]["mp4"] / len(p["frames"]) if segments else 0.0
     return {
         "global || intervals": max(g, p["intervals"]),
@@ -252,7 +272,7 @@ def serial_part(p, latency, windows, piece_keys=0, segments=False):
         "movie merge": merge,
         "longest frame": max(p["frames"]) + encode,
         "ffmpeg": video_path(p, segments),
-        "scheduling": (5 if merge else 4) * latency,
+        "scheduling": stage_boundaries(windows, merge) * latency,
     }
 
 
@@ -285,19 +305,22 @@ def self_test():
     p["movie_plans"] = {0: (2, 0.5), 1: (2, 0.5), 2: (2, 0.5), 3: (6, 1.0)}
     p["movie_bytes"] = {0: 100, 1: 100, 2: 100, 3: 600}
     p["write_per_byte"] = 0.0005
-    pieces, merge = movie_pieces(p, 2)
+    pieces, merges = movie_pieces(p, 2)
     check("three pieces of movie 3", len([x for x in pieces if x[0] == 3]), 3)
     check("a piece: planning + a third of the keys", pieces[3][2], 1.0 + 2.0 / 3.0)
-    check("the merge", merge, 0.5 + 0.6)
-    check("no pieces: no merge", movie_pieces(p, 0)[1], 0.0)
+    check("the merge", merge_seconds(p, merges, 4), 0.5 + 0.6)
+    check("no pieces: no merge", merge_seconds(p, movie_pieces(p, 0)[1], 4), 0.0)
     path, wall = model(p, 2, 2, 1.0, False, 2)
     check("movies on 4 shards: shard 0 holds movie 0 and a piece of movie 3",
           path["movies"], 0.5 + 1.0 + 1.0 + 2.0 / 3.0)
     check("a stage more", path["scheduling"], 5.0)
+    path, wall = model(p, 2, 2, 1.0, True, 2)
+    check("and one more for the global merge", path["scheduling"], 6.0)
     serial = serial_part(p, 0.0, False, 2)
     check("serial: the longest piece",
           serial["longest movie"], 1.0 + 2.0 / 3.0)
     check("serial merge", serial["movie merge"], 1.1)
+    check("serial scheduling, windows and merges", serial_part(p, 1.0, True, 2)["scheduling"], 6.0)
     # Segments: each chunk of two frames encodes them (1 s for 4 frames: 0.5 s a chunk); then
     # the longer of the join (0.25 s) and the contact sheet (0.5 s).
     p["video_parts"] = {"mp4": 1.0, "contact": 0.5, "concat": 0.25}
