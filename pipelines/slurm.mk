@@ -39,7 +39,7 @@ GLOBAL_WINDOWS ?= 1
 # Keys per movie piece (rad-movies --piece-keys; 0: whole movies, no merge job). Each piece plans
 # its movie again, so a smaller piece cuts the longest task and adds planning (docs/results.md,
 # "Farm tasks finer than one movie").
-MOVIE_PIECE_KEYS ?= 8
+MOVIE_PIECE_KEYS ?= 4
 PARTITION    ?=
 WAIT         ?= 0
 SBATCH_FLAGS ?=
