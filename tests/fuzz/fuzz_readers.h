@@ -98,7 +98,8 @@ inline void feedIntervals(const uint8_t* data, size_t size) {
 }
 
 // A texture movie (multi-part EXR) read whole (rad-inspect, tests) and as rad-compose streams
-// it (every key through textureAt).
+// it (every key through textureAt); and as rad-movies --merge-pieces reads a piece of one
+// (formats/texture_movie_piece.md: every key).
 inline void feedTextureMovie(const uint8_t* data, size_t size) {
   const std::string path = writeScratch("000000.exr", data, size);
   runReader([&] { (void)readTextureMovie(path); });
@@ -107,6 +108,10 @@ inline void feedTextureMovie(const uint8_t* data, size_t size) {
     std::vector<float> texels;
     const std::vector<double> times = stream.movie().keyTimes;
     for (double t : times) stream.textureAt(t, texels);
+  });
+  runReader([&] {
+    TextureMovieStream piece(path, MovieFileKind::kPiece);
+    for (size_t k = 0; k < piece.movie().keyTimes.size(); ++k) (void)piece.key(k);
   });
 }
 

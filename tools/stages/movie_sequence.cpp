@@ -30,11 +30,14 @@ class MovieFileSink : public BakedKeySink {
   MovieFileSink(bool collapse, double& secondsWrite)
       : collapse_(collapse), secondsWrite_(secondsWrite) {}
 
-  // The movie the next bake() streams: its metadata (keys come from the baker) and file; for a
-  // piece, its place in the movie (meta.piece), whose keys alone the file holds.
-  void start(TextureMovie meta, std::string path) {
-    meta_ = std::move(meta);
-    path_ = std::move(path);
+  // The movie the next bake() streams: its metadata (keys come from the baker) and file in `dir`;
+  // for a piece, its place in the movie (meta.piece), whose keys alone the file holds.
+  void start(const MovieWork& work, const std::string& provenanceJson, const std::string& dir) {
+    const MovieExtent& m = *work.movie;
+    meta_ = textureMovieOf(m, provenanceJson);
+    meta_.piece = work.piece;
+    path_ = work.piece.isPiece() ? textureMoviePiecePath(dir, m.movie, work.piece.index)
+                                 : textureMoviePath(dir, m.movie);
   }
   // Drops a half-written movie (nothing is left at its path).
   void discard() { writer_.reset(); }
@@ -72,6 +75,19 @@ class MovieFileSink : public BakedKeySink {
   std::string path_;
   std::unique_ptr<TextureMovieWriter> writer_;
 };
+
+// What a unit of work cost, for the report.
+MovieWorkSeconds workSeconds(const MovieWork& work, const BakedMovie& baked, double seconds) {
+  const TextureMoviePiece& piece = work.piece;
+  const int movieKeys = int(baked.keyFrames.size());
+  return {work.movie->movie,
+          piece.isPiece() ? piece.index : -1,
+          piece.isPiece() ? piece.keys : movieKeys,
+          movieKeys,
+          long(work.movie->width) * long(work.movie->height),
+          seconds,
+          baked.secondsPlan};
+}
 
 }  // namespace
 
@@ -112,7 +128,6 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker,
     throw outputError(options.moviesDir, "cannot create the movie directory" +
                                              (ec ? ": " + ec.message() : std::string()));
   const std::string provenanceJson = provenance.toJson().dump();
-
   // One worker per allowed thread (--threads), each baking whole movies with its own baker: a big
   // scene's movies are mostly a few texels, too small for the per-texel loops inside a movie to
   // keep two cores busy. `baker` is worker 0 on this thread; the others are its siblings, made,
@@ -143,21 +158,14 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker,
     tbb::task_arena alone(1);
     for (size_t i; !stop && (i = next++) < movies.size();) {
       const MovieExtent& m = *movies[i].movie;
-      const TextureMoviePiece& piece = movies[i].piece;
       const auto movieStart = SteadyClock::now();
       BakedMovie baked;
       try {
-        TextureMovie meta = textureMovieOf(m, provenanceJson);
-        meta.piece = piece;
-        sink.start(std::move(meta),
-                   piece.isPiece() ? textureMoviePiecePath(options.moviesDir, m.movie, piece.index)
-                                   : textureMoviePath(options.moviesDir, m.movie));
-        const MovieKeyRange keys =
-            piece.isPiece() ? MovieKeyRange{piece.firstKey, piece.keys} : MovieKeyRange{};
+        sink.start(movies[i], provenanceJson, options.moviesDir);
         if (workers > 1 && i + workers < movies.size())
-          alone.execute([&] { baked = mine.bake(m, sink, keys); });
+          alone.execute([&] { baked = mine.bake(m, sink, movies[i].keys()); });
         else
-          baked = mine.bake(m, sink, keys);
+          baked = mine.bake(m, sink, movies[i].keys());
       } catch (...) {
         sink.discard();
         std::lock_guard<std::mutex> lock(mutex);
@@ -165,13 +173,7 @@ MovieSequenceReport bakeMovieSequence(TextureMovieBaker& baker,
         stop = true;
         return;
       }
-      movieSeconds[i] = {m.movie,
-                         piece.isPiece() ? piece.index : -1,
-                         piece.isPiece() ? piece.keys : int(baked.keyFrames.size()),
-                         int(baked.keyFrames.size()),
-                         long(m.width) * long(m.height),
-                         secondsSince(movieStart),
-                         baked.secondsPlan};
+      movieSeconds[i] = workSeconds(movies[i], baked, secondsSince(movieStart));
       if (progress) {
         std::lock_guard<std::mutex> lock(mutex);
         progress();

@@ -37,6 +37,10 @@ struct MovieSequenceOptions {
 struct MovieWork {
   const MovieExtent* movie = nullptr;
   TextureMoviePiece piece;
+  // The keys to bake: the piece's, or all.
+  MovieKeyRange keys() const {
+    return piece.isPiece() ? MovieKeyRange{piece.firstKey, piece.keys} : MovieKeyRange{};
+  }
 };
 
 // What one unit cost: the farm model (pipelines/farm_model.py) re-splits a run's movies into any
