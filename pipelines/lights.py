@@ -128,8 +128,8 @@ def closed_forms(a, log):
             bands = ["all"] + (["inner", "between"] if lamp == "spot" else [])
             for band in bands:
                 name = "%s lamp, %s: frame / closed form%s" % (
-                    lamp, tool, "" if band == "all" else " (%s the cones)" % (
-                        "inside" if band == "inner" else "between"))
+                    lamp, tool, {"all": "", "inner": " (inner cone)",
+                                 "between": " (between the cones)"}[band])
                 figure(name, "%+.3f %%" % (100 * (q[band] - 1)), "within 0.5 %",
                        abs(q[band] - 1) <= 0.005)
     for rho in (0.5, 0.9):
