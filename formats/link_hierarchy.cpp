@@ -109,11 +109,12 @@ GlobalSolution readSolution(const ContainerReader& r, const Scene& scene, bool r
   if (b.size() != N * K * 3) throw inputError(where, "node_radiosity has the wrong size");
   s.nodeRadiosity = unflatten(b);
   s.leafRow = r.array<int32_t>("leaf_row");
+  // Since 1.2; rad-compose's fallback divides the lamps' leaf average by it.
+  if (r.has("node_exposure")) s.nodeExposure = r.array<float>("node_exposure");
   if (radiosityOnly) {
     s.validateRadiosity(where);
     return s;
   }
-  if (r.has("node_exposure")) s.nodeExposure = r.array<float>("node_exposure");  // since 1.2
   s.leafVertexGoodIrradiance = unflatten(r.array<float>("leaf_vertex_good_irradiance"));
   s.links = readLinkRows(r, where);
   s.linkSampleKeys = r.array<uint32_t>("link_sample_keys");

@@ -29,6 +29,12 @@
 #       structured error and its reference floor, the largest seam step beyond the reference's,
 #       against two rad-reference renders with the frames' filter; IMAGE_CORPUS adds the public
 #       scenes of pipelines/corpus/scenes.py; out/image/image-figures.csv
+#   make -f pipelines/bench.mk lights [LIGHTS_ONLY=closed,room,moving,heldout] [LIGHTS_SPP=512] [LIGHTS_FRAMES=96] [LIGHTS_REPEAT=3]
+#       issue 57's figures for punctual lamps, each against its goal (pipelines/lights.py): closed
+#       forms through the real tools (point, spot across its cones, sun, the closed box), the
+#       Blender lamp room against Cycles, a moving lamp coherent against --no-coherence (bit-
+#       identical) and its whole pipeline's speed-up, a held-out Blender scene against Cycles;
+#       out/lights/lights.json
 #   make -f pipelines/bench.mk fuzz [FUZZ_SECONDS=600] [FUZZ_RUNS=-1]
 #       every reader's libFuzzer harness for FUZZ_SECONDS each, or until FUZZ_RUNS executions
 #       (-1: no bound but the time; the issue's long run: FUZZ_RUNS=1000000 FUZZ_SECONDS=5400)
@@ -67,10 +73,15 @@ IMAGE_EVAL_FRAME ?= 20
 IMAGE_SPP ?= 1024
 IMAGE_PRESETS ?= default,final
 
+LIGHTS_ONLY ?= closed,room,moving,heldout
+LIGHTS_SPP ?= 512
+LIGHTS_FRAMES ?= 96
+LIGHTS_REPEAT ?= 3
+
 FUZZ_SECONDS ?= 600
 FUZZ_RUNS ?= -1
 
-.PHONY: tables tradeoff furnace contact scale farm-model image fuzz
+.PHONY: tables tradeoff furnace contact scale farm-model image lights fuzz
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -101,6 +112,10 @@ image:
 	python3 pipelines/image_figures.py --bin $(BIN) --frames $(IMAGE_FRAMES) --eval-frame $(IMAGE_EVAL_FRAME) \
 	  --size $(BENCH_SIZE) --spp $(IMAGE_SPP) --presets $(IMAGE_PRESETS) --out out/image \
 	  $(if $(IMAGE_OWN),--own $(IMAGE_OWN)) $(if $(IMAGE_CORPUS),--corpus $(IMAGE_CORPUS))
+
+lights:
+	python3 pipelines/lights.py --bin $(BIN) --only $(LIGHTS_ONLY) --spp $(LIGHTS_SPP) \
+	  --moving-frames $(LIGHTS_FRAMES) --repeat $(LIGHTS_REPEAT) --out out/lights --check
 
 fuzz:
 	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) bash tests/fuzz/run.sh

@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 
 #include "libcommon/compose/edge_cells.h"
+#include "libcommon/compose/fallback_lamp_light.h"
 #include "libcommon/compose/footprint_filter.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
@@ -204,6 +205,7 @@ struct FrameComposer::Impl {
   ItemBufferRenderer renderer;
   ItemBuffer items;                           // of the sample grid
   std::unique_ptr<SceneVisibility> rayScene;  // refineSilhouettes' rays, made on first use
+  FallbackLampLight lampLight;                // the lamps at fallback samples
   std::vector<uint8_t> edgeMask;              // refineSilhouettes': samples with another neighbour
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
@@ -211,9 +213,14 @@ struct FrameComposer::Impl {
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
+  // The shadow rays' scene at time t (made on first use), for silhouettes and lamps.
+  SceneVisibility& raysAt(double t);
   // Returns the samples it looked at: those whose id differed from a 4-neighbour's.
   std::vector<size_t> refineSilhouettes(double t, const PrimaryRays& rays);
   void placeVisibleTops(VisibleTops& visible) const;
+  glm::dvec3 fallbackRadiance(double t, const VisibleTops& visible, int top, glm::dvec2 topUv,
+                              const glm::dvec3& emitted, const glm::dvec3& texFactor,
+                              bool textured) const;
   PixelSource shadeSample(double t, const std::vector<MovieTexture>& movies,
                           const VisibleTops& visible, const ActiveMovies& active,
                           const PrimaryRays& rays, glm::dvec2 pixel, int top, float* rgb) const;
@@ -239,6 +246,7 @@ struct FrameComposer::Impl {
         edgeCells(edgeCoverage),
         edgeContrast(minContrast),
         tops(s.inputPolygons()),
+        lampLight(s, g),
         renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
       throw inputError(s.path, nodeLabel(s, cam) + " is not a camera");
@@ -302,6 +310,15 @@ CameraView FrameComposer::Impl::renderItems(double t) {
   return view;
 }
 
+SceneVisibility& FrameComposer::Impl::raysAt(double t) {
+  if (!rayScene) {
+    const std::vector<double>& k = solution.keyTimes;
+    rayScene = std::make_unique<SceneVisibility>(scene, solution.hierarchy, k.front(), k.back());
+  }
+  rayScene->setTime(t);
+  return *rayScene;
+}
+
 // The item buffer's silhouettes decided by the pixel centre's ray. GL rasterizes with a few bits of
 // sub-pixel precision (llvmpipe: 8), so a silhouette edge that passes within ~1/256 pixel of a
 // centre can give the pixel either surface, while rad-reference --pixel-filter none (and a
@@ -331,11 +348,7 @@ std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const Prima
   for (size_t p = 0; p < edgeMask.size(); ++p)
     if (edgeMask[p]) edge.push_back(p);
   if (edge.empty() || (filter && edgeCells)) return edge;
-  if (!rayScene) {
-    const std::vector<double>& k = solution.keyTimes;
-    rayScene = std::make_unique<SceneVisibility>(scene, solution.hierarchy, k.front(), k.back());
-  }
-  rayScene->setTime(t);
+  raysAt(t);
   std::vector<uint32_t> decided(edge.size());
   tbb::parallel_for(size_t(0), edge.size(), [&](size_t e) {
     const size_t p = edge[e];
@@ -378,6 +391,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   VisibleTops visible;
   m.placeVisibleTops(visible);
   const ActiveMovies active = indexMovies(movies, int(m.tops.size()));
+  if (!m.lampLight.empty()) m.lampLight.setTime(t, m.raysAt(t).visibility());
 
   out.size = size;
   out.time = t;
@@ -506,6 +520,31 @@ void FrameComposer::Impl::weighEdgeCells(const VisibleTops& visible, const Camer
   filter->setEdgeCells(findEdgeCells(in, edgeCandidates));
 }
 
+// A sample no movie textures: the union leaf's radiosity, $L = B / \pi$; with a texture, the
+// reflected part modulated (B holds the patch's mean emission, emission_texture.h); with lamps,
+// their leaf average replaced by the point's direct light (fallback_lamp_light.h).
+glm::dvec3 FrameComposer::Impl::fallbackRadiance(double t, const VisibleTops& visible, int top,
+                                                 glm::dvec2 topUv, const glm::dvec3& emitted,
+                                                 const glm::dvec3& texFactor, bool textured) const {
+  const int leaf = leafAtTopUv(solution.hierarchy, top, topUv);
+  const glm::dvec3 B = solution.radiosity(leaf, t);
+  if (lampLight.empty()) {
+    if (textured)
+      return emitted + texFactor * glm::max(B / kPi - topEmission[size_t(top)], glm::dvec3(0.0));
+    return B / kPi;
+  }
+  const glm::dmat4& toWorld = transforms[topObject[size_t(top)]];
+  const glm::dvec3 x =
+      glm::dvec3(toWorld * glm::dvec4(solution.hierarchy.pointAt(top, topUv), 1.0));
+  const Polygon leafWorld = solution.hierarchy.node(leaf).local.transformed(toWorld);
+  const FallbackLampLight::Terms lamps =
+      lampLight.at(leaf, leafWorld, x, visible.normals[size_t(top)], top);
+  const glm::dvec3 rhoOverPi = materials[size_t(top)].reflectance / kPi;
+  const glm::dvec3 indirect =
+      glm::max(B / kPi - topEmission[size_t(top)] - rhoOverPi * lamps.leafAverage, glm::dvec3(0.0));
+  return emitted + texFactor * (indirect + rhoOverPi * lamps.atPoint);
+}
+
 // One covered sample at image position `pixel` on top-level patch `top`: its radiance into
 // rgb[0..2], from the deepest active movie containing the point, else from the global solution.
 PixelSource FrameComposer::Impl::shadeSample(double t, const std::vector<MovieTexture>& movies,
@@ -537,13 +576,7 @@ PixelSource FrameComposer::Impl::shadeSample(double t, const std::vector<MovieTe
     L = emitted + (mat.reflectance * texFactor / kPi) * H;
     source = PixelSource::kMovie;
   } else {
-    // Fallback: the union leaf's radiosity, $L = B / \pi$.
-    int leaf = leafAtTopUv(solution.hierarchy, top, topUv);
-    glm::dvec3 B = solution.radiosity(leaf, t);
-    if (textured || emissiveTextured)  // B holds the patch's mean emission (emission_texture.h)
-      L = emitted + texFactor * glm::max(B / kPi - topEmission[size_t(top)], glm::dvec3(0.0));
-    else
-      L = B / kPi;
+    L = fallbackRadiance(t, visible, top, topUv, emitted, texFactor, textured || emissiveTextured);
     source = PixelSource::kFallback;
   }
   for (int a = 0; a < 3; ++a) rgb[a] = std::isfinite(L[a]) ? float(std::max(L[a], 0.0)) : 0.0f;

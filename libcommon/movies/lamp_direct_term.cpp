@@ -29,6 +29,13 @@ bool lampShadowsMove(const Scene& scene, const std::vector<InputPolygon>& tops,
   return false;
 }
 
+glm::dvec3 lampDirectAt(const PlacedEmitter& lamp, const glm::dvec3& p, const glm::dvec3& n,
+                        const VisibilityScene& visibility, std::uint32_t receiverTop) {
+  const glm::dvec3 E = lamp.irradiance(p, n);
+  if (!(std::max(E.x, std::max(E.y, E.z)) > 0.0)) return glm::dvec3(0.0);
+  return visibility.occluded(p, lamp.shadowTarget(p), receiverTop) ? glm::dvec3(0.0) : E;
+}
+
 LampDirectTerm::LampDirectTerm(const SceneEmitters& emitters, const MovieGeometry& geometry,
                                SceneVisibility& visibility, std::uint32_t receiverTop)
     : emitters_(emitters), geo_(geometry), vis_(visibility), receiverTop_(receiverTop) {

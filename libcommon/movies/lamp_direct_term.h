@@ -30,6 +30,14 @@ bool lampShadowsMove(const Scene& scene, const std::vector<InputPolygon>& tops,
                      const SceneEmitters& emitters, int receiverNode, const Polygon& receiver,
                      double t0, double t1);
 
+// One point's direct irradiance from one placed lamp (W/m^2): the lamp's irradiance at p (unit
+// normal n) when the segment from p to its shadowTarget is open in `visibility`, ignoring the
+// surface `receiverTop` (the point's own top-level patch), else 0. The test LampDirectTerm::add
+// makes per texel, against one whole scene instead of its static and moving parts; rad-compose's
+// fallback samples take their lamps' light from it (fallback_lamp_light.h).
+glm::dvec3 lampDirectAt(const PlacedEmitter& lamp, const glm::dvec3& p, const glm::dvec3& n,
+                        const VisibilityScene& visibility, std::uint32_t receiverTop);
+
 // One movie's lamp term. Used by one thread (the movie's baker), with `visibility` its own.
 class LampDirectTerm {
  public:

@@ -211,6 +211,12 @@ void GlobalSolution::validateRadiosity(const std::string& where) const {
       bad("leaf node without a leaf row");
     }
   }
+  if (!nodeExposure.empty()) {
+    if (nodeExposure.size() != size_t(hierarchy.size()) * keyTimes.size())
+      bad("node_exposure has the wrong size");
+    for (float e : nodeExposure)
+      if (!(e >= 0.0f && e <= 1.0f)) bad("node exposure outside [0, 1]");
+  }
 }
 
 void GlobalSolution::validate(const std::string& where) const {
@@ -220,12 +226,6 @@ void GlobalSolution::validate(const std::string& where) const {
   size_t leaves = 0;
   for (int32_t row : leafRow) leaves += row >= 0;
   if (leafVertexGoodIrradiance.size() != leaves * K * 4) bad("leaf irradiance has the wrong size");
-  if (!nodeExposure.empty()) {
-    if (nodeExposure.size() != size_t(hierarchy.size()) * keyTimes.size())
-      bad("node_exposure has the wrong size");
-    for (float e : nodeExposure)
-      if (!(e >= 0.0f && e <= 1.0f)) bad("node exposure outside [0, 1]");
-  }
   if (linkSampleKeys.size() != linkSampleValues.size()) bad("link sample arrays differ in size");
   if (!linkSampleVisibility.empty()) {
     if (linkSampleVisibility.size() != linkSampleKeys.size())

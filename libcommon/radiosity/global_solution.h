@@ -123,8 +123,9 @@ class GlobalSolution {
 
   // Throws rad::inputError(where, ...) when sizes or indices are inconsistent.
   void validate(const std::string& where) const;
-  // The part of validate() that covers keyTimes, hierarchy, nodeRadiosity and leafRow only:
-  // all a solution read without its links and good irradiance (rad-compose) must satisfy.
+  // The part of validate() that covers keyTimes, hierarchy, nodeRadiosity, leafRow and
+  // nodeExposure only: all a solution read without its links and good irradiance (rad-compose) must
+  // satisfy.
   void validateRadiosity(const std::string& where) const;
 };
 
