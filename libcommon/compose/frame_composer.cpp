@@ -246,8 +246,8 @@ struct FrameComposer::Impl {
         edgeCells(edgeCoverage),
         edgeContrast(minContrast),
         tops(s.inputPolygons()),
-        lampLight(s, g),
-        renderer(grid, ItemBufferOptions{true, false}) {  // ids only: compose reads no depth
+        renderer(grid, ItemBufferOptions{true, false}),  // ids only: compose reads no depth
+        lampLight(s, g) {
     if (cam < 0 || cam >= int(s.nodes.size()) || s.nodes[cam].camera < 0)
       throw inputError(s.path, nodeLabel(s, cam) + " is not a camera");
     if (g.hierarchy.topCount() != int(tops.size()))
