@@ -18,10 +18,51 @@
 namespace rad {
 namespace {
 
-// The nearest of the receiver's centroid and corners to polygon p (the split rule's distance).
+// The distance between segments [a0, a1] and [b0, b1] (Ericson 2005, "Real-Time Collision
+// Detection" §5.1.9, the clamped closest points).
+double segmentDistance(const glm::dvec3& a0, const glm::dvec3& a1, const glm::dvec3& b0,
+                       const glm::dvec3& b1) {
+  const glm::dvec3 d1 = a1 - a0, d2 = b1 - b0, r = a0 - b0;
+  const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+  double s = 0.0, t = 0.0;
+  if (a <= 0.0 && e <= 0.0) return glm::length(r);
+  if (a <= 0.0) {
+    t = glm::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = glm::dot(d1, r);
+    if (e <= 0.0) {
+      s = glm::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = glm::dot(d1, d2), denom = a * e - b * b;
+      s = denom > 0.0 ? glm::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0.0) {
+        t = 0.0;
+        s = glm::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1.0) {
+        t = 1.0;
+        s = glm::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return glm::length(a0 + s * d1 - (b0 + t * d2));
+}
+
+// The split rule's distance: from the receiver's nearest point to polygon p (convex polygons
+// that do not cross: the nearest of each one's corners to the other and of their edges).
+// Not from the receiver's centroid and corners only: a sliver of a fan (issue 56) whose long
+// edge passes by a shooter part, but whose corners are far from it, kept the part whole while
+// its small neighbour across that edge split it, and the two gathered the shooter's radiosity
+// at different resolutions along their shared edge (a step there).
 double distanceFromReceiver(const Polygon& receiver, const Polygon& p) {
-  double d = distanceToPolygon(receiver.centroid(), p);
-  for (int i = 0; i < receiver.count; ++i) d = std::min(d, distanceToPolygon(receiver.v[i], p));
+  double d = std::numeric_limits<double>::infinity();
+  const size_t m = size_t(receiver.count), n = size_t(p.count);
+  for (size_t i = 0; i < m; ++i) d = std::min(d, distanceToPolygon(receiver.v[i], p));
+  for (size_t j = 0; j < n; ++j) d = std::min(d, distanceToPolygon(p.v[j], receiver));
+  for (size_t i = 0; i < m; ++i)
+    for (size_t j = 0; j < n; ++j)
+      d = std::min(
+          d, segmentDistance(receiver.v[i], receiver.v[(i + 1) % m], p.v[j], p.v[(j + 1) % n]));
   return d;
 }
 

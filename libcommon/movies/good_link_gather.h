@@ -99,7 +99,9 @@ struct GoodLinkGatherStats {
 class GoodLinkGather {
  public:
   // Plans the gather of one movie: its links (each shooter split into the parts of its union
-  // sub-tree larger than shooterRatio times their distance to the receiver; 0: no split), their
+  // sub-tree larger than shooterRatio times their distance to the receiver's nearest point, so
+  // that the parts depend on where a receiver is, not on its shape or the level at which it is
+  // linked; 0: no split), their
   // visibility at the global keys it needs and, within `cacheBytes`, the per-texel form factors
   // of the links whose ends do not move.
   // `emitters` are the lights among the solution's tops (SceneEmitters of hierarchy.tops()).
