@@ -247,9 +247,21 @@ class GoodLinkGather {
   double cellRatio(const Link& l, int key) const;  // the cell's B over its leaf's (1: no cell)
   // Per near leaf shooter, the areas of its 4^nearShooterLevels_ cells (cellRatio's weights).
   std::unordered_map<uint32_t, std::vector<double>> cellAreas_;
-  void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request);
+  void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
+                 const std::vector<char>& neededKeys);
   void shooterParts(const std::vector<Polygon>& receiverAt, const std::vector<double>& times,
-                    uint32_t shooter, std::vector<uint32_t>& out) const;
+                    const std::vector<char>& neededKeys, uint32_t shooter,
+                    std::vector<std::pair<uint32_t, int>>& out) const;
+  // The parts come with the levels they lie below the last node larger than kRaysRatio times
+  // the ratio: such a node's rays are shared among its parts (a quarter a level, as a near
+  // leaf's cells share them), for they split where B varies, not V, and a texel's V of the node
+  // is then taken from as many rays as before its parts were made finer for their B.
+  static constexpr double kRaysRatio = 2.0;
+  // A shooter part is split only where its children's radiosities differ from its own by more
+  // than this share (childrenDiffer): the step two receivers linked at different levels can
+  // make is then at most this share of the part's term.
+  static constexpr double kPartSpread = 0.02;
+  bool childrenDiffer(uint32_t q, const std::vector<char>& neededKeys) const;
   void planWeights(const std::vector<char>& neededKeys);
   void selectPartialLinks(const std::vector<double>& risk, const std::vector<double>& carried);
   void planTexels(double cacheBytes);
