@@ -130,7 +130,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   for (const Link& l : links_) {
     stats.partialLinks += l.partial ? 1 : 0;
     stats.partialLinksMovingBlockers += l.partial && l.movingBlockers ? 1 : 0;
-    stats.partialLinksFewRays += l.partial && l.rays < visibilityRays_ && l.cell == 1 ? 1 : 0;
+    stats.partialLinksFewRays += l.fewRays ? 1 : 0;
   }
   stats.partialTileLinksPerTexel += long(partialTileLinksPerTexel_);
 }
@@ -427,6 +427,7 @@ void GoodLinkGather::selectPartialLinks(const std::vector<double>& risk,
         continue;
       }
       links_[j].partial = true;
+      links_[j].fewRays = true;
       links_[j].rays = std::max(1, links_[j].rays / 4);
     }
   }

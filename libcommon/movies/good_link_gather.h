@@ -134,6 +134,9 @@ class GoodLinkGather {
     // whose ends do not move are cast against the static blockers once per movie; against the
     // moving ones at every key, only when a moving node's swept bounds meet its shaft.
     bool movingBlockers = false;
+    // One of the small partial links that take a quarter of the rays (selectPartialLinks; the
+    // stats): not told by its ray count since a node's parts and a leaf's cells share rays too.
+    bool fewRays = false;
     uint64_t seed = 0;                // of its shooter points (the same for every texel)
     std::vector<glm::dvec3> points;   // ends static: the shooter points (world)
     std::vector<int> pointLeaf;       // the union leaf under each shooter point
