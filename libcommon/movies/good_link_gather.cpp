@@ -18,10 +18,51 @@
 namespace rad {
 namespace {
 
-// The nearest of the receiver's centroid and corners to polygon p (the split rule's distance).
+// The distance between segments [a0, a1] and [b0, b1] (Ericson 2005, "Real-Time Collision
+// Detection" §5.1.9, the clamped closest points).
+double segmentDistance(const glm::dvec3& a0, const glm::dvec3& a1, const glm::dvec3& b0,
+                       const glm::dvec3& b1) {
+  const glm::dvec3 d1 = a1 - a0, d2 = b1 - b0, r = a0 - b0;
+  const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+  double s = 0.0, t = 0.0;
+  if (a <= 0.0 && e <= 0.0) return glm::length(r);
+  if (a <= 0.0) {
+    t = glm::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = glm::dot(d1, r);
+    if (e <= 0.0) {
+      s = glm::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = glm::dot(d1, d2), denom = a * e - b * b;
+      s = denom > 0.0 ? glm::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0.0) {
+        t = 0.0;
+        s = glm::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1.0) {
+        t = 1.0;
+        s = glm::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return glm::length(a0 + s * d1 - (b0 + t * d2));
+}
+
+// The split rule's distance: from the receiver's nearest point to polygon p (convex polygons
+// that do not cross: the nearest of each one's corners to the other and of their edges).
+// Not from the receiver's centroid and corners only: a sliver of a fan (issue 56) whose long
+// edge passes by a shooter part, but whose corners are far from it, kept the part whole while
+// its small neighbour across that edge split it, and the two gathered the shooter's radiosity
+// at different resolutions along their shared edge (a step there).
 double distanceFromReceiver(const Polygon& receiver, const Polygon& p) {
-  double d = distanceToPolygon(receiver.centroid(), p);
-  for (int i = 0; i < receiver.count; ++i) d = std::min(d, distanceToPolygon(receiver.v[i], p));
+  double d = std::numeric_limits<double>::infinity();
+  const size_t m = size_t(receiver.count), n = size_t(p.count);
+  for (size_t i = 0; i < m; ++i) d = std::min(d, distanceToPolygon(receiver.v[i], p));
+  for (size_t j = 0; j < n; ++j) d = std::min(d, distanceToPolygon(p.v[j], receiver));
+  for (size_t i = 0; i < m; ++i)
+    for (size_t j = 0; j < n; ++j)
+      d = std::min(
+          d, segmentDistance(receiver.v[i], receiver.v[(i + 1) % m], p.v[j], p.v[(j + 1) % n]));
   return d;
 }
 
@@ -69,7 +110,6 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
     for (int node : movingNodes_)
       swept_.push_back(scene.sweptBounds(node, keyTimes_.front(), keyTimes_.back()));
   }
-  planLinks(byReceiver, request);
   // The global keys the movie's key times fall between.
   std::vector<char> needed(size_t(solution.keyCount()), 0);
   for (double t : keyTimes_) {
@@ -78,6 +118,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
     solution.keyWeights(t, k0, k1, w);
     needed[size_t(k0)] = needed[size_t(k1)] = 1;
   }
+  planLinks(byReceiver, request, needed);
   planNearShooters(needed, stats);
   planWeights(needed);
   planTexels(cacheBytes);
@@ -89,7 +130,7 @@ GoodLinkGather::GoodLinkGather(const Scene& scene, const GlobalSolution& solutio
   for (const Link& l : links_) {
     stats.partialLinks += l.partial ? 1 : 0;
     stats.partialLinksMovingBlockers += l.partial && l.movingBlockers ? 1 : 0;
-    stats.partialLinksFewRays += l.partial && l.rays < visibilityRays_ && l.cell == 1 ? 1 : 0;
+    stats.partialLinksFewRays += l.fewRays ? 1 : 0;
   }
   stats.partialTileLinksPerTexel += long(partialTileLinksPerTexel_);
 }
@@ -101,7 +142,8 @@ Polygon GoodLinkGather::nodeWorld(uint32_t node, double t) const {
 
 // The links whose receiver is the movie's node, one of its ancestors or one of its descendants:
 // every texel's chain is made of these.
-void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request) {
+void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
+                               const std::vector<char>& neededKeys) {
   const PatchHierarchy& h = solution_.hierarchy;
   std::vector<int> receivers;
   int movieNode = h.find(request.patch);
@@ -126,7 +168,8 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
   // A pair that moves is split where it is near at any of the movie's keys, not only at its
   // first: a moving box's foot may meet the floor strip beside it only at later keys.
   const std::vector<double> firstKey{t0};
-  std::vector<uint32_t> shooters, cells{1u};
+  std::vector<std::pair<uint32_t, int>> shooters;
+  std::vector<uint32_t> cells{1u};
   std::vector<Polygon> receiverAt;
   for (int r : receivers) {
     for (uint32_t k = byReceiver.start[size_t(r)]; k < byReceiver.start[size_t(r) + 1]; ++k) {
@@ -136,8 +179,8 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
       const std::vector<double>& times = moves ? keyTimes_ : firstKey;
       receiverAt.clear();
       for (double t : times) receiverAt.push_back(nodeWorld(uint32_t(r), t));
-      shooterParts(receiverAt, times, shooter, shooters);
-      for (uint32_t q : shooters) {
+      shooterParts(receiverAt, times, neededKeys, shooter, shooters);
+      for (const auto& [q, shared] : shooters) {
         const bool emitter = emitters_.topEmits(int(h.node(int(q)).id.top));
         if (nearShooterLevels_ > 0 && h.isLeaf(int(q)) && !emitter)
           nearCells(receiverAt, times, q, cells);
@@ -148,7 +191,7 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
           l.row = row;
           l.shooter = q;
           l.cell = cell;
-          l.rays = std::max(1, visibilityRays_ >> (2 * cellLevel(cell)));
+          l.rays = std::max(1, visibilityRays_ >> (2 * (cellLevel(cell) + shared)));
           l.moves = moves;
           links_.push_back(std::move(l));
         }
@@ -162,35 +205,61 @@ void GoodLinkGather::planLinks(const GoodLinksByReceiver& byReceiver, const Movi
 // factor weights the near part of a shooter most, and the shooter's B is constant over a node:
 // near parts take their own B; far ones, over which F hardly varies, keep the link's node.
 void GoodLinkGather::shooterParts(const std::vector<Polygon>& receiverAt,
-                                  const std::vector<double>& times, uint32_t shooter,
-                                  std::vector<uint32_t>& out) const {
+                                  const std::vector<double>& times,
+                                  const std::vector<char>& neededKeys, uint32_t shooter,
+                                  std::vector<std::pair<uint32_t, int>>& out) const {
   const PatchHierarchy& h = solution_.hierarchy;
   out.clear();
-  std::vector<uint32_t> stack{shooter};
+  std::vector<std::pair<uint32_t, int>> stack{{shooter, 0}};
   std::vector<Polygon> world(times.size());
   while (!stack.empty()) {
-    const uint32_t q = stack.back();
+    const auto [q, shared] = stack.back();
     stack.pop_back();
-    bool split = !h.isLeaf(int(q)) && shooterRatio_ > 0.0;
+    // With near cells a leaf's cells carry B of their own that its mean does not show, so a
+    // node whose children's means agree is split all the same.
+    bool split = !h.isLeaf(int(q)) && shooterRatio_ > 0.0 &&
+                 (nearShooterLevels_ > 0 || childrenDiffer(q, neededKeys));
+    bool near = false;  // larger than kRaysRatio times the ratio: its parts take their own rays
     if (split) {
       for (size_t k = 0; k < times.size(); ++k) world[k] = nodeWorld(q, times[k]);
-      split = polygonSize(world[0]) > shooterRatio_ * nearestDistance(receiverAt, world);
+      const double size = polygonSize(world[0]), d = nearestDistance(receiverAt, world);
+      split = size > shooterRatio_ * d;
+      near = size > kRaysRatio * shooterRatio_ * d;
     }
     if (!split) {
-      out.push_back(q);
+      out.emplace_back(q, shared);
       continue;
     }
-    for (int c = 3; c >= 0; --c) stack.push_back(uint32_t(h.node(int(q)).firstChild + c));
+    for (int c = 3; c >= 0; --c)
+      stack.emplace_back(uint32_t(h.node(int(q)).firstChild + c), shared + (near ? 0 : 1));
   }
+}
+
+// Whether a child of interior node q has a radiosity more than kPartSpread of q's (channel sums)
+// at a needed key. Where none has, the children's terms sum to q's own within that share of it
+// (\sum_i B_i F_i against B_q \sum_i F_i), and splitting q would only cost.
+bool GoodLinkGather::childrenDiffer(uint32_t q, const std::vector<char>& neededKeys) const {
+  const int first = solution_.hierarchy.node(int(q)).firstChild;
+  auto sum = [](const glm::dvec3& b) { return b.x + b.y + b.z; };
+  for (int k = 0; k < solution_.keyCount(); ++k) {
+    if (!neededKeys[size_t(k)]) continue;
+    const double bq = sum(solution_.radiosityAtKey(int(q), k));
+    for (int c = 0; c < 4; ++c)
+      if (std::abs(sum(solution_.radiosityAtKey(first + c, k)) - bq) > kPartSpread * bq)
+        return true;
+  }
+  return false;
 }
 
 Polygon GoodLinkGather::linkWorld(const Link& l, double t) const {
   return cellPolygon(nodeWorld(l.shooter, t), l.cell);
 }
 
-// The cells of a near leaf shooter a texel gathers from: its virtual quadtree descended, as
-// shooterParts descends the union tree, while a cell is larger than shooterRatio times its
-// distance to the receiver, down to nearShooterLevels_.
+// The cells of a near leaf shooter a texel gathers from: its virtual quadtree descended while a
+// cell is larger than kRaysRatio times shooterRatio times its distance to the receiver, down to
+// nearShooterLevels_. Not at shooterRatio, as shooterParts: at that ratio the cells followed
+// the floor's shadow at a box's foot less well (NearShooterCellsFollowTheFloorsShadowAtAFoot);
+// a cell's rays are its leaf's shared by level, and why finer cells did worse is not settled.
 void GoodLinkGather::nearCells(const std::vector<Polygon>& receiverAt,
                                const std::vector<double>& times, uint32_t leaf,
                                std::vector<uint32_t>& out) const {
@@ -202,7 +271,8 @@ void GoodLinkGather::nearCells(const std::vector<Polygon>& receiverAt,
     auto [cell, poly] = std::move(stack.back());
     stack.pop_back();
     bool split = cellLevel(cell) < nearShooterLevels_;
-    if (split) split = polygonSize(poly[0]) > shooterRatio_ * nearestDistance(receiverAt, poly);
+    if (split)
+      split = polygonSize(poly[0]) > kRaysRatio * shooterRatio_ * nearestDistance(receiverAt, poly);
     if (!split) {
       out.push_back(cell);
       continue;
@@ -357,6 +427,7 @@ void GoodLinkGather::selectPartialLinks(const std::vector<double>& risk,
         continue;
       }
       links_[j].partial = true;
+      links_[j].fewRays = true;
       links_[j].rays = std::max(1, links_[j].rays / 4);
     }
   }

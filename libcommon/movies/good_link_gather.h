@@ -99,7 +99,9 @@ struct GoodLinkGatherStats {
 class GoodLinkGather {
  public:
   // Plans the gather of one movie: its links (each shooter split into the parts of its union
-  // sub-tree larger than shooterRatio times their distance to the receiver; 0: no split), their
+  // sub-tree larger than shooterRatio times their distance to the receiver's nearest point, so
+  // that the parts depend on where a receiver is, not on its shape or the level at which it is
+  // linked; 0: no split), their
   // visibility at the global keys it needs and, within `cacheBytes`, the per-texel form factors
   // of the links whose ends do not move.
   // `emitters` are the lights among the solution's tops (SceneEmitters of hierarchy.tops()).
@@ -132,6 +134,9 @@ class GoodLinkGather {
     // whose ends do not move are cast against the static blockers once per movie; against the
     // moving ones at every key, only when a moving node's swept bounds meet its shaft.
     bool movingBlockers = false;
+    // One of the small partial links that take a quarter of the rays (selectPartialLinks; the
+    // stats): not told by its ray count since a node's parts and a leaf's cells share rays too.
+    bool fewRays = false;
     uint64_t seed = 0;                // of its shooter points (the same for every texel)
     std::vector<glm::dvec3> points;   // ends static: the shooter points (world)
     std::vector<int> pointLeaf;       // the union leaf under each shooter point
@@ -245,9 +250,21 @@ class GoodLinkGather {
   double cellRatio(const Link& l, int key) const;  // the cell's B over its leaf's (1: no cell)
   // Per near leaf shooter, the areas of its 4^nearShooterLevels_ cells (cellRatio's weights).
   std::unordered_map<uint32_t, std::vector<double>> cellAreas_;
-  void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request);
+  void planLinks(const GoodLinksByReceiver& byReceiver, const MovieExtent& request,
+                 const std::vector<char>& neededKeys);
   void shooterParts(const std::vector<Polygon>& receiverAt, const std::vector<double>& times,
-                    uint32_t shooter, std::vector<uint32_t>& out) const;
+                    const std::vector<char>& neededKeys, uint32_t shooter,
+                    std::vector<std::pair<uint32_t, int>>& out) const;
+  // The parts come with the levels they lie below the last node larger than kRaysRatio times
+  // the ratio: such a node's rays are shared among its parts (a quarter a level, as a near
+  // leaf's cells share them), for they split where B varies, not V, and a texel's V of the node
+  // is then taken from as many rays as before its parts were made finer for their B.
+  static constexpr double kRaysRatio = 2.0;
+  // A shooter part is split only where its children's radiosities differ from its own by more
+  // than this share (childrenDiffer): the step two receivers linked at different levels can
+  // make is then at most this share of the part's term.
+  static constexpr double kPartSpread = 0.02;
+  bool childrenDiffer(uint32_t q, const std::vector<char>& neededKeys) const;
   void planWeights(const std::vector<char>& neededKeys);
   void selectPartialLinks(const std::vector<double>& risk, const std::vector<double>& carried);
   void planTexels(double cacheBytes);

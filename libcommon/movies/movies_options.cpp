@@ -51,7 +51,7 @@ void addGatherParameters(ParameterTable<O>& t) {
             "each link's shooter) or gouraud (the global solution's vertex values, paper §3.1)");
   t.add("gather-shooter-ratio", &O::gatherShooterRatio,
         "gather: split a link's shooter into the parts of its sub-tree larger than this times "
-        "their distance to the receiver (0: no split)",
+        "their distance to the receiver's nearest point (0: no split)",
         Check::nonNegative());
   t.add("gather-rays", &O::gatherRays,
         "gather: shadow rays from each texel to a partly occluded link's shooter, 1..64 (0: "

@@ -92,7 +92,11 @@ struct TextureMovieBakerOptions {
   GoodLayer goodLayer = GoodLayer::kGather;  // --good-layer
   // --gather-shooter-ratio: a gathered link's shooter is split into the parts of its sub-tree
   // larger than this times their distance to the receiver (good_link_gather.h); 0: no split.
-  double gatherShooterRatio = 1.0;
+  // The parts' size then bounds how much two neighbouring receivers, linked to one shooter at
+  // different levels, differ in what they gather: each weights a part's mean B by a form factor
+  // that varies over the part by about this ratio (issue 56; "Seams from the link sets'
+  // resolution" in docs/results.md).
+  double gatherShooterRatio = 0.5;
   // --gather-rays: a gathered link that is partly occluded gets its visibility per texel from this
   // many shadow rays to its shooter part, weighted by the shooter's radiosity at their ends
   // (good_link_gather.h); 0: the link's one V over its receiver node, which steps where two

@@ -858,6 +858,85 @@ TEST(TextureMovieBaker, GatheredIrradianceIsContinuousAcrossDifferentlyRefinedTi
   EXPECT_LT(worst, 0.01) << "step across the edge";
 }
 
+// Two coplanar slivers y in [-0.2, 0] (a) and [0, 0.2] (b) meet along y = 0 under a white shooter
+// whose four children hold very different radiosities (issue 56). The links are made by hand as
+// rad-global makes them where it refines two receivers differently: a gathers the shooter at its
+// root, b at its children. The texels of both, extrapolated to the shared edge, agree within 1 %:
+// the gather splits a's link into the parts b gathers, as the parts' size against their distance
+// to the receiver's nearest point asks (a's corners and centroid are over 1.4 from the shooter,
+// its long edge passes 1.2 under it), whatever the level at which a is linked. Before, a kept the
+// shooter whole and the edge stepped ("Seams from the link sets' resolution" in results.md).
+TEST(TextureMovieBaker, ReceiversLinkedToOneShooterAtDifferentLevelsGatherAlikeAtTheirEdge) {
+  Scene s;
+  Material white;
+  white.reflectance = glm::dvec3(0.5);
+  s.materials = {white};
+  const int a = addQuadNode(s, {-3, -0.2, 0}, {3, -0.2, 0}, {3, 0, 0}, {-3, 0, 0}, 0);
+  const int b = addQuadNode(s, {-3, 0, 0}, {3, 0, 0}, {3, 0.2, 0}, {-3, 0.2, 0}, 0);
+  const int q = addQuadNode(s, {0.75, 0, 1.2}, {0.75, 1, 1.2}, {1.75, 1, 1.2}, {1.75, 0, 1.2}, 0);
+  GlobalSolution g;
+  g.keyTimes = {0.0};
+  g.hierarchy = PatchHierarchy(s.inputPolygons());
+  const int topA = topOfNode(g, a), topB = topOfNode(g, b), topQ = topOfNode(g, q);
+  const int first = g.hierarchy.subdivide(topQ);
+  const int n = g.hierarchy.size();
+  g.nodeRadiosity.assign(size_t(n), glm::vec3(0.0f));
+  const float leafB[4] = {40.0f, 1.0f, 10.0f, 2.0f};
+  for (int c = 0; c < 4; ++c) {
+    g.nodeRadiosity[size_t(first + c)] = glm::vec3(leafB[c]);
+    g.nodeRadiosity[size_t(topQ)] += glm::vec3(0.25f * leafB[c]);
+  }
+  int rows = 0;
+  for (int i = 0; i < n; ++i) g.leafRow.push_back(g.hierarchy.isLeaf(i) ? rows++ : -1);
+  g.leafVertexGoodIrradiance.assign(size_t(rows) * 4, glm::vec3(0.0f));
+  auto link = [&](int receiver, int shooter) {  // unoccluded; its F·V is not used by the gather
+    GlobalLink l;
+    l.receiver = uint32_t(receiver);
+    l.shooter = uint32_t(shooter);
+    l.sampleOffset = uint32_t(g.linkSampleKeys.size());
+    l.sampleCount = 1;
+    g.links.push_back(l);
+    g.linkSampleKeys.push_back(0);
+    g.linkSampleValues.push_back(0.01f);
+    g.linkSampleVisibility.push_back(1.0f);
+  };
+  link(topA, topQ);
+  for (int c = 0; c < 4; ++c) link(topB, first + c);
+  g.validate("test");
+
+  const int w = 96, h = 4;
+  // Per texel column, each side's two rows nearest the edge extrapolated linearly to y = 0.
+  auto step = [&](const TextureMovieBakerOptions& o) {
+    const std::vector<BakedTexel> ta = bakeTop(s, g, topA, w, h, o);
+    const std::vector<BakedTexel> tb = bakeTop(s, g, topB, w, h, o);
+    auto at = [&](const std::vector<BakedTexel>& t, double x, double y) {
+      for (const BakedTexel& e : t)
+        if (std::abs(e.x.x - x) < 1e-6 && std::abs(e.x.y - y) < 1e-6) return e.h;
+      return -1.0;
+    };
+    double worst = 0.0;
+    int columns = 0;
+    for (int i = 0; i < w; ++i) {
+      const double x = -3.0 + 6.0 * (i + 0.5) / w, d = 0.2 / h;
+      const double a1 = at(ta, x, -0.5 * d), a2 = at(ta, x, -1.5 * d);
+      const double b1 = at(tb, x, 0.5 * d), b2 = at(tb, x, 1.5 * d);
+      if (a1 <= 0.0 || a2 <= 0.0 || b1 <= 0.0 || b2 <= 0.0) continue;
+      const double fromA = a1 + 0.5 * (a1 - a2), fromB = b1 - 0.5 * (b2 - b1);
+      worst = std::max(worst, std::abs(fromA - fromB) / fromB);
+      ++columns;
+    }
+    EXPECT_EQ(columns, w);
+    return worst;
+  };
+  EXPECT_LT(step(TextureMovieBakerOptions{}), 0.01) << "step across the shared edge";
+  TextureMovieBakerOptions ratioOne;
+  ratioOne.gatherShooterRatio = 1.0;  // the nearest point alone splits a's link here
+  EXPECT_LT(step(ratioOne), 0.01) << "step across the shared edge at ratio 1";
+  TextureMovieBakerOptions whole;
+  whole.gatherShooterRatio = 0.0;  // no split: a gathers the shooter's mean radiosity
+  EXPECT_GT(step(whole), 0.05) << "the configuration must make a step when a keeps the root";
+}
+
 // A texture whose side is not a power of two (the sqrt 2 ladder's 45) cuts the receiver's nodes
 // between texels, so most 8 x 8 tiles straddle two nodes. The far links of the nodes below a
 // tile's common one are interpolated over the tile too, for their own texels only: as few
