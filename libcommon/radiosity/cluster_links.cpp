@@ -176,7 +176,7 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
   // estimate, it moves the frames away from the all-pairs ones. One between a few members that
   // carries nothing (blocked) is dropped (the top of cluster_links.h).
   const double d = glm::length(S.centre() - R.centre());
-  if (!(d > separation_ * (R.radius() + S.radius()))) {
+  if (near(l.receiver, l.shooter)) {
     if (emitted > 0.0) return Fate::kRefine;
     const size_t T = emission_.size();
     const uint8_t* known =
@@ -501,28 +501,59 @@ ClusterLinks::RayPair ClusterLinks::rayPair(ClusterRef r, ClusterRef s, int i, i
   return p;
 }
 
+bool ClusterLinks::near(ClusterRef r, ClusterRef s) const {
+  const ClusterBounds& R = bounds(r);
+  const ClusterBounds& S = bounds(s);
+  return !(glm::length(S.centre() - R.centre()) > separation_ * (R.radius() + S.radius()));
+}
+
+bool ClusterLinks::facingMembers(ClusterRef end, ClusterRef other, size_t most,
+                                 std::vector<uint32_t>& out) const {
+  const ClusterBounds& box = bounds(other);
+  if (!isCluster(end)) {
+    if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
+    return true;
+  }
+  const ClusterNode& n = tree_.node(clusterIndex(end));
+  for (uint32_t i = n.first; i < n.first + n.count; ++i)
+    if (mayFace(tree_.members()[i], box)) {
+      if (out.size() == most) return false;
+      out.push_back(tree_.members()[i]);
+    }
+  return true;
+}
+
+bool ClusterLinks::tooManyPairsToTest(ClusterRef r, ClusterRef s) const {
+  std::vector<uint32_t> a, b;
+  if (!facingMembers(r, s, kTestedMemberPairs, a)) return true;
+  return !a.empty() && !facingMembers(s, r, kTestedMemberPairs / a.size(), b);
+}
+
+void ClusterLinks::countInto(LinkCensus& census) const {
+  auto sizeOf = [&](ClusterRef r, ClusterRef s) {
+    return size_t(LinkCensus::sizeClass(std::max(memberCount(r), memberCount(s))));
+  };
+  for (const ClusterLink& l : links_) {
+    LinkCensus::BySize& kind = emits(l.shooter)              ? census.clusterLight
+                               : near(l.receiver, l.shooter) ? census.clusterNear
+                                                             : census.clusterFar;
+    ++kind[sizeOf(l.receiver, l.shooter)];
+  }
+  for (const NearLinkTest& t : nearTests_) {
+    LinkCensus::BySize& kind = t.blocked ? census.nearDropped
+                               : visibility_ && tooManyPairsToTest(t.receiver, t.shooter)
+                                   ? census.nearUntested
+                                   : census.nearRefined;
+    ++kind[sizeOf(t.receiver, t.shooter)];
+  }
+}
+
 bool ClusterLinks::blocked(ClusterRef r, ClusterRef s) const {
   if (!visibility_) return false;
-  // The members of each end whose plane has some of the other end's box in front (the others
-  // see none of it), at most `most` of them (more: the link is not tested).
-  auto facing = [&](ClusterRef end, ClusterRef other, size_t most, std::vector<uint32_t>& out) {
-    const ClusterBounds& box = bounds(other);
-    if (!isCluster(end)) {
-      if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
-      return true;
-    }
-    const ClusterNode& n = tree_.node(clusterIndex(end));
-    for (uint32_t i = n.first; i < n.first + n.count; ++i)
-      if (mayFace(tree_.members()[i], box)) {
-        if (out.size() == most) return false;
-        out.push_back(tree_.members()[i]);
-      }
-    return true;
-  };
   std::vector<uint32_t> a, b;
-  if (!facing(r, s, kTestedMemberPairs, a)) return false;
+  if (!facingMembers(r, s, kTestedMemberPairs, a)) return false;
   if (a.empty()) return true;  // nothing of r faces s
-  if (!facing(s, r, kTestedMemberPairs / a.size(), b)) return false;
+  if (!facingMembers(s, r, kTestedMemberPairs / a.size(), b)) return false;
   // One ray between the centroids of each pair that face each other there first: where the
   // ends see each other (most near links of an open room), one of them gets through.
   for (const uint32_t i : a)

@@ -71,6 +71,7 @@
 #include <glm/glm.hpp>
 
 #include "libcommon/radiosity/cluster_tree.h"
+#include "libcommon/radiosity/link_census.h"
 #include "libcommon/radiosity/pair_table.h"
 #include "libcommon/radiosity/visibility.h"
 
@@ -177,6 +178,11 @@ class ClusterLinks {
   // The near links tested for being blocked in this key's rounds, with the answer, for the next
   // key's coherence (ClusterLinkCache::blocked).
   const std::vector<NearLinkTest>& nearTests() const { return nearTests_; }
+  // Whether the ends r and s are near: their bounding spheres' centres closer than the
+  // separation times the radii's sum (the point approximation does not hold; fateOf).
+  bool near(ClusterRef r, ClusterRef s) const;
+  // The kept links and this key's near tests into `census` (link_census.h).
+  void countInto(LinkCensus& census) const;
   size_t size() const { return links_.size(); }
   size_t reusedCount() const { return reused_; }
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
@@ -223,6 +229,15 @@ class ClusterLinks {
   // of the two miss (tried: near cluster links with V = 0.6 dropped).
   bool blocked(ClusterRef r, ClusterRef s) const;
   static constexpr int kTestedMemberPairs = 16;
+  // The member tops of `end` whose plane has some of `other`'s box in front (the others see
+  // none of it) into `out`; false when there are more than `most` (blocked does not test).
+  bool facingMembers(ClusterRef end, ClusterRef other, size_t most,
+                     std::vector<uint32_t>& out) const;
+  // Whether blocked(r, s) takes more member pairs than it tests (it then answers false).
+  bool tooManyPairsToTest(ClusterRef r, ClusterRef s) const;
+  size_t memberCount(ClusterRef r) const {
+    return isCluster(r) ? tree_.node(clusterIndex(r)).count : 1;
+  }
   const ClusterBounds& bounds(ClusterRef r) const {
     return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];
   }
