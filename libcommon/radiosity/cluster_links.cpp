@@ -176,8 +176,17 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
   // estimate, it moves the frames away from the all-pairs ones. One between a few members that
   // carries nothing (blocked) is dropped (the top of cluster_links.h).
   const double d = glm::length(S.centre() - R.centre());
+  // A light's B before the first solve is its emission (the radiosity of the last gather is 0
+  // then, and would keep every light link at the first round).
+  const double bv = std::max(maxRadiosity(l.shooter), emitted) * l.visibility;
   if (near(l.receiver, l.shooter)) {
     if (emitted > 0.0) return Fate::kRefine;
+    // Smits et al. §3's bound with F = 1, which holds however near the ends are: a near link
+    // that cannot carry eps Phi is kept, as a far one is (the transfer's distance is at least
+    // the shooter's radius, formFactor). Refining such links down to every pair of members
+    // that face each other made, among packed small objects (binders on shelves, keyboards'
+    // keys), links quadratic in the objects within the separation of each other (issue 58).
+    if (!(bv * std::min(R.area, S.area) > epsAbs)) return Fate::kKeep;
     const size_t T = emission_.size();
     const uint8_t* known =
         reuse_ ? reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))
@@ -185,9 +194,6 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
     const bool isBlocked = known ? *known != 0 : blocked(l.receiver, l.shooter);
     return isBlocked ? Fate::kDrop : Fate::kRefineNear;
   }
-  // A light's B before the first solve is its emission (the radiosity of the last gather is 0
-  // then, and would keep every light link at the first round).
-  const double bv = std::max(maxRadiosity(l.shooter), emitted) * l.visibility;
   const double gap = d - R.radius() - S.radius();
   const double f = std::min(1.0, S.area / (M_PI * gap * gap));
   return bv * std::min(R.area * f, S.area) > epsAbs ? Fate::kRefine : Fate::kKeep;
