@@ -186,7 +186,8 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
     // the shooter's radius, formFactor). Refining such links down to every pair of members
     // that face each other made, among packed small objects (binders on shelves, keyboards'
     // keys), links quadratic in the objects within the separation of each other (issue 58).
-    if (!(bv * std::min(R.area, S.area) > epsAbs)) return Fate::kKeep;
+    // Without the shooters' radiosity (setRadiosity) the separation alone decides.
+    if (radiosityKnown_ && !(bv * std::min(R.area, S.area) > epsAbs)) return Fate::kKeep;
     const size_t T = emission_.size();
     const uint8_t* known =
         reuse_ ? reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))
@@ -849,6 +850,18 @@ void ClusterLinks::buildReceiverLists(const std::vector<double>& exposure) {
 // patch. Six axis bins with squared direction weights (an estimate of the same projection that
 // leaves out how each group's area is oriented) come out darker than the exact sums of B F V over
 // the shooters' members with the links' V; the groups' projected areas come closer to them.
+void ClusterLinks::setRadiosity(const std::vector<glm::dvec3>& topB) {
+  for (size_t t = 0; t < topMaxB_.size(); ++t) topMaxB_[t] = maxComponent(topB[t]);
+  for (int c = tree_.size(); c-- > 0;) {  // sub-clusters (higher indices) first
+    double maxB = 0.0;
+    for (ClusterRef r : tree_.node(c).children)
+      maxB = std::max(maxB,
+                      isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)]);
+    clusterMaxB_[size_t(c)] = maxB;
+  }
+  radiosityKnown_ = true;
+}
+
 void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
                           std::vector<glm::dvec3>& out) {
   buildReceiverLists(exposure);
@@ -858,25 +871,21 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector
     std::array<double, 6> area;       // A_g
   };
   std::vector<GroupRadiosity> groups(size_t(tree_.size()));
-  for (size_t t = 0; t < T; ++t) topMaxB_[t] = maxComponent(topB[t]);
+  setRadiosity(topB);
   for (int c = tree_.size(); c-- > 0;) {  // sub-clusters (higher indices) first
     GroupRadiosity& g = groups[size_t(c)];
     g.power.fill(glm::dvec3(0.0));
     g.area.fill(0.0);
-    double maxB = 0.0;
     for (ClusterRef r : tree_.node(c).children) {
       if (isCluster(r)) {
         const GroupRadiosity& cg = groups[size_t(clusterIndex(r))];
         for (size_t k = 0; k < 6; ++k) g.power[k] += cg.power[k], g.area[k] += cg.area[k];
-        maxB = std::max(maxB, clusterMaxB_[size_t(clusterIndex(r))]);
       } else {
         const size_t k = size_t(facingGroupOf(normal_[size_t(r)]));
         g.power[k] += area_[size_t(r)] * topB[size_t(r)];
         g.area[k] += area_[size_t(r)];
-        maxB = std::max(maxB, topMaxB_[size_t(r)]);
       }
     }
-    clusterMaxB_[size_t(c)] = maxB;
   }
   // Per link: its shooter's B towards its receiver.
   linkB_.assign(links_.size(), glm::vec3(0.0f));

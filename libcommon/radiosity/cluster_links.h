@@ -171,6 +171,11 @@ class ClusterLinks {
   // (exposure 0) gathers nothing.
   void gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
               std::vector<glm::dvec3>& out);
+  // The tops' radiosity `topB` (per top) that refinement judges the links by (their shooters'
+  // largest B); gather sets it too. Until it is given, near links are refined by the
+  // separation alone (fateOf).
+  void setRadiosity(const std::vector<glm::dvec3>& topB);
+  bool radiosityKnown() const { return radiosityKnown_; }
   // Per top: the sum of its cluster links' form factors H_i / B_S over the exposed part, as
   // gather weighs them (its row sum's cluster part).
   std::vector<double> rowSums(const std::vector<double>& exposure);
@@ -320,6 +325,7 @@ class ClusterLinks {
   std::vector<FacingGroups> clusterFacing_;
   std::vector<double> clusterEmission_;
   std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
+  bool radiosityKnown_ = false;                // setRadiosity or gather has run
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;
