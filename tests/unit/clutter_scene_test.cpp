@@ -71,7 +71,7 @@ size_t total(const LinkCensus::BySize& s) {
 }
 
 // cluster_links.h, fateOf: a near link whose bound with F = 1, max B_S V min(A_R, A_S), is under
-// eps Phi is kept, not refined. Before: 267 k near links refined, tested or dropped against 90 k
+// eps Phi is kept, not refined. Before: 265 k near links refined, tested or dropped against 83 k
 // links kept, and a bound of 25 links a triangle (graz at the default bound has 150) reached.
 TEST(ClutterScene, NearLinksThatCannotCarryEpsPhiAreKept) {
   RadiosityOptions options;
