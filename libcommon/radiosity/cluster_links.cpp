@@ -186,8 +186,10 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
     // the shooter's radius, formFactor). Refining such links down to every pair of members
     // that face each other made, among packed small objects (binders on shelves, keyboards'
     // keys), links quadratic in the objects within the separation of each other (issue 58).
-    // Without the shooters' radiosity (setRadiosity) the separation alone decides.
-    if (radiosityKnown_ && !(bv * std::min(R.area, S.area) > epsAbs)) return Fate::kKeep;
+    // Without the shooters' radiosity (setRadiosity) the separation alone decides. Opt-in
+    // (keepWeakNearLinks): the kept links' point estimate is rough between near ends.
+    if (keepWeakNear_ && radiosityKnown_ && !(bv * std::min(R.area, S.area) > epsAbs))
+      return Fate::kKeep;
     const size_t T = emission_.size();
     const uint8_t* known =
         reuse_ ? reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))

@@ -176,6 +176,8 @@ class ClusterLinks {
   // separation alone (fateOf).
   void setRadiosity(const std::vector<glm::dvec3>& topB);
   bool radiosityKnown() const { return radiosityKnown_; }
+  // fateOf keeps near links that cannot carry eps Phi (RadiosityOptions::keepWeakNearLinks).
+  void keepWeakNearLinks(bool on) { keepWeakNear_ = on; }
   // Per top: the sum of its cluster links' form factors H_i / B_S over the exposed part, as
   // gather weighs them (its row sum's cluster part).
   std::vector<double> rowSums(const std::vector<double>& exposure);
@@ -326,6 +328,7 @@ class ClusterLinks {
   std::vector<double> clusterEmission_;
   std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
   bool radiosityKnown_ = false;                // setRadiosity or gather has run
+  bool keepWeakNear_ = false;                  // keepWeakNearLinks
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;

@@ -89,6 +89,7 @@ KeySolution KeyTimeSolver::run() {
                                                input_.visibility, opt_.rays, opt_.clusterSeparation,
                                                opt_.lightClusterShare, opt_.clusterMemberRays,
                                                opt_.isotropicClusters, input_.reuseClusterLinks);
+    clusters_->keepWeakNearLinks(opt_.keepWeakNearLinks);
     if (input_.expectedClusterLinks > 0)
       clusters_->expectLinks(withMargin(input_.expectedClusterLinks));
   } else {

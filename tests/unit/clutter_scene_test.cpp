@@ -76,6 +76,7 @@ size_t total(const LinkCensus::BySize& s) {
 TEST(ClutterScene, NearLinksThatCannotCarryEpsPhiAreKept) {
   RadiosityOptions options;
   options.maxLinks = 75000;
+  options.keepWeakNearLinks = true;
   const ClutterSolve s(options);
   const LinkCensus& c = s.solution.linkCensus;
   const size_t nearMet = total(c.nearRefined) + total(c.nearUntested) + total(c.nearDropped);
@@ -90,7 +91,9 @@ TEST(ClutterScene, NearLinksThatCannotCarryEpsPhiAreKept) {
 // (docs/results.md, "Which links fill the link bound"); before, near links were refined to
 // patch links and the room absorbed what it emitted to 0.3 %.
 TEST(ClutterScene, AClosedRoomAbsorbsWhatItIsLitWith) {
-  const ClutterSolve s{RadiosityOptions()};
+  RadiosityOptions options;
+  options.keepWeakNearLinks = true;
+  const ClutterSolve s(options);
   const glm::dvec3 a = s.solution.absorbedPower(s.hierarchy, s.surfaces);
   const glm::dvec3 e = s.solution.emittedPower(s.hierarchy, s.surfaces);
   const double share = std::max({a.x, a.y, a.z}) / std::max({e.x, e.y, e.z});
