@@ -35,6 +35,15 @@
 #       Blender lamp room against Cycles, a moving lamp coherent against --no-coherence (bit-
 #       identical) and its whole pipeline's speed-up, a held-out Blender scene against Cycles;
 #       out/lights/lights.json
+#   make -f pipelines/bench.mk corpus [CORPUS_SCENES=all|graz,soda|none] [CORPUS_DIR=out/corpus/scenes] [CORPUS_KEEP=REGEX]
+#                                     [CORPUS_GENERATED=contact] [CORPUS_FRAMES=0-95] [CORPUS_SIZE=352x240]
+#                                     [CORPUS_EVAL_FRAME=48] [CORPUS_SPP=256]
+#       issue 58's figures per scene (pipelines/corpus_bench.py): the public scenes of
+#       pipelines/corpus/scenes.py fetched and converted into CORPUS_DIR at benchmark time (never
+#       committed), and generated ones; triangles, key times at the link bound, links and cluster
+#       links, each stage's time and peak memory, RMSE / mean, bias, structured error and floor
+#       against two rad-reference renders (image_figures.py's figures), each row checked against
+#       the issue's goals, held-out scenes marked; out/corpus/corpus.csv
 #   make -f pipelines/bench.mk fuzz [FUZZ_SECONDS=600] [FUZZ_RUNS=-1]
 #       every reader's libFuzzer harness for FUZZ_SECONDS each, or until FUZZ_RUNS executions
 #       (-1: no bound but the time; the issue's long run: FUZZ_RUNS=1000000 FUZZ_SECONDS=5400)
@@ -77,11 +86,19 @@ LIGHTS_ONLY ?= closed,room,moving,heldout
 LIGHTS_SPP ?= 512
 LIGHTS_FRAMES ?= 96
 LIGHTS_REPEAT ?= 3
+CORPUS_DIR ?= out/corpus/scenes
+CORPUS_SCENES ?= all
+CORPUS_KEEP ?=
+CORPUS_GENERATED ?=
+CORPUS_FRAMES ?= 0-95
+CORPUS_SIZE ?= 352x240
+CORPUS_EVAL_FRAME ?= 48
+CORPUS_SPP ?= 256
 
 FUZZ_SECONDS ?= 600
 FUZZ_RUNS ?= -1
 
-.PHONY: tables tradeoff furnace contact scale farm-model image lights fuzz
+.PHONY: tables tradeoff furnace contact scale farm-model image lights corpus fuzz
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -116,6 +133,12 @@ image:
 lights:
 	python3 pipelines/lights.py --bin $(BIN) --only $(LIGHTS_ONLY) --spp $(LIGHTS_SPP) \
 	  --moving-frames $(LIGHTS_FRAMES) --repeat $(LIGHTS_REPEAT) --out out/lights --check
+
+corpus:
+	python3 pipelines/corpus_bench.py --bin $(BIN) --out out/corpus --corpus $(CORPUS_DIR) \
+	  --scenes $(CORPUS_SCENES) $(if $(CORPUS_KEEP),--keep '$(CORPUS_KEEP)') \
+	  $(if $(CORPUS_GENERATED),--generated $(CORPUS_GENERATED)) --frames $(CORPUS_FRAMES) \
+	  --size $(CORPUS_SIZE) --eval-frame $(CORPUS_EVAL_FRAME) --spp $(CORPUS_SPP)
 
 fuzz:
 	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) bash tests/fuzz/run.sh

@@ -176,8 +176,20 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
   // estimate, it moves the frames away from the all-pairs ones. One between a few members that
   // carries nothing (blocked) is dropped (the top of cluster_links.h).
   const double d = glm::length(S.centre() - R.centre());
-  if (!(d > separation_ * (R.radius() + S.radius()))) {
+  // A light's B before the first solve is its emission (the radiosity of the last gather is 0
+  // then, and would keep every light link at the first round).
+  const double bv = std::max(maxRadiosity(l.shooter), emitted) * l.visibility;
+  if (near(l.receiver, l.shooter)) {
     if (emitted > 0.0) return Fate::kRefine;
+    // Smits et al. §3's bound with F = 1, which holds however near the ends are: a near link
+    // that cannot carry eps Phi is kept, as a far one is (the transfer's distance is at least
+    // the shooter's radius, formFactor). Refining such links down to every pair of members
+    // that face each other made, among packed small objects (binders on shelves, keyboards'
+    // keys), links quadratic in the objects within the separation of each other (issue 58).
+    // Without the shooters' radiosity (setRadiosity) the separation alone decides. Opt-in
+    // (keepWeakNearLinks): the kept links' point estimate is rough between near ends.
+    if (keepWeakNear_ && radiosityKnown_ && !(bv * std::min(R.area, S.area) > epsAbs))
+      return Fate::kKeep;
     const size_t T = emission_.size();
     const uint8_t* known =
         reuse_ ? reuse_->blocked.find(clusterLinkEnd(l.receiver, T), clusterLinkEnd(l.shooter, T))
@@ -185,9 +197,6 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
     const bool isBlocked = known ? *known != 0 : blocked(l.receiver, l.shooter);
     return isBlocked ? Fate::kDrop : Fate::kRefineNear;
   }
-  // A light's B before the first solve is its emission (the radiosity of the last gather is 0
-  // then, and would keep every light link at the first round).
-  const double bv = std::max(maxRadiosity(l.shooter), emitted) * l.visibility;
   const double gap = d - R.radius() - S.radius();
   const double f = std::min(1.0, S.area / (M_PI * gap * gap));
   return bv * std::min(R.area * f, S.area) > epsAbs ? Fate::kRefine : Fate::kKeep;
@@ -501,28 +510,59 @@ ClusterLinks::RayPair ClusterLinks::rayPair(ClusterRef r, ClusterRef s, int i, i
   return p;
 }
 
+bool ClusterLinks::near(ClusterRef r, ClusterRef s) const {
+  const ClusterBounds& R = bounds(r);
+  const ClusterBounds& S = bounds(s);
+  return !(glm::length(S.centre() - R.centre()) > separation_ * (R.radius() + S.radius()));
+}
+
+bool ClusterLinks::facingMembers(ClusterRef end, ClusterRef other, size_t most,
+                                 std::vector<uint32_t>& out) const {
+  const ClusterBounds& box = bounds(other);
+  if (!isCluster(end)) {
+    if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
+    return true;
+  }
+  const ClusterNode& n = tree_.node(clusterIndex(end));
+  for (uint32_t i = n.first; i < n.first + n.count; ++i)
+    if (mayFace(tree_.members()[i], box)) {
+      if (out.size() == most) return false;
+      out.push_back(tree_.members()[i]);
+    }
+  return true;
+}
+
+bool ClusterLinks::tooManyPairsToTest(ClusterRef r, ClusterRef s) const {
+  std::vector<uint32_t> a, b;
+  if (!facingMembers(r, s, kTestedMemberPairs, a)) return true;
+  return !a.empty() && !facingMembers(s, r, kTestedMemberPairs / a.size(), b);
+}
+
+void ClusterLinks::countInto(LinkCensus& census) const {
+  auto sizeOf = [&](ClusterRef r, ClusterRef s) {
+    return size_t(LinkCensus::sizeClass(std::max(memberCount(r), memberCount(s))));
+  };
+  for (const ClusterLink& l : links_) {
+    LinkCensus::BySize& kind = emits(l.shooter)              ? census.clusterLight
+                               : near(l.receiver, l.shooter) ? census.clusterNear
+                                                             : census.clusterFar;
+    ++kind[sizeOf(l.receiver, l.shooter)];
+  }
+  for (const NearLinkTest& t : nearTests_) {
+    LinkCensus::BySize& kind = t.blocked ? census.nearDropped
+                               : visibility_ && tooManyPairsToTest(t.receiver, t.shooter)
+                                   ? census.nearUntested
+                                   : census.nearRefined;
+    ++kind[sizeOf(t.receiver, t.shooter)];
+  }
+}
+
 bool ClusterLinks::blocked(ClusterRef r, ClusterRef s) const {
   if (!visibility_) return false;
-  // The members of each end whose plane has some of the other end's box in front (the others
-  // see none of it), at most `most` of them (more: the link is not tested).
-  auto facing = [&](ClusterRef end, ClusterRef other, size_t most, std::vector<uint32_t>& out) {
-    const ClusterBounds& box = bounds(other);
-    if (!isCluster(end)) {
-      if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
-      return true;
-    }
-    const ClusterNode& n = tree_.node(clusterIndex(end));
-    for (uint32_t i = n.first; i < n.first + n.count; ++i)
-      if (mayFace(tree_.members()[i], box)) {
-        if (out.size() == most) return false;
-        out.push_back(tree_.members()[i]);
-      }
-    return true;
-  };
   std::vector<uint32_t> a, b;
-  if (!facing(r, s, kTestedMemberPairs, a)) return false;
+  if (!facingMembers(r, s, kTestedMemberPairs, a)) return false;
   if (a.empty()) return true;  // nothing of r faces s
-  if (!facing(s, r, kTestedMemberPairs / a.size(), b)) return false;
+  if (!facingMembers(s, r, kTestedMemberPairs / a.size(), b)) return false;
   // One ray between the centroids of each pair that face each other there first: where the
   // ends see each other (most near links of an open room), one of them gets through.
   for (const uint32_t i : a)
@@ -812,6 +852,18 @@ void ClusterLinks::buildReceiverLists(const std::vector<double>& exposure) {
 // patch. Six axis bins with squared direction weights (an estimate of the same projection that
 // leaves out how each group's area is oriented) come out darker than the exact sums of B F V over
 // the shooters' members with the links' V; the groups' projected areas come closer to them.
+void ClusterLinks::setRadiosity(const std::vector<glm::dvec3>& topB) {
+  for (size_t t = 0; t < topMaxB_.size(); ++t) topMaxB_[t] = maxComponent(topB[t]);
+  for (int c = tree_.size(); c-- > 0;) {  // sub-clusters (higher indices) first
+    double maxB = 0.0;
+    for (ClusterRef r : tree_.node(c).children)
+      maxB = std::max(maxB,
+                      isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)]);
+    clusterMaxB_[size_t(c)] = maxB;
+  }
+  radiosityKnown_ = true;
+}
+
 void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
                           std::vector<glm::dvec3>& out) {
   buildReceiverLists(exposure);
@@ -821,25 +873,21 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector
     std::array<double, 6> area;       // A_g
   };
   std::vector<GroupRadiosity> groups(size_t(tree_.size()));
-  for (size_t t = 0; t < T; ++t) topMaxB_[t] = maxComponent(topB[t]);
+  setRadiosity(topB);
   for (int c = tree_.size(); c-- > 0;) {  // sub-clusters (higher indices) first
     GroupRadiosity& g = groups[size_t(c)];
     g.power.fill(glm::dvec3(0.0));
     g.area.fill(0.0);
-    double maxB = 0.0;
     for (ClusterRef r : tree_.node(c).children) {
       if (isCluster(r)) {
         const GroupRadiosity& cg = groups[size_t(clusterIndex(r))];
         for (size_t k = 0; k < 6; ++k) g.power[k] += cg.power[k], g.area[k] += cg.area[k];
-        maxB = std::max(maxB, clusterMaxB_[size_t(clusterIndex(r))]);
       } else {
         const size_t k = size_t(facingGroupOf(normal_[size_t(r)]));
         g.power[k] += area_[size_t(r)] * topB[size_t(r)];
         g.area[k] += area_[size_t(r)];
-        maxB = std::max(maxB, topMaxB_[size_t(r)]);
       }
     }
-    clusterMaxB_[size_t(c)] = maxB;
   }
   // Per link: its shooter's B towards its receiver.
   linkB_.assign(links_.size(), glm::vec3(0.0f));

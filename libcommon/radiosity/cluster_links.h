@@ -71,6 +71,7 @@
 #include <glm/glm.hpp>
 
 #include "libcommon/radiosity/cluster_tree.h"
+#include "libcommon/radiosity/link_census.h"
 #include "libcommon/radiosity/pair_table.h"
 #include "libcommon/radiosity/visibility.h"
 
@@ -170,6 +171,13 @@ class ClusterLinks {
   // (exposure 0) gathers nothing.
   void gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
               std::vector<glm::dvec3>& out);
+  // The tops' radiosity `topB` (per top) that refinement judges the links by (their shooters'
+  // largest B); gather sets it too. Until it is given, near links are refined by the
+  // separation alone (fateOf).
+  void setRadiosity(const std::vector<glm::dvec3>& topB);
+  bool radiosityKnown() const { return radiosityKnown_; }
+  // fateOf keeps near links that cannot carry eps Phi (RadiosityOptions::keepWeakNearLinks).
+  void keepWeakNearLinks(bool on) { keepWeakNear_ = on; }
   // Per top: the sum of its cluster links' form factors H_i / B_S over the exposed part, as
   // gather weighs them (its row sum's cluster part).
   std::vector<double> rowSums(const std::vector<double>& exposure);
@@ -177,6 +185,11 @@ class ClusterLinks {
   // The near links tested for being blocked in this key's rounds, with the answer, for the next
   // key's coherence (ClusterLinkCache::blocked).
   const std::vector<NearLinkTest>& nearTests() const { return nearTests_; }
+  // Whether the ends r and s are near: their bounding spheres' centres closer than the
+  // separation times the radii's sum (the point approximation does not hold; fateOf).
+  bool near(ClusterRef r, ClusterRef s) const;
+  // The kept links and this key's near tests into `census` (link_census.h).
+  void countInto(LinkCensus& census) const;
   size_t size() const { return links_.size(); }
   size_t reusedCount() const { return reused_; }
   const std::vector<ClusterBounds>& clusterBounds() const { return clusterBounds_; }
@@ -223,6 +236,15 @@ class ClusterLinks {
   // of the two miss (tried: near cluster links with V = 0.6 dropped).
   bool blocked(ClusterRef r, ClusterRef s) const;
   static constexpr int kTestedMemberPairs = 16;
+  // The member tops of `end` whose plane has some of `other`'s box in front (the others see
+  // none of it) into `out`; false when there are more than `most` (blocked does not test).
+  bool facingMembers(ClusterRef end, ClusterRef other, size_t most,
+                     std::vector<uint32_t>& out) const;
+  // Whether blocked(r, s) takes more member pairs than it tests (it then answers false).
+  bool tooManyPairsToTest(ClusterRef r, ClusterRef s) const;
+  size_t memberCount(ClusterRef r) const {
+    return isCluster(r) ? tree_.node(clusterIndex(r)).count : 1;
+  }
   const ClusterBounds& bounds(ClusterRef r) const {
     return isCluster(r) ? clusterBounds_[size_t(clusterIndex(r))] : topBounds_[size_t(r)];
   }
@@ -305,6 +327,8 @@ class ClusterLinks {
   std::vector<FacingGroups> clusterFacing_;
   std::vector<double> clusterEmission_;
   std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
+  bool radiosityKnown_ = false;                // setRadiosity or gather has run
+  bool keepWeakNear_ = false;                  // keepWeakNearLinks
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;

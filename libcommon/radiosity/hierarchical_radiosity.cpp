@@ -89,6 +89,7 @@ KeySolution KeyTimeSolver::run() {
                                                input_.visibility, opt_.rays, opt_.clusterSeparation,
                                                opt_.lightClusterShare, opt_.clusterMemberRays,
                                                opt_.isotropicClusters, input_.reuseClusterLinks);
+    clusters_->keepWeakNearLinks(opt_.keepWeakNearLinks);
     if (input_.expectedClusterLinks > 0)
       clusters_->expectLinks(withMargin(input_.expectedClusterLinks));
   } else {
@@ -196,6 +197,7 @@ KeySolution KeyTimeSolver::finish() {
     (l.reused ? s_.linksReused : s_.linksComputed)++;
     s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
   }
+  countLinks();
   if (clusters_) {  // at the final B, as the merge gathers the patch links
     gatherClusterLight();
     s_.topClusterIrradiance = clusterH_;
@@ -232,6 +234,23 @@ KeySolution KeyTimeSolver::finish() {
         s_.lampIrradiance[i] = lampE_[i] / s_.exposure[i];
   }
   return std::move(s_);
+}
+
+// The key's links by kind (link_census.h), before the cluster links are handed on.
+void KeyTimeSolver::countLinks() {
+  LinkCensus& c = s_.linkCensus;
+  for (const SolverLink& l : s_.links) {
+    if (l.refined) {
+      ++c.patchRefined;
+      continue;
+    }
+    ++c.patchLeaves;
+    const uint32_t r = h_.node(l.receiver).id.top, q = h_.node(l.shooter).id.top;
+    c.patchLight += maxComponent(surfaces_[q].emission) > 0.0 ? 1 : 0;
+    c.patchBlocked += l.rayVisibility == 0.0 ? 1 : 0;
+    c.patchNearTops += clusters_ && clusters_->near(ClusterRef(r), ClusterRef(q)) ? 1 : 0;
+  }
+  if (clusters_) clusters_->countInto(c);
 }
 
 KeySolution solveKeyTime(PatchHierarchy& h, const std::vector<SurfaceProperties>& surfaces,

@@ -142,6 +142,7 @@ struct KeySolution {
   // Per top-level patch: the irradiance it gathers through cluster links at the final B, over
   // its exposure (uniform over the top; no closure factor). Empty without cluster links.
   std::vector<glm::dvec3> topClusterIrradiance;
+  LinkCensus linkCensus;          // the key's links by kind at the end of its refinement
   size_t clusterLinks = 0;        // cluster links gathered (not refined)
   size_t clusterLinksReused = 0;  // of them: values taken over (reuseClusterLinks)
   // The cluster links gathered, with their values, and the clusters' bounds at this key (for

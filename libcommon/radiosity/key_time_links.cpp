@@ -28,6 +28,9 @@ size_t KeyTimeSolver::refineClusterLinks() {
   const size_t held = s_.links.size() + clusters_->size();
   const size_t budget = opt_.maxLinks > held ? opt_.maxLinks - held : 0;
   bool overBudget = false;
+  // The first round's B (the lights' emission, 0 elsewhere), so that near links are judged by
+  // what they can carry from the start (cluster_links.h).
+  if (!clusters_->radiosityKnown()) clusters_->setRadiosity(B_);
   const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs, overBudget);
   if (overBudget || s_.links.size() + clusters_->size() + pairs.size() > opt_.maxLinks)
     s_.linkCapReached = true;

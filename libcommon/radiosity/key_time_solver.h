@@ -58,6 +58,7 @@ class KeyTimeSolver {
   void setThresholds();
   void raiseThresholdToCarriedPower();
   KeySolution finish();
+  void countLinks();
 
   // Link, evaluate, refine, the accurate pass and the radiosity-weighted visibility
   // (key_time_links.cpp).

@@ -26,6 +26,7 @@ nlohmann::json KeyTimeReport::toJson() const {
     j["lamp_values"] = lampValues;
     j["lamp_values_reused"] = lampValuesReused;
   }
+  if (!linkCensus.is_null()) j["link_census"] = linkCensus;
   return j;
 }
 
@@ -48,6 +49,7 @@ KeyTimeReport KeyTimeReport::fromJson(const nlohmann::json& j) {
   r.secondsLinks = j.value("seconds_links", 0.0);
   r.secondsSolve = j.value("seconds_solve", 0.0);
   r.secondsCoherence = j.value("seconds_coherence", 0.0);
+  if (j.contains("link_census")) r.linkCensus = j["link_census"];
   return r;
 }
 

@@ -33,6 +33,9 @@ struct KeyTimeReport {
   size_t lampValues = 0;          // (node, lamp) direct irradiance values of the key's leaves
   size_t lampValuesReused = 0;    // of them: taken over from the previous key
   double secondsLinks = 0, secondsSolve = 0, secondsCoherence = 0;
+  // The key's links by kind at the end of its refinement (LinkCensus::toJson; null: not
+  // counted, as in a key window file written before it).
+  nlohmann::json linkCensus;
 
   // The --report JSON of one key (keys "time", "links", "recomputed", ...; global_stage.h),
   // also how a key window file carries its keys' figures to the merge.

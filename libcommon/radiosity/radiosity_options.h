@@ -88,6 +88,12 @@ struct RadiosityOptions {
   // (cluster_links.h). Off: scenes of flat surfaces (a wall's tiles show all of their area to
   // what faces them, not a quarter) come out far too dark with isotropic ends.
   bool isotropicClusters = false;
+  // Keep a near cluster link without a light whose bound with F = 1 cannot carry eps Phi,
+  // instead of refining it (cluster_links.h, fateOf). Off by default: the kept links' point
+  // estimate moves an exposed floor away from all pairs
+  // (ClusterLinks.ExposedFloorMatchesAllPairsAtTheDefaultSeparation); on, packed small objects
+  // (shelves of binders, keyboards) stop filling the link bound.
+  bool keepWeakNearLinks = false;
 };
 
 }  // namespace rad

@@ -201,6 +201,7 @@ KeyTimeReport keyTimeReportOf(const KeySolution& s, const PatchHierarchy& h, dou
   kr.lampValuesReused = s.lampValuesReused;
   kr.secondsLinks = s.secondsLinks;
   kr.secondsSolve = s.secondsSolve;
+  kr.linkCensus = s.linkCensus.toJson();
   for (int i = 0; i < h.size(); ++i) kr.nodes += s.inTree(i, h) ? 1 : 0;
   return kr;
 }

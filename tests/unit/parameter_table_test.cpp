@@ -44,6 +44,7 @@ TEST(ParameterTable, GlobalProvenanceKeysAreUnchanged) {
                                             "fps",
                                             "frames",
                                             "isotropic-clusters",
+                                            "keep-weak-near-links",
                                             "key-step",
                                             "light-cluster-share",
                                             "max-links",
