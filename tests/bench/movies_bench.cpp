@@ -51,22 +51,15 @@ Mesh box(glm::dvec3 h) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  const int moving = argc > 1 ? std::atoi(argv[1]) : 1;
-  const int frames = argc > 2 ? std::atoi(argv[2]) : 96;
-  const int tiles = argc > 3 ? std::atoi(argv[3]) : 6;
-  const int texels = argc > 4 ? std::atoi(argv[4]) : 32;
-  // The baseline's key step: 6 (same keys, every blocker per key) or 1 (every frame, the
-  // paper's per-frame static method).
-  const int baselineKeyStep = argc > 5 ? std::atoi(argv[5]) : 6;
-  const double fps = 24.0;
-
+// The bench's room: a tiled floor under one square lamp, four chairs and a table, and `moving`
+// cubes crossing it over the run; floorNodes gets the floor tiles' nodes.
+static Scene benchScene(int moving, int frames, int tiles, double fps,
+                        std::vector<int>& floorNodes) {
   Scene s;
   Material white, lamp;
   white.reflectance = glm::dvec3(0.6);
   lamp.emission = glm::dvec3(5.0);
   s.materials = {white, lamp};
-  std::vector<int> floorNodes;
   const double room = 4.0, tile = room / tiles;
   for (int j = 0; j < tiles; ++j)
     for (int i = 0; i < tiles; ++i) {
@@ -98,6 +91,22 @@ int main(int argc, char** argv) {
     ch.values = {-2.2, y, z, 2.2, -y, z};
     s.channels.push_back(ch);
   }
+
+  return s;
+}
+
+int main(int argc, char** argv) {
+  const int moving = argc > 1 ? std::atoi(argv[1]) : 1;
+  const int frames = argc > 2 ? std::atoi(argv[2]) : 96;
+  const int tiles = argc > 3 ? std::atoi(argv[3]) : 6;
+  const int texels = argc > 4 ? std::atoi(argv[4]) : 32;
+  // The baseline's key step: 6 (same keys, every blocker per key) or 1 (every frame, the
+  // paper's per-frame static method).
+  const int baselineKeyStep = argc > 5 ? std::atoi(argv[5]) : 6;
+  const double fps = 24.0;
+
+  std::vector<int> floorNodes;
+  const Scene s = benchScene(moving, frames, tiles, fps, floorNodes);
 
   GlobalSolution g;
   g.keyTimes = {0.0};
