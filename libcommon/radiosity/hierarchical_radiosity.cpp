@@ -17,6 +17,7 @@
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/key_time_solver.h"
+#include "libcommon/scene/closed_solid.h"
 #include "libcommon/scene/emission_texture.h"
 
 namespace rad {
@@ -24,8 +25,13 @@ namespace rad {
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
                                                    const PatchHierarchy& hierarchy) {
   std::vector<SurfaceProperties> out(size_t(hierarchy.topCount()));
+  const std::vector<bool> closed = closedSolidMeshes(scene);
   for (int t = 0; t < hierarchy.topCount(); ++t) {
-    int m = hierarchy.top(t).material;
+    const InputPolygon& top = hierarchy.top(t);
+    const int node = top.node, mesh = node >= 0 ? scene.nodes[size_t(node)].mesh : -1;
+    out[size_t(t)].closedSolid = mesh >= 0 && size_t(mesh) < closed.size() && closed[size_t(mesh)];
+    out[size_t(t)].backFace = top.backFace;
+    int m = top.material;
     if (m >= 0 && m < int(scene.materials.size())) {
       const Material& mat = scene.materials[size_t(m)];
       out[size_t(t)].reflectance = glm::clamp(mat.reflectance, glm::dvec3(0.0), glm::dvec3(1.0));

@@ -65,10 +65,26 @@ struct SurfaceProperties {
   glm::dvec3 reflectance{0.0};
   glm::dvec3 emission{0.0};
   bool doubleSided = false;  // the material is doubleSided: its back is a surface too
+  // Its mesh is a closed solid with faces out (closed_solid.h): the winding gives the outside
+  // even when the material is doubleSided.
+  bool closedSolid = false;
+  bool backFace = false;  // the reversed copy of a doubleSided polygon (InputPolygon::backFace)
   bool isEmitter() const { return emission.x > 0 || emission.y > 0 || emission.z > 0; }
+  // The normal of the solid's outside at this patch, from its geometric normal n: -n for the
+  // reversed copy of a closed solid's face, else n (a one-sided patch's back is its inside).
+  glm::dvec3 outwardNormal(const glm::dvec3& n) const {
+    return doubleSided && closedSolid && backFace ? -n : n;
+  }
+  // Whether this patch bounds a solid (one-sided, or a face of a closed solid), so that a ray
+  // meeting it from behind outwardNormal starts inside (rad-global's exposure).
+  bool boundsSolid() const { return !doubleSided || closedSolid; }
+  // Whether a ray along d that first meets this patch (geometric normal n) starts inside a solid.
+  bool entersFromInside(const glm::dvec3& n, const glm::dvec3& d) const {
+    return boundsSolid() && glm::dot(outwardNormal(n), d) > 0.0;
+  }
 };
 // From the scene's materials (reflectance clamped to [0, 1]; the glTF default material is
-// white).
+// white) and meshes (closedSolid).
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
                                                    const PatchHierarchy& hierarchy);
 

@@ -21,14 +21,16 @@ namespace rad {
 // exposure e is the fraction of its ray start points (samplePoints, the same for all its links)
 // that are not covered: a point is covered when it lies in a contact gap (inContact) or when a
 // cosine-distributed ray from it first meets the back of a one-sided surface (the inside of a
-// solid, the back of a wall). The gather divides a node's links' irradiance by e, so B and H are
-// those of the exposed part, and a parent pulls its children's B weighted by exposed area. That
-// holds when the covered points' ray pairs are the ones removed, so the links' visibility counts
-// those pairs as blocked without casting them (evaluateLink, coveredPoints_): a shadow ray skips
-// the first and last kSegmentEpsilon of its length, and from a board's face 20 micrometres from
-// the next board's it passes that board, whose far side the exposure's shorter ray meets. The
-// link then read V = 1 at e = 1/16, F V / e = 16 (issue 58: the solve diverged without the
-// closed-room rows, and was far too bright at the link bound).
+// solid, the back of a wall) or a face of a closed solid from behind its outward normal, whatever
+// its material's doubleSided says (closed_solid.h: Blender exports every material doubleSided). The
+// gather divides a node's links' irradiance by e, so B and H are those of the exposed part, and a
+// parent pulls its children's B weighted by exposed area. That holds when the covered points' ray
+// pairs are the ones removed, so the links' visibility counts those pairs as blocked without
+// casting them (evaluateLink, coveredPoints_): a shadow ray skips the first and last
+// kSegmentEpsilon of its length, and from a board's face 20 micrometres from the next board's it
+// passes that board, whose far side the exposure's shorter ray meets. The link then read V = 1 at e
+// = 1/16, F V / e = 16 (issue 58: the solve diverged without the closed-room rows, and was far too
+// bright at the link bound).
 void KeyTimeSolver::computeExposures() {
   const size_t N = size_t(h_.size());
   exposure_.resize(N, -1.0);
@@ -77,8 +79,8 @@ void KeyTimeSolver::expose(int i) {
     }
     const glm::dvec3 d = direction(seed, k) * size;  // firstHit's tnear is relative to |d|
     const RayStart r = rayStart(*input_.visibility, points[k], d, n.id.top, [&](uint32_t hit) {
-      return hit < uint32_t(h_.topCount()) && !surfaces_[hit].doubleSided &&
-             glm::dot(s_.world[hit].normal(), d) > 0.0;
+      return hit < uint32_t(h_.topCount()) &&
+             surfaces_[hit].entersFromInside(s_.world[hit].normal(), d);
     });
     state[k] = r == RayStart::kOutside ? kExposed : r == RayStart::kInside ? kInside : kUndecided;
     (r == RayStart::kOutside ? exposed : r == RayStart::kInside ? inside : undecided) += 1;
@@ -115,8 +117,10 @@ bool KeyTimeSolver::inContact(const glm::dvec3& x, const glm::dvec3& normal, uin
   if (h.surface == VisibilityScene::kNoSurface || h.surface >= uint32_t(h_.topCount()))
     return false;
   const Polygon& S = s_.world[h.surface];
-  const glm::dvec3 m = S.normal();
-  if (glm::dot(m, normal) > 0.0) return !surfaces_[h.surface].doubleSided;  // a back: inside
+  const SurfaceProperties& surface = surfaces_[h.surface];
+  // Either of a closed solid's two copies of a face gives the same answer (closed_solid.h).
+  const glm::dvec3 m = surface.outwardNormal(S.normal());
+  if (glm::dot(m, normal) > 0.0) return surface.boundsSolid();  // a back: inside
   return glm::dot(m, normal) < -kContactParallel && glm::dot(m, x - S.v[0]) > rounding;
 }
 
