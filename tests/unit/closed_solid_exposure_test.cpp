@@ -108,10 +108,10 @@ TEST(ClosedSolid, AWatertightOutwardWoundMeshIsASolidAndNothingElseIs) {
 
 // The doubleSided room finds the parts under the walls covered, as the one-sided room does, and
 // its walls come out as bright as the one-sided room's. Before: no covered leaf, and the room's B
-// 28 % below the one-sided room's (the parts under the walls averaged in, light lost at each
-// bounce). The closed-room fill (key_time_closure.cpp) leaves the doubleSided room darker than
-// the one-sided one at the defaults; without it the two are closer (docs/results.md, issue 57's
-// covered test).
+// far below the one-sided room's (the parts under the walls averaged in, light lost at each
+// bounce; figures in docs/results.md). The closed-room fill (key_time_closure.cpp) leaves the
+// doubleSided room darker than the one-sided one at the defaults; without it the two are closer
+// (docs/results.md, issue 57's covered test).
 TEST(ClosedSolid, DoubleSidedSlabRoomIsCoveredAndLitAsTheOneSidedRoom) {
   const Scene twoSidedScene = slabRoom("double"), oneSidedScene = slabRoom("single");
   const SlabRoomSolve twoSided(twoSidedScene, RadiosityOptions()),
