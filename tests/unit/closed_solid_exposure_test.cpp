@@ -6,12 +6,10 @@
 // averaged their lit part with the part under the wall and shot that diluted radiosity, light
 // lost at every bounce (docs/results.md, "Lamps: leaks, fallback pixels, ...", finding 5).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -22,23 +20,14 @@
 #include "libcommon/radiosity/scene_visibility.h"
 #include "libcommon/scene/closed_solid.h"
 #include "libcommon/scene/scene_emitters.h"
-
-namespace fs = std::filesystem;
+#include "tests/unit/key_time_solve_fixture.h"
 
 namespace rad {
 namespace {
 
-// The slab room, "double" or "single", generated once per variant and test process.
+// The slab room, "double" or "single".
 Scene slabRoom(const std::string& sides) {
-  const fs::path dir = fs::temp_directory_path() / ("rad_slab_room_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  const std::string path = (dir / (sides + ".gltf")).string();
-  const std::string command = "python3 " RAD_SOURCE_DIR "/pipelines/scenes/make_lamp_slab_box.py " +
-                              sides + " " + path + " >/dev/null 2>&1";
-  if (std::system(command.c_str()) != 0) throw std::runtime_error("failed: " + command);
-  Scene s = readGltfScene(path, GltfReadOptions());
-  fs::remove_all(dir);
-  return s;
+  return generatedScene("make_lamp_slab_box.py", sides + " {out}");
 }
 
 // A key-time solve at time 0 with clusters, visibility and the lamp, as rad-global makes one
@@ -50,20 +39,9 @@ struct SlabRoomSolve {
   double roomB = 0.0;
 
   SlabRoomSolve(const Scene& scene, const RadiosityOptions& options) {
-    PatchHierarchy hierarchy(scene.inputPolygons());  // the solve subdivides it
-    const std::vector<SurfaceProperties> surfaces = surfacePropertiesOf(scene, hierarchy);
-    SceneVisibility visibility(scene, hierarchy, 0.0, 0.0);
-    visibility.setTime(0.0);
-    const ClusterTree tree = clusterTreeOf(scene, hierarchy, 0.0, 0.0);
-    const SceneEmitters emitters(scene, hierarchy.tops());
-    const PlacedLamps lamps = placeLamps(emitters, 0.0);
-    KeySolveInput in;
-    in.topToWorld = topTransforms(scene, hierarchy, 0.0);
-    in.visibility = &visibility.visibility();
-    in.movingTops = movingTopsOf(scene, hierarchy, 0.0, 0.0);
-    in.clusters = &tree;
-    in.lamps = lamps.lamps;
-    const KeySolution k = solveKeyTime(hierarchy, surfaces, in, options);
+    const KeyTimeSolve solve(scene, options);
+    const PatchHierarchy& hierarchy = solve.hierarchy;
+    const KeySolution& k = solve.solution;
     double sumB = 0.0, sumA = 0.0;
     for (int i = 0; i < hierarchy.size(); ++i) {
       if (!k.inTree(i, hierarchy) || k.split[size_t(i)]) continue;

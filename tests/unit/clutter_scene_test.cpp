@@ -6,11 +6,9 @@
 // is near, so the near links refined and tested far outnumbered the links kept, and graz reached
 // the link bound (docs/results.md, "Which links fill the link bound").
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -18,50 +16,21 @@
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/radiosity/key_solve_inputs.h"
 #include "libcommon/radiosity/scene_visibility.h"
-
-namespace fs = std::filesystem;
+#include "tests/unit/key_time_solve_fixture.h"
 
 namespace rad {
 namespace {
 
 // The generated scene, written once per test process.
 const Scene& clutterScene() {
-  static const Scene scene = [] {
-    const fs::path dir = fs::temp_directory_path() / ("rad_clutter_" + std::to_string(getpid()));
-    fs::create_directories(dir);
-    const std::string path = (dir / "clutter.gltf").string();
-    const std::string command = "python3 " RAD_SOURCE_DIR
-                                "/pipelines/scenes/make_clutter_scenes.py " +
-                                path + " --shelves 4 --binders 12 2>/dev/null";
-    if (std::system(command.c_str()) != 0) throw std::runtime_error("failed: " + command);
-    Scene s = readGltfScene(path, GltfReadOptions());
-    fs::remove_all(dir);
-    return s;
-  }();
+  static const Scene scene =
+      generatedScene("make_clutter_scenes.py", "{out} --shelves 4 --binders 12");
   return scene;
 }
 
-// A key-time solve of the scene at time 0 with its clusters and visibility, as rad-global makes
-// one (space_time_radiosity.cpp).
-struct ClutterSolve {
-  PatchHierarchy hierarchy;
-  std::vector<SurfaceProperties> surfaces;
-  KeySolution solution;
-
-  explicit ClutterSolve(const RadiosityOptions& options)
-      : hierarchy(clutterScene().inputPolygons()) {
-    const Scene& scene = clutterScene();
-    surfaces = surfacePropertiesOf(scene, hierarchy);
-    SceneVisibility visibility(scene, hierarchy, 0.0, 0.0);
-    visibility.setTime(0.0);
-    const ClusterTree tree = clusterTreeOf(scene, hierarchy, 0.0, 0.0);
-    KeySolveInput in;
-    in.topToWorld = topTransforms(scene, hierarchy, 0.0);
-    in.visibility = &visibility.visibility();
-    in.movingTops = movingTopsOf(scene, hierarchy, 0.0, 0.0);
-    in.clusters = &tree;
-    solution = solveKeyTime(hierarchy, surfaces, in, options);
-  }
+// One key-time solve of the clutter scene.
+struct ClutterSolve : KeyTimeSolve {
+  explicit ClutterSolve(const RadiosityOptions& options) : KeyTimeSolve(clutterScene(), options) {}
 };
 
 size_t total(const LinkCensus::BySize& s) {
@@ -94,9 +63,7 @@ TEST(ClutterScene, AClosedRoomAbsorbsWhatItIsLitWith) {
   RadiosityOptions options;
   options.keepWeakNearLinks = true;
   const ClutterSolve s(options);
-  const glm::dvec3 a = s.solution.absorbedPower(s.hierarchy, s.surfaces);
-  const glm::dvec3 e = s.solution.emittedPower(s.hierarchy, s.surfaces);
-  const double share = std::max({a.x, a.y, a.z}) / std::max({e.x, e.y, e.z});
+  const double share = s.absorbedShare();
   std::cout << "absorbed / emitted " << share << "\n";
   EXPECT_GT(share, 0.95);
   EXPECT_LE(share, 1.02);

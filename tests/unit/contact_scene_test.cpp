@@ -7,11 +7,9 @@
 // the closed-room rows filled what links were left, up to 2.5e6 times, so that at the link bound
 // the room absorbed several times the light it was lit with.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -19,58 +17,20 @@
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/radiosity/key_solve_inputs.h"
 #include "libcommon/radiosity/scene_visibility.h"
-
-namespace fs = std::filesystem;
+#include "tests/unit/key_time_solve_fixture.h"
 
 namespace rad {
 namespace {
 
 // The generated scene, written once per test process.
 const Scene& contactScene() {
-  static const Scene scene = [] {
-    const fs::path dir = fs::temp_directory_path() / ("rad_contact_" + std::to_string(getpid()));
-    fs::create_directories(dir);
-    const std::string path = (dir / "contact.gltf").string();
-    const std::string command = "python3 " RAD_SOURCE_DIR
-                                "/pipelines/scenes/make_contact_scenes.py " +
-                                path + " --cols 3 --rows 2 2>/dev/null";
-    if (std::system(command.c_str()) != 0) throw std::runtime_error("failed: " + command);
-    Scene s = readGltfScene(path, GltfReadOptions());
-    fs::remove_all(dir);
-    return s;
-  }();
+  static const Scene scene = generatedScene("make_contact_scenes.py", "{out} --cols 3 --rows 2");
   return scene;
 }
 
-// A key-time solve of the scene at time 0 with its clusters and visibility, as rad-global makes
-// one (space_time_radiosity.cpp).
-struct ContactSolve {
-  PatchHierarchy hierarchy;
-  std::vector<SurfaceProperties> surfaces;
-  KeySolution solution;
-
-  explicit ContactSolve(const RadiosityOptions& options)
-      : hierarchy(contactScene().inputPolygons()) {
-    const Scene& scene = contactScene();
-    surfaces = surfacePropertiesOf(scene, hierarchy);
-    SceneVisibility visibility(scene, hierarchy, 0.0, 0.0);
-    visibility.setTime(0.0);
-    const ClusterTree tree = clusterTreeOf(scene, hierarchy, 0.0, 0.0);
-    KeySolveInput in;
-    in.topToWorld = topTransforms(scene, hierarchy, 0.0);
-    in.visibility = &visibility.visibility();
-    in.movingTops = movingTopsOf(scene, hierarchy, 0.0, 0.0);
-    in.clusters = &tree;
-    solution = solveKeyTime(hierarchy, surfaces, in, options);
-  }
-
-  // Absorbed over emitted power, the largest channel: at most 1 in a closed room (1 when every
-  // row sums to 1 exactly).
-  double absorbedShare() const {
-    const glm::dvec3 a = solution.absorbedPower(hierarchy, surfaces);
-    const glm::dvec3 e = solution.emittedPower(hierarchy, surfaces);
-    return std::max({a.x, a.y, a.z}) / std::max({e.x, e.y, e.z});
-  }
+// One key-time solve of the contact scene.
+struct ContactSolve : KeyTimeSolve {
+  explicit ContactSolve(const RadiosityOptions& options) : KeyTimeSolve(contactScene(), options) {}
 };
 
 // Fix 1 (cluster_links.h, blocked): near cluster links between boards that cannot see each
