@@ -211,14 +211,7 @@ def main():
         rows.append(measure(args, name, scene, kind, log))
         write_csv(rows, args, os.path.join(args.out, "corpus.csv"))
     print_table(rows, args)
-    if any("error" in r for r in rows):
-        return 1
-    if args.check:
-        missing = [(r["scene"], c) for r in rows for c in COLUMNS if r.get(c) is None]
-        for scene, column in missing:
-            print("corpus_bench.py: %s: no %s figure" % (scene, column), file=sys.stderr)
-        return 1 if missing else 0
-    return 0
+    return image_figures.exit_status(rows, COLUMNS, args.check, "corpus_bench.py")
 
 
 if __name__ == "__main__":

@@ -221,12 +221,18 @@ def main():
             rows.append(measure(args, name, scene, kind, preset, log))
             write_csv(rows, os.path.join(args.out, "image-figures.csv"))
     print_table(rows, args)
+    return exit_status(rows, COLUMNS, args.check, "image_figures.py")
+
+
+def exit_status(rows, columns, check, prog):
+    """1 when a row failed, or with check when a row lacks one of columns' figures (each
+    named on stderr); else 0."""
     if any("error" in r for r in rows):
         return 1
-    if args.check:
-        missing = [(r["scene"], c) for r in rows for c in COLUMNS if r.get(c) is None]
+    if check:
+        missing = [(r["scene"], c) for r in rows for c in columns if r.get(c) is None]
         for scene, column in missing:
-            print("image_figures.py: %s: no %s figure" % (scene, column), file=sys.stderr)
+            print("%s: %s: no %s figure" % (prog, scene, column), file=sys.stderr)
         return 1 if missing else 0
     return 0
 
