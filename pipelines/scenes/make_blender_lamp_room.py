@@ -18,45 +18,20 @@ usage: blender -b --factory-startup -P make_blender_lamp_room.py -- OUT.gltf [--
 The render size is 352x240 (the exported camera's aspectRatio). The animation: 48 frames at 24 fps (2 s), the cube sliding 1.5 m along +X.
 """
 import math
+import os
 import sys
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_room_kit as kit  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 out = argv[0] if argv else "lamp-room.gltf"
 blend = argv[argv.index("--blend") + 1] if "--blend" in argv else None
 
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
-scene.render.fps = 24
-scene.frame_start, scene.frame_end = 0, 47
-# The exporter writes the camera's aspectRatio from the render size: the pipeline's 352x240.
-scene.render.resolution_x, scene.render.resolution_y = 352, 240
-materials = {}
-
-
-def material(name, rgb):
-    if name not in materials:
-        m = bpy.data.materials.new(name)
-        m.use_nodes = True
-        bsdf = m.node_tree.nodes["Principled BSDF"]
-        bsdf.inputs["Base Color"].default_value = (*rgb, 1.0)
-        bsdf.inputs["Roughness"].default_value = 1.0
-        bsdf.inputs["Specular"].default_value = 0.0
-        materials[name] = m
-    return materials[name]
-
-
-def box(name, centre, size, mat):
-    """An axis-aligned box (Blender Z-up), size in metres."""
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=centre)
-    o = bpy.context.active_object
-    o.name = name
-    o.scale = size
-    bpy.ops.object.transform_apply(location=False, rotation=False, scale=True)
-    o.data.materials.append(material(*mat))
-    return o
-
+kit.new_scene(47)
+box, lamp = kit.box, kit.lamp
 
 WALL = ("wall", (0.7, 0.7, 0.68))
 W, D, H, T = 4.0, 3.0, 2.6, 0.1  # width (x), depth (y), height (z), wall thickness
@@ -86,20 +61,6 @@ for fc in cube.animation_data.action.fcurves:
         k.interpolation = "LINEAR"
 
 
-def lamp(name, kind, energy, location, rotation=(0.0, 0.0, 0.0)):
-    data = bpy.data.lights.new(name, kind)
-    data.energy = energy
-    if kind == "SUN":
-        data.angle = 0.0
-    else:
-        data.shadow_soft_size = 0.0
-    o = bpy.data.objects.new(name, data)
-    o.location = location
-    o.rotation_euler = rotation
-    scene.collection.objects.link(o)
-    return data
-
-
 lamp("ceiling-lamp", "POINT", 60.0, (-0.8, -0.2, H - 0.3))
 spot = lamp("table-spot", "SPOT", 150.0, (0.6, 0.6, 2.2))
 spot.spot_size = math.radians(45.0)
@@ -107,16 +68,8 @@ spot.spot_blend = 0.3
 # The sun: 4 W/m^2, 35 degrees below the horizon, shining in through the opening (+Y, -Z).
 lamp("sun", "SUN", 4.0, (0, -3, 3), (math.radians(55.0), 0.0, math.radians(10.0)))
 
-cam = bpy.data.cameras.new("camera")
-cam.sensor_fit = "VERTICAL"
-cam.angle_y = math.radians(60.0)
-cam_obj = bpy.data.objects.new("camera", cam)
-cam_obj.location = (1.7, -1.35, 1.9)
-cam_obj.rotation_euler = (math.radians(62.0), 0.0, math.radians(48.0))
-scene.collection.objects.link(cam_obj)
-scene.camera = cam_obj
+kit.camera(60.0, (1.7, -1.35, 1.9), (62.0, 0.0, 48.0))
 
 if blend:
     bpy.ops.wm.save_as_mainfile(filepath=blend)
-bpy.ops.export_scene.gltf(filepath=out, export_format="GLTF_EMBEDDED", export_cameras=True,
-                          export_lights=True)
+kit.export(out)

@@ -21,43 +21,19 @@ usage: blender -b --factory-startup -P make_blender_lamp_study.py -- OUT.gltf
 The render size is 352x240 (the exported camera's aspectRatio); 24 frames at 24 fps.
 """
 import math
+import os
 import sys
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import blender_room_kit as kit  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 out = argv[0] if argv else "lamp-study.gltf"
 
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
-scene.render.fps = 24
-scene.frame_start, scene.frame_end = 0, 23
-scene.render.resolution_x, scene.render.resolution_y = 352, 240
-materials = {}
-
-
-def material(name, rgb):
-    if name not in materials:
-        m = bpy.data.materials.new(name)
-        m.use_nodes = True
-        bsdf = m.node_tree.nodes["Principled BSDF"]
-        bsdf.inputs["Base Color"].default_value = (*rgb, 1.0)
-        bsdf.inputs["Roughness"].default_value = 1.0
-        bsdf.inputs["Specular"].default_value = 0.0
-        materials[name] = m
-    return materials[name]
-
-
-def box(name, centre, size, mat):
-    """An axis-aligned box (Blender Z-up), size in metres."""
-    bpy.ops.mesh.primitive_cube_add(size=1.0, location=centre)
-    o = bpy.context.active_object
-    o.name = name
-    o.scale = size
-    bpy.ops.object.transform_apply(location=False, rotation=False, scale=True)
-    o.data.materials.append(material(*mat))
-    return o
-
+kit.new_scene(23)
+box, lamp = kit.box, kit.lamp
 
 WALL = ("plaster", (0.62, 0.66, 0.6))
 W, D, H, T = 5.0, 3.6, 2.8, 0.12  # width (x), depth (y), height (z), wall thickness
@@ -85,38 +61,15 @@ box("sofa-back", (2.2, -0.7, 0.55), (0.25, 1.8, 0.5), ("sofa", (0.18, 0.3, 0.22)
 box("rug", (0.5, -0.2, 0.005), (1.6, 1.2, 0.01), ("rug", (0.6, 0.5, 0.35)))
 
 
-def lamp(name, kind, energy, colour, location, rotation=(0.0, 0.0, 0.0)):
-    data = bpy.data.lights.new(name, kind)
-    data.energy = energy
-    data.color = colour
-    if kind == "SUN":
-        data.angle = 0.0
-    else:
-        data.shadow_soft_size = 0.0
-    o = bpy.data.objects.new(name, data)
-    o.location = location
-    o.rotation_euler = rotation
-    scene.collection.objects.link(o)
-    return data
-
-
-lamp("corner-lamp", "POINT", 40.0, (1.0, 0.85, 0.65), (1.7, 1.0, H - 0.5))
+lamp("corner-lamp", "POINT", 40.0, (1.7, 1.0, H - 0.5), colour=(1.0, 0.85, 0.65))
 # The spot hangs by the front wall, tilted 25 degrees from the vertical toward the desk (+Y).
-spot = lamp("desk-spot", "SPOT", 90.0, (0.75, 0.85, 1.0), (-0.9, -1.6, 2.2),
-            (math.radians(25.0), 0.0, 0.0))
+spot = lamp("desk-spot", "SPOT", 90.0, (-0.9, -1.6, 2.2), (math.radians(25.0), 0.0, 0.0),
+            colour=(0.75, 0.85, 1.0))
 spot.spot_size = math.radians(60.0)
 spot.spot_blend = 0.5
 # The sun: 3 W/m^2 from the left, 40 degrees above the horizon, in through the window (+X, -Z).
-lamp("sun", "SUN", 3.0, (1.0, 0.96, 0.9), (-4, 0, 3), (0.0, math.radians(-50.0), 0.0))
+lamp("sun", "SUN", 3.0, (-4, 0, 3), (0.0, math.radians(-50.0), 0.0), colour=(1.0, 0.96, 0.9))
 
-cam = bpy.data.cameras.new("camera")
-cam.sensor_fit = "VERTICAL"
-cam.angle_y = math.radians(55.0)
-cam_obj = bpy.data.objects.new("camera", cam)
-cam_obj.location = (2.1, -1.55, 1.6)
-cam_obj.rotation_euler = (math.radians(75.0), 0.0, math.radians(62.0))
-scene.collection.objects.link(cam_obj)
-scene.camera = cam_obj
+kit.camera(55.0, (2.1, -1.55, 1.6), (75.0, 0.0, 62.0))
 
-bpy.ops.export_scene.gltf(filepath=out, export_format="GLTF_EMBEDDED", export_cameras=True,
-                          export_lights=True)
+kit.export(out)
