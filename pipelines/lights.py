@@ -47,6 +47,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import bench  # noqa: E402
 import cycles_reference  # noqa: E402
+import image_figures  # noqa: E402
 
 FLOOR_SIZE, HALF, RHO = 64, 2.0, 0.5  # make_lamp_floor.py's view and floor
 COLOUR = (1.0, 0.8, 0.6)
@@ -158,18 +159,27 @@ def cycles(a, scene, out, frame, size, seed, log):
 
 
 def against_cycles(a, label, scene, out, frames, frame, log):
+    """The pipeline's frame against two Cycles renders of other seeds, with image_figures.py's
+    figures (docs/design.md §10): bias, RMSE / mean with the references' noise removed, and the
+    structured error against its floor."""
     os.makedirs(out, exist_ok=True)
-    r = bench.run_stages(a.bin, scene, out, frames, a.size, {}, log)
+    items = os.path.join(out, "items")
+    r = bench.run_stages(a.bin, scene, out, frames, a.size,
+                         {"intervals": ["--item-buffers", items]}, log)
     if r["failed"]:
         figure(label + ": pipeline", "failed: " + r["error"], "|bias| <= 2 %", False)
         return
     refs = [cycles(a, scene, out, frame, a.size, seed, log) for seed in (1, 2)]
-    d = bench.rad_diff(a.bin, os.path.join(out, "frames", "%04d.exr" % frame), refs[0], refs[1])
-    noise = bench.rad_diff(a.bin, refs[0], refs[0], refs[1])["noise_over_mean"]
-    figure(label + ": bias against Cycles", "%+.2f %%" % (100 * d["bias"]), "|bias| <= 2 %",
-           abs(d["bias"]) <= 0.02, deterministic=False)
-    figure(label + ": RMSE / mean (noise removed)", "%.2f %%" % (100 * d["rmse_over_mean"]),
-           "(Cycles noise %.1f %%)" % (100 * noise), True, deterministic=False)
+    f = image_figures.figures(argparse.Namespace(bin=a.bin, eval_frame=frame), scene,
+                              os.path.join(out, "frames"), items, refs)
+    figure(label + ": bias against Cycles", "%+.2f %%" % f["bias"], "|bias| <= 2 %",
+           abs(f["bias"]) <= 2.0, deterministic=False)
+    figure(label + ": RMSE / mean (noise removed)", "%.2f %%" % f["rmse"],
+           "(Cycles noise %.1f %%)" % f["noise"], True, deterministic=False)
+    if f["struct"] is not None and f["floor"] is not None:
+        figure(label + ": structured error p95 (floor)",
+               "%.2f %% (%.2f %%)" % (f["struct"], f["floor"]), "<= floor + 1",
+               f["struct"] <= f["floor"] + 1.0, deterministic=False)
 
 
 def moving_lamp_scene(src, dst, frames):
