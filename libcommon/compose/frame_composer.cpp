@@ -15,6 +15,7 @@
 #include "libcommon/compose/edge_cells.h"
 #include "libcommon/compose/fallback_lamp_light.h"
 #include "libcommon/compose/footprint_filter.h"
+#include "libcommon/compose/still_samples.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
 #include "libcommon/radiosity/scene_visibility.h"
@@ -125,6 +126,15 @@ ActiveMovies indexMovies(const std::vector<MovieTexture>& movies, int topCount) 
   return a;
 }
 
+// Per top, the packed patch ids of its active movies, sorted (StillSamples::beginFrame).
+std::vector<std::vector<uint64_t>> moviePatchesByTop(const std::vector<MovieTexture>& movies,
+                                                     size_t topCount) {
+  std::vector<std::vector<uint64_t>> byTop(topCount);
+  for (const MovieTexture& mt : movies) byTop[mt.patch.top].push_back(mt.patch.packed());
+  for (std::vector<uint64_t>& ids : byTop) std::sort(ids.begin(), ids.end());
+  return byTop;
+}
+
 // Top-level (u,v) of the hit point of the ray through image position `pixel` (a sample,
 // sample_grid.h) with the patch's plane. (A ray parallel to the plane cannot hit it; its
 // centroid stands in.)
@@ -210,6 +220,7 @@ struct FrameComposer::Impl {
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
   std::vector<uint8_t> edgeCandidates;  // weighEdgeCells': the edge samples
+  StillSamples still;                   // the samples' geometry kept from frame to frame
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
@@ -221,9 +232,16 @@ struct FrameComposer::Impl {
   glm::dvec3 fallbackRadiance(double t, const VisibleTops& visible, int top, glm::dvec2 topUv,
                               const glm::dvec3& emitted, const glm::dvec3& texFactor,
                               bool textured) const;
+  // Sample `sample` (a grid index) at image position `pixel`, showing top-level patch `top`.
   PixelSource shadeSample(double t, const std::vector<MovieTexture>& movies,
                           const VisibleTops& visible, const ActiveMovies& active,
-                          const PrimaryRays& rays, glm::dvec2 pixel, int top, float* rgb) const;
+                          const PrimaryRays& rays, size_t sample, glm::dvec2 pixel, int top,
+                          float* rgb);
+  // The top-level (u,v) of a sample and its deepest movie, from `still` where they hold.
+  glm::dvec2 sampleTopUv(const VisibleTops& visible, const PrimaryRays& rays, size_t sample,
+                         glm::dvec2 pixel, int top, bool& kept);
+  int sampleMovie(const std::vector<MovieTexture>& movies, const ActiveMovies& active,
+                  size_t sample, bool keptTopUv, int top, glm::dvec2 topUv, glm::dvec2& foundUv);
   void composeFiltered(double t, const std::vector<MovieTexture>& movies,
                        const VisibleTops& visible, const ActiveMovies& active,
                        const CameraView& view, const PrimaryRays& rays,
@@ -391,6 +409,8 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   VisibleTops visible;
   m.placeVisibleTops(visible);
   const ActiveMovies active = indexMovies(movies, int(m.tops.size()));
+  m.still.beginFrame(view, m.transforms, moviePatchesByTop(movies, m.tops.size()),
+                     m.items.id.size());
   if (!m.lampLight.empty()) m.lampLight.setTime(t, m.raysAt(t).visibility());
 
   out.size = size;
@@ -399,6 +419,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   out.rgb.assign(n * 3, 0.0f);
   out.source.assign(n, PixelSource::kBackground);
   if (m.filter) {
+    m.filter->plan(m.items.id, edges, m.texturedItem);
     m.composeFiltered(t, movies, visible, active, view, rays, edges, out);
     return;
   }
@@ -413,8 +434,8 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
         if (id == kNoItem) continue;
         ++rowCovered[row];
         const PixelSource source =
-            m.shadeSample(t, movies, visible, active, rays, m.grid.position(col, row), int(id - 1),
-                          &out.rgb[p * 3]);
+            m.shadeSample(t, movies, visible, active, rays, p, m.grid.position(col, row),
+                          int(id - 1), &out.rgb[p * 3]);
         out.source[p] = source;
         ++(source == PixelSource::kMovie ? rowMovie : rowFallback)[row];
       }
@@ -430,12 +451,12 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
 
 // The filtered frame (footprint_filter.h): the samples the filter reads are shaded, then each
 // pixel is filtered from them. A pixel counts as covered when a sample it reads shows a
-// surface, as fallen back when one of them fell back, as a movie pixel otherwise.
+// surface, as fallen back when one of them fell back, as a movie pixel otherwise. The filter
+// has planned this item buffer (compose).
 void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTexture>& movies,
                                           const VisibleTops& visible, const ActiveMovies& active,
                                           const CameraView& view, const PrimaryRays& rays,
                                           const std::vector<size_t>& edges, ComposedFrame& out) {
-  filter->plan(items.id, edges, texturedItem);
   const std::vector<uint8_t>& needed = filter->needed();
   const int gw = items.width, gh = items.height;
   // Only the needed samples are written and read: no fill of the whole grid.
@@ -448,7 +469,7 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
       std::fill_n(&sampleRgb[3 * p], 3, 0.0f);
       sampleSource[p] = PixelSource::kBackground;
     } else {
-      sampleSource[p] = shadeSample(t, movies, visible, active, rays, grid.position(i, j),
+      sampleSource[p] = shadeSample(t, movies, visible, active, rays, p, grid.position(i, j),
                                     int(id - 1), &sampleRgb[3 * p]);
     }
   };
@@ -547,15 +568,40 @@ glm::dvec3 FrameComposer::Impl::fallbackRadiance(double t, const VisibleTops& vi
 
 // One covered sample at image position `pixel` on top-level patch `top`: its radiance into
 // rgb[0..2], from the deepest active movie containing the point, else from the global solution.
+glm::dvec2 FrameComposer::Impl::sampleTopUv(const VisibleTops& visible, const PrimaryRays& rays,
+                                            size_t sample, glm::dvec2 pixel, int top, bool& kept) {
+  glm::dvec2 topUv;
+  const uint32_t id = uint32_t(top) + 1;
+  kept = still.topUv(sample, id, topObject[size_t(top)], topUv);
+  if (kept) return topUv;
+  topUv = topUvOfSample(rays, pixel, visible.world[size_t(top)], visible.normals[size_t(top)],
+                        visible.uvMaps[size_t(top)]);
+  if (still.enabled()) still.setTopUv(sample, id, topUv);
+  return topUv;
+}
+
+int FrameComposer::Impl::sampleMovie(const std::vector<MovieTexture>& movies,
+                                     const ActiveMovies& active, size_t sample, bool keptTopUv,
+                                     int top, glm::dvec2 topUv, glm::dvec2& foundUv) {
+  uint64_t patch;
+  // The same set of movies on the top: the descent ends at the same patch (the index's find is
+  // the descent's own).
+  if (keptTopUv && still.movie(sample, uint32_t(top), patch, foundUv))
+    return int(active.movieOf.find(patch));
+  const int found = deepestMovieAt(active, top, topUv, tops[size_t(top)].local.count == 3, foundUv);
+  if (found >= 0 && still.enabled())
+    still.setMovie(sample, movies[size_t(found)].patch.packed(), foundUv);
+  return found;
+}
+
 PixelSource FrameComposer::Impl::shadeSample(double t, const std::vector<MovieTexture>& movies,
                                              const VisibleTops& visible, const ActiveMovies& active,
-                                             const PrimaryRays& rays, glm::dvec2 pixel, int top,
-                                             float* rgb) const {
+                                             const PrimaryRays& rays, size_t sample,
+                                             glm::dvec2 pixel, int top, float* rgb) {
   const Polygon& poly = visible.world[top];
-  const bool triangle = poly.count == 3;
   const Material& mat = materials[top];
-  const glm::dvec2 topUv =
-      topUvOfSample(rays, pixel, poly, visible.normals[size_t(top)], visible.uvMaps[size_t(top)]);
+  bool keptTopUv;
+  const glm::dvec2 topUv = sampleTopUv(visible, rays, sample, pixel, top, keptTopUv);
   glm::dvec3 texFactor;
   const bool textured = textureFactorAt(scene, mat, tops[top], poly.count, topUv, texFactor);
   // $L_e(x)$: the emissive texture per sample (emission_texture.h), else the material's.
@@ -564,7 +610,7 @@ PixelSource FrameComposer::Impl::shadeSample(double t, const std::vector<MovieTe
       emissiveTextured ? emissionAt(scene, mat, interpolateCorners(tops[top].uv, poly.count, topUv))
                        : mat.emission;
   glm::dvec2 foundUv;
-  const int found = deepestMovieAt(active, top, topUv, triangle, foundUv);
+  const int found = sampleMovie(movies, active, sample, keptTopUv, top, topUv, foundUv);
 
   glm::dvec3 L;
   PixelSource source;
