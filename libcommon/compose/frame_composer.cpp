@@ -126,6 +126,34 @@ ActiveMovies indexMovies(const std::vector<MovieTexture>& movies, int topCount) 
   return a;
 }
 
+// The frame's movies with each one between two keys blended once, texel by texel, into `blended`
+// (reused from frame to frame), with TextureMovie::textureAt's float arithmetic: a texel read by
+// several samples (a texel covers about one pixel, nine samples) is blended once, not at each
+// read, and a sample reads one texture instead of two. Bit-identical to blending as sampled.
+std::vector<MovieTexture> blendKeys(const std::vector<MovieTexture>& movies,
+                                    std::vector<float>& blended) {
+  std::vector<size_t> offset(movies.size() + 1, 0);
+  for (size_t k = 0; k < movies.size(); ++k) {
+    const MovieTexture& mt = movies[k];
+    const size_t floats = mt.nextIrradiance ? size_t(mt.width) * size_t(mt.height) * 3 : 0;
+    offset[k + 1] = offset[k] + floats;
+  }
+  blended.resize(offset.back());
+  std::vector<MovieTexture> out = movies;
+  tbb::parallel_for(size_t(0), movies.size(), [&](size_t k) {
+    const MovieTexture& mt = movies[k];
+    if (!mt.nextIrradiance) return;
+    const float weight = mt.weight, keep = 1.0f - weight;
+    float* to = blended.data() + offset[k];
+    for (size_t i = 0; i < offset[k + 1] - offset[k]; ++i)
+      to[i] = keep * mt.irradiance[i] + weight * mt.nextIrradiance[i];
+    out[k].irradiance = to;
+    out[k].nextIrradiance = nullptr;
+    out[k].weight = 0.0f;
+  });
+  return out;
+}
+
 // Per top, the packed patch ids of its active movies, sorted (StillSamples::beginFrame).
 std::vector<std::vector<uint64_t>> moviePatchesByTop(const std::vector<MovieTexture>& movies,
                                                      size_t topCount) {
@@ -220,6 +248,7 @@ struct FrameComposer::Impl {
   std::vector<float> sampleRgb;               // filtered frames: radiance of the grid's samples
   std::vector<PixelSource> sampleSource;
   std::vector<uint8_t> edgeCandidates;  // weighEdgeCells': the edge samples
+  std::vector<float> blendedKeys;       // blendKeys' textures of the frame
   StillSamples still;                   // the samples' geometry kept from frame to frame
 
   // The named steps of FrameComposer::compose, in order.
@@ -409,6 +438,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   VisibleTops visible;
   m.placeVisibleTops(visible);
   const ActiveMovies active = indexMovies(movies, int(m.tops.size()));
+  const std::vector<MovieTexture> keyed = blendKeys(movies, m.blendedKeys);
   m.still.beginFrame(view, m.transforms, moviePatchesByTop(movies, m.tops.size()),
                      m.items.id.size());
   if (!m.lampLight.empty()) m.lampLight.setTime(t, m.raysAt(t).visibility());
@@ -420,7 +450,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   out.source.assign(n, PixelSource::kBackground);
   if (m.filter) {
     m.filter->plan(m.items.id, edges, m.texturedItem);
-    m.composeFiltered(t, movies, visible, active, view, rays, edges, out);
+    m.composeFiltered(t, keyed, visible, active, view, rays, edges, out);
     return;
   }
   std::vector<long long> rowMovie(size.height, 0), rowFallback(size.height, 0),
@@ -434,7 +464,7 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
         if (id == kNoItem) continue;
         ++rowCovered[row];
         const PixelSource source =
-            m.shadeSample(t, movies, visible, active, rays, p, m.grid.position(col, row),
+            m.shadeSample(t, keyed, visible, active, rays, p, m.grid.position(col, row),
                           int(id - 1), &out.rgb[p * 3]);
         out.source[p] = source;
         ++(source == PixelSource::kMovie ? rowMovie : rowFallback)[row];
