@@ -15,6 +15,7 @@
 #include "libcommon/compose/edge_cells.h"
 #include "libcommon/compose/fallback_lamp_light.h"
 #include "libcommon/compose/footprint_filter.h"
+#include "libcommon/compose/smooth_surfaces.h"
 #include "libcommon/compose/still_samples.h"
 #include "libcommon/core/error.h"
 #include "libcommon/radiosity/hierarchical_radiosity.h"
@@ -249,14 +250,21 @@ struct FrameComposer::Impl {
   std::vector<PixelSource> sampleSource;
   std::vector<uint8_t> edgeCandidates;  // weighEdgeCells': the edge samples
   std::vector<float> blendedKeys;       // blendKeys' textures of the frame
-  StillSamples still;                   // the samples' geometry kept from frame to frame
+  // Filtered frames with edge cells: per grid sample, its smooth surface (smooth_surfaces.h).
+  std::vector<uint32_t> surfaceIds;
+  SmoothSurfaces surfaces;
+  StillSamples still;  // the samples' geometry kept from frame to frame
 
   // The named steps of FrameComposer::compose, in order.
   CameraView renderItems(double t);
   // The shadow rays' scene at time t (made on first use), for silhouettes and lamps.
   SceneVisibility& raysAt(double t);
   // Returns the samples it looked at: those whose id differed from a 4-neighbour's.
-  std::vector<size_t> refineSilhouettes(double t, const PrimaryRays& rays);
+  // `ids`: the buffer whose neighbours are compared (the items, or the smooth surfaces).
+  std::vector<size_t> refineSilhouettes(double t, const PrimaryRays& rays,
+                                        const std::vector<uint32_t>& ids);
+  // The samples' smooth surfaces into surfaceIds.
+  void markSurfaces(const VisibleTops& visible);
   void placeVisibleTops(VisibleTops& visible) const;
   glm::dvec3 fallbackRadiance(double t, const VisibleTops& visible, int top, glm::dvec2 topUv,
                               const glm::dvec3& emitted, const glm::dvec3& texFactor,
@@ -377,12 +385,13 @@ SceneVisibility& FrameComposer::Impl::raysAt(double t) {
 // edge cells are weighed by coverage casts no ray: a cell whose sample is that close to an edge
 // takes each side's share of it from the polygons' outlines (edge_cells.h), whichever item the
 // sample shows, and the item buffer's ids are then rad-intervals' own, so no sample falls back.
-std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays) {
+std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const PrimaryRays& rays,
+                                                           const std::vector<uint32_t>& ids) {
   const int w = items.width, h = items.height;  // the sample grid's (sample_grid.h)
   // Each pair of neighbours compared once (right, below), both marked when they differ; then
   // the marked samples in row-major order.
-  edgeMask.assign(items.id.size(), 0);
-  const uint32_t* id = items.id.data();
+  edgeMask.assign(ids.size(), 0);
+  const uint32_t* id = ids.data();
   for (int row = 0; row < h; ++row) {
     const size_t r = size_t(row) * w;
     for (int col = 0; col + 1 < w; ++col)
@@ -412,6 +421,15 @@ std::vector<size_t> FrameComposer::Impl::refineSilhouettes(double t, const Prima
   return edge;
 }
 
+void FrameComposer::Impl::markSurfaces(const VisibleTops& visible) {
+  std::vector<int> material(tops.size());
+  for (size_t i = 0; i < tops.size(); ++i) material[i] = tops[i].material;
+  surfaces = smoothSurfaces(visible.world, visible.normals, material, topObject, texturedItem);
+  surfaceIds.resize(items.id.size());
+  const uint32_t* of = surfaces.surfaceOf.data();
+  for (size_t p = 0; p < items.id.size(); ++p) surfaceIds[p] = of[items.id[p]];
+}
+
 void FrameComposer::Impl::placeVisibleTops(VisibleTops& v) const {
   const int topCount = int(tops.size());
   v.world.assign(topCount, Polygon{});
@@ -434,9 +452,17 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   const CameraView view = m.renderItems(t);
   // The frame's primary rays (the lens is validated here, once).
   const PrimaryRays rays(view, size);
-  const std::vector<size_t> edges = m.refineSilhouettes(t, rays);
+  // Where edge cells are weighed no id changes and the filter sees the smooth surfaces
+  // (smooth_surfaces.h); otherwise the silhouettes are re-decided first.
+  const bool bySurface = m.filter && m.edgeCells;
   VisibleTops visible;
-  m.placeVisibleTops(visible);
+  if (bySurface) {
+    m.placeVisibleTops(visible);
+    m.markSurfaces(visible);
+  }
+  const std::vector<size_t> edges =
+      m.refineSilhouettes(t, rays, bySurface ? m.surfaceIds : m.items.id);
+  if (!bySurface) m.placeVisibleTops(visible);
   const ActiveMovies active = indexMovies(movies, int(m.tops.size()));
   const std::vector<MovieTexture> keyed = blendKeys(movies, m.blendedKeys);
   m.still.beginFrame(view, m.transforms, moviePatchesByTop(movies, m.tops.size()),
@@ -449,7 +475,10 @@ void FrameComposer::compose(double t, const std::vector<MovieTexture>& movies, C
   out.rgb.assign(n * 3, 0.0f);
   out.source.assign(n, PixelSource::kBackground);
   if (m.filter) {
-    m.filter->plan(m.items.id, edges, m.texturedItem);
+    if (bySurface)
+      m.filter->plan(m.surfaceIds, edges, m.surfaces.fullSurface);
+    else
+      m.filter->plan(m.items.id, edges, m.texturedItem);
     m.composeFiltered(t, keyed, visible, active, view, rays, edges, out);
     return;
   }
@@ -507,6 +536,9 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
   // are shaded, then the others are interpolated from the centres (footprint_filter.h).
   const int s = grid.perAxis, mid = (s - 1) / 2;
   const int pw = gw / s, ph = gh / s;
+  // The ids plan() saw: the smooth surfaces where edge cells are weighed.
+  const std::vector<uint32_t>& planned = edgeCells ? surfaceIds : items.id;
+  auto sameSurface = [&](size_t p, size_t q) { return planned[p] == planned[q]; };
   for (const bool second : {false, true})
     tbb::parallel_for(tbb::blocked_range<int>(0, ph), [&](const tbb::blocked_range<int>& r) {
       for (int py = r.begin(); py < r.end(); ++py)
@@ -523,7 +555,7 @@ void FrameComposer::Impl::composeFiltered(double t, const std::vector<MovieTextu
             for (int i = px * s; i < (px + 1) * s; ++i) {
               const size_t p = size_t(j) * gw + i;
               if (!needed[p]) continue;
-              const bool interpolated = smooth && p != centre && items.id[p] == items.id[centre];
+              const bool interpolated = smooth && p != centre && sameSurface(p, centre);
               if (interpolated != second) continue;
               if (interpolated) {
                 filter->interpolate(i, j, sampleRgb.data(), &sampleRgb[3 * p]);
