@@ -29,7 +29,9 @@
 // sample within max(radius, 1) px of its centre sees the same top-level patch, untextured, or
 // every one the background) takes
 // that kernel over its own and its 8 neighbours' centres: one shaded sample a pixel instead of
-// s^2 (a footprint all background is 0 either way). Every other pixel (edges, textured
+// s^2 (a footprint all background is 0 either way). The "item ids" plan() reads may be surfaces
+// rather than patches: rad-compose gives the smooth surfaces (smooth_surfaces.h), so coplanar
+// patches of one material count as one. Every other pixel (edges, textured
 // materials) takes full sampling. The
 // shortcut is off when σ² > 1 (the kernel would need a negative weight) or when asked
 // (everySample).

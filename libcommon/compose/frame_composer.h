@@ -22,6 +22,10 @@
 // with a base colour texture the reflected part is modulated, $L = L_e + \frac{tex(x)}{\overline
 // {tex}} (B/\pi - L_e)$. The pixels that read such a sample are counted so the tool can warn:
 // never silently black.
+//
+// Under a still camera the samples keep their (u,v) and movie from frame to frame
+// (still_samples.h; bit-identical), and the filter sees coplanar patches of one material as one
+// surface (smooth_surfaces.h).
 #pragma once
 
 #include <cstdint>
@@ -40,10 +44,10 @@ namespace rad {
 
 // One texture movie's irradiance at the frame's time (TextureMovie::textureAt): W/m^2, RGB,
 // width * height texels row-major from j = 0 (v = 0). Not owned; must outlive compose().
-// Between two key textures, the blend TextureMovie::textureAt would compute is done per texel
-// as it is sampled, with the same float arithmetic (so the frame is bit-identical), instead of
-// into a copy of the whole texture: irradiance = key k0, nextIrradiance = key k1, weight = w,
-// texel = (1 - w) * k0 + w * k1 in float.
+// Between two key textures (irradiance = key k0, nextIrradiance = key k1, weight = w) the texel
+// is (1 - w) * k0 + w * k1 in float, TextureMovie::textureAt's arithmetic (so the frame is
+// bit-identical): the composer blends each such movie once a frame into a buffer it reuses, not
+// the caller into a copy of each texture.
 struct MovieTexture {
   PatchId patch;
   int width = 1, height = 1;
