@@ -354,40 +354,15 @@ def ngon():
     return g
 
 
-SCENES = [("office-fan", office_fan, 40.0), ("slivers", slivers, 40.0),
-          ("t-junctions", t_junctions, 40.0), ("ngon", ngon, 40.0)]
-
-
-def parse_args(argv):
-    """OUTDIR and the wanted scene names; exits 2 with one line on a usage error, 0 after
-    --help (which writes nothing)."""
-    names = [name for name, _, _ in SCENES]
-    parser = argparse.ArgumentParser(
-        prog="make_seam_scenes.py", description=__doc__.split("\n\n")[0],
-        epilog="scenes: " + " ".join(names),
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("outdir", metavar="OUTDIR", help="folder to write NAME.gltf into")
-    parser.add_argument("names", metavar="NAME", nargs="*", help="scenes to write (default: all)")
-    args = parser.parse_args(argv)
-    if args.outdir.startswith("-"):
-        parser.error(f"OUTDIR {args.outdir!r} starts with '-'; write ./{args.outdir} to mean it")
-    unknown = [n for n in args.names if n not in names]
-    if unknown:
-        parser.error("unknown scene " + ", ".join(unknown) + "; scenes: " + " ".join(names))
-    return args.outdir, set(args.names)
+SCENES = [("office-fan", office_fan), ("slivers", slivers), ("t-junctions", t_junctions),
+          ("ngon", ngon)]
+LIGHT_STRENGTH = 40.0
 
 
 def main():
-    outdir, wanted = parse_args(sys.argv[1:])
-    os.makedirs(outdir, exist_ok=True)
-    for name, make, strength in SCENES:
-        if wanted and name not in wanted:
-            continue
-        path = os.path.join(outdir, name + ".gltf")
-        tmp = path + ".tmp"
-        make().write(tmp, strength)
-        os.replace(tmp, path)
-        print(path)
+    paper.scene_set_main("make_seam_scenes.py", __doc__,
+                         [(name, lambda make=make: (make(), LIGHT_STRENGTH))
+                          for name, make in SCENES])
 
 
 if __name__ == "__main__":
