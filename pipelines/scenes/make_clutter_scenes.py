@@ -61,14 +61,7 @@ def binder(x0, y0, z0, rings, segments):
 
 def scene(shelves, binders, rings, segments):
     g = M.Gltf("clutter-%dx%d" % (shelves, binders))
-    count = 0
-    for name, quads in M.room(W, H, D, 4).items():
-        g.node(name, g.mesh(name, quads, WHITE))
-        count += 2 * len(quads)
-    for i, cx in enumerate((1.3, 2.7)):
-        name = "light%d" % i
-        g.node(name, g.mesh(name, M.light_quad(0, 0, 0, 0.2), LIGHT), translation=(cx, H - 0.002, 1.6))
-        count += 2
+    count = M.ceiling_lit_room(g, W, H, D, WHITE, LIGHT)
     width = binders * (BINDER_W + BINDER_GAP)
     x0, z0 = 0.5 * (W - width), D - BINDER_D - 0.02
     boards, shells, metal = [], [], []

@@ -91,14 +91,7 @@ def turned(quads, degrees, cx, cz):
 
 def scene(cols, rows, gap, turn):
     g = M.Gltf("contact-shelf-%dx%d" % (cols, rows))
-    count = 0
-    for name, quads in M.room(W, H, D, 4).items():
-        g.node(name, g.mesh(name, quads, WHITE))
-        count += 2 * len(quads)
-    for i, cx in enumerate((1.3, 2.7)):
-        name = "light%d" % i
-        g.node(name, g.mesh(name, M.light_quad(0, 0, 0, 0.2), LIGHT), translation=(cx, H - 0.002, 1.6))
-        count += 2
+    count = M.ceiling_lit_room(g, W, H, D, WHITE, LIGHT)
     # The shelf: its back against the back wall (z = D), cubbies facing -z; built facing +z at
     # z in [0, DEPTH] and placed by mirroring z.
     sx0 = 0.5 * (W - cols * CUBBY)

@@ -239,6 +239,21 @@ def chair(cx, cz, facing):
     return q
 
 
+def ceiling_lit_room(g, w, h, d, wall_material, light_material, light_xs=(1.3, 2.7), light_z=1.6):
+    """Adds an inward-facing room [0,w] x [0,h] x [0,d] of 4 x 4 quads a wall and 0.2 m square
+    lights 2 mm under its ceiling at (x, light_z) for x in light_xs; returns the triangles."""
+    count = 0
+    for name, quads in room(w, h, d, 4).items():
+        g.node(name, g.mesh(name, quads, wall_material))
+        count += 2 * len(quads)
+    for i, cx in enumerate(light_xs):
+        name = "light%d" % i
+        g.node(name, g.mesh(name, light_quad(0, 0, 0, 0.2), light_material),
+               translation=(cx, h - 0.002, light_z))
+        count += 2
+    return count
+
+
 def light_quad(cx, y, cz, s):
     return [[(cx - s, y, cz - s), (cx + s, y, cz - s), (cx + s, y, cz + s), (cx - s, y, cz + s)]]
 
