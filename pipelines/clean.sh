@@ -39,7 +39,7 @@ temporaries='\..+\.tmp\.[0-9]+\.[0-9]+(\.[A-Za-z0-9]+)?|.+\.tmp\.[0-9]+'
 clean_part() {
   case $1 in
     movies)
-      remove_matching "$out/movies" "[0-9]{6}(\.piece-[0-9]{4})?\.exr|\.done|\.(p?shard[0-9]*)-[0-9]+-of-[0-9]+|$temporaries"
+      remove_matching "$out/movies" "[0-9]{6}(\.piece-[0-9]{4})?\.exr|[0-9]{6}\.merge-lock|\.done|\.(p?shard[0-9]*)-[0-9]+-of-[0-9]+|$temporaries"
       remove_folder "$out/movies" ;;
     frames)
       remove_matching "$out/frames" "[0-9]+\.(exr|png)|segment-[0-9]+-[0-9]+\.mp4|\.done|\.chunk-[0-9]+-of-[0-9]+|$temporaries"

@@ -17,9 +17,12 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
                         With --piece-keys K (slurm.mk's MOVIE_PIECE_KEYS, issue 58), a movie of
                         n > K keys is P = ceil(n / K) pieces, every movie's pieces dealt to
                         the shards in order, each paying the movie's planning (its report's
-                        seconds_plan) and its share of the movie's key time; then the merges,
-                        movie m in task m % SHARDS (the fixed cost and, per movie cut, reading
-                        and writing its bytes at the run's write rate), one more stage boundary
+                        seconds_plan) and its share of the movie's key time; each task then
+                        joins the movies whose last piece it holds (slurm.mk: a second process,
+                        the fixed cost once, and per movie reading and writing its bytes at the
+                        run's write rate). With --merge-stage, as slurm.mk did before: the
+                        merges as a stage of their own, movie m in task m % SHARDS, one more
+                        stage boundary
   compose               SHARDS contiguous chunks of frames, each paying the fixed cost once
   mp4 + contact sheet   one task each, side by side; with --video-segments (slurm.mk, issue 58)
                         each compose chunk also encodes its frames as a segment (the one-core
@@ -27,18 +30,18 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
                         (-c copy); the contact sheet decodes its eight frames. The three are
                         timed on the run's frames, one core each (video-seconds.json)
   + one scheduling latency per stage on the critical path (--latency, seconds; measured on the
-    local cluster: tests/slurm/cluster.sh): global (and its merge when windowed), movies (and
-    their merges with pieces), compose, the mp4
+    local cluster: tests/slurm/cluster.sh): global (and its merge when windowed), movies (and,
+    with --merge-stage, their merges), compose, the mp4
 
 The serial part is what no number of nodes shortens, the critical path on unlimited nodes: the
 longer of global and intervals (or, windowed, the slowest window and the merge), the fixed cost
 of one movies and one compose task (scene loading), the longest single movie (with pieces: the
-longest piece, and the merge) and frame, ffmpeg and the latencies. The one-core time over it
+longest piece with the merge its task does) and frame, ffmpeg and the latencies. The one-core time over it
 bounds the speed-up.
 
 usage: farm_model.py --scene SCENE [--frames 0-95] [--size 352x240] [--nodes 1,4,16,64]
                      [--cores N] [--latency 1.0] [--global-windows] [--piece-keys K]
-                     [--video-segments] [--bin DIR] [--out DIR]
+                     [--merge-stage] [--video-segments] [--bin DIR] [--out DIR]
        farm_model.py --from DIR ...   (model an earlier one-core run in DIR, without running)
        farm_model.py --self-test      (the model's arithmetic on made-up pieces)
 """
@@ -227,14 +230,36 @@ def video_path(p, segments):
     return max(v["concat"], v["contact"])
 
 
-def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False):
+def merges_in_tasks(p, pieces, merges, shards):
+    """Per movie shard, the seconds of the merges its task does after its pieces (slurm.mk's
+    --merge-ready): the fixed cost of its second process, once, and the merge of every movie
+    whose last piece (in dealing order) it holds. 0 where a shard has no piece of a cut movie."""
+    out = [0.0] * shards
+    last = {}
+    for u, (mid, _, _) in enumerate(pieces):
+        if mid in merges:
+            last[mid] = u % shards
+    holders = set()
+    for u, (mid, _, _) in enumerate(pieces):
+        if mid in merges:
+            holders.add(u % shards)
+    for shard in holders:
+        out[shard] += p["movies_fixed"]
+    for mid, shard in last.items():
+        out[shard] += merges[mid]
+    return out
+
+
+def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False, merge_stage=False):
     slots = nodes * cores
     shards = slots
     movie_shards = [0.0] * shards
     pieces, merges = movie_pieces(p, piece_keys)
-    merge = merge_seconds(p, merges, shards)
+    merge = merge_seconds(p, merges, shards) if merge_stage else 0.0
     for u, (mid, _, s) in enumerate(pieces):  # rad-movies' shardWork: pieces dealt in order
         movie_shards[(u if piece_keys > 0 else mid) % shards] += s
+    if not merge_stage:
+        movie_shards = [a + b for a, b in zip(movie_shards, merges_in_tasks(p, pieces, merges, shards))]
     movie_tasks = [p["movies_fixed"] + s for s in movie_shards if s > 0.0]
     n = len(p["frames"])
     chunks = min(shards, n)
@@ -248,31 +273,39 @@ def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False):
         "movie merge": merge,
         "compose": makespan(compose_tasks, slots),
         "mp4 + contact sheet": video_path(p, segments),
-        "scheduling": stage_boundaries(windows and slots > 1, merge) * latency,
+        "scheduling": stage_boundaries(windows and slots > 1, merge_stage and merge) * latency,
     }
     return path, sum(path.values())
 
 
 def stage_boundaries(global_windows, movie_merge):
     """The stages on the critical path, each started after one scheduling latency: global (and its
-    merge, when in windows), movies (and their merges), compose, the mp4."""
+    merge, when in windows), movies (and their merges when a stage of their own), compose, the
+    mp4."""
     return 4 + (1 if global_windows else 0) + (1 if movie_merge else 0)
 
 
-def serial_part(p, latency, windows, piece_keys=0, segments=False):
+def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=False):
     """The critical path with unlimited nodes: what no number of nodes shortens."""
     g = global_seconds(p, len(p["keys"]), windows)
     pieces, merges = movie_pieces(p, piece_keys)
-    merge = merge_seconds(p, merges, max(1, len(merges)))
+    if merge_stage:
+        merge = merge_seconds(p, merges, max(1, len(merges)))
+        longest = max(s for _, _, s in pieces)
+    else:  # one task a piece: the task of a movie's last piece also merges it
+        merge = p["movies_fixed"] if merges else 0.0
+        last = {mid: j for mid, j, _ in pieces}
+        longest = max(s + (merges[mid] if mid in merges and j == last[mid] else 0.0)
+                      for mid, j, s in pieces)
     encode = p["video_parts"]["mp4"] / len(p["frames"]) if segments else 0.0
     return {
         "global || intervals": max(g, p["intervals"]),
         "scene loading": p["movies_fixed"] + p["compose_fixed"],
-        "longest movie": max(s for _, _, s in pieces),
+        "longest movie": longest,
         "movie merge": merge,
         "longest frame": max(p["frames"]) + encode,
         "ffmpeg": video_path(p, segments),
-        "scheduling": stage_boundaries(windows, merge) * latency,
+        "scheduling": stage_boundaries(windows, merge_stage and merge) * latency,
     }
 
 
@@ -310,17 +343,32 @@ def self_test():
     check("a piece: planning + a third of the keys", pieces[3][2], 1.0 + 2.0 / 3.0)
     check("the merge", merge_seconds(p, merges, 4), 0.5 + 0.6)
     check("no pieces: no merge", merge_seconds(p, movie_pieces(p, 0)[1], 4), 0.0)
-    path, wall = model(p, 2, 2, 1.0, False, 2)
+    path, wall = model(p, 2, 2, 1.0, False, 2, merge_stage=True)
     check("movies on 4 shards: shard 0 holds movie 0 and a piece of movie 3",
           path["movies"], 0.5 + 1.0 + 1.0 + 2.0 / 3.0)
     check("a stage more", path["scheduling"], 5.0)
-    path, wall = model(p, 2, 2, 1.0, True, 2)
+    path, wall = model(p, 2, 2, 1.0, True, 2, merge_stage=True)
     check("and one more for the global merge", path["scheduling"], 6.0)
-    serial = serial_part(p, 0.0, False, 2)
+    serial = serial_part(p, 0.0, False, 2, merge_stage=True)
     check("serial: the longest piece",
           serial["longest movie"], 1.0 + 2.0 / 3.0)
     check("serial merge", serial["movie merge"], 1.1)
-    check("serial scheduling, windows and merges", serial_part(p, 1.0, True, 2)["scheduling"], 6.0)
+    check("serial scheduling, windows and merges",
+          serial_part(p, 1.0, True, 2, merge_stage=True)["scheduling"], 6.0)
+    # The merges in the piece tasks (slurm.mk's default): movie 3's pieces are units 3, 4, 5,
+    # in shards 3, 0, 1 of 4; shard 1 holds its last piece and merges it (0.6 s) after its
+    # second process's fixed cost (0.5 s); shards 3 and 0 pay that fixed cost too, for nothing
+    # to merge. Shard 0: movie 0 (1 s) and piece 1 (5/3 s); shard 1: movie 1 and piece 2 plus
+    # the merge.
+    path, wall = model(p, 2, 2, 1.0, False, 2)
+    check("no merge stage", path["movie merge"], 0.0)
+    check("no stage more", path["scheduling"], 4.0)
+    check("movies: shard 1 bakes and merges",
+          path["movies"], 0.5 + 1.0 + 1.0 + 2.0 / 3.0 + 0.5 + 0.6)
+    serial = serial_part(p, 0.0, False, 2)
+    check("serial: the last piece and its merge", serial["longest movie"], 1.0 + 2.0 / 3.0 + 0.6)
+    check("serial: the merge's fixed cost", serial["movie merge"], 0.5)
+    check("serial scheduling, windows, no merge stage", serial_part(p, 1.0, True, 2)["scheduling"], 5.0)
     # Segments: each chunk of two frames encodes them (1 s for 4 frames: 0.5 s a chunk); then
     # the longer of the join (0.25 s) and the contact sheet (0.5 s).
     p["video_parts"] = {"mp4": 1.0, "contact": 0.5, "concat": 0.25}
@@ -344,6 +392,9 @@ def main():
                     help="the mp4 as segments encoded by the compose tasks, then joined (slurm.mk)")
     ap.add_argument("--piece-keys", type=int, default=0,
                     help="movies in pieces of at most K keys (slurm.mk's MOVIE_PIECE_KEYS); 0: whole")
+    ap.add_argument("--merge-stage", action="store_true",
+                    help="with --piece-keys: the merges as a stage of their own (slurm.mk before "
+                    "the merges went into the piece tasks)")
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "farm-model"))
     ap.add_argument("--from", dest="from_dir")
@@ -370,7 +421,9 @@ def main():
              sum(s for _, s in p["movies"]), p["movies_fixed"], len(p["frames"]), sum(p["frames"]),
              p["compose_fixed"], p["video"], args.cores, args.latency,
              ", rad-global in time windows" if args.global_windows else "",
-             ", movies in pieces of at most %d keys" % args.piece_keys if args.piece_keys else "",
+             ", movies in pieces of at most %d keys (merged %s)"
+             % (args.piece_keys, "as a stage" if args.merge_stage else "in the piece tasks")
+             if args.piece_keys else "",
              ", the mp4 in segments (encode %.1f, join %.1f, contact sheet %.1f)"
              % (p["video_parts"]["mp4"], p["video_parts"]["concat"], p["video_parts"]["contact"])
              if args.video_segments else ""))
@@ -378,12 +431,12 @@ def main():
     print("%6s %9s %9s  %s" % ("nodes", "wall s", "speed-up", "critical path (s)"))
     for nodes in [int(x) for x in args.nodes.split(",")]:
         path, wall = model(p, nodes, args.cores, args.latency, args.global_windows,
-                           args.piece_keys, args.video_segments)
+                           args.piece_keys, args.video_segments, args.merge_stage)
         rows.append({"nodes": nodes, "wall": wall, "path": path})
         print("%6d %9.1f %8.1fx  %s" % (nodes, wall, one_core / wall,
                                         ", ".join("%s %.1f" % kv for kv in path.items())))
     serial = serial_part(p, args.latency, args.global_windows, args.piece_keys,
-                         args.video_segments)
+                         args.video_segments, args.merge_stage)
     total = sum(serial.values())
     print("serial part (the critical path on unlimited nodes): %.1f s = %.1f %% of the one-core "
           "time, so the speed-up is at most %.1fx: %s"

@@ -13,9 +13,10 @@
 #   rad-movies                       an array over `--shard i/SHARDS`; with MOVIE_PIECE_KEYS=K
 #                                    (the default), a movie of more than K keys is baked as
 #                                    pieces of at most K keys spread over the shards
-#                                    (`--piece-keys`), and an array of merges (`--merge-pieces`,
-#                                    by `--shard i/SHARDS` of the movies) joins them into the
-#                                    movies one task bakes, byte for byte
+#                                    (`--piece-keys`), and each task then joins the movies whose
+#                                    last piece it wrote (`--merge-pieces K --merge-ready`, under
+#                                    a lock per movie) into the movies one task bakes, byte for
+#                                    byte: no merge stage
 #   rad-compose                      an array over SHARDS contiguous chunks of FRAMES, each
 #                                    also encoding its frames as a segment of the mp4
 #   the mp4 and the contact sheet    one job each; the mp4 joins the segments (-c copy,
@@ -36,9 +37,9 @@ include $(HERE)stages.mk
 
 SHARDS         ?= 4
 GLOBAL_WINDOWS ?= 1
-# Keys per movie piece (rad-movies --piece-keys; 0: whole movies, no merge job). Each piece plans
+# Keys per movie piece (rad-movies --piece-keys; 0: whole movies, no merge). Each piece plans
 # its movie again, so a smaller piece cuts the longest task and adds planning (docs/results.md,
-# "Farm tasks finer than one movie").
+# "Farm tasks finer than one movie" and its sequel).
 MOVIE_PIECE_KEYS ?= 4
 PARTITION    ?=
 WAIT         ?= 0
@@ -126,31 +127,27 @@ $(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-int
 # never merged: slurm-pieces.sh empties the folder when the stamps are of another kind.
 MOVIES_SHARD_KIND := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)),pshard$(MOVIE_PIECE_KEYS),shard)
 MOVIES_PIECE_ARGS := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)), --piece-keys $(MOVIE_PIECE_KEYS))
-SHARD_INDICES := $(shell seq -s, 0 $$(($(SHARDS) - 1)))
 
-# The shards, then (with pieces) the merges, one per shard of the movies (id % SHARDS), side by
-# side, then a job that stamps. A re-run after a failed merge merges again (a merged movie's pieces
-# are gone, and its merge takes it as done).
+# The shards, each (with pieces) then joining the movies whose last piece it wrote, then a job
+# that stamps. A shard's stamp follows its merges, so a task killed before or during them runs
+# again and merges what it finds complete (a movie merged meanwhile has the pieces of the re-run
+# removed).
+MOVIES_TASK_MERGE = $(if $(MOVIES_PIECE_ARGS), && $(call MOVIES_MERGE_READY_CMD,$(MOVIE_PIECE_KEYS),$${SLURM_ARRAY_TASK_ID}/$(SHARDS)))
 $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
 	@rm -f $@ && \
 	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies $(MOVIES_SHARD_KIND) $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,movies,$$missing,global global-merge intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS))$(MOVIES_PIECE_ARGS) \
-	    && touch $(OUT)/movies/.$(MOVIES_SHARD_KIND)-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)); \
-	fi && \
-	if [ -n "$(MOVIES_PIECE_ARGS)" ]; then \
-	  $(call submit,movies-merge,$(SHARD_INDICES),global global-merge intervals movies,$(call MOVIES_MERGE_CMD,$(MOVIE_PIECE_KEYS),$${SLURM_ARRAY_TASK_ID}/$(SHARDS))) && \
-	  $(call submit,movies-done,,movies-merge,touch $@); \
-	elif [ -n "$$missing" ]; then \
+	  $(call submit,movies,$$missing,global global-merge intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS))$(MOVIES_PIECE_ARGS)$(MOVIES_TASK_MERGE) \
+	    && touch $(OUT)/movies/.$(MOVIES_SHARD_KIND)-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)) && \
 	  $(call submit,movies-done,,movies,touch $@); \
 	else touch $@; fi
 
 $(OUT)/frames/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
 	@rm -f $@ && \
-	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals movies movies-merge" $^) && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals movies" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,compose,$$missing,global global-merge intervals movies movies-merge,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
+	  $(call submit,compose,$$missing,global global-merge intervals movies,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
 	    $(call COMPOSE_CHUNK_CMD,$$1) && $(call SEGMENT_CMD,$$1) && \
 	    touch $(OUT)/frames/.chunk-$$SLURM_ARRAY_TASK_ID-of-$(CHUNK_COUNT)) && \
 	  $(call submit,frames-done,,compose,touch $@); \

@@ -98,6 +98,9 @@ MOVIES_SHARD_CMD  = $(call MOVIES_RUN,$(OUT)/movies-report-$(1)of$(2).json) --sh
 # movies of shard $(2) (i/n): it writes what MOVIES_CMD writes, byte for byte (it is MOVIES_CMD
 # plus --merge-pieces and --shard, which the movies' provenance leaves out).
 MOVIES_MERGE_CMD  = $(MOVIES_CMD) --merge-pieces $(1) --shard $(2)
+# The same inside the task that baked movie shard $(2)'s pieces, after them: only the movies of
+# which it baked a piece and whose pieces are all written (slurm.mk; movie_pieces.h).
+MOVIES_MERGE_READY_CMD = $(call MOVIES_MERGE_CMD,$(1),$(2)) --merge-ready
 COMPOSE_CHUNK_CMD = $(call COMPOSE_RUN,--frames $(1) $(COMPOSE_FLAGS),$(OUT)/compose-report-$(1).json)
 GLOBAL_RUN  = $(strip $(BIN)/rad-global $(SCENE) -o $(1) $(GLOBAL_ARGS) --report $(2))
 MOVIES_RUN  = $(strip $(BIN)/rad-movies $(SCENE) $(OUT)/global.rlh $(OUT)/intervals.rti -o $(OUT)/movies \

@@ -61,14 +61,7 @@ def binder(x0, y0, z0, rings, segments):
 
 def scene(shelves, binders, rings, segments):
     g = M.Gltf("clutter-%dx%d" % (shelves, binders))
-    count = 0
-    for name, quads in M.room(W, H, D, 4).items():
-        g.node(name, g.mesh(name, quads, WHITE))
-        count += 2 * len(quads)
-    for i, cx in enumerate((1.3, 2.7)):
-        name = "light%d" % i
-        g.node(name, g.mesh(name, M.light_quad(0, 0, 0, 0.2), LIGHT), translation=(cx, H - 0.002, 1.6))
-        count += 2
+    count = M.ceiling_lit_room(g, W, H, D, WHITE, LIGHT)
     width = binders * (BINDER_W + BINDER_GAP)
     x0, z0 = 0.5 * (W - width), D - BINDER_D - 0.02
     boards, shells, metal = [], [], []
@@ -81,14 +74,8 @@ def scene(shelves, binders, rings, segments):
             metal += parts
     for name, quads, material in (("boards", boards, WOOD), ("binders", shells, BLUE),
                                   ("metal", metal, METAL)):
-        for part in range(0, len(quads), 8000):  # 16-bit indices: at most 8000 quads a mesh
-            n = "%s%d" % (name, part // 8000)
-            g.node(n, g.mesh(n, quads[part:part + 8000], material))
-        count += 2 * len(quads)
-    cam = g.node("camera", camera=g.camera(1.0))
-    eye, target = (2.0, 1.3, 0.4), (2.0, 0.9, D)
-    g.nodes[cam]["translation"] = list(eye)
-    g.nodes[cam]["rotation"] = list(M.quat_look(eye, target))
+        count += g.split_mesh_nodes(name, quads, material)
+    g.still_camera((2.0, 1.3, 0.4), (2.0, 0.9, D), yfov=1.0)
     return g, count
 
 
@@ -105,9 +92,7 @@ def main():
         sys.exit("make_clutter_scenes.py: --shelves 1-6, --binders 1-60, --rings 0-4, "
                  "--segments 3-32")
     g, count = scene(a.shelves, a.binders, a.rings, a.segments)
-    tmp = a.out + ".tmp"
-    g.write(tmp, 12.0, MATERIALS)
-    os.replace(tmp, a.out)
+    g.write(a.out, 12.0, MATERIALS)
     print("make_clutter_scenes.py: %s: %d triangles (%d shelves of %d binders)"
           % (a.out, count, a.shelves, a.binders), file=sys.stderr)
 

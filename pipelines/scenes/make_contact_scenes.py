@@ -91,14 +91,7 @@ def turned(quads, degrees, cx, cz):
 
 def scene(cols, rows, gap, turn):
     g = M.Gltf("contact-shelf-%dx%d" % (cols, rows))
-    count = 0
-    for name, quads in M.room(W, H, D, 4).items():
-        g.node(name, g.mesh(name, quads, WHITE))
-        count += 2 * len(quads)
-    for i, cx in enumerate((1.3, 2.7)):
-        name = "light%d" % i
-        g.node(name, g.mesh(name, M.light_quad(0, 0, 0, 0.2), LIGHT), translation=(cx, H - 0.002, 1.6))
-        count += 2
+    count = M.ceiling_lit_room(g, W, H, D, WHITE, LIGHT)
     # The shelf: its back against the back wall (z = D), cubbies facing -z; built facing +z at
     # z in [0, DEPTH] and placed by mirroring z.
     sx0 = 0.5 * (W - cols * CUBBY)
@@ -120,18 +113,12 @@ def scene(cols, rows, gap, turn):
     for name, quads, material in (("boards", boards, WOOD), ("lips", lips, WOOD),
                                   ("labels", labels, WHITE), ("books", books, BLUE)):
         q = placed(quads)
-        for part in range(0, len(q), 8000):  # 16-bit indices: at most 8000 quads a mesh
-            n = "%s%d" % (name, part // 8000)
-            g.node(n, g.mesh(n, q[part:part + 8000], material))
-        count += 2 * len(q)
+        count += g.split_mesh_nodes(name, q, material)
     g.node("partition", g.mesh("partition", partition(), WHITE))
     box = M.box(2.6, 0.0, 1.0, 3.1, 0.45, 1.5)  # resting on the floor, its bottom on it
     g.node("box", g.mesh("box", box, RED))
     count += 2 * 2 + 2 * len(box)
-    cam = g.node("camera", camera=g.camera(1.0))
-    eye, target = (2.0, 1.4, 0.3), (2.0, 0.75, D)
-    g.nodes[cam]["translation"] = list(eye)
-    g.nodes[cam]["rotation"] = list(M.quat_look(eye, target))
+    g.still_camera((2.0, 1.4, 0.3), (2.0, 0.75, D), yfov=1.0)
     return g, count
 
 
@@ -149,9 +136,7 @@ def main():
     if not (0.0 <= a.gap <= 0.01):
         sys.exit("make_contact_scenes.py: --gap %g: expected 0 to 0.01 m" % a.gap)
     g, count = scene(a.cols, a.rows, a.gap, a.turn)
-    tmp = a.out + ".tmp"
-    g.write(tmp, 12.0, MATERIALS)
-    os.replace(tmp, a.out)
+    g.write(a.out, 12.0, MATERIALS)
     print("make_contact_scenes.py: %s: %d triangles (%d x %d cubbies)" % (a.out, count, a.cols,
                                                                          a.rows), file=sys.stderr)
 

@@ -122,6 +122,19 @@ class Gltf:
                               "target": {"node": node, "path": path}})
         self.nodes[node][path] = [float(x) for x in values[0]]
 
+    def split_mesh_nodes(self, name, quads, material):
+        """Nodes NAME0, NAME1, ... of at most 8000 quads each (16-bit indices take at most 32,000
+        vertices a mesh); returns the triangles they add."""
+        for part in range(0, len(quads), 8000):
+            n = "%s%d" % (name, part // 8000)
+            self.node(n, self.mesh(n, quads[part:part + 8000], material))
+        return 2 * len(quads)
+
+    def still_camera(self, eye, target, yfov=0.9):
+        """A camera node "camera" at eye looking at target."""
+        return self.node("camera", camera=self.camera(yfov), translation=eye,
+                         rotation=quat_look(eye, target))
+
     def camera(self, yfov=0.9):
         self.cameras.append({"name": "camera", "type": "perspective",
                              "perspective": {"yfov": yfov, "znear": 0.02, "zfar": 50.0}})
@@ -158,9 +171,12 @@ class Gltf:
         if self.channels:
             g["animations"] = [{"name": "motion", "samplers": self.samplers,
                                 "channels": self.channels}]
-        with open(path, "w") as f:
+        # Atomic: a reader never sees half a file, a failed run leaves the old one.
+        tmp = path + ".tmp"
+        with open(tmp, "w") as f:
             json.dump(g, f, indent=1)
             f.write("\n")
+        os.replace(tmp, path)
 
 
 # --- geometry -----------------------------------------------------------------------------
@@ -221,6 +237,21 @@ def chair(cx, cz, facing):
     bz = cz - facing * 0.2
     q += box(cx - 0.22, 0.46, bz - 0.02, cx + 0.22, 0.95, bz + 0.02)
     return q
+
+
+def ceiling_lit_room(g, w, h, d, wall_material, light_material, light_xs=(1.3, 2.7), light_z=1.6):
+    """Adds an inward-facing room [0,w] x [0,h] x [0,d] of 4 x 4 quads a wall and 0.2 m square
+    lights 2 mm under its ceiling at (x, light_z) for x in light_xs; returns the triangles."""
+    count = 0
+    for name, quads in room(w, h, d, 4).items():
+        g.node(name, g.mesh(name, quads, wall_material))
+        count += 2 * len(quads)
+    for i, cx in enumerate(light_xs):
+        name = "light%d" % i
+        g.node(name, g.mesh(name, light_quad(0, 0, 0, 0.2), light_material),
+               translation=(cx, h - 0.002, light_z))
+        count += 2
+    return count
 
 
 def light_quad(cx, y, cz, s):
@@ -410,38 +441,37 @@ def all_scenes():
     yield "cubic", lambda: (cubic_scene(), 30.0)
 
 
-def parse_args(argv):
-    """OUTDIR and the wanted scene names; exits 2 with one line on a usage error, 0 after
-    --help (which writes nothing)."""
-    names = [name for name, _ in all_scenes()]
+def scene_set_main(prog, doc, scenes, argv=None):
+    """The command line of a generator of named scenes: `PROG OUTDIR [NAME...]` writes
+    OUTDIR/NAME.gltf for each wanted scene of `scenes` ((name, make) pairs, make() returning
+    (Gltf, light strength)) and prints its path; exits 2 with one line on a usage error, 0
+    after --help (which writes nothing)."""
+    scenes = list(scenes)
+    names = [name for name, _ in scenes]
     parser = argparse.ArgumentParser(
-        prog="make_paper_scenes.py", description=__doc__.split("\n\n")[0],
-        epilog="scenes: " + " ".join(names),
+        prog=prog, description=doc.split("\n\n")[0], epilog="scenes: " + " ".join(names),
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("outdir", metavar="OUTDIR", help="folder to write NAME.gltf into")
     parser.add_argument("names", metavar="NAME", nargs="*", help="scenes to write (default: all)")
-    args = parser.parse_args(argv)
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
     # A folder named like an option is a typo for one (`--help` once became a folder).
     if args.outdir.startswith("-"):
         parser.error(f"OUTDIR {args.outdir!r} starts with '-'; write ./{args.outdir} to mean it")
     unknown = [n for n in args.names if n not in names]
     if unknown:
         parser.error("unknown scene " + ", ".join(unknown) + "; scenes: " + " ".join(names))
-    return args.outdir, set(args.names)
+    os.makedirs(args.outdir, exist_ok=True)
+    for name, make in scenes:
+        if args.names and name not in args.names:
+            continue
+        g, strength = make()
+        path = os.path.join(args.outdir, name + ".gltf")
+        g.write(path, strength)
+        print(path)
 
 
 def main():
-    outdir, wanted = parse_args(sys.argv[1:])
-    os.makedirs(outdir, exist_ok=True)
-    for name, make in all_scenes():
-        if wanted and name not in wanted:
-            continue
-        g, strength = make()
-        path = os.path.join(outdir, name + ".gltf")
-        tmp = path + ".tmp"
-        g.write(tmp, strength)
-        os.replace(tmp, path)
-        print(path)
+    scene_set_main("make_paper_scenes.py", __doc__, all_scenes())
 
 
 if __name__ == "__main__":

@@ -251,31 +251,6 @@ def desk(x0, z0, x1, z1):
     return join(top, *legs)
 
 
-def quat_look(eye, target):
-    """Rotation taking the camera's -Z onto target - eye with +Y up (x y z w)."""
-    f = [target[k] - eye[k] for k in range(3)]
-    n = math.sqrt(sum(c * c for c in f))
-    z = [-c / n for c in f]
-    x = [z[2], 0.0, -z[0]]  # up x z with up = +Y
-    n = math.sqrt(sum(c * c for c in x))
-    x = [c / n for c in x]
-    y = [z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]]
-    m = [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]]
-    tr = m[0][0] + m[1][1] + m[2][2]
-    if tr > 0:
-        s = math.sqrt(tr + 1.0) * 2
-        return ((m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, 0.25 * s)
-    i = max(range(3), key=lambda k: m[k][k])
-    j, k = (i + 1) % 3, (i + 2) % 3
-    s = math.sqrt(1.0 + m[i][i] - m[j][j] - m[k][k]) * 2
-    q = [0.0, 0.0, 0.0, 0.0]
-    q[i] = 0.25 * s
-    q[j] = (m[j][i] + m[i][j]) / s
-    q[k] = (m[k][i] + m[i][k]) / s
-    q[3] = (m[k][j] - m[j][k]) / s
-    return tuple(q)
-
-
 def room_walls(g, W, H, D, far_wall, left_wall=None):
     """An inward-facing room [0,W] x [0,H] x [0,D]: the far wall (z = D) from far_wall's
     (points, tris) in its (u = x, v = y) plane seen from inside (u runs to -x, so front faces
@@ -317,7 +292,7 @@ def office_fan():
     target = (2.5, 1.3, D)
     eyes = [(2.1, 1.55, 0.35), (2.5, 1.6, 0.3), (2.9, 1.55, 0.35)]
     g.animate(cam, "translation", times, eyes)
-    g.animate(cam, "rotation", times, [quat_look(e, target) for e in eyes])
+    g.animate(cam, "rotation", times, [paper.quat_look(e, target) for e in eyes])
     return g
 
 
@@ -331,7 +306,7 @@ def small_room(name, far_wall, lamp_z=1.9):
     cam = g.node("camera", camera=g.camera(0.95))
     eye = (2.0, 1.3, 0.05)
     g.nodes[cam]["translation"] = list(eye)
-    g.nodes[cam]["rotation"] = list(quat_look(eye, (2.0, 1.2, D)))
+    g.nodes[cam]["rotation"] = list(paper.quat_look(eye, (2.0, 1.2, D)))
     return g
 
 
@@ -354,40 +329,15 @@ def ngon():
     return g
 
 
-SCENES = [("office-fan", office_fan, 40.0), ("slivers", slivers, 40.0),
-          ("t-junctions", t_junctions, 40.0), ("ngon", ngon, 40.0)]
-
-
-def parse_args(argv):
-    """OUTDIR and the wanted scene names; exits 2 with one line on a usage error, 0 after
-    --help (which writes nothing)."""
-    names = [name for name, _, _ in SCENES]
-    parser = argparse.ArgumentParser(
-        prog="make_seam_scenes.py", description=__doc__.split("\n\n")[0],
-        epilog="scenes: " + " ".join(names),
-        formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("outdir", metavar="OUTDIR", help="folder to write NAME.gltf into")
-    parser.add_argument("names", metavar="NAME", nargs="*", help="scenes to write (default: all)")
-    args = parser.parse_args(argv)
-    if args.outdir.startswith("-"):
-        parser.error(f"OUTDIR {args.outdir!r} starts with '-'; write ./{args.outdir} to mean it")
-    unknown = [n for n in args.names if n not in names]
-    if unknown:
-        parser.error("unknown scene " + ", ".join(unknown) + "; scenes: " + " ".join(names))
-    return args.outdir, set(args.names)
+SCENES = [("office-fan", office_fan), ("slivers", slivers), ("t-junctions", t_junctions),
+          ("ngon", ngon)]
+LIGHT_STRENGTH = 40.0
 
 
 def main():
-    outdir, wanted = parse_args(sys.argv[1:])
-    os.makedirs(outdir, exist_ok=True)
-    for name, make, strength in SCENES:
-        if wanted and name not in wanted:
-            continue
-        path = os.path.join(outdir, name + ".gltf")
-        tmp = path + ".tmp"
-        make().write(tmp, strength)
-        os.replace(tmp, path)
-        print(path)
+    paper.scene_set_main("make_seam_scenes.py", __doc__,
+                         [(name, lambda make=make: (make(), LIGHT_STRENGTH))
+                          for name, make in SCENES])
 
 
 if __name__ == "__main__":

@@ -2,7 +2,9 @@
 // through the real tools: movies cut into pieces of keys by --piece-keys tasks and joined by
 // --merge-pieces (two merges, each of half the movies) are the one-task bake's files byte for
 // byte; a piece is never read as a movie
-// (rad-compose refuses it by name); the merge refuses a piece of another run and a missing piece.
+// (rad-compose refuses it by name); the merge refuses a piece of another run and a missing piece;
+// merged inside the piece tasks (--merge-ready), by the task that writes a movie's last piece,
+// once even when two tasks find every piece at once.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -103,6 +105,70 @@ TEST_F(MoviePiecesCli, PiecesMergedAreTheOneTaskBakeByteForByte) {
           << name;
     }
   }
+}
+
+// The merge inside the piece tasks (slurm.mk): each task runs --merge-ready after its pieces
+// and joins the movies whose pieces are then all written. The tasks run one after the other,
+// so the first finds movies still waiting for another task's pieces, and the last joins them.
+TEST_F(MoviePiecesCli, TheTaskThatWritesAMoviesLastPieceMergesIt) {
+  // Into the one-task bake's -o, which the movies' provenance records.
+  const std::string out = "movies";
+  fs::remove_all(path(out));
+  long waitingAfterTheFirst = -1;  // pieces left by the first task for later ones
+  for (int s = 0; s < 3; ++s) {
+    const std::string shard = " --shard " + std::to_string(s) + "/3";
+    CommandResult r = runCommand(movies("--piece-keys 3" + shard, out));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    CommandResult m = runCommand(movies("--merge-pieces 3 --merge-ready" + shard, out));
+    ASSERT_EQ(m.exitCode, 0) << m.err;
+    if (s == 0) {
+      waitingAfterTheFirst = 0;
+      for (const auto& [name, bytes] : files(path(out)))
+        waitingAfterTheFirst += std::regex_match(name, kPieceName) ? 1 : 0;
+    }
+  }
+  EXPECT_GT(waitingAfterTheFirst, 0) << "the first task merged movies it had not every piece of";
+  const std::map<std::string, std::string> whole = files(path("whole")), merged = files(path(out));
+  ASSERT_EQ(merged.size(), whole.size()) << "no piece and no lock left, every movie there";
+  int split = 0;
+  for (const auto& [name, bytes] : whole) {
+    ASSERT_TRUE(merged.count(name)) << name;
+    if (readTextureMovie(path("whole/" + name)).keyFrames.size() <= 3) continue;  // one piece
+    ++split;
+    EXPECT_TRUE(merged.at(name) == bytes) << name << ": merged in the tasks, not the one-task bake";
+  }
+  EXPECT_GE(split, 2);
+}
+
+// Two tasks that both find every piece of the same movies written (they ran at once) merge
+// each movie once, under its lock: both succeed, the movies are the one-task bake's.
+TEST_F(MoviePiecesCli, TwoTasksMergingAtOnceMergeEachMovieOnce) {
+  // Into the one-task bake's -o, which the movies' provenance records.
+  const std::string out = "movies";
+  fs::remove_all(path(out));
+  for (int s = 0; s < 2; ++s) {
+    CommandResult r = runCommand(movies("--piece-keys 3 --shard " + std::to_string(s) + "/2", out));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+  }
+  const std::string a = movies("--merge-pieces 3 --merge-ready --shard 0/2", out),
+                    b = movies("--merge-pieces 3 --merge-ready --shard 1/2", out);
+  CommandResult both =
+      runCommand("( " + a + " & pid=$!; " + b + "; rb=$?; wait $pid && exit $rb )");
+  ASSERT_EQ(both.exitCode, 0) << both.err;
+  long mergedSum = 0;
+  const std::regex said("rad-movies: merged ([0-9]+) movies");
+  for (auto it = std::sregex_iterator(both.err.begin(), both.err.end(), said);
+       it != std::sregex_iterator(); ++it)
+    mergedSum += std::stol((*it)[1].str());
+  long split = 0;
+  const std::map<std::string, std::string> whole = files(path("whole")), merged = files(path(out));
+  ASSERT_EQ(merged.size(), whole.size()) << "no piece and no lock left, every movie there";
+  for (const auto& [name, bytes] : whole) {
+    if (readTextureMovie(path("whole/" + name)).keyFrames.size() <= 3) continue;
+    ++split;
+    EXPECT_TRUE(merged.at(name) == bytes) << name;
+  }
+  EXPECT_EQ(mergedSum, split) << both.err;
 }
 
 TEST_F(MoviePiecesCli, APieceIsNeverTakenForAMovie) {

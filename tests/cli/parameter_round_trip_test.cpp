@@ -35,6 +35,7 @@ const std::set<std::string> kPlumbing = {
     "print-windows",  // rad-global's render farm: same bytes either way
     "piece-keys",
     "merge-pieces",  // rad-movies' render farm: the merged movies are the one task's bytes
+    "merge-ready",   // the same merge inside the piece tasks
 };
 
 // Values for the options whose default is unset, or too slow for a test.

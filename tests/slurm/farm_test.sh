@@ -6,9 +6,10 @@
 #      run's byte for byte, and every frame's pixels (EXR and PNG) are bit-identical to
 #      animation.mk's (the frame files differ only in their provenance, which records each
 #      task's own command line and paths); the movies of more than MOVIE_PIECE_KEYS=4 keys were
-#      baked in pieces and merged (issue 58), and every output (global.rlh, intervals.rti, movies,
-#      frames) is animation.mk's (pipelines/same_outputs.py); the mp4 joined from the compose
-#      tasks' segments holds every frame;
+#      baked in pieces and merged by the movies tasks themselves, no merge stage (issue 58),
+#      and every output (global.rlh, intervals.rti, movies, frames) is animation.mk's
+#      (pipelines/same_outputs.py); the mp4 joined from the compose tasks' segments holds every
+#      frame;
 #   2. a movies task killed mid-run makes WAIT fail with one line naming the stage, the task and
 #      its log; the dependent jobs are cancelled; nothing downstream is marked done; the re-run
 #      submits only the killed shard and ends with the same frames;
@@ -67,11 +68,13 @@ same_frames() {
 make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 GLOBAL_WINDOWS=3 WAIT=1 \
   MOVIE_PIECE_KEYS=4 2>"$work/farm.err" || fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
 same_frames "$work/local" "$work/farm"
-grep -q "slurm.mk: movies-merge submitted" "$work/farm.err" || fail "no merge of movie pieces submitted"
-merged=$(cat "$work"/farm/logs/movies-merge_*.log | sed -n 's/^rad-movies: merged \([0-9]*\) movies.*/\1/p' |
+if grep -q "slurm.mk: movies-merge submitted" "$work/farm.err"; then
+  fail "a merge stage was submitted: the movies tasks merge their pieces themselves"
+fi
+merged=$(cat "$work"/farm/logs/movies_*.log | sed -n 's/^rad-movies: merged \([0-9]*\) movies.*/\1/p' |
   awk '{n += $1} END {print n + 0}')
-[ "$merged" -gt 0 ] || fail "no movie was baked in pieces (logs/movies-merge_*.log)"
-if ls "$work/farm/movies" | grep -q piece; then fail "movie pieces left after the merge"; fi
+[ "$merged" -gt 0 ] || fail "no movie was baked in pieces and merged by a movies task (logs/movies_*.log)"
+if ls "$work/farm/movies" | grep -q 'piece\|merge-lock'; then fail "movie pieces or locks left after the merge"; fi
 python3 pipelines/same_outputs.py "$work/local" "$work/farm" >"$work/same.out" ||
   fail "slurm.mk's outputs differ from animation.mk's: $(cat "$work/same.out")"
 echo "farm_test: $merged movies baked in pieces and merged; $(tail -1 "$work/same.out")"

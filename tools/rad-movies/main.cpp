@@ -32,8 +32,9 @@ struct Options {
   rad::TextureMovieBakerOptions baker;  // bound to the flags; its toJson() is the provenance
   std::string preset;                   // --preset, recorded beside the values it set
   std::string shard = "0/1";
-  int pieceKeys = 0;    // --piece-keys: render farm pieces (tools/stages/movie_pieces.h)
-  int mergePieces = 0;  // --merge-pieces: join the pieces of that size instead of baking
+  int pieceKeys = 0;        // --piece-keys: render farm pieces (tools/stages/movie_pieces.h)
+  int mergePieces = 0;      // --merge-pieces: join the pieces of that size instead of baking
+  bool mergeReady = false;  // --merge-ready: only the movies whose pieces are all written
   std::string report;
 };
 
@@ -67,14 +68,18 @@ void addDeprecatedOptions(CLI::App& app, rad::TextureMovieBakerOptions& b) {
 int mergePieces(const Options& o, const rad::TextureMovieBaker& baker,
                 const rad::TextureIntervals& intervals, const rad::Provenance& provenance,
                 const nlohmann::json& parameters, rad::SteadyClock::time_point start) {
-  const rad::MoviePieceMergeReport merged = rad::mergeMoviePieces(
-      baker, intervals, o.outDir, o.mergePieces, provenance, rad::MovieShard::parse(o.shard));
+  const rad::MovieShard shard = rad::MovieShard::parse(o.shard);
+  const rad::MoviePieceMergeReport merged =
+      o.mergeReady
+          ? rad::mergeReadyMoviePieces(baker, intervals, o.outDir, o.mergePieces, provenance, shard)
+          : rad::mergeMoviePieces(baker, intervals, o.outDir, o.mergePieces, provenance, shard);
   std::cerr << kTool << ": merged " << merged.moviesMerged << " movies from " << merged.piecesRead
             << " pieces\n";
   if (!o.report.empty()) {
     nlohmann::json report;
     report["tool"] = kTool;
     report["merge_pieces"] = o.mergePieces;
+    report["merge_ready"] = o.mergeReady;
     report["shard"] = o.shard;
     report["movies_merged"] = merged.moviesMerged;
     report["pieces_read"] = merged.piecesRead;
@@ -213,13 +218,22 @@ int main(int argc, char** argv) {
           ->check(rad::nonNegativeInteger())
           ->capture_default_str()
           ->group(farm);
-  app.add_option("--merge-pieces", o.mergePieces,
-                 "render farm: instead of baking, join the pieces that --piece-keys K runs of this "
-                 "same command line wrote into their movies (with --shard i/n, those with id % n "
-                 "== i): the same bytes as the run without --merge-pieces, provenance included")
-      ->type_name("K")
-      ->check(rad::positiveInteger())
-      ->excludes(pieces)
+  auto* mergePieces =
+      app.add_option(
+             "--merge-pieces", o.mergePieces,
+             "render farm: instead of baking, join the pieces that --piece-keys K runs of this "
+             "same command line wrote into their movies (with --shard i/n, those with id % n "
+             "== i): the same bytes as the run without --merge-pieces, provenance included")
+          ->type_name("K")
+          ->check(rad::positiveInteger())
+          ->excludes(pieces)
+          ->group(farm);
+  app.add_flag("--merge-ready", o.mergeReady,
+               "render farm: with --merge-pieces K --shard i/n, run in the task that baked "
+               "--piece-keys K --shard i/n after it: join only the movies of which that shard "
+               "baked a piece and whose pieces are all written, each under a lock "
+               "(NNNNNN.merge-lock); the task that writes a movie's last piece joins it")
+      ->needs(mergePieces)
       ->group(farm);
   addDeprecatedOptions(app, b);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;

@@ -1,12 +1,14 @@
 // Texture movies in pieces: the cut and the merge. Contracts in movie_pieces.h.
 #include "tools/stages/movie_pieces.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
 #include "formats/atomic_file.h"
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "tools/stages/file_lock.h"
 
 namespace rad {
 
@@ -33,6 +35,7 @@ std::vector<std::string> argumentsWithoutMergePieces(int argc, const char* const
       ++i;  // and its value
       continue;
     }
+    if (w == "--merge-ready") continue;
     if (w.rfind("--merge-pieces=", 0) == 0 || w.rfind("--shard=", 0) == 0) continue;
     words.push_back(w);
   }
@@ -80,6 +83,37 @@ void requirePieceOf(const std::string& path, const TextureMovie& piece, const Mo
                                  std::to_string(plan.keyFrames[size_t(want.firstKey) + j]));
 }
 
+// Joins the pieces of movie `m` (every one on disk) into its movie file, each piece checked
+// before the movie is written, then removes them.
+void mergeMovie(const TextureMovieBaker& baker, const MovieExtent& m, const BakedMovie& plan,
+                const std::vector<TextureMoviePiece>& pieces, const std::string& moviesDir,
+                const Provenance& provenance, const std::string& provenanceJson) {
+  std::vector<std::unique_ptr<TextureMovieStream>> streams;
+  for (const TextureMoviePiece& want : pieces) {
+    const std::string path = textureMoviePiecePath(moviesDir, m.movie, want.index);
+    streams.push_back(std::make_unique<TextureMovieStream>(path, MovieFileKind::kPiece));
+    requirePieceOf(path, streams.back()->movie(), m, want, plan);
+    requireSameRun(path, streams.back()->movie().provenanceJson, provenance);
+  }
+  TextureMovie meta = textureMovieOf(m, provenanceJson);
+  meta.keyFrames = plan.keyFrames;
+  meta.keyTimes = plan.keyTimes;
+  TextureMovieWriter writer(textureMoviePath(moviesDir, m.movie), meta, baker.options().coherence,
+                            AtomicFile::Durability::kDeferred);
+  for (size_t p = 0; p < pieces.size(); ++p) {
+    TextureMovieStream& piece = *streams[p];
+    const bool constant = piece.movie().keyFrames.size() == 1;  // all its keys equal
+    for (int j = 0; j < pieces[p].keys; ++j) {
+      const std::vector<float>& key = piece.key(constant ? 0 : size_t(j));
+      writer.writeKey(size_t(pieces[p].firstKey + j), key);
+    }
+    streams[p].reset();  // a piece's keys are held until the piece is written
+  }
+  writer.commit();
+  for (const TextureMoviePiece& piece : pieces)
+    std::filesystem::remove(textureMoviePiecePath(moviesDir, m.movie, piece.index));
+}
+
 }  // namespace
 
 MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
@@ -120,38 +154,59 @@ MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
     todo.push_back({&m, std::move(plan), std::move(pieces)});
   }
   for (const Split& split : todo) {
-    const MovieExtent& m = *split.movie;
-    const BakedMovie& plan = split.plan;
-    const std::vector<TextureMoviePiece>& pieces = split.pieces;
-    // Every piece is opened and checked before the movie is written.
-    std::vector<std::unique_ptr<TextureMovieStream>> streams;
-    for (const TextureMoviePiece& want : pieces) {
-      const std::string path = textureMoviePiecePath(moviesDir, m.movie, want.index);
-      streams.push_back(std::make_unique<TextureMovieStream>(path, MovieFileKind::kPiece));
-      requirePieceOf(path, streams.back()->movie(), m, want, plan);
-      requireSameRun(path, streams.back()->movie().provenanceJson, provenance);
+    mergeMovie(baker, *split.movie, split.plan, split.pieces, moviesDir, provenance,
+               provenanceJson);
+    ++report.moviesMerged;
+    report.piecesRead += long(split.pieces.size());
+  }
+  syncFileSystemOf(moviesDir);
+  report.seconds = secondsSince(start);
+  return report;
+}
+
+std::string movieMergeLockPath(const std::string& dir, uint32_t id) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06u.merge-lock", id);
+  return (std::filesystem::path(dir) / name).string();
+}
+
+MoviePieceMergeReport mergeReadyMoviePieces(const TextureMovieBaker& baker,
+                                            const TextureIntervals& intervals,
+                                            const std::string& moviesDir, int pieceKeys,
+                                            const Provenance& provenance, MovieShard shard) {
+  const auto start = SteadyClock::now();
+  const std::string provenanceJson = provenance.toJson().dump();
+  MoviePieceMergeReport report;
+  const MovieExtent* previous = nullptr;
+  for (const MovieWork& work : shardWork(intervals, shard, pieceKeys, baker)) {
+    if (!work.piece.isPiece() || work.movie == previous) continue;
+    previous = work.movie;
+    const MovieExtent& m = *work.movie;
+    const std::vector<TextureMoviePiece> pieces = moviePieces(work.piece.movieKeys, pieceKeys);
+    const std::string moviePath = textureMoviePath(moviesDir, m.movie);
+    auto piecesOnDisk = [&] {
+      size_t n = 0;
+      for (const TextureMoviePiece& p : pieces)
+        n += std::filesystem::exists(textureMoviePiecePath(moviesDir, m.movie, p.index)) ? 1 : 0;
+      return n;
+    };
+    // Not ready (a piece still to come: the task that writes it merges), or nothing to do.
+    size_t have = piecesOnDisk();
+    if (have == 0 || (have < pieces.size() && !std::filesystem::exists(moviePath))) continue;
+    // Checked again under the lock: another task may have merged it meanwhile.
+    FileLock lock(movieMergeLockPath(moviesDir, m.movie));
+    have = piecesOnDisk();
+    if (std::filesystem::exists(moviePath)) {  // merged; pieces of a task that ran again
+      for (const TextureMoviePiece& p : pieces)
+        std::filesystem::remove(textureMoviePiecePath(moviesDir, m.movie, p.index));
+      continue;
     }
-    TextureMovie meta = textureMovieOf(m, provenanceJson);
-    meta.keyFrames = plan.keyFrames;
-    meta.keyTimes = plan.keyTimes;
-    TextureMovieWriter writer(textureMoviePath(moviesDir, m.movie), meta, baker.options().coherence,
-                              AtomicFile::Durability::kDeferred);
-    for (size_t p = 0; p < pieces.size(); ++p) {
-      TextureMovieStream& piece = *streams[p];
-      const bool constant = piece.movie().keyFrames.size() == 1;  // all its keys equal
-      for (int j = 0; j < pieces[p].keys; ++j) {
-        const std::vector<float>& key = piece.key(constant ? 0 : size_t(j));
-        writer.writeKey(size_t(pieces[p].firstKey + j), key);
-      }
-      streams[p].reset();  // a piece's keys are held until the piece is written
-    }
-    writer.commit();
-    for (const TextureMoviePiece& piece : pieces)
-      std::filesystem::remove(textureMoviePiecePath(moviesDir, m.movie, piece.index));
+    if (have < pieces.size()) continue;
+    mergeMovie(baker, m, baker.keyPlan(m), pieces, moviesDir, provenance, provenanceJson);
     ++report.moviesMerged;
     report.piecesRead += long(pieces.size());
   }
-  syncFileSystemOf(moviesDir);
+  if (report.moviesMerged > 0) syncFileSystemOf(moviesDir);
   report.seconds = secondsSince(start);
   return report;
 }
