@@ -13,7 +13,9 @@
 #   2. a movies task killed mid-run makes WAIT fail with one line naming the stage, the task and
 #      its log; the dependent jobs are cancelled; nothing downstream is marked done; the re-run
 #      submits only the killed shard and ends with the same frames;
-#   3. an up-to-date run submits nothing, and a change of COMPOSE_FLAGS only the frames on.
+#   3. an up-to-date run submits nothing, and a change of COMPOSE_FLAGS only the frames on;
+#   4. with MOVIE_PIECE_COSTS (the first run's shard reports), only the costly movies are cut,
+#      dealt by cost, merged by the tasks, and every output is still animation.mk's.
 # Needs root (it starts slurmctld/slurmd): without it, skipped with one line (exit 77).
 #
 #   tests/slurm/farm_test.sh BIN_DIR WORK_DIR
@@ -148,3 +150,20 @@ if grep -q "global submitted\|intervals submitted" "$work/rerun.err"; then
 fi
 same_frames "$work/local" "$out"
 echo "farm_test: the re-run submitted only movies task 1 and gave the same frames"
+
+# 4. The cut by known cost (issue 58; rad-movies --piece-costs): the first run's shard reports
+# cut the movies that took more than MOVIE_PIECE_SECONDS, the others whole. The cut changes the
+# shards' stamps, so the movies are baked again (merged by the tasks) and are animation.mk's.
+costs=$(ls "$work"/farm/movies-report-*of4.json | tr '\n' ' ')
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 MOVIE_PIECE_KEYS=4 \
+  MOVIE_PIECE_COSTS="$costs" MOVIE_PIECE_SECONDS=0.5 WAIT=1 2>"$work/cost.err" ||
+  fail "slurm.mk with MOVIE_PIECE_COSTS failed: $(tail -1 "$work/cost.err")"
+grep -q "slurm.mk: movies submitted" "$work/cost.err" || fail "the cut by cost baked no movie again"
+ls "$work"/farm/movies/.pshard4cost*-0-of-4 >/dev/null 2>&1 || fail "the shards' stamps do not name the cut"
+merged=$(cat "$work"/farm/logs/movies_*.log | sed -n 's/^rad-movies: merged \([0-9]*\) movies.*/\1/p' |
+  awk '{n += $1} END {print n + 0}')
+[ "$merged" -gt 0 ] || fail "the cut by cost cut no movie (MOVIE_PIECE_SECONDS=0.5)"
+if ls "$work/farm/movies" | grep -q 'piece\|merge-lock'; then fail "movie pieces or locks left after the merge"; fi
+python3 pipelines/same_outputs.py "$work/local" "$work/farm" >"$work/same-cost.out" ||
+  fail "with the cut by cost, slurm.mk's outputs differ from animation.mk's: $(cat "$work/same-cost.out")"
+echo "farm_test: the cut by cost: $merged movies cut and merged; $(tail -1 "$work/same-cost.out")"
