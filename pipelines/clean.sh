@@ -39,7 +39,7 @@ temporaries='\..+\.tmp\.[0-9]+\.[0-9]+(\.[A-Za-z0-9]+)?|.+\.tmp\.[0-9]+'
 clean_part() {
   case $1 in
     movies)
-      remove_matching "$out/movies" "[0-9]{6}(\.piece-[0-9]{4})?\.exr|[0-9]{6}\.merge-lock|\.done|\.(p?shard[0-9]*)-[0-9]+-of-[0-9]+|$temporaries"
+      remove_matching "$out/movies" "[0-9]{6}(\.piece-[0-9]{4})?\.exr|[0-9]{6}\.merge-lock|\.done|\.(p?shard[0-9a-z]*)-[0-9]+-of-[0-9]+|$temporaries"
       remove_folder "$out/movies" ;;
     frames)
       remove_matching "$out/frames" "[0-9]+\.(exr|png)|segment-[0-9]+-[0-9]+\.mp4|\.done|\.chunk-[0-9]+-of-[0-9]+|$temporaries"
@@ -52,6 +52,8 @@ clean_part() {
       remove_folder "$out/logs" ;;
     all)
       for p in movies frames global-windows logs; do clean_part "$p"; done
+      remove_matching "$out/piece-costs" "[0-9]+-[0-9]+\.json"
+      remove_folder "$out/piece-costs"
       remove_matching "$out" "global\.rlh|intervals\.rti|scene\.json|\.(movies|frames)\.lock|movie\.mp4|contact-sheet\.png|slurm-jobs|(scene|global|intervals|movies|compose)\.params|(global|intervals|movies|compose)-report(-[0-9x-]+|-[0-9]+of[0-9]+)?\.json|$temporaries"
       remove_folder "$out" ;;
     *) echo "clean.sh: unknown part $1" >&2; exit 2 ;;

@@ -48,6 +48,7 @@ usage: farm_model.py --scene SCENE [--frames 0-95] [--size 352x240] [--nodes 1,4
 import argparse
 import heapq
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -190,16 +191,21 @@ def global_seconds(p, slots, windows):
     return slowest + merge
 
 
-def movie_pieces(p, piece_keys):
+def movie_pieces(p, piece_keys, piece_seconds=0.0):
     """(movie id, piece index, seconds) of every piece, and {movie id: seconds to merge it} of
     the movies cut. A movie of n > K keys is ceil(n / K) pieces, as rad-movies --piece-keys cuts
     it, each paying the movie's planning and its share of the key time
     (tools/stages/movie_pieces.h); its merge reads its pieces and writes it: twice its bytes at
-    the run's write rate."""
+    the run's write rate. With piece_seconds T (rad-movies --piece-costs, the cut by known cost,
+    tools/stages/movie_cut.h): a movie of s seconds is min(n, ceil(s / T)) pieces, the others
+    whole (the costs are this run's own: a farm reads an earlier run's)."""
     out, merges = [], {}
     for mid, s in p["movies"]:
         keys, plan = p.get("movie_plans", {}).get(mid, (1, 0.0))
-        count = (keys + piece_keys - 1) // piece_keys if piece_keys > 0 and keys > piece_keys else 1
+        if piece_seconds > 0:
+            count = max(1, min(keys, int(math.ceil(s / piece_seconds))))
+        else:
+            count = (keys + piece_keys - 1) // piece_keys if piece_keys > 0 and keys > piece_keys else 1
         if count == 1:
             out.append((mid, 0, s))
             continue
@@ -208,6 +214,25 @@ def movie_pieces(p, piece_keys):
             n = keys * (j + 1) // count - keys * j // count
             out.append((mid, j, plan + (s - plan) * n / keys))
     return out, merges
+
+
+def deal_by_cost(seconds, shards):
+    """rad-movies' dealByCost (tools/stages/movie_cut.h): each unit's shard, the units longest
+    first (ties: the lower unit), each to the shard with the least so far (ties: the lower)."""
+    load = [0.0] * max(1, shards)
+    shard_of = [0] * len(seconds)
+    for u in sorted(range(len(seconds)), key=lambda u: -seconds[u]):
+        s = min(range(len(load)), key=lambda i: (load[i], i))
+        load[s] += seconds[u]
+        shard_of[u] = s
+    return shard_of
+
+
+def units_shards(pieces, shards, piece_keys, piece_seconds):
+    """Each unit's shard as rad-movies' shardWork deals them: by cost, in order, or by movie id."""
+    if piece_seconds > 0:
+        return deal_by_cost([s for _, _, s in pieces], shards)
+    return [(u if piece_keys > 0 else mid) % shards for u, (mid, _, _) in enumerate(pieces)]
 
 
 def merge_seconds(p, merges, shards):
@@ -230,19 +255,20 @@ def video_path(p, segments):
     return max(v["concat"], v["contact"])
 
 
-def merges_in_tasks(p, pieces, merges, shards):
+def merges_in_tasks(p, pieces, merges, shards, shard_of=None):
     """Per movie shard, the seconds of the merges its task does after its pieces (slurm.mk's
     --merge-ready): the fixed cost of its second process, once, and the merge of every movie
-    whose last piece (in dealing order) it holds. 0 where a shard has no piece of a cut movie."""
+    whose last piece (in dealing order) it holds. 0 where a shard has no piece of a cut movie.
+    shard_of: each unit's shard (default: dealt in order)."""
+    if shard_of is None:
+        shard_of = [u % shards for u in range(len(pieces))]
     out = [0.0] * shards
     last = {}
-    for u, (mid, _, _) in enumerate(pieces):
-        if mid in merges:
-            last[mid] = u % shards
     holders = set()
     for u, (mid, _, _) in enumerate(pieces):
         if mid in merges:
-            holders.add(u % shards)
+            last[mid] = shard_of[u]
+            holders.add(shard_of[u])
     for shard in holders:
         out[shard] += p["movies_fixed"]
     for mid, shard in last.items():
@@ -250,16 +276,19 @@ def merges_in_tasks(p, pieces, merges, shards):
     return out
 
 
-def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False, merge_stage=False):
+def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False, merge_stage=False,
+          piece_seconds=0.0):
     slots = nodes * cores
     shards = slots
     movie_shards = [0.0] * shards
-    pieces, merges = movie_pieces(p, piece_keys)
+    pieces, merges = movie_pieces(p, piece_keys, piece_seconds)
     merge = merge_seconds(p, merges, shards) if merge_stage else 0.0
-    for u, (mid, _, s) in enumerate(pieces):  # rad-movies' shardWork: pieces dealt in order
-        movie_shards[(u if piece_keys > 0 else mid) % shards] += s
+    shard_of = units_shards(pieces, shards, piece_keys, piece_seconds)  # rad-movies' shardWork
+    for u, (mid, _, s) in enumerate(pieces):
+        movie_shards[shard_of[u]] += s
     if not merge_stage:
-        movie_shards = [a + b for a, b in zip(movie_shards, merges_in_tasks(p, pieces, merges, shards))]
+        movie_shards = [a + b for a, b in
+                        zip(movie_shards, merges_in_tasks(p, pieces, merges, shards, shard_of))]
     movie_tasks = [p["movies_fixed"] + s for s in movie_shards if s > 0.0]
     n = len(p["frames"])
     chunks = min(shards, n)
@@ -285,10 +314,11 @@ def stage_boundaries(global_windows, movie_merge):
     return 4 + (1 if global_windows else 0) + (1 if movie_merge else 0)
 
 
-def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=False):
+def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=False,
+                piece_seconds=0.0):
     """The critical path with unlimited nodes: what no number of nodes shortens."""
     g = global_seconds(p, len(p["keys"]), windows)
-    pieces, merges = movie_pieces(p, piece_keys)
+    pieces, merges = movie_pieces(p, piece_keys, piece_seconds)
     if merge_stage:
         merge = merge_seconds(p, merges, max(1, len(merges)))
         longest = max(s for _, _, s in pieces)
@@ -375,6 +405,20 @@ def self_test():
     path, wall = model(p, 1, 2, 1.0, False, 0, True)
     check("compose chunks encode their segments", path["compose"], 0.1 + 0.5 + 0.5)
     check("the join or the contact sheet", path["mp4 + contact sheet"], 0.5)
+    # The cut by known cost (--piece-seconds T = 1.5): movie 3 (3 s, 6 keys, 1 s of planning) in
+    # ceil(3 / 1.5) = 2 pieces of 1 + 1 s, the 1 s movies whole; dealt longest first on 4
+    # shards: the pieces to shards 0 and 1, movies 0, 1, 2 to shards 2, 3, 2. The last piece's
+    # shard (1) merges movie 3: fixed 0.5 s and 0.6 s; shard 0 pays the fixed cost for nothing.
+    pieces, merges = movie_pieces(p, 0, 1.5)
+    check("two pieces of movie 3 by cost", len([x for x in pieces if x[0] == 3]), 2)
+    check("cheap movies whole", len(pieces), 5)
+    check("a cost piece: planning + half the keys", pieces[3][2], 2.0)
+    check("deal by cost", deal_by_cost([1.0, 1.0, 1.0, 2.0, 2.0], 4) == [2, 3, 2, 0, 1], True)
+    path, wall = model(p, 2, 2, 1.0, False, 0, piece_seconds=1.5)
+    check("movies by cost: shard 1 bakes the last piece and merges it",
+          path["movies"], 0.5 + 2.0 + 0.5 + 0.6)
+    serial = serial_part(p, 0.0, False, 0, piece_seconds=1.5)
+    check("serial by cost: the last piece and its merge", serial["longest movie"], 2.0 + 0.6)
     print("farm_model.py: self-test passed")
     return 0
 
@@ -392,6 +436,10 @@ def main():
                     help="the mp4 as segments encoded by the compose tasks, then joined (slurm.mk)")
     ap.add_argument("--piece-keys", type=int, default=0,
                     help="movies in pieces of at most K keys (slurm.mk's MOVIE_PIECE_KEYS); 0: whole")
+    ap.add_argument("--piece-seconds", type=float, default=0.0,
+                    help="the cut by known cost (slurm.mk's MOVIE_PIECE_COSTS, rad-movies "
+                    "--piece-costs --piece-seconds T): movies of more than T seconds in pieces "
+                    "of about T, the rest whole, dealt longest first; the costs are the run's own")
     ap.add_argument("--merge-stage", action="store_true",
                     help="with --piece-keys: the merges as a stage of their own (slurm.mk before "
                     "the merges went into the piece tasks)")
@@ -416,7 +464,7 @@ def main():
         p["video_parts"] = time_video(run_dir)
     one_core = p["wall"]
     print("farm model of %s: one core %.1f s (global %.1f, intervals %.1f, %d movies %.1f + %.2f fixed, "
-          "%d frames %.1f + %.2f fixed, ffmpeg %.1f); %d cores per node, %.1f s latency per stage%s%s%s"
+          "%d frames %.1f + %.2f fixed, ffmpeg %.1f); %d cores per node, %.1f s latency per stage%s%s%s%s"
           % (run_dir, one_core, p["global"], p["intervals"], len(p["movies"]),
              sum(s for _, s in p["movies"]), p["movies_fixed"], len(p["frames"]), sum(p["frames"]),
              p["compose_fixed"], p["video"], args.cores, args.latency,
@@ -424,6 +472,8 @@ def main():
              ", movies in pieces of at most %d keys (merged %s)"
              % (args.piece_keys, "as a stage" if args.merge_stage else "in the piece tasks")
              if args.piece_keys else "",
+             ", movies of more than %.1f s cut by known cost" % args.piece_seconds
+             if args.piece_seconds else "",
              ", the mp4 in segments (encode %.1f, join %.1f, contact sheet %.1f)"
              % (p["video_parts"]["mp4"], p["video_parts"]["concat"], p["video_parts"]["contact"])
              if args.video_segments else ""))
@@ -431,12 +481,13 @@ def main():
     print("%6s %9s %9s  %s" % ("nodes", "wall s", "speed-up", "critical path (s)"))
     for nodes in [int(x) for x in args.nodes.split(",")]:
         path, wall = model(p, nodes, args.cores, args.latency, args.global_windows,
-                           args.piece_keys, args.video_segments, args.merge_stage)
+                           args.piece_keys, args.video_segments, args.merge_stage,
+                           args.piece_seconds)
         rows.append({"nodes": nodes, "wall": wall, "path": path})
         print("%6d %9.1f %8.1fx  %s" % (nodes, wall, one_core / wall,
                                         ", ".join("%s %.1f" % kv for kv in path.items())))
     serial = serial_part(p, args.latency, args.global_windows, args.piece_keys,
-                         args.video_segments, args.merge_stage)
+                         args.video_segments, args.merge_stage, args.piece_seconds)
     total = sum(serial.values())
     print("serial part (the critical path on unlimited nodes): %.1f s = %.1f %% of the one-core "
           "time, so the speed-up is at most %.1fx: %s"

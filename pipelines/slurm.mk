@@ -41,6 +41,15 @@ GLOBAL_WINDOWS ?= 1
 # its movie again, so a smaller piece cuts the longest task and adds planning (docs/results.md,
 # "Farm tasks finer than one movie" and its sequel).
 MOVIE_PIECE_KEYS ?= 4
+# The cut by known cost (rad-movies --piece-costs, tools/stages/movie_cut.h): the movies reports
+# of an earlier run of these movies (e.g. OUT/movies-report-*.json, the shards' reports of the
+# run before); a movie that took more than MOVIE_PIECE_SECONDS is cut into pieces of about that
+# cost, the others baked whole (movies the reports do not name: MOVIE_PIECE_KEYS), every unit
+# dealt to the shards longest first. The reports are copied to OUT/piece-costs/ under their
+# content's checksum before the tasks are submitted (this run rewrites the shards' reports), and
+# the shards' stamps name it, so pieces of another cut are never merged. Empty: by keys.
+MOVIE_PIECE_COSTS   ?=
+MOVIE_PIECE_SECONDS ?= 2
 PARTITION    ?=
 WAIT         ?= 0
 SBATCH_FLAGS ?=
@@ -125,16 +134,33 @@ $(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-int
 
 # The shards' stamps name the piece size (.pshardK-I-of-N), so that pieces of another size are
 # never merged: slurm-pieces.sh empties the folder when the stamps are of another kind.
+ifneq ($(strip $(MOVIE_PIECE_COSTS)),)
+MOVIES_COST_SUM   := $(firstword $(shell cat $(MOVIE_PIECE_COSTS) 2>/dev/null | cksum))
+MOVIES_COST_FILES := $(foreach i,$(shell seq $(words $(MOVIE_PIECE_COSTS))),$(OUT)/piece-costs/$(MOVIES_COST_SUM)-$(i).json)
+MOVIES_SHARD_KIND := pshard$(MOVIE_PIECE_KEYS)cost$(MOVIES_COST_SUM)
+MOVIES_PIECE_ARGS := $(space)--piece-keys $(MOVIE_PIECE_KEYS)$(foreach f,$(MOVIES_COST_FILES), --piece-costs $(f)) \
+                     --piece-seconds $(MOVIE_PIECE_SECONDS)
+MOVIES_MERGE_K    := $(MOVIE_PIECE_KEYS)
+ifeq ($(filter-out 0,$(MOVIE_PIECE_KEYS)),)
+$(error slurm.mk: MOVIE_PIECE_COSTS needs MOVIE_PIECE_KEYS > 0, the cut of the movies the reports do not name)
+endif
+MOVIES_MERGE_COSTS = $(foreach f,$(MOVIES_COST_FILES), --piece-costs $(f)) --piece-seconds $(MOVIE_PIECE_SECONDS)
+# The snapshot of the reports the tasks read (cp fails, and stops the run, on a missing one).
+MOVIES_COST_COPY   = mkdir -p $(OUT)/piece-costs && set -- $(MOVIE_PIECE_COSTS) && \
+                     for f in $(MOVIES_COST_FILES); do cp "$$1" "$$f" && shift || exit 1; done &&
+else
 MOVIES_SHARD_KIND := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)),pshard$(MOVIE_PIECE_KEYS),shard)
 MOVIES_PIECE_ARGS := $(if $(filter-out 0,$(MOVIE_PIECE_KEYS)), --piece-keys $(MOVIE_PIECE_KEYS))
+MOVIES_MERGE_K    := $(MOVIE_PIECE_KEYS)
+endif
 
 # The shards, each (with pieces) then joining the movies whose last piece it wrote, then a job
 # that stamps. A shard's stamp follows its merges, so a task killed before or during them runs
 # again and merges what it finds complete (a movie merged meanwhile has the pieces of the re-run
 # removed).
-MOVIES_TASK_MERGE = $(if $(MOVIES_PIECE_ARGS), && $(call MOVIES_MERGE_READY_CMD,$(MOVIE_PIECE_KEYS),$${SLURM_ARRAY_TASK_ID}/$(SHARDS)))
+MOVIES_TASK_MERGE = $(if $(MOVIES_PIECE_ARGS), && $(call MOVIES_MERGE_READY_CMD,$(MOVIES_MERGE_K),$${SLURM_ARRAY_TASK_ID}/$(SHARDS))$(MOVIES_MERGE_COSTS))
 $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
-	@rm -f $@ && \
+	@rm -f $@ && $(MOVIES_COST_COPY) \
 	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies $(MOVIES_SHARD_KIND) $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
 	if [ -n "$$missing" ]; then \
 	  $(call submit,movies,$$missing,global global-merge intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS))$(MOVIES_PIECE_ARGS)$(MOVIES_TASK_MERGE) \

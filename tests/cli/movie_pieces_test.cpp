@@ -8,10 +8,15 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <regex>
 #include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "formats/texture_movie.h"
 #include "tests/cli/cli_util.h"
@@ -101,7 +106,7 @@ TEST_F(MoviePiecesCli, PiecesMergedAreTheOneTaskBakeByteForByte) {
           << name << ": merged pieces differ from the one-task bake";
     } else {  // a movie of one piece, baked whole by its shard (whose --shard it records)
       EXPECT_EQ(readTextureMovie(path("movies/" + name)).keys,
-                readTextureMovie(path("whole/" + name)).keys)
+                readTextureMovie(path("whole/" + std::string(name))).keys)
           << name;
     }
   }
@@ -169,6 +174,52 @@ TEST_F(MoviePiecesCli, TwoTasksMergingAtOnceMergeEachMovieOnce) {
     EXPECT_TRUE(merged.at(name) == bytes) << name;
   }
   EXPECT_EQ(mergedSum, split) << both.err;
+}
+
+// The cut by known cost (--piece-costs, movie_cut.h): an earlier run's report cuts only the
+// movies that took longer than --piece-seconds, deals every unit by its estimated cost, and the
+// pieces merged inside the tasks are the one-task bake's bytes.
+TEST_F(MoviePiecesCli, TheCutByKnownCostMergesToTheOneTaskBake) {
+  const std::string report = path("cost-run.json");
+  CommandResult r = runCommand(movies("--report " + report, "cost-run"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json work = nlohmann::json::parse(readWholeFile(report))["work_seconds"];
+  std::vector<double> seconds;
+  for (const nlohmann::json& w : work) seconds.push_back(w["seconds"].get<double>());
+  ASSERT_GE(seconds.size(), 3u);
+  std::sort(seconds.begin(), seconds.end());
+  // Between the two costliest movies' halves: the costliest are cut, the cheap ones whole.
+  const double target = 0.5 * seconds[seconds.size() - 2];
+  std::ostringstream flags;
+  flags << " --piece-costs " << report << " --piece-seconds " << target;
+  const std::string out = "movies";
+  fs::remove_all(path(out));
+  for (int s = 0; s < 3; ++s) {
+    const std::string shard = " --shard " + std::to_string(s) + "/3";
+    CommandResult b = runCommand(movies(flags.str() + shard, out));
+    ASSERT_EQ(b.exitCode, 0) << b.err;
+    CommandResult m =
+        runCommand(movies("--merge-pieces 1 --merge-ready" + flags.str() + shard, out));
+    ASSERT_EQ(m.exitCode, 0) << m.err;
+  }
+  const std::map<std::string, std::string> whole = files(path("whole")), merged = files(path(out));
+  ASSERT_EQ(merged.size(), whole.size()) << "no piece and no lock left, every movie there";
+  int cut = 0, kept = 0;
+  for (const nlohmann::json& w : work) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%06u.exr", w["movie"].get<unsigned>());
+    ASSERT_TRUE(merged.count(name)) << name;
+    const bool costly = w["seconds"].get<double>() > target && w["movie_keys"].get<int>() > 1;
+    (costly ? cut : kept) += 1;
+    if (costly)  // merged from its pieces: the one-task bake's bytes, provenance included
+      EXPECT_TRUE(merged.at(name) == whole.at(name)) << name << ": not the one-task bake";
+    else  // baked whole by its shard (whose --shard it records): the same keys
+      EXPECT_EQ(readTextureMovie(path(out + "/" + name)).keys,
+                readTextureMovie(path("whole/" + std::string(name))).keys)
+          << name;
+  }
+  EXPECT_GE(cut, 1) << "no movie costly enough to cut";
+  EXPECT_GE(kept, 1) << "every movie cut: the cut is not by cost";
 }
 
 TEST_F(MoviePiecesCli, APieceIsNeverTakenForAMovie) {

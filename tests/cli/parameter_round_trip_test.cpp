@@ -36,6 +36,8 @@ const std::set<std::string> kPlumbing = {
     "piece-keys",
     "merge-pieces",  // rad-movies' render farm: the merged movies are the one task's bytes
     "merge-ready",   // the same merge inside the piece tasks
+    "piece-costs",   // the cut by known cost: which task bakes which keys, not their bytes
+    "piece-seconds",
 };
 
 // Values for the options whose default is unset, or too slow for a test.

@@ -13,7 +13,9 @@
 #   2. a movies task killed mid-run makes WAIT fail with one line naming the stage, the task and
 #      its log; the dependent jobs are cancelled; nothing downstream is marked done; the re-run
 #      submits only the killed shard and ends with the same frames;
-#   3. an up-to-date run submits nothing, and a change of COMPOSE_FLAGS only the frames on.
+#   3. an up-to-date run submits nothing, and a change of COMPOSE_FLAGS only the frames on;
+#   4. with MOVIE_PIECE_COSTS (the first run's shard reports), only the costly movies are cut,
+#      dealt by cost, merged by the tasks, and every output is still animation.mk's.
 # Needs root (it starts slurmctld/slurmd): without it, skipped with one line (exit 77).
 #
 #   tests/slurm/farm_test.sh BIN_DIR WORK_DIR
@@ -148,3 +150,25 @@ if grep -q "global submitted\|intervals submitted" "$work/rerun.err"; then
 fi
 same_frames "$work/local" "$out"
 echo "farm_test: the re-run submitted only movies task 1 and gave the same frames"
+
+# 4. The cut by known cost (issue 58; rad-movies --piece-costs): the first run's shard reports
+# cut the movies that took more than MOVIE_PIECE_SECONDS, the others whole, and the movies are
+# animation.mk's. The cut changes no byte of them, so an up-to-date movies stage is not baked
+# again for it: the movies are cleaned first.
+costs=$(ls "$work"/farm/movies-report-*of4.json | tr '\n' ' ')
+pipelines/clean.sh "$work/farm" movies
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 MOVIE_PIECE_KEYS=4 \
+  MOVIE_PIECE_COSTS="$costs" MOVIE_PIECE_SECONDS=0.5 WAIT=1 2>"$work/cost.err" ||
+  fail "slurm.mk with MOVIE_PIECE_COSTS failed: $(tail -1 "$work/cost.err")"
+grep -q "slurm.mk: movies submitted" "$work/cost.err" || fail "the cut by cost baked no movie again"
+ls "$work"/farm/movies/.pshard4cost*-0-of-4 >/dev/null 2>&1 || fail "the shards' stamps do not name the cut"
+# This run's shard reports: pieces of the costly movies, the cheap ones whole.
+read -r pieces whole < <(python3 -c 'import json, sys
+units = [w for f in sys.argv[1:] for w in json.load(open(f))["work_seconds"]]
+print(sum(w["piece"] >= 0 for w in units), sum(w["piece"] < 0 for w in units))' "$work"/farm/movies-report-*of4.json)
+[ "$pieces" -gt 0 ] || fail "the cut by cost cut no movie (MOVIE_PIECE_SECONDS=0.5)"
+[ "$whole" -gt 0 ] || fail "the cut by cost cut every movie: not by cost"
+if ls "$work/farm/movies" | grep -q 'piece\|merge-lock'; then fail "movie pieces or locks left after the merge"; fi
+python3 pipelines/same_outputs.py "$work/local" "$work/farm" >"$work/same-cost.out" ||
+  fail "with the cut by cost, slurm.mk's outputs differ from animation.mk's: $(cat "$work/same-cost.out")"
+echo "farm_test: the cut by cost: $pieces pieces and $whole whole movies; $(tail -1 "$work/same-cost.out")"

@@ -35,6 +35,9 @@ struct Options {
   int pieceKeys = 0;        // --piece-keys: render farm pieces (tools/stages/movie_pieces.h)
   int mergePieces = 0;      // --merge-pieces: join the pieces of that size instead of baking
   bool mergeReady = false;  // --merge-ready: only the movies whose pieces are all written
+  // --piece-costs, --piece-seconds: the cut by an earlier run's costs (tools/stages/movie_cut.h).
+  std::vector<std::string> pieceCosts;
+  double pieceSeconds = 4.0;
   std::string report;
 };
 
@@ -65,14 +68,21 @@ void addDeprecatedOptions(CLI::App& app, rad::TextureMovieBakerOptions& b) {
 }
 
 // --merge-pieces: the pieces of --piece-keys tasks joined into their movies (movie_pieces.h).
+// The cut of the movies into pieces: by keys (K), or by an earlier run's costs.
+rad::MovieCut movieCut(const Options& o, int pieceKeys) {
+  return o.pieceCosts.empty() ? rad::MovieCut(pieceKeys)
+                              : rad::MovieCut::fromReports(o.pieceCosts, o.pieceSeconds, pieceKeys);
+}
+
 int mergePieces(const Options& o, const rad::TextureMovieBaker& baker,
                 const rad::TextureIntervals& intervals, const rad::Provenance& provenance,
                 const nlohmann::json& parameters, rad::SteadyClock::time_point start) {
   const rad::MovieShard shard = rad::MovieShard::parse(o.shard);
   const rad::MoviePieceMergeReport merged =
-      o.mergeReady
-          ? rad::mergeReadyMoviePieces(baker, intervals, o.outDir, o.mergePieces, provenance, shard)
-          : rad::mergeMoviePieces(baker, intervals, o.outDir, o.mergePieces, provenance, shard);
+      o.mergeReady ? rad::mergeReadyMoviePieces(baker, intervals, o.outDir,
+                                                movieCut(o, o.mergePieces), provenance, shard)
+                   : rad::mergeMoviePieces(baker, intervals, o.outDir, movieCut(o, o.mergePieces),
+                                           provenance, shard);
   std::cerr << kTool << ": merged " << merged.moviesMerged << " movies from " << merged.piecesRead
             << " pieces\n";
   if (!o.report.empty()) {
@@ -138,7 +148,8 @@ int run(Options o, int argc, char** argv) {
   backends.formFactorSpill = rad::formFactorScratchFiles();
   rad::TextureMovieBaker baker(scene, solution, intervals.fps, o.baker, backends);
   if (o.mergePieces > 0) return mergePieces(o, baker, intervals, provenance, parameters, start);
-  const std::vector<rad::MovieWork> work = rad::shardWork(intervals, shard, o.pieceKeys, baker);
+  const std::vector<rad::MovieWork> work =
+      rad::shardWork(intervals, shard, movieCut(o, o.pieceKeys), baker);
   rad::Progress progress(kTool, long(work.size()));
   const rad::MovieSequenceReport written = rad::bakeMovieSequence(
       baker, work, {o.intervals, o.outDir}, provenance, [&] { progress.advance(); });
@@ -234,6 +245,21 @@ int main(int argc, char** argv) {
                "baked a piece and whose pieces are all written, each under a lock "
                "(NNNNNN.merge-lock); the task that writes a movie's last piece joins it")
       ->needs(mergePieces)
+      ->group(farm);
+  app.add_option("--piece-costs", o.pieceCosts,
+                 "render farm: cut by known cost instead: the --report files of an earlier run "
+                 "of these movies (one a flag); a movie that took more than --piece-seconds is "
+                 "cut into pieces of about that cost, the others baked whole (movies they do "
+                 "not name: --piece-keys), every unit dealt to the shards longest first; give "
+                 "the same files to --merge-pieces")
+      ->type_name("REPORT")
+      ->allow_extra_args(false)
+      ->group(farm);
+  app.add_option("--piece-seconds", o.pieceSeconds,
+                 "render farm: with --piece-costs, the seconds of work a piece aims at")
+      ->type_name("T")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
       ->group(farm);
   addDeprecatedOptions(app, b);
   if (int rc = rad::parseCommandLine(app, kTool, argc, argv); rc >= 0) return rc;

@@ -13,7 +13,10 @@
 namespace rad {
 
 std::vector<TextureMoviePiece> moviePieces(int keys, int pieceKeys) {
-  const int count = pieceKeys > 0 && keys > pieceKeys ? (keys + pieceKeys - 1) / pieceKeys : 1;
+  return moviePiecesByCount(keys, MovieCut(pieceKeys).pieceCount(0, keys));
+}
+
+std::vector<TextureMoviePiece> moviePiecesByCount(int keys, int count) {
   std::vector<TextureMoviePiece> pieces;
   for (int p = 0; p < count; ++p) {
     TextureMoviePiece piece;
@@ -31,12 +34,14 @@ std::vector<std::string> argumentsWithoutMergePieces(int argc, const char* const
   std::vector<std::string> words;
   for (int i = 0; i < argc; ++i) {
     const std::string w = argv[i];
-    if (w == "--merge-pieces" || w == "--shard") {
+    if (w == "--merge-pieces" || w == "--shard" || w == "--piece-costs" || w == "--piece-seconds") {
       ++i;  // and its value
       continue;
     }
     if (w == "--merge-ready") continue;
-    if (w.rfind("--merge-pieces=", 0) == 0 || w.rfind("--shard=", 0) == 0) continue;
+    if (w.rfind("--merge-pieces=", 0) == 0 || w.rfind("--shard=", 0) == 0 ||
+        w.rfind("--piece-costs=", 0) == 0 || w.rfind("--piece-seconds=", 0) == 0)
+      continue;
     words.push_back(w);
   }
   return words;
@@ -118,7 +123,7 @@ void mergeMovie(const TextureMovieBaker& baker, const MovieExtent& m, const Bake
 
 MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
                                        const TextureIntervals& intervals,
-                                       const std::string& moviesDir, int pieceKeys,
+                                       const std::string& moviesDir, const MovieCut& cut,
                                        const Provenance& provenance, MovieShard shard) {
   const auto start = SteadyClock::now();
   const std::string provenanceJson = provenance.toJson().dump();
@@ -135,7 +140,8 @@ MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
   for (const MovieExtent& m : intervals.movies) {
     if (!shard.contains(m.movie)) continue;
     BakedMovie plan = baker.keyPlan(m);
-    std::vector<TextureMoviePiece> pieces = moviePieces(int(plan.keyFrames.size()), pieceKeys);
+    const int keys = int(plan.keyFrames.size());
+    std::vector<TextureMoviePiece> pieces = moviePiecesByCount(keys, cut.pieceCount(m.movie, keys));
     if (pieces.size() < 2) continue;
     bool anyPiece = false;
     std::string missing;
@@ -149,8 +155,8 @@ MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
     if (!anyPiece && std::filesystem::exists(textureMoviePath(moviesDir, m.movie))) continue;
     if (!missing.empty())
       throw inputError(missing, "missing: a piece of movie " + std::to_string(m.movie) +
-                                    " was not baked (rad-movies --piece-keys " +
-                                    std::to_string(pieceKeys) + " --shard ...)");
+                                    " was not baked (rad-movies --piece-keys or --piece-costs"
+                                    " with --shard ...)");
     todo.push_back({&m, std::move(plan), std::move(pieces)});
   }
   for (const Split& split : todo) {
@@ -172,17 +178,18 @@ std::string movieMergeLockPath(const std::string& dir, uint32_t id) {
 
 MoviePieceMergeReport mergeReadyMoviePieces(const TextureMovieBaker& baker,
                                             const TextureIntervals& intervals,
-                                            const std::string& moviesDir, int pieceKeys,
+                                            const std::string& moviesDir, const MovieCut& cut,
                                             const Provenance& provenance, MovieShard shard) {
   const auto start = SteadyClock::now();
   const std::string provenanceJson = provenance.toJson().dump();
   MoviePieceMergeReport report;
   const MovieExtent* previous = nullptr;
-  for (const MovieWork& work : shardWork(intervals, shard, pieceKeys, baker)) {
+  for (const MovieWork& work : shardWork(intervals, shard, cut, baker)) {
     if (!work.piece.isPiece() || work.movie == previous) continue;
     previous = work.movie;
     const MovieExtent& m = *work.movie;
-    const std::vector<TextureMoviePiece> pieces = moviePieces(work.piece.movieKeys, pieceKeys);
+    const std::vector<TextureMoviePiece> pieces =
+        moviePiecesByCount(work.piece.movieKeys, work.piece.count);
     const std::string moviePath = textureMoviePath(moviesDir, m.movie);
     auto piecesOnDisk = [&] {
       size_t n = 0;

@@ -20,6 +20,7 @@
 #include "formats/texture_intervals.h"
 #include "formats/texture_movie.h"
 #include "libcommon/movies/texture_movie_baker.h"
+#include "tools/stages/movie_cut.h"
 #include "tools/stages/movie_sequence.h"
 
 namespace rad {
@@ -28,9 +29,12 @@ namespace rad {
 // of as equal a size as the keys allow (piece p holds keys [keys p / P, keys (p + 1) / P)).
 // pieceKeys <= 0 or keys <= pieceKeys: one piece (count 1), the whole movie.
 std::vector<TextureMoviePiece> moviePieces(int keys, int pieceKeys);
+// The same cut into `count` pieces (MovieCut::pieceCount; 1: the whole movie).
+std::vector<TextureMoviePiece> moviePiecesByCount(int keys, int count);
 
-// The command line of a --merge-pieces run without `--merge-pieces K`, `--shard i/n` (or their
-// `=` forms) and `--merge-ready`: the provenance the merged movies record, the whole bake's.
+// The command line of a --merge-pieces run without `--merge-pieces K`, `--shard i/n`,
+// `--piece-costs FILE`, `--piece-seconds T` (or their `=` forms) and `--merge-ready`: the
+// provenance the merged movies record, the whole bake's.
 std::vector<std::string> argumentsWithoutMergePieces(int argc, const char* const* argv);
 
 struct MoviePieceMergeReport {
@@ -39,7 +43,7 @@ struct MoviePieceMergeReport {
 };
 
 // Joins the pieces of every movie of `intervals` of `shard` (id % n == i, so that merges run side
-// by side) that --piece-keys `pieceKeys` cut into more than one piece: reads
+// by side) that `cut` (--piece-keys, --piece-costs) cut into more than one piece: reads
 // MOVIES_DIR/MMMMMM.piece-PPPP.exr for every piece (each checked against the movie's key plan from
 // `baker` and against `provenance`: made with the same parameters, --shard aside, and from the same
 // inputs), writes MOVIES_DIR/MMMMMM.exr (provenance: `provenance`) and removes the pieces. Movies
@@ -48,7 +52,7 @@ struct MoviePieceMergeReport {
 // written) and rad::outputError when a movie cannot be written.
 MoviePieceMergeReport mergeMoviePieces(const TextureMovieBaker& baker,
                                        const TextureIntervals& intervals,
-                                       const std::string& moviesDir, int pieceKeys,
+                                       const std::string& moviesDir, const MovieCut& cut,
                                        const Provenance& provenance, MovieShard shard);
 
 // The lock a merge of movie `id` holds (DIR/MMMMMM.merge-lock, tools/stages/file_lock.h).
@@ -66,7 +70,7 @@ std::string movieMergeLockPath(const std::string& dir, uint32_t id);
 // and rad::outputError when the lock cannot be taken.
 MoviePieceMergeReport mergeReadyMoviePieces(const TextureMovieBaker& baker,
                                             const TextureIntervals& intervals,
-                                            const std::string& moviesDir, int pieceKeys,
+                                            const std::string& moviesDir, const MovieCut& cut,
                                             const Provenance& provenance, MovieShard shard);
 
 }  // namespace rad

@@ -100,20 +100,30 @@ MovieShard MovieShard::parse(const std::string& s) {
   return {i, n};
 }
 
-std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard, int pieceKeys,
-                                 const TextureMovieBaker& baker) {
-  std::vector<MovieWork> mine;
-  uint32_t unit = 0;  // the index of a piece among every movie's pieces
+std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard,
+                                 const MovieCut& cut, const TextureMovieBaker& baker) {
+  std::vector<MovieWork> all;  // every movie's units, in id and piece order
+  std::vector<double> estimates;
   for (const MovieExtent& m : intervals.movies) {
-    if (pieceKeys <= 0) {
-      if (shard.contains(m.movie)) mine.push_back({&m, TextureMoviePiece{}});
+    if (!cut.cuts()) {
+      if (shard.contains(m.movie)) all.push_back({&m, TextureMoviePiece{}});
       continue;
     }
+    const int keys = int(baker.keyPlan(m).keyFrames.size());
     const std::vector<TextureMoviePiece> pieces =
-        moviePieces(int(baker.keyPlan(m).keyFrames.size()), pieceKeys);
-    for (const TextureMoviePiece& p : pieces)
-      if (shard.contains(unit++)) mine.push_back({&m, pieces.size() > 1 ? p : TextureMoviePiece{}});
+        moviePiecesByCount(keys, cut.pieceCount(m.movie, keys));
+    for (const TextureMoviePiece& p : pieces) {
+      all.push_back({&m, pieces.size() > 1 ? p : TextureMoviePiece{}});
+      estimates.push_back(cut.estimate(m.movie, keys, p.index, p.count));
+    }
   }
+  if (!cut.cuts()) return all;
+  const std::vector<int> shardOf =
+      cut.byCost() ? dealByCost(estimates, shard.count) : std::vector<int>();
+  std::vector<MovieWork> mine;
+  for (size_t u = 0; u < all.size(); ++u)
+    if (cut.byCost() ? shardOf[u] == shard.index : shard.contains(uint32_t(u)))
+      mine.push_back(all[u]);
   return mine;
 }
 

@@ -17,6 +17,7 @@
 #include "formats/texture_intervals.h"
 #include "formats/texture_movie.h"
 #include "libcommon/movies/texture_movie_baker.h"
+#include "tools/stages/movie_cut.h"
 
 namespace rad {
 
@@ -62,17 +63,18 @@ struct MovieSequenceReport {
   std::string rendererName;  // the first worker's that rendered a mask ("" when none did)
 };
 
-// The work of `shard`, in id order (and piece order within a movie). --piece-keys K (render
-// farm, docs/design.md §6.3): a movie of more than K keys is baked as pieces of at most K
-// consecutive keys (movie_pieces.h), each written as a piece file for --merge-pieces to join;
-// 0: whole movies. Without pieces, the movies with id % n == i. With pieces, every movie's
-// pieces (a movie of at most K keys is one piece, its whole movie) are dealt to the shards in
-// id and piece order: the u-th is shard u % n's, so a long movie's pieces go to consecutive
-// shards. A piece's cost is not known before it is baked (the texels' cost varies by far more
-// than their count), so no schedule by cost is attempted. Every task computes the same list
-// from the inputs alone (`baker` gives each movie's key count, keyPlan).
-std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard, int pieceKeys,
-                                 const TextureMovieBaker& baker);
+// The work of `shard`, in id order (and piece order within a movie). `cut` (render farm,
+// docs/design.md §6.3, movie_cut.h): a movie it cuts is baked as pieces of consecutive keys
+// (movie_pieces.h), each written as a piece file for --merge-pieces to join. Without a cut, the
+// movies with id % n == i. By keys (--piece-keys), every movie's pieces (a movie of one piece is
+// its whole movie) are dealt to the shards in id and piece order: the u-th is shard u % n's, so
+// a long movie's pieces go to consecutive shards (a piece's cost is not known before it is
+// baked: the texels' cost varies by far more than their count). By known cost (--piece-costs:
+// an earlier run's reports), only the costly movies are cut and the units are dealt by their
+// estimated seconds, longest first (dealByCost). Every task computes the same list from the
+// inputs alone (`baker` gives each movie's key count, keyPlan).
+std::vector<MovieWork> shardWork(const TextureIntervals& intervals, MovieShard shard,
+                                 const MovieCut& cut, const TextureMovieBaker& baker);
 
 // Bakes and writes every movie and piece of `work` (shardWork) with as many workers as TBB's
 // allowed parallelism (the tools' --threads): `baker` and baker.sibling()s, whose stats are added
