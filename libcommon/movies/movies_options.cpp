@@ -27,6 +27,10 @@ void addSampleParameters(ParameterTable<O>& t) {
         "frames between key textures of a movie whose bad links' shadows move (a moving "
         "blocker in the shaft, or a moving end); 0: --movie-key-step",
         Check::nonNegative());
+  t.add("good-layer-key-step", &O::goodLayerKeyStep,
+        "frames between the good layer's gathers in a movie keyed more finely (its shadows "
+        "move); the keys between interpolate it in time (0: gathered at every key)",
+        Check::nonNegative());
   t.add("weak-share", &O::weakShare,
         "a bad link giving less than this share of every texel's direct light takes a quarter "
         "of --min-samples at least (0: off)",

@@ -27,6 +27,7 @@
 
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
+#include "libcommon/movies/good_layer_keys.h"
 #include "libcommon/movies/lamp_direct_term.h"
 #include "libcommon/movies/movie_geometry.h"
 #include "libcommon/movies/ray_cast_masks.h"
@@ -138,7 +139,7 @@ class MovieBake {
             const SceneEmitters& emitters, const TextureMovieBakerOptions& options,
             TextureMovieBakerStats& stats, const std::function<OcclusionMaskRenderer&()>& renderer,
             FormFactorSpill& spill, const MovieExtent& req, MovieGeometry& geometry,
-            const GoodLinkGather* gather, SceneVisibility* visibility, const BlockerIndex& blockers,
+            GoodLayerKeys* gather, SceneVisibility* visibility, const BlockerIndex& blockers,
             uint32_t surface)
       : solution_(solution),
         tops_(tops),
@@ -368,7 +369,7 @@ class MovieBake {
   void goodLayer(double t) {
     auto clock = SteadyClock::now();
     if (gather_) {
-      gather_->gather(t, acc_);
+      gather_->at(t, acc_);
       stats_.secondsGood += secondsSince(clock);
       return;
     }
@@ -498,7 +499,7 @@ class MovieBake {
   FormFactorSpill& spill_;
   const MovieExtent& req_;
   MovieGeometry& geo_;
-  const GoodLinkGather* gather_;           // null: Gouraud
+  GoodLayerKeys* gather_;                  // null: Gouraud
   SceneVisibility* visibility_;            // null: covered texels are left as they are
   const uint32_t surface_;                 // the receiver top's planar surface: the samples' seed
   std::unique_ptr<LampDirectTerm> lamps_;  // null: the scene has no lamp
@@ -944,10 +945,15 @@ BakedMovie TextureMovieBaker::bake(const MovieExtent& req, BakedKeySink& sink, M
         options_.nearShooterLevels, options_.gatherPartialShare, options_.clusterVisibilityRays);
     stats_.secondsGood += secondsSince(clock);
   }
+  std::unique_ptr<GoodLayerKeys> goodKeys;
+  if (gather)
+    goodKeys = std::make_unique<GoodLayerKeys>(
+        *gather, goodLayerGatherTimes(req.firstFrame, req.lastFrame, movie.keyStep,
+                                      options_.goodLayerKeyStep, fps_));
   if (!blockers_) blockers_ = std::make_unique<BlockerIndex>(scene_, tops_);
   if (surfaceOfTop_.empty()) surfaceOfTop_ = planarSurfaceOfTops(tops_);
   MovieBake bake(solution_, tops_, emitters_, options_, stats_, gl, *spill, req, geometry,
-                 gather.get(),
+                 goodKeys.get(),
                  options_.fillCovered || !emitters_.lamps().empty() ? sceneVisibility() : nullptr,
                  *blockers_, surfaceOfTop_[req.patch.top]);
   bake.plan(badShooters);

@@ -68,10 +68,15 @@ struct TextureMovieBakerOptions {
   int keyStep = 6;  // --movie-key-step: frames between key textures (>= 1)
   // --moving-shadow-key-step: the key step of a movie whose bad links' shadows move (a moving
   // node's swept bounds meet a bad pair's shaft, or an end moves): the paper computes the dynamic
-  // blockers' shadows every frame (§5), and a shadow interpolated between two keys six frames apart
-  // shows at both places half dark. 0: keyStep. The default, half the default key step, takes most
-  // of that error away and keeps most of the coherence of a scene of many moving objects.
-  int movingShadowKeyStep = 3;
+  // blockers' shadows every frame (§5, Figure 6), and a shadow interpolated between two keys
+  // shows at both places half dark, a double shadow that the structured error reads as blotches
+  // (issue 56). 0: keyStep.
+  int movingShadowKeyStep = 1;
+  // --good-layer-key-step: in a movie keyed more finely than this, the good layer is gathered
+  // every this many frames and interpolated in time at the keys between (good_layer_keys.h): the
+  // gather is most of a key's cost and the indirect light it carries changes slowly. 0 or at
+  // most the movie's key step: gathered at every key.
+  int goodLayerKeyStep = 3;
   // Shooter samples per bad link, lower bound. 16, not 4: a small light (the Cornell box's) gets
   // only a few samples from 256 x its form factor, and its penumbrae then show as straight-edged
   // bands, one hard shadow per sample; at 16 the bands are gone.

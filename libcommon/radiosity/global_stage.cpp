@@ -33,6 +33,11 @@ void addSolveParameters(ParameterTable<GlobalOptions>& t) {
       "or, once it is larger, carried (sum of A B over the patches)",
       Check::nonNegative(), Group::kQuality);
   t.add(
+      "shadow-eps-share", [](GlobalOptions& g) -> double& { return radiosity(g).shadowEpsShare; },
+      "also refine a partly visible link while B_q F_pq min(V, 1 - V) A_p > this x eps x the "
+      "power: the receiver's one radiosity blends both sides of a shadow boundary (0: off)",
+      Check::nonNegative());
+  t.add(
       "rays", [](GlobalOptions& g) -> int& { return radiosity(g).rays; },
       "shadow-ray pairs per link", Check::positive(), Group::kQuality);
   t.addEnum(

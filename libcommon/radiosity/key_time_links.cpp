@@ -291,6 +291,15 @@ bool KeyTimeSolver::oracleWantsRefinement(const SolverLink& l) const {
   double range = size_t(l.shooter) < shooterRange_.size() ? shooterRange_[size_t(l.shooter)] : 0;
   bool power =
       std::max(bv, range * l.visibility) * l.estimate * s_.area[size_t(l.receiver)] > epsAbs_;
+  // A partly visible link: a shadow boundary crosses its receiver, whose one B holds the mean
+  // of its lit and shadowed parts, and rad-movies gathers that B wherever another surface sees
+  // this one at close range (a box's face over the floor in the box's own shadow). What the
+  // mean misplaces, B_q F~ min(V, 1 - V) A_p, is refined down to shadowEpsShare x eps.
+  const double v = l.visibility;
+  if (opt_.shadowEpsShare > 0.0 && v > 0.0 && v < 1.0)
+    power = power || maxComponent(B_[size_t(l.shooter)]) * std::min(v, 1.0 - v) * l.estimate *
+                             s_.area[size_t(l.receiver)] >
+                         opt_.shadowEpsShare * epsAbs_;
   bool error = bv * l.spreadArea > epsAbs_;
   return opt_.oracle == RefinementOracle::kPower   ? power
          : opt_.oracle == RefinementOracle::kError ? error

@@ -36,6 +36,12 @@ struct RadiosityOptions {
   // hierarchical_radiosity.h). 2e-4: below it the error against converged references falls
   // little more while the time keeps growing ("Accuracy against converged references").
   double eps = 2e-4;
+  // --shadow-eps-share: a partly visible link (0 < V < 1) is also refined while
+  // B_q F~ min(V, 1 - V) A_p > shadowEpsShare x eps x Phi: its receiver's one radiosity blends
+  // the lit and shadowed sides of a shadow boundary, and the movies' gather takes that blend
+  // wherever a near surface sees the receiver (issue 56: the bundled scene's short box, bright
+  // over the floor in its own shadow). 0: off (the power and error oracles alone).
+  double shadowEpsShare = 0.25;
   double minArea = 0.0;        // m^2: a link whose larger patch is not larger than this stays
   bool refine = true;          // false: top-level links only (discrete system of the input patches)
   int rays = 16;               // shadow-ray pairs per link

@@ -43,14 +43,15 @@ void runGlobalAndIntervals(const fs::path& dir, const std::string& frames) {
   EXPECT_EQ(r.exitCode, 0) << r.err;
 }
 
-// rad-movies on dir's solution and intervals, a key every keyStep frames; its report.
+// rad-movies on dir's solution and intervals, a key every keyStep frames (moving shadows too);
+// its report.
 MoviesRun bake(const fs::path& dir, int keyStep) {
   const std::string tag = std::to_string(keyStep);
   const std::string report = (dir / ("movies" + tag + ".json")).string();
-  CommandResult r =
-      runCommand(tool("rad-movies") + " " + kScene + " " + (dir / "global.rlh").string() + " " +
-                 (dir / "intervals.rti").string() + " -o " + (dir / ("movies" + tag)).string() +
-                 " --threads 1 --movie-key-step " + tag + " --report " + report);
+  CommandResult r = runCommand(
+      tool("rad-movies") + " " + kScene + " " + (dir / "global.rlh").string() + " " +
+      (dir / "intervals.rti").string() + " -o " + (dir / ("movies" + tag)).string() +
+      " --threads 1 --movie-key-step " + tag + " --moving-shadow-key-step 0 --report " + report);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   MoviesRun run;
   if (r.exitCode != 0) return run;

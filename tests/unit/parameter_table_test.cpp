@@ -58,6 +58,7 @@ TEST(ParameterTable, GlobalProvenanceKeysAreUnchanged) {
                                             "partial-power-share",
                                             "partial-threshold",
                                             "rays",
+                                            "shadow-eps-share",
                                             "tol"}));
   EXPECT_EQ(GlobalOptions{}.toJson().at("no-coherence"), false);
   EXPECT_EQ(GlobalOptions{}.toJson().at("oracle"), "both");
