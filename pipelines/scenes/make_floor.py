@@ -86,7 +86,7 @@ def room_shell(cell):
 def corridor_segment(cell):
     """One pitch of the corridor, x in [0, PITCH], z in [0, CORRIDOR]: floor, ceiling, the
     south wall (z = 0, the office's doorway) and the north wall (z = CORRIDOR, the
-    classroom's), with the doorways' jambs across the wall thickness."""
+    classroom's), with the doorways' jambs and thresholds across the wall thickness."""
     L, H, C = PITCH, HEIGHT, CORRIDOR
     north = (DOOR_X, DOOR_X + DOOR_W)
     south = (ROOM_W - DOOR_X - DOOR_W, ROOM_W - DOOR_X)  # the office is turned half round
@@ -100,6 +100,7 @@ def corridor_segment(cell):
         q.append([(a, 0, z1), (a, 0, z0), (a, DOOR_H, z0), (a, DOOR_H, z1)])  # faces +x
         q.append([(b, 0, z0), (b, 0, z1), (b, DOOR_H, z1), (b, DOOR_H, z0)])  # faces -x
         q.append([(a, DOOR_H, z0), (b, DOOR_H, z0), (b, DOOR_H, z1), (a, DOOR_H, z1)])  # -y
+        q.append([(a, 0, z0), (a, 0, z1), (b, 0, z1), (b, 0, z0)])  # the threshold, +y
     return q
 
 
