@@ -16,6 +16,12 @@
 #       stage's time and peak memory, rad-global's links, the log-log slopes of links (at the
 #       first key with no link bound: one more rad-global run a size, 3.2 GB at 100k) and of
 #       rad-global's time against the triangle count; out/scale/scale.csv and scale.png
+#   make -f pipelines/bench.mk million [MILLION_TRIANGLES=100000,1000000] [MILLION_FRAMES=0-95] [MILLION_MAX_SECONDS=7200]
+#       issue 58's million triangles: make_floor.py's floor of furnished rooms (meshes shared by
+#       many nodes) at each count through the four stages (pipelines/scale.py --scene floor):
+#       triangles, each stage's time and peak memory, rad-global's links and its key times at
+#       the link bound; out/million/scale.csv. Goals: 10^5 <= 4 min, 10^6 <= 40 min, every stage
+#       <= 8 GB. Not a timed test: run it on a quiet machine
 #   make -f pipelines/bench.mk farm-model [FARM_SCENE=pipelines/scenes/cornell-moving.gltf] [FARM_FRAMES=0-95] [FARM_NODES=1,4,16,64] [FARM_FLAGS=--global-windows]
 #       one run of animation.mk on one core, then the wall time slurm.mk would take on N nodes
 #       of this machine's size, its critical path and the serial part (pipelines/farm_model.py);
@@ -66,6 +72,9 @@ SCALE_TRIANGLES ?= 1000,3000,10000,30000,100000
 SCALE_FRAMES ?= 0-95
 SCALE_MAX_SECONDS ?= 1800
 SCALE_MOVING_LIGHT ?=
+MILLION_TRIANGLES ?= 100000,1000000
+MILLION_FRAMES ?= 0-95
+MILLION_MAX_SECONDS ?= 7200
 
 FARM_SCENE ?= pipelines/scenes/cornell-moving.gltf
 FARM_FRAMES ?= 0-95
@@ -98,7 +107,7 @@ CORPUS_SPP ?= 256
 FUZZ_SECONDS ?= 600
 FUZZ_RUNS ?= -1
 
-.PHONY: tables tradeoff furnace contact scale farm-model image lights corpus fuzz
+.PHONY: tables tradeoff furnace contact scale million farm-model image lights corpus fuzz
 tables:
 	python3 pipelines/bench.py --bin $(BIN) --frames $(BENCH_FRAMES) --size $(BENCH_SIZE) \
 	  $(if $(BENCH_ONLY),--only $(BENCH_ONLY)) --reference-spp $(BENCH_REFERENCE_SPP) --out out/bench
@@ -116,6 +125,10 @@ scale:
 	python3 pipelines/scale.py --bin $(BIN) --triangles $(SCALE_TRIANGLES) --frames $(SCALE_FRAMES) \
 	  --size $(BENCH_SIZE) --max-seconds $(SCALE_MAX_SECONDS) $(if $(SCALE_MOVING_LIGHT),--moving-light) \
 	  --out out/scale$(if $(SCALE_MOVING_LIGHT),-moving-light)
+
+million:
+	python3 pipelines/scale.py --scene floor --no-unbounded --bin $(BIN) --triangles $(MILLION_TRIANGLES) \
+	  --frames $(MILLION_FRAMES) --size $(BENCH_SIZE) --max-seconds $(MILLION_MAX_SECONDS) --out out/million
 
 furnace:
 	python3 pipelines/furnace.py --bin $(BIN) --rho $(FURNACE_RHO) --out out/furnace \

@@ -13,8 +13,12 @@ links grow (it had put the slope over 1k-100k at 0.88). A stage that runs past -
 is killed and reported; the larger sizes are then skipped (they would take longer still).
 Writes OUT/scale.csv and, with gnuplot, OUT/scale.png.
 
+With --scene floor the scenes are make_floor.py's floors of furnished rooms (issue 58: a
+million triangles, meshes shared by many nodes); the table also gives each size's key times at
+the link bound.
+
 usage: scale.py [--triangles 1000,3000,10000,30000,100000] [--frames 0-95] [--size 352x240]
-                [--moving-light] [--max-seconds 1800] [--bin DIR] [--out DIR] [--no-unbounded]
+                [--scene hall|floor] [--moving-light] [--max-seconds 1800] [--bin DIR] [--out DIR] [--no-unbounded]
                 [--check]
   --no-unbounded  skip the unbounded first-key run (the links' slope is then the pipeline's,
             bounded, largest key's)
@@ -73,14 +77,18 @@ def first_key_unbounded(global_argv, out, log, limit):
     return k.get("links", 0) + k.get("cluster_links", 0), seconds, mib
 
 
-def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit, unbounded=True):
-    name = "hall-%d%s" % (triangles, "-moving-light" if moving_light else "")
+GENERATORS = {"hall": "make_hall.py", "floor": "make_floor.py"}
+
+
+def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit, unbounded=True,
+             kind="hall"):
+    name = "%s-%d%s" % (kind, triangles, "-moving-light" if moving_light else "")
     out = os.path.join(out_root, name)
     requested = triangles
     shutil.rmtree(out, ignore_errors=True)
     os.makedirs(out)
     scene = os.path.join(out, name + ".gltf")
-    made = subprocess.run([sys.executable, os.path.join(HERE, "scenes", "make_hall.py"), scene,
+    made = subprocess.run([sys.executable, os.path.join(HERE, "scenes", GENERATORS[kind]), scene,
                            "--triangles", str(triangles)] +
                           (["--moving-light"] if moving_light else []),
                           check=True, capture_output=True, text=True)
@@ -93,7 +101,7 @@ def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit, un
     for stage, argv in commands:
         t0 = time.monotonic()
         try:
-            seconds, mib, _ = bench.run(argv, log, limit=max(left, 1.0))
+            seconds, mib, cpu = bench.run(argv, log, limit=max(left, 1.0))
         except bench.Timeout as killed:
             row[stage + "_s"], row[stage + "_mib"] = killed.seconds, killed.peak_mib
             row["status"] = stage + " timeout"
@@ -101,7 +109,7 @@ def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit, un
         except RuntimeError:
             row[stage + "_s"], row["status"] = time.monotonic() - t0, stage + " failed"
             break
-        row[stage + "_s"], row[stage + "_mib"] = seconds, mib
+        row[stage + "_s"], row[stage + "_mib"], row[stage + "_cpu"] = seconds, mib, cpu
         left -= seconds
     try:
         with open(os.path.join(out, "global-report.json")) as f:
@@ -112,6 +120,8 @@ def one_size(bin_dir, out_root, triangles, frames, size, moving_light, limit, un
                            for k in keys) if keys else None
         row["nodes"] = max(k.get("nodes", 0) for k in keys) if keys else None
         row["link_cap"] = any(k.get("link_cap_reached") for k in keys)
+        row["keys"] = len(keys)
+        row["keys_at_bound"] = sum(1 for k in keys if k.get("link_cap_reached"))
     except (OSError, ValueError):
         pass
     if unbounded and row["status"] == "ok":
@@ -152,6 +162,9 @@ def main():
     ap.add_argument("--frames", default="0-95")
     ap.add_argument("--size", default="352x240")
     ap.add_argument("--moving-light", action="store_true")
+    ap.add_argument("--scene", choices=sorted(GENERATORS), default="hall",
+                    help="hall: make_hall.py's lecture hall; floor: make_floor.py's floor of "
+                    "furnished rooms, its meshes instanced (issue 58)")
     ap.add_argument("--max-seconds", type=float, default=1800.0,
                     help="per size, for the four stages together")
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
@@ -159,26 +172,34 @@ def main():
     ap.add_argument("--no-unbounded", action="store_true")
     ap.add_argument("--check", action="store_true")
     a = ap.parse_args()
+    if a.moving_light and a.scene != "hall":
+        sys.exit("scale.py: --moving-light: only with --scene hall")
     os.makedirs(a.out, exist_ok=True)
     rows = []
     for n in [int(x) for x in a.triangles.split(",")]:
-        print("scale: hall of %d triangles, frames %s at %s ..." % (n, a.frames, a.size),
+        print("scale: %s of %d triangles, frames %s at %s ..." % (a.scene, n, a.frames, a.size),
               file=sys.stderr, flush=True)
         row = one_size(a.bin, a.out, n, a.frames, a.size, a.moving_light, a.max_seconds,
-                       not a.no_unbounded)
+                       not a.no_unbounded, a.scene)
         rows.append(row)
         print("scale:   %s" % row["status"], file=sys.stderr, flush=True)
         if row["status"] != "ok":
             break  # the larger sizes would run longer still
-    print("%-26s %8s %9s %8s  %s  %s" % ("scene", "tris", "links", "nodes",
-                                         " ".join("%16s" % s for s in STAGES), "total s  status"))
+    print("%-26s %8s %9s %8s %7s  %s  %s" % ("scene", "tris", "links", "nodes", "bound",
+                                              " ".join("%16s" % s for s in STAGES),
+                                              "total s  status"))
     for r in rows:
         cells = " ".join("%7.1fs %6.0fM" % (r.get(s + "_s", 0), r.get(s + "_mib", 0))
                          if s + "_s" in r else "%16s" % "-" for s in STAGES)
         total = sum(r.get(s + "_s", 0) for s in STAGES)
-        print("%-26s %8d %9s %8s  %s  %7.1f  %s%s" % (
-            r["scene"], r["triangles"], r.get("links", "-"), r.get("nodes", "-"), cells, total,
+        bound = "%d/%d" % (r["keys_at_bound"], r["keys"]) if "keys" in r else "-"
+        print("%-26s %8d %9s %8s %7s  %s  %7.1f  %s%s" % (
+            r["scene"], r["triangles"], r.get("links", "-"), r.get("nodes", "-"), bound, cells,
+            total,
             r["status"], " (link bound reached)" if r.get("link_cap") else ""))
+    for r in rows:  # on a shared machine the wall seconds above include others' load
+        print("%-26s CPU seconds (user + system): %s" % (r["scene"], " ".join(
+            "%s %.1f" % (s, r[s + "_cpu"]) for s in STAGES if s + "_cpu" in r)))
     done = [r for r in rows if r["status"] == "ok"]
     unbounded = all("links_unbounded" in r for r in done)
     counted = "links_unbounded" if unbounded else "links"
@@ -194,8 +215,9 @@ def main():
               fmt(sl), "first key, no link bound" if unbounded else "largest key, bounded",
               fmt(st)))
     path = os.path.join(a.out, "scale.csv")
-    fields = ["scene", "triangles", "links", "nodes", "link_cap", "status"] + \
-        [s + k for s in STAGES for k in ("_s", "_mib")] + \
+    fields = ["scene", "triangles", "links", "nodes", "link_cap", "keys", "keys_at_bound",
+              "status"] + \
+        [s + k for s in STAGES for k in ("_s", "_mib", "_cpu")] + \
         ["links_unbounded", "unbounded_s", "unbounded_mib"]
     with open(path + ".tmp", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")

@@ -4,11 +4,13 @@
 #include "libcommon/gl/item_buffer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
 
 #include "libcommon/core/error.h"
+#include "libcommon/gl/clip_volume_cull.h"
 
 namespace rad {
 namespace {
@@ -49,6 +51,9 @@ static_assert(sizeof(Vertex) == 16, "tightly packed vertex");
 struct DrawRange {
   GLint first = 0;
   GLsizei count = 0;
+  // Of the float vertices drawn (empty for no vertex): the object is skipped in a frame whose
+  // clip volume it lies outside (clip_volume_cull.h).
+  LocalBounds bounds{glm::vec3(INFINITY), glm::vec3(-INFINITY)};
 };
 
 // Flips rows in place: GL reads bottom-up, our buffers are top-down.
@@ -202,8 +207,11 @@ void ItemBufferRenderer::setGeometry(const std::vector<ItemObject>& objects) {
         throw Error(ExitCode::kInternal, "item buffer",
                     "object " + std::to_string(k) + " triangle " + std::to_string(t) +
                         " has the reserved id 0");
-      for (const glm::dvec3& p : o.triangles[t])
+      for (const glm::dvec3& p : o.triangles[t]) {
         vertices.push_back({float(p.x), float(p.y), float(p.z), o.ids[t]});
+        const glm::vec3 v(vertices.back().x, vertices.back().y, vertices.back().z);
+        r.bounds = {glm::min(r.bounds[0], v), glm::max(r.bounds[1], v)};
+      }
     }
     r.count = GLsizei(vertices.size()) - r.first;
     ranges.push_back(r);
@@ -276,6 +284,7 @@ void ItemBufferRenderer::render(const CameraView& view,
         m.grid.isPixelCentres()
             ? rasterClipFromLocal(view, size, worldFromLocal)
             : rasterClipFromLocal(view, m.grid.image, worldFromLocal, m.grid.ndcScale());
+    if (outsideClipVolume(clip, r.bounds)) continue;
     glm::dmat4 eyeFromLocal = eyeFromWorld * worldFromLocal;
     // Row 2 of eyeFromLocal (glm is column-major), negated: depth = -z_eye.
     glm::vec4 depthRow(-eyeFromLocal[0][2], -eyeFromLocal[1][2], -eyeFromLocal[2][2],

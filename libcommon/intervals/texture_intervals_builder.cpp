@@ -24,9 +24,9 @@ namespace {
 constexpr double kGuardBand = 64.0;
 
 // Largest subdivision the builder makes: ~480 bytes per node (patch hierarchy, GL and item
-// geometry), so at most ~1 GB, within the goal of 2 GB a stage, and room for the 100k-triangle hall
-// at the default --max-level 2.
-constexpr long kMaxNodes = 1L << 21;
+// geometry), so at most ~8 GB, issue 58's bound a stage: room for the million-triangle floor of
+// make_floor.py at the default --max-level 2 (the 2^21 of the 100k-triangle hall refused it).
+constexpr long kMaxNodes = 1L << 24;
 
 }  // namespace
 
@@ -137,6 +137,7 @@ struct TextureIntervalsBuilder::Impl {
                       std::to_string(kMaxNodes) + "); use a smaller --max-level");
     // Regular subdivision down to maxLevel: level by level, so dense indices grow with depth
     // and every child comes after its parent.
+    hierarchy.reserve(size_t(nodes));
     std::vector<int> level(hierarchy.topCount());
     for (int i = 0; i < hierarchy.topCount(); ++i) level[i] = i;
     for (int l = 0; l < options.maxLevel; ++l) {
@@ -171,6 +172,16 @@ struct TextureIntervalsBuilder::Impl {
   // dropped once uploaded, so that they are not held through the frames.
   std::vector<ItemObject> itemObjects() const {
     std::vector<ItemObject> objects(meshNodes.size());
+    // Exact sizes first: at a million triangles the leaves' triangles are gigabytes, and growing
+    // them by doubling held up to twice that (issue 58).
+    std::vector<size_t> triangles(meshNodes.size(), 0);
+    for (int i = 0; i < hierarchy.size(); ++i)
+      if (hierarchy.isLeaf(i))
+        triangles[nodeObject[i]] += size_t(hierarchy.node(i).local.count - 2);
+    for (size_t k = 0; k < objects.size(); ++k) {
+      objects[k].triangles.reserve(triangles[k]);
+      objects[k].ids.reserve(triangles[k]);
+    }
     for (int i = 0; i < hierarchy.size(); ++i)
       if (hierarchy.isLeaf(i))
         objects[nodeObject[i]].addPolygon(hierarchy.node(i).local, uint32_t(i + 1));

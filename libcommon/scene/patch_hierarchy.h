@@ -64,6 +64,9 @@ class PatchHierarchy {
   // triangles: at edge midpoints, the centre child inverted) and returns the first child's
   // dense index; returns the existing first child if already split.
   int subdivide(int i);
+  // Room for n nodes in all, so that a caller that knows its final size (rad-intervals' full
+  // subdivision) does not hold the growing array twice while it is copied.
+  void reserve(size_t n) { nodes_.reserve(n); }
   // Dense index of the node with this id, or -1 when that node does not exist (yet).
   int find(PatchId id) const;
   // Creates the node with this id and its ancestors' siblings as needed; returns its index.

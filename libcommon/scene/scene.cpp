@@ -481,56 +481,79 @@ glm::dvec3 shadingNormalAt(const InputPolygon& p, glm::dvec2 uv) {
   return n / len;
 }
 
-std::vector<InputPolygon> Scene::inputPolygons() const {
+namespace {
+
+// The top-level patches of one mesh in its own frame (node -1): merged quads, triangles rooted
+// at their widest corner, a doubleSided material's reversed copies. A mesh that many nodes share
+// (glTF instancing) is merged once, not once per node (issue 58's floor of furnished rooms).
+std::vector<InputPolygon> meshPolygons(const Mesh& mesh, const std::vector<Material>& materials) {
   std::vector<InputPolygon> out;
-  for (int node : meshNodes()) {
-    const Mesh& mesh = meshes[size_t(nodes[size_t(node)].mesh)];
-    std::vector<Tri> tris;
-    for (const MeshTriangle& t : mesh.triangles) tris.push_back({t.p, t.uv, t.normal, t.material});
-    // Directed edge -> triangles that have it, to find the neighbour across an edge.
-    std::map<EdgeKey, std::vector<size_t>> byEdge;
-    for (size_t i = 0; i < tris.size(); ++i)
-      for (size_t k = 0; k < 3; ++k)
-        byEdge[edgeKey(tris[i].p[k], tris[i].p[(k + 1) % 3])].push_back(i);
-    std::vector<char> used(tris.size(), 0);
-    for (size_t i = 0; i < tris.size(); ++i) {
-      if (used[i]) continue;
-      used[i] = 1;
-      InputPolygon poly;
-      poly.node = node;
-      bool merged = false;
-      // The lowest-index unused neighbour that merges, over i's edges in order.
-      std::set<size_t> candidates;
-      for (size_t k = 0; k < 3; ++k) {
-        auto it = byEdge.find(edgeKey(tris[i].p[(k + 1) % 3], tris[i].p[k]));
-        if (it == byEdge.end()) continue;
-        for (size_t j : it->second)
-          if (j > i && !used[j]) candidates.insert(j);
-      }
-      for (size_t j : candidates) {
-        if (tryMerge(tris[i], tris[j], &poly)) {
-          used[j] = 1;
-          merged = true;
-          break;
-        }
-      }
-      if (!merged) {
-        poly.local.count = 3;
-        for (size_t k = 0; k < 3; ++k) {
-          poly.local.v[k] = tris[i].p[k];
-          poly.uv[k] = tris[i].uv[k];
-          poly.normal[k] = tris[i].normal[k];
-        }
-        poly.material = tris[i].material;
-        rootAtWidestCorner(poly);
-      }
-      poly.node = node;
-      out.push_back(poly);
-      const int mat = poly.material;
-      if (mat >= 0 && mat < int(materials.size()) && materials[size_t(mat)].doubleSided)
-        out.push_back(reversed(poly));
+  std::vector<Tri> tris;
+  for (const MeshTriangle& t : mesh.triangles) tris.push_back({t.p, t.uv, t.normal, t.material});
+  // Directed edge -> triangles that have it, to find the neighbour across an edge.
+  std::map<EdgeKey, std::vector<size_t>> byEdge;
+  for (size_t i = 0; i < tris.size(); ++i)
+    for (size_t k = 0; k < 3; ++k)
+      byEdge[edgeKey(tris[i].p[k], tris[i].p[(k + 1) % 3])].push_back(i);
+  std::vector<char> used(tris.size(), 0);
+  for (size_t i = 0; i < tris.size(); ++i) {
+    if (used[i]) continue;
+    used[i] = 1;
+    InputPolygon poly;
+    bool merged = false;
+    // The lowest-index unused neighbour that merges, over i's edges in order.
+    std::set<size_t> candidates;
+    for (size_t k = 0; k < 3; ++k) {
+      auto it = byEdge.find(edgeKey(tris[i].p[(k + 1) % 3], tris[i].p[k]));
+      if (it == byEdge.end()) continue;
+      for (size_t j : it->second)
+        if (j > i && !used[j]) candidates.insert(j);
     }
+    for (size_t j : candidates) {
+      if (tryMerge(tris[i], tris[j], &poly)) {
+        used[j] = 1;
+        merged = true;
+        break;
+      }
+    }
+    if (!merged) {
+      poly.local.count = 3;
+      for (size_t k = 0; k < 3; ++k) {
+        poly.local.v[k] = tris[i].p[k];
+        poly.uv[k] = tris[i].uv[k];
+        poly.normal[k] = tris[i].normal[k];
+      }
+      poly.material = tris[i].material;
+      rootAtWidestCorner(poly);
+    }
+    out.push_back(poly);
+    const int mat = poly.material;
+    if (mat >= 0 && mat < int(materials.size()) && materials[size_t(mat)].doubleSided)
+      out.push_back(reversed(poly));
   }
+  return out;
+}
+
+}  // namespace
+
+std::vector<InputPolygon> Scene::inputPolygons() const {
+  const std::vector<int> nodeList = meshNodes();
+  std::vector<std::vector<InputPolygon>> perMesh(meshes.size());
+  std::vector<char> merged(meshes.size(), 0);
+  size_t total = 0;
+  for (int node : nodeList) {
+    const size_t m = size_t(nodes[size_t(node)].mesh);
+    if (!merged[m]) perMesh[m] = meshPolygons(meshes[m], materials);
+    merged[m] = 1;
+    total += perMesh[m].size();
+  }
+  std::vector<InputPolygon> out;
+  out.reserve(total);
+  for (int node : nodeList)
+    for (const InputPolygon& p : perMesh[size_t(nodes[size_t(node)].mesh)]) {
+      out.push_back(p);
+      out.back().node = node;
+    }
   return cutAtContacts(*this, std::move(out));
 }
 

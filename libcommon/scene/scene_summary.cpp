@@ -1,5 +1,6 @@
 #include "libcommon/scene/scene_summary.h"
 
+#include <map>
 #include <sstream>
 
 #include "libcommon/scene/emission_texture.h"
@@ -69,11 +70,22 @@ nlohmann::json summarizeScene(const Scene& scene) {
   s["mesh_nodes"] = scene.meshNodes().size();
   s["triangles"] = triangles;
   s["patches"] = polygons.size();
+  // One pass over the polygons (in node order), each node's transform made once: a floor of
+  // thousands of mesh nodes made the per-node scans of every polygon quadratic (issue 58).
   size_t quads = 0;
   double area = 0.0;
+  std::map<int, std::pair<glm::dvec3, size_t>> emitted;  // node -> (power, patches)
+  int placedNode = -1;
+  glm::dmat4 worldFromLocal(1.0);
   for (const InputPolygon& p : polygons) {
+    if (p.node != placedNode) worldFromLocal = scene.worldTransform(placedNode = p.node, t0);
     quads += p.local.count == 4;
-    area += p.local.transformed(scene.worldTransform(p.node, t0)).area();
+    area += p.local.transformed(worldFromLocal).area();
+    if (p.material < 0 || !scene.materials[p.material].isEmitter()) continue;
+    std::pair<glm::dvec3, size_t>& e =
+        emitted.try_emplace(p.node, glm::dvec3(0.0), 0).first->second;
+    e.first += emittedPower(scene, p, t0);
+    ++e.second;
   }
   s["quads"] = quads;
   s["total_area_m2"] = area;
@@ -81,14 +93,10 @@ nlohmann::json summarizeScene(const Scene& scene) {
   // Emitters grouped by mesh node.
   nlohmann::json emitters = nlohmann::json::array();
   for (int n : scene.meshNodes()) {
-    glm::dvec3 power(0.0);
-    size_t count = 0;
-    for (const InputPolygon& p : polygons) {
-      if (p.node != n || p.material < 0 || !scene.materials[p.material].isEmitter()) continue;
-      power += emittedPower(scene, p, t0);
-      ++count;
-    }
-    if (count == 0) continue;
+    const auto it = emitted.find(n);
+    if (it == emitted.end()) continue;
+    const glm::dvec3 power = it->second.first;
+    const size_t count = it->second.second;
     emitters.push_back({{"node", n},
                         {"name", scene.nodes[n].name},
                         {"patches", count},

@@ -376,6 +376,35 @@ TEST(InputPolygons, OrderByNodeAndUnreachableSkipped) {
   EXPECT_EQ(polys[1].node, 2);
 }
 
+// glTF instancing (issue 58): a mesh many nodes share is merged once and each of its nodes gets
+// the same polygons in the mesh's frame, its reversed copies included, in node order.
+TEST(InputPolygons, SharedMeshGivesEachNodeTheSamePolygons) {
+  Scene s;
+  s.nodes.resize(4);
+  s.roots = {0, 1, 2, 3};
+  s.nodes[0].mesh = s.nodes[2].mesh = s.nodes[3].mesh = 0;
+  s.nodes[1].mesh = 1;
+  s.nodes[2].translation = {5, 0, 0};
+  s.nodes[3].translation = {0, 0, 7};
+  Mesh bent = unitSquare(1);
+  bent.triangles[1].p[2].z = 0.5;  // two triangles, not a quad
+  s.meshes = {unitSquare(0), bent};
+  s.materials.resize(2);
+  s.materials[0].doubleSided = true;
+  const std::vector<InputPolygon> polys = s.inputPolygons();
+  ASSERT_EQ(polys.size(), 8u);  // node 0: quad + back, node 1: 2 triangles, nodes 2, 3: as 0
+  const std::vector<int> nodes{0, 0, 1, 1, 2, 2, 3, 3};
+  for (size_t i = 0; i < polys.size(); ++i) EXPECT_EQ(polys[i].node, nodes[i]) << i;
+  for (size_t first : {size_t(4), size_t(6)})
+    for (size_t k = 0; k < 2; ++k) {
+      EXPECT_EQ(polys[first + k].local.toString(), polys[k].local.toString());
+      EXPECT_EQ(polys[first + k].backFace, polys[k].backFace);
+      EXPECT_EQ(polys[first + k].uv, polys[k].uv);
+    }
+  EXPECT_EQ(polys[2].local.count, 3);
+  EXPECT_EQ(polys[3].local.count, 3);
+}
+
 // A lamp (0.5 m square, facing +z like the ceiling it hangs in front of) `gap` in front of a
 // 4 m ceiling square (node 0), at x, y in [1.5, 2].
 Scene lampUnderCeiling(double gap) {
