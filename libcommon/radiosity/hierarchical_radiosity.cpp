@@ -204,7 +204,11 @@ KeySolution KeyTimeSolver::finish() {
     s_.linksVisibilityOnly += l.visibilityOnly ? 1 : 0;
   }
   countLinks();
-  if (clusters_) {  // at the final B, as the merge gathers the patch links
+  if (clusters_) {               // at the final B, as the merge gathers the patch links
+    if (clusters_->reusing()) {  // held to the end (refineClusterLinks)
+      clusters_->forgetReuse();
+      if (input_.releaseClusterLinks) input_.releaseClusterLinks();
+    }
     gatherClusterLight();
     s_.topClusterIrradiance = clusterH_;
     s_.clusterLinks = clusters_->size();

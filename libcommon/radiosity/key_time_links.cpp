@@ -53,7 +53,13 @@ size_t KeyTimeSolver::refineClusterLinks() {
       s_.links.push_back(l);
     }
   clusters_->evaluate();
-  if (input_.releaseClusterLinks && clusters_->reusing()) {
+  // The previous key's cluster links go after the first round, for the peak (most links are
+  // made at it). Not with keepWeakNearLinks: the first round, knowing only the lights' B,
+  // keeps every near link without a light, and the links below them are made at the later
+  // rounds, which would then compute every one of them afresh at every key (paper §4.2's
+  // coherence lost for them; docs/results.md, "Near cluster links kept"): the cache is held to
+  // the key's end.
+  if (input_.releaseClusterLinks && clusters_->reusing() && !opt_.keepWeakNearLinks) {
     clusters_->forgetReuse();
     input_.releaseClusterLinks();
   }
