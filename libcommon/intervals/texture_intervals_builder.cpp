@@ -309,6 +309,25 @@ struct TextureIntervalsBuilder::Impl {
     addRendered(v, buffer, secondsSince(start), observer);
   }
 
+  // visible[i] = the samples of `ids` showing leaf i. Counted by runs of one id: a leaf covers
+  // many neighbouring samples of a row (the grid has s^2 a pixel), so one add a run instead of
+  // one a sample; the same sums.
+  void countVisibleSamples(const std::vector<uint32_t>& ids) {
+    std::fill(visible.begin(), visible.end(), 0);
+    const uint32_t n = uint32_t(hierarchy.size());
+    const size_t count = ids.size();
+    for (size_t k = 0; k < count;) {
+      const uint32_t id = ids[k];
+      size_t end = k + 1;
+      while (end < count && ids[end] == id) ++end;
+      if (id != kNoItem) {
+        if (id > n) throw Error(ExitCode::kInternal, "", "item buffer id out of range");
+        visible[id - 1] += long(end - k);
+      }
+      k = end;
+    }
+  }
+
   // Frame v.frame, whose item buffer `items` was rendered at v in `seconds`.
   void addRendered(const FrameView& v, const ItemBuffer& items, double seconds,
                    const std::function<void(const IntervalFrame&)>& observer) {
@@ -321,13 +340,7 @@ struct TextureIntervalsBuilder::Impl {
     itemSeconds += seconds;
 
     // Visible pixels per leaf, then summed up the tree (children come after parents).
-    std::fill(visible.begin(), visible.end(), 0);
-    const long n = long(hierarchy.size());
-    for (uint32_t id : items.id) {
-      if (id == kNoItem) continue;
-      if (long(id) > n) throw Error(ExitCode::kInternal, "", "item buffer id out of range");
-      ++visible[id - 1];
-    }
+    countVisibleSamples(items.id);
     for (int i = hierarchy.size() - 1; i >= hierarchy.topCount(); --i)
       visible[hierarchy.node(i).parent] += visible[i];
 

@@ -30,6 +30,17 @@ TextureIntervals intervalsRecord(const std::vector<MovieExtent>& extents,
   return iv;
 }
 
+// Whether any pixel centre of `samples` (a buffer of `grid`) shows a surface: pixelCentreSamples'
+// ids not all kNoItem, without making that buffer every frame.
+bool showsSurfaceAtPixelCentres(const ItemBuffer& samples, const SampleGrid& grid) {
+  for (int row = 0; row < grid.image.height; ++row) {
+    const uint32_t* line = samples.id.data() + size_t(grid.centre(row)) * samples.width;
+    for (int col = 0; col < grid.image.width; ++col)
+      if (line[grid.centre(col)] != kNoItem) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
@@ -58,13 +69,11 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
       frames, renderers,
       [&](const IntervalFrame& fr) {
         run.itemSeconds.push_back(fr.itemBufferSeconds);
-        // The pixel centres: what the frame shows (the grid's margin lies outside it), and the
-        // pixel-sized buffer rad-diff --surfaces reads.
-        const ItemBuffer centres = pixelCentreSamples(*fr.itemBuffer, grid);
-        const std::vector<uint32_t>& ids = centres.id;
-        if (std::all_of(ids.begin(), ids.end(), [](uint32_t id) { return id == kNoItem; }))
-          run.emptyFrames.push_back(fr.frame);
+        // The pixel centres: what the frame shows (the grid's margin lies outside it).
+        if (!showsSurfaceAtPixelCentres(*fr.itemBuffer, grid)) run.emptyFrames.push_back(fr.frame);
         if (itemBuffersDir.empty()) return;
+        // The pixel-sized buffer rad-diff --surfaces reads.
+        const ItemBuffer centres = pixelCentreSamples(*fr.itemBuffer, grid);
         char name[32];
         std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
         writeItemBufferExr(itemBuffersDir + name, centres, fr.frame, fr.time, provenanceJson);
