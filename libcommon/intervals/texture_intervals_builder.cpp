@@ -331,6 +331,26 @@ struct TextureIntervalsBuilder::Impl {
   // Frame v.frame, whose item buffer `items` was rendered at v in `seconds`.
   void addRendered(const FrameView& v, const ItemBuffer& items, double seconds,
                    const std::function<void(const IntervalFrame&)>& observer) {
+    countVisibleSamples(items.id);
+    addCounted(v, &items, seconds, observer);
+  }
+
+  // visible[i] = counts[k] for leaves[k] (addVisibleSamples' contract), 0 elsewhere.
+  void setVisibleSamples(const std::vector<uint32_t>& leaves, const std::vector<uint32_t>& counts) {
+    if (leaves.size() != counts.size())
+      throw Error(ExitCode::kInternal, "", "visible samples: leaves and counts differ in number");
+    std::fill(visible.begin(), visible.end(), 0);
+    for (size_t k = 0; k < leaves.size(); ++k) {
+      if (leaves[k] >= uint32_t(hierarchy.size()) || !hierarchy.isLeaf(int(leaves[k])))
+        throw Error(ExitCode::kInternal, "", "visible samples: not a leaf of the subdivision");
+      visible[leaves[k]] = long(counts[k]);
+    }
+  }
+
+  // Frame v.frame, whose leaves' visible samples are in `visible` (item buffer `items`, or
+  // none when they were counted elsewhere).
+  void addCounted(const FrameView& v, const ItemBuffer* items, double seconds,
+                  const std::function<void(const IntervalFrame&)>& observer) {
     const int frame = v.frame;
     if (frames > 0 && frame <= lastFrame)
       throw Error(ExitCode::kInternal, "", "frames must be strictly increasing");
@@ -339,8 +359,7 @@ struct TextureIntervalsBuilder::Impl {
     const std::vector<glm::dmat4>& transforms = v.transforms;
     itemSeconds += seconds;
 
-    // Visible pixels per leaf, then summed up the tree (children come after parents).
-    countVisibleSamples(items.id);
+    // Visible pixels per leaf summed up the tree (children come after parents).
     for (int i = hierarchy.size() - 1; i >= hierarchy.topCount(); --i)
       visible[hierarchy.node(i).parent] += visible[i];
 
@@ -415,7 +434,7 @@ struct TextureIntervalsBuilder::Impl {
       f.frame = frame;
       f.time = t;
       f.itemBufferSeconds = seconds;
-      f.itemBuffer = &items;
+      f.itemBuffer = items;
       f.visiblePixels = &visible;
       f.projectedArea = &area;
       f.areaInFrustum = &inFrustum;
@@ -584,6 +603,13 @@ const TextureIntervalsOptions& TextureIntervalsBuilder::options() const {
 void TextureIntervalsBuilder::addFrame(int frame,
                                        const std::function<void(const IntervalFrame&)>& observer) {
   impl_->addFrame(frame, observer);
+}
+void TextureIntervalsBuilder::addVisibleSamples(
+    int frame, const std::vector<uint32_t>& leaves, const std::vector<uint32_t>& counts,
+    double itemBufferSeconds, const std::function<void(const IntervalFrame&)>& observer) {
+  Impl& b = *impl_;
+  b.setVisibleSamples(leaves, counts);
+  b.addCounted(b.frameView(frame), nullptr, itemBufferSeconds, observer);
 }
 const std::vector<MovieExtent>& TextureIntervalsBuilder::movies() const {
   return impl_->movies;

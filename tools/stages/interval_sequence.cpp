@@ -41,6 +41,17 @@ bool showsSurfaceAtPixelCentres(const ItemBuffer& samples, const SampleGrid& gri
   return false;
 }
 
+// Item buffers drawn by one GL context a thread (TextureIntervalsBuilder::addFrames).
+size_t renderersForThisProcess() {
+  return std::clamp<size_t>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1, 4);
+}
+
+void finishSequence(IntervalSequence& run, TextureIntervalsBuilder& builder, const Scene& scene,
+                    int cameraNode, const std::vector<int>& frames,
+                    const TextureIntervalsOptions& options,
+                    std::chrono::steady_clock::time_point start);
+
 }  // namespace
 
 IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
@@ -62,11 +73,8 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
   TextureIntervalsBuilder builder(scene, cameraNode, built);
   const SampleGrid grid = options.sampling.grid(options.imageSize);
   run.setupSeconds = secondsSince(start);
-  // Item buffers drawn by one GL context a thread (TextureIntervalsBuilder::addFrames).
-  const size_t renderers = std::clamp<size_t>(
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1, 4);
   builder.addFrames(
-      frames, renderers,
+      frames, renderersForThisProcess(),
       [&](const IntervalFrame& fr) {
         run.itemSeconds.push_back(fr.itemBufferSeconds);
         // The pixel centres: what the frame shows (the grid's margin lies outside it).
@@ -79,6 +87,73 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
         writeItemBufferExr(itemBuffersDir + name, centres, fr.frame, fr.time, provenanceJson);
       },
       frameDone);
+  finishSequence(run, builder, scene, cameraNode, frames, options, start);
+  return run;
+}
+
+IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
+                                         const std::vector<int>& frames,
+                                         const TextureIntervalsOptions& options,
+                                         const std::vector<VisibleSamplesFrame>& counted,
+                                         const std::function<void()>& frameDone) {
+  if (counted.size() != frames.size())
+    throw Error(ExitCode::kInternal, "", "visible samples: not one record a frame");
+  IntervalSequence run;
+  const auto start = std::chrono::steady_clock::now();
+  TextureIntervalsOptions built = options;
+  built.itemBufferDepth = false;
+  TextureIntervalsBuilder builder(scene, cameraNode, built);
+  run.setupSeconds = secondsSince(start);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const VisibleSamplesFrame& c = counted[i];
+    if (c.frame != frames[i])
+      throw Error(ExitCode::kInternal, "", "visible samples: frames out of order");
+    builder.addVisibleSamples(c.frame, c.leaf, c.count, c.itemBufferSeconds);
+    run.itemSeconds.push_back(c.itemBufferSeconds);
+    if (c.empty) run.emptyFrames.push_back(c.frame);
+    if (frameDone) frameDone();
+  }
+  finishSequence(run, builder, scene, cameraNode, frames, options, start);
+  return run;
+}
+
+VisibleSamples computeVisibleSamples(const Scene& scene, int cameraNode,
+                                     const std::vector<int>& frames,
+                                     const TextureIntervalsOptions& options,
+                                     const nlohmann::json& parameters,
+                                     const std::function<void()>& frameDone) {
+  VisibleSamples out;
+  out.parameters = parameters;
+  TextureIntervalsOptions built = options;
+  built.itemBufferDepth = false;
+  TextureIntervalsBuilder builder(scene, cameraNode, built);
+  const SampleGrid grid = options.sampling.grid(options.imageSize);
+  const PatchHierarchy& ph = builder.hierarchy();
+  builder.addFrames(
+      frames, renderersForThisProcess(),
+      [&](const IntervalFrame& fr) {
+        VisibleSamplesFrame f;
+        f.frame = fr.frame;
+        f.empty = !showsSurfaceAtPixelCentres(*fr.itemBuffer, grid);
+        f.itemBufferSeconds = fr.itemBufferSeconds;
+        const std::vector<long>& visible = *fr.visiblePixels;
+        for (int i = 0; i < ph.size(); ++i)
+          if (visible[i] > 0 && ph.isLeaf(i)) {
+            f.leaf.push_back(uint32_t(i));
+            f.count.push_back(uint32_t(visible[i]));
+          }
+        out.frames.push_back(std::move(f));
+      },
+      frameDone);
+  return out;
+}
+
+namespace {
+
+void finishSequence(IntervalSequence& run, TextureIntervalsBuilder& builder, const Scene& scene,
+                    int cameraNode, const std::vector<int>& frames,
+                    const TextureIntervalsOptions& options,
+                    std::chrono::steady_clock::time_point start) {
   const std::vector<MovieExtent> extents = builder.finish();
   run.totalSeconds = secondsSince(start);
 
@@ -94,8 +169,9 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
   run.patchNodes = ph.size();
   run.itemBufferSeconds = builder.itemBufferSeconds();
   run.continuedOverGaps = builder.moviesContinuedOverGaps();
-  return run;
 }
+
+}  // namespace
 
 nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::string& output) {
   nlohmann::json report = summarizeTextureIntervals(ContainerReader::open(output));
