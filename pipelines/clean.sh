@@ -4,7 +4,7 @@
 # they are about to refill. A file the pipeline did not write is left where it is, and the folder
 # that holds it is kept and named on stderr.
 #
-#   pipelines/clean.sh OUT [all|movies|frames|global-windows]...
+#   pipelines/clean.sh OUT [all|movies|frames|global-windows|interval-windows]...
 #
 # OUT has been checked by check-variables.sh (stages.mk) before this runs.
 set -euo pipefail
@@ -47,11 +47,14 @@ clean_part() {
     global-windows)
       remove_matching "$out/global-windows" "w[0-9]+\.rkw|w[0-9]+-report\.json|\.window-[0-9]+-of-[0-9]+|$temporaries"
       remove_folder "$out/global-windows" ;;
+    interval-windows)
+      remove_matching "$out/interval-windows" "w[0-9]+\.rvs|\.window-[0-9]+-of-[0-9]+|$temporaries"
+      remove_folder "$out/interval-windows" ;;
     logs)
       remove_matching "$out/logs" "[a-z-]+_[0-9]+\.(log|exit)(\.tmp)?"
       remove_folder "$out/logs" ;;
     all)
-      for p in movies frames global-windows logs; do clean_part "$p"; done
+      for p in movies frames global-windows interval-windows logs; do clean_part "$p"; done
       remove_matching "$out/piece-costs" "[0-9]+-[0-9]+\.json"
       remove_folder "$out/piece-costs"
       remove_matching "$out" "global\.rlh|intervals\.rti|scene\.json|\.(movies|frames)\.lock|movie\.mp4|contact-sheet\.png|slurm-jobs|(scene|global|intervals|movies|compose)\.params|(global|intervals|movies|compose)-report(-[0-9x-]+|-[0-9]+of[0-9]+)?\.json|$temporaries"

@@ -11,7 +11,12 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
 
   global || intervals   one task each (global: the sum of its key times; with --global-windows,
                         W = min(N x C, keys) windows, each paying a from-scratch first key
-                        (key 0's time) and the rest coherent, then the merge)
+                        (key 0's time) and the rest coherent, then the merge; with
+                        --interval-windows (slurm.mk's INTERVAL_WINDOWS), rad-intervals'
+                        item buffers in W = min(N x C, frames) windows of frames, each paying
+                        the set-up and its frames' share of the per-frame time, then the pass
+                        over their counts: the set-up and --interval-merge-fraction of the
+                        per-frame time, what drawing no item buffer leaves of it)
   movies                movie i in shard i % SHARDS; each shard pays the fixed cost once;
                         shards are list-scheduled on the N x C cores (longest first).
                         With --piece-keys K (slurm.mk's MOVIE_PIECE_KEYS, issue 58), a movie of
@@ -152,6 +157,8 @@ def pieces(run_dir):
         "global_fixed": g["seconds"]["total"] - sum(keys),
         "keys": keys,
         "intervals": i["total_seconds"],
+        "intervals_fixed": i["setup_seconds"],
+        "intervals_frames": i["frames"],
         "movies": movies,
         "movie_plans": {mid: plans.get(mid, (1, 0.0)) for mid, _ in movies},
         "movies_fixed": m["seconds"]["total"] - sum(s for _, s in movies),
@@ -188,6 +195,20 @@ def global_seconds(p, slots, windows):
     slowest = max(p["global_fixed"] + scratch + sum(p["keys"][a + 1:b])
                   for a, b in zip(bounds, bounds[1:]))
     merge = p["global_fixed"]  # reading the windows and writing global.rlh
+    return slowest + merge
+
+
+def intervals_seconds(p, slots, windows, merge_fraction):
+    """rad-intervals' time on the critical path: one task, or windows of frames side by side and
+    the pass over their counts (rad-intervals --window, --merge)."""
+    if not windows or slots <= 1:
+        return p["intervals"]
+    n = p["intervals_frames"]
+    w = min(slots, n)
+    per_frame = (p["intervals"] - p["intervals_fixed"]) / n
+    largest = max(n * (j + 1) // w - n * j // w for j in range(w))
+    slowest = p["intervals_fixed"] + per_frame * largest
+    merge = p["intervals_fixed"] + per_frame * n * merge_fraction
     return slowest + merge
 
 
@@ -277,7 +298,7 @@ def merges_in_tasks(p, pieces, merges, shards, shard_of=None):
 
 
 def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False, merge_stage=False,
-          piece_seconds=0.0):
+          piece_seconds=0.0, interval_windows=False, interval_merge_fraction=0.01):
     slots = nodes * cores
     shards = slots
     movie_shards = [0.0] * shards
@@ -296,28 +317,31 @@ def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False, merge
     compose_tasks = [p["compose_fixed"] + sum(p["frames"][n * j // chunks:n * (j + 1) // chunks])
                      + encode * (n * (j + 1) // chunks - n * j // chunks) for j in range(chunks)]
     g = global_seconds(p, slots, windows)
+    iv = intervals_seconds(p, slots, interval_windows, interval_merge_fraction)
     path = {
-        "global || intervals": max(g, p["intervals"]),
+        "global || intervals": max(g, iv),
         "movies": makespan(movie_tasks, slots),
         "movie merge": merge,
         "compose": makespan(compose_tasks, slots),
         "mp4 + contact sheet": video_path(p, segments),
-        "scheduling": stage_boundaries(windows and slots > 1, merge_stage and merge) * latency,
+        "scheduling": stage_boundaries((windows or interval_windows) and slots > 1,
+                                       merge_stage and merge) * latency,
     }
     return path, sum(path.values())
 
 
 def stage_boundaries(global_windows, movie_merge):
     """The stages on the critical path, each started after one scheduling latency: global (and its
-    merge, when in windows), movies (and their merges when a stage of their own), compose, the
-    mp4."""
+    merge, when in windows; or rad-intervals' pass over its windows, taken as on the path too),
+    movies (and their merges when a stage of their own), compose, the mp4."""
     return 4 + (1 if global_windows else 0) + (1 if movie_merge else 0)
 
 
 def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=False,
-                piece_seconds=0.0):
+                piece_seconds=0.0, interval_windows=False, interval_merge_fraction=0.01):
     """The critical path with unlimited nodes: what no number of nodes shortens."""
     g = global_seconds(p, len(p["keys"]), windows)
+    iv = intervals_seconds(p, p["intervals_frames"], interval_windows, interval_merge_fraction)
     pieces, merges = movie_pieces(p, piece_keys, piece_seconds)
     if merge_stage:
         merge = merge_seconds(p, merges, max(1, len(merges)))
@@ -329,13 +353,13 @@ def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=F
                       for mid, j, s in pieces)
     encode = p["video_parts"]["mp4"] / len(p["frames"]) if segments else 0.0
     return {
-        "global || intervals": max(g, p["intervals"]),
+        "global || intervals": max(g, iv),
         "scene loading": p["movies_fixed"] + p["compose_fixed"],
         "longest movie": longest,
         "movie merge": merge,
         "longest frame": max(p["frames"]) + encode,
         "ffmpeg": video_path(p, segments),
-        "scheduling": stage_boundaries(windows, merge_stage and merge) * latency,
+        "scheduling": stage_boundaries(windows or interval_windows, merge_stage and merge) * latency,
     }
 
 
@@ -348,6 +372,7 @@ def self_test():
     check("LPT of 5,1,1,1 on 4 cores", makespan([5, 1, 1, 1], 4), 5)
     check("no task", makespan([], 4), 0)
     p = {"global": 10.0, "global_fixed": 0.0, "keys": [4.0, 2.0, 2.0, 2.0], "intervals": 1.0,
+         "intervals_fixed": 0.2, "intervals_frames": 10,
          "movies": [(0, 1.0), (1, 1.0), (2, 1.0), (3, 3.0)], "movies_fixed": 0.5,
          "frames": [0.25] * 4, "compose_fixed": 0.1, "video": 2.0, "wall": 20.0}
     path, wall = model(p, 1, 2, 1.0, False)
@@ -362,6 +387,19 @@ def self_test():
     check("movies on 16 cores: the longest movie", path["movies"], 0.5 + 3.0)
     serial = serial_part(p, 0.0, False)
     check("serial part", sum(serial.values()), 10.0 + 0.6 + 3.0 + 0.25 + 2.0)
+    # rad-intervals in windows of frames: 10 frames of 2 s after 0.2 s of set-up, on 4 cores
+    # windows of 2, 3, 2, 3 frames, then the pass over their counts (the set-up and 1 %).
+    q = dict(p, intervals=20.2, **{"global": 1.0})
+    path, wall = model(q, 2, 2, 1.0, False)
+    check("intervals as one task", path["global || intervals"], 20.2)
+    path, wall = model(q, 2, 2, 1.0, False, interval_windows=True)
+    check("intervals in four windows and the pass", path["global || intervals"],
+          0.2 + 3 * 2.0 + 0.2 + 0.01 * 20.0)
+    check("the pass is one more stage", path["scheduling"], 5.0)
+    serial = serial_part(q, 1.0, False, interval_windows=True)
+    check("serial: a window of one frame and the pass", serial["global || intervals"],
+          0.2 + 2.0 + 0.2 + 0.01 * 20.0)
+    check("serial: the pass's stage", serial["scheduling"], 5.0)
     # Pieces (issue 58): movie 3 (3 s, 6 keys, 1 s of planning) in pieces of at most 2 keys is
     # 3 pieces of 1 + 2/3 s each, the 4th to 6th pieces dealt: shards 3, 0, 1;
     # the merge reads and writes its 600 bytes at 0.0005 s a byte, after the fixed 0.5 s.
@@ -440,6 +478,12 @@ def main():
                     help="the cut by known cost (slurm.mk's MOVIE_PIECE_COSTS, rad-movies "
                     "--piece-costs --piece-seconds T): movies of more than T seconds in pieces "
                     "of about T, the rest whole, dealt longest first; the costs are the run's own")
+    ap.add_argument("--interval-windows", action="store_true",
+                    help="rad-intervals' item buffers in windows of frames, then the pass over "
+                    "their counts (slurm.mk's INTERVAL_WINDOWS)")
+    ap.add_argument("--interval-merge-fraction", type=float, default=0.01,
+                    help="the pass over the windows' counts, as a fraction of rad-intervals' "
+                    "per-frame time (docs/results.md, \"rad-intervals' item buffers by windows\")")
     ap.add_argument("--merge-stage", action="store_true",
                     help="with --piece-keys: the merges as a stage of their own (slurm.mk before "
                     "the merges went into the piece tasks)")
@@ -464,11 +508,12 @@ def main():
         p["video_parts"] = time_video(run_dir)
     one_core = p["wall"]
     print("farm model of %s: one core %.1f s (global %.1f, intervals %.1f, %d movies %.1f + %.2f fixed, "
-          "%d frames %.1f + %.2f fixed, ffmpeg %.1f); %d cores per node, %.1f s latency per stage%s%s%s%s"
+          "%d frames %.1f + %.2f fixed, ffmpeg %.1f); %d cores per node, %.1f s latency per stage%s%s%s%s%s"
           % (run_dir, one_core, p["global"], p["intervals"], len(p["movies"]),
              sum(s for _, s in p["movies"]), p["movies_fixed"], len(p["frames"]), sum(p["frames"]),
              p["compose_fixed"], p["video"], args.cores, args.latency,
              ", rad-global in time windows" if args.global_windows else "",
+             ", rad-intervals' item buffers in windows" if args.interval_windows else "",
              ", movies in pieces of at most %d keys (merged %s)"
              % (args.piece_keys, "as a stage" if args.merge_stage else "in the piece tasks")
              if args.piece_keys else "",
@@ -482,12 +527,14 @@ def main():
     for nodes in [int(x) for x in args.nodes.split(",")]:
         path, wall = model(p, nodes, args.cores, args.latency, args.global_windows,
                            args.piece_keys, args.video_segments, args.merge_stage,
-                           args.piece_seconds)
+                           args.piece_seconds, args.interval_windows,
+                           args.interval_merge_fraction)
         rows.append({"nodes": nodes, "wall": wall, "path": path})
         print("%6d %9.1f %8.1fx  %s" % (nodes, wall, one_core / wall,
                                         ", ".join("%s %.1f" % kv for kv in path.items())))
     serial = serial_part(p, args.latency, args.global_windows, args.piece_keys,
-                         args.video_segments, args.merge_stage, args.piece_seconds)
+                         args.video_segments, args.merge_stage, args.piece_seconds,
+                         args.interval_windows, args.interval_merge_fraction)
     total = sum(serial.values())
     print("serial part (the critical path on unlimited nodes): %.1f s = %.1f %% of the one-core "
           "time, so the speed-up is at most %.1fx: %s"

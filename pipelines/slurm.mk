@@ -10,6 +10,11 @@
 #                                    as an array over W time windows of FRAMES (`--window`) and
 #                                    a merge job (`--merge`), whose global.rlh is the one job's,
 #                                    byte for byte
+#                                    With INTERVAL_WINDOWS=W (default 4), rad-intervals as an
+#                                    array drawing the item buffers of W contiguous windows of
+#                                    FRAMES (`--window`, each writing its frames' visible samples)
+#                                    and a job deciding the movies from them (`--merge`), whose
+#                                    intervals.rti is the one job's, byte for byte
 #   rad-movies                       an array over `--shard i/SHARDS`; with MOVIE_PIECE_KEYS=K
 #                                    (the default), a movie of more than K keys is baked as
 #                                    pieces of at most K keys spread over the shards
@@ -37,6 +42,9 @@ include $(HERE)stages.mk
 
 SHARDS         ?= 4
 GLOBAL_WINDOWS ?= 1
+# rad-intervals' windows of item buffers (1: one job). Its sequential pass over their counts is
+# a small part of its time (docs/results.md, "rad-intervals' item buffers by windows").
+INTERVAL_WINDOWS ?= 4
 # Keys per movie piece (rad-movies --piece-keys; 0: whole movies, no merge). Each piece plans
 # its movie again, so a smaller piece cuts the longest task and adds planning (docs/results.md,
 # "Farm tasks finer than one movie" and its sequel).
@@ -88,6 +96,10 @@ $(error slurm.mk: GLOBAL_WINDOWS=$(GLOBAL_WINDOWS): $(BIN)/rad-global --print-wi
 endif
 endif
 WINDOW_COUNT := $(words $(WINDOWS))
+# rad-intervals' windows: contiguous chunks of FRAMES (any frame may start one).
+INTERVAL_WINDOW_LIST  := $(call split-frames,$(INTERVAL_WINDOWS))
+INTERVAL_WINDOW_COUNT := $(words $(INTERVAL_WINDOW_LIST))
+INTERVAL_WINDOW_FILES := $(foreach i,$(shell seq 0 $$(($(INTERVAL_WINDOW_COUNT) - 1))),$(OUT)/interval-windows/w$(i).rvs)
 WINDOW_FILES := $(foreach i,$(shell seq 0 $$(($(WINDOW_COUNT) - 1))),$(OUT)/global-windows/w$(i).rkw)
 
 # Submits stage $(1): array indices $(2) (a shell word; empty: one task, numbered 0), after the
@@ -129,8 +141,20 @@ else
 	$(call submit,global-merge,,global,$(call GLOBAL_MERGE_CMD,$(WINDOW_FILES)))
 endif
 
+# One job, or INTERVAL_WINDOWS windows of item buffers side by side and the pass over their
+# counts (the same bytes).
 $(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-intervals
+ifeq ($(INTERVAL_WINDOW_COUNT),1)
 	@$(call submit,intervals,,,$(INTERVALS_CMD))
+else
+	@missing=$$($(HERE)slurm-pieces.sh $(OUT)/interval-windows window $(INTERVAL_WINDOW_COUNT) $(JOBS) "" $^) && \
+	if [ -n "$$missing" ]; then \
+	  $(call submit,intervals,$$missing,,set -- $(INTERVAL_WINDOW_LIST) && shift $${SLURM_ARRAY_TASK_ID} && \
+	    $(call INTERVALS_WINDOW_CMD,$$1,$(OUT)/interval-windows/w$${SLURM_ARRAY_TASK_ID}.rvs) && \
+	    touch $(OUT)/interval-windows/.window-$${SLURM_ARRAY_TASK_ID}-of-$(INTERVAL_WINDOW_COUNT)); \
+	fi && \
+	$(call submit,intervals-merge,,intervals,$(call INTERVALS_MERGE_CMD,$(INTERVAL_WINDOW_FILES)))
+endif
 
 # The shards' stamps name the piece size (.pshardK-I-of-N), so that pieces of another size are
 # never merged: slurm-pieces.sh empties the folder when the stamps are of another kind.
@@ -161,9 +185,9 @@ endif
 MOVIES_TASK_MERGE = $(if $(MOVIES_PIECE_ARGS), && $(call MOVIES_MERGE_READY_CMD,$(MOVIES_MERGE_K),$${SLURM_ARRAY_TASK_ID}/$(SHARDS))$(MOVIES_MERGE_COSTS))
 $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies.params $(BIN)/rad-movies
 	@rm -f $@ && $(MOVIES_COST_COPY) \
-	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies $(MOVIES_SHARD_KIND) $(SHARDS) $(JOBS) "global global-merge intervals" $^) && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/movies $(MOVIES_SHARD_KIND) $(SHARDS) $(JOBS) "global global-merge intervals intervals-merge" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,movies,$$missing,global global-merge intervals,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS))$(MOVIES_PIECE_ARGS)$(MOVIES_TASK_MERGE) \
+	  $(call submit,movies,$$missing,global global-merge intervals intervals-merge,$(call MOVIES_SHARD_CMD,$${SLURM_ARRAY_TASK_ID},$(SHARDS))$(MOVIES_PIECE_ARGS)$(MOVIES_TASK_MERGE) \
 	    && touch $(OUT)/movies/.$(MOVIES_SHARD_KIND)-$$SLURM_ARRAY_TASK_ID-of-$(SHARDS)) && \
 	  $(call submit,movies-done,,movies,touch $@); \
 	else touch $@; fi
@@ -171,9 +195,9 @@ $(OUT)/movies/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti 
 $(OUT)/frames/.done: $(OUT)/scene.params $(OUT)/global.rlh $(OUT)/intervals.rti $(OUT)/movies/.done $(OUT)/compose.params \
                      $(BIN)/rad-compose
 	@rm -f $@ && \
-	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals movies" $^) && \
+	missing=$$($(HERE)slurm-pieces.sh $(OUT)/frames chunk $(CHUNK_COUNT) $(JOBS) "global global-merge intervals intervals-merge movies" $^) && \
 	if [ -n "$$missing" ]; then \
-	  $(call submit,compose,$$missing,global global-merge intervals movies,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
+	  $(call submit,compose,$$missing,global global-merge intervals intervals-merge movies,set -- $(CHUNKS) && shift $$SLURM_ARRAY_TASK_ID && \
 	    $(call COMPOSE_CHUNK_CMD,$$1) && $(call SEGMENT_CMD,$$1) && \
 	    touch $(OUT)/frames/.chunk-$$SLURM_ARRAY_TASK_ID-of-$(CHUNK_COUNT)) && \
 	  $(call submit,frames-done,,compose,touch $@); \

@@ -93,6 +93,11 @@ COMPOSE_CMD   = $(call COMPOSE_RUN,$(COMPOSE_ARGS),$(OUT)/compose-report.json)
 # byte for byte (it is GLOBAL_CMD plus --merge); movie shard $(1) of $(2); the frames $(1).
 GLOBAL_WINDOW_CMD = $(call GLOBAL_RUN,$(2),$(2:.rkw=-report.json)) --window $(1)
 GLOBAL_MERGE_CMD  = $(GLOBAL_CMD) --merge $(1)
+# rad-intervals' item buffers of the frames $(1) (FIRST-LAST) counted into window file $(2), and
+# the pass over the window files $(1), which writes what INTERVALS_CMD writes, byte for byte (it
+# is INTERVALS_CMD plus --merge, which the provenance leaves out).
+INTERVALS_WINDOW_CMD = $(strip $(BIN)/rad-intervals $(SCENE) -o $(2) $(INTERVALS_ARGS)) --window $(1)
+INTERVALS_MERGE_CMD  = $(INTERVALS_CMD) --merge $(1)
 MOVIES_SHARD_CMD  = $(call MOVIES_RUN,$(OUT)/movies-report-$(1)of$(2).json) --shard $(1)/$(2)
 # The merge of the movie pieces of at most $(1) keys the shards baked (--piece-keys), of the
 # movies of shard $(2) (i/n): it writes what MOVIES_CMD writes, byte for byte (it is MOVIES_CMD

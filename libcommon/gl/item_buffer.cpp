@@ -42,6 +42,28 @@ void main() {
 }
 )";
 
+// The ids alone (ItemBufferOptions::readDepth false): no depth varying to set up and interpolate
+// and no second output, so llvmpipe's fragment stage does less a sample. gl_Position is computed
+// as in kVertexShader, so the same samples pass the depth test and the ids are the same.
+constexpr const char* kIdsOnlyVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in uint itemId;
+uniform mat4 clipFromLocal;
+flat out uint vItemId;
+void main() {
+  vItemId = itemId;
+  gl_Position = clipFromLocal * vec4(position, 1.0);
+}
+)";
+
+constexpr const char* kIdsOnlyFragmentShader = R"(#version 450 core
+flat in uint vItemId;
+layout(location = 0) out uint outItemId;
+void main() {
+  outItemId = vItemId;
+}
+)";
+
 struct Vertex {
   float x, y, z;
   uint32_t id;
@@ -82,9 +104,10 @@ struct ItemBufferRenderer::Impl {
   SampleGrid grid;    // the image the projection is of, and the samples drawn
   ImageSize size;     // grid.size(): the buffer's
   ItemBufferOptions options;
-  GLuint program = 0, vao = 0, vbo = 0, fbo = 0;
+  GLuint program = 0, idsOnlyProgram = 0, vao = 0, vbo = 0, fbo = 0;
   GLuint idTexture = 0, depthTexture = 0, depthRenderbuffer = 0;
   GLint clipFromLocalLocation = -1, depthFromLocalLocation = -1;
+  GLint idsOnlyClipFromLocalLocation = -1;
   std::vector<DrawRange> ranges;
 
   Impl(const SampleGrid& g, ItemBufferOptions o) : grid(g), size(g.size()), options(o) {
@@ -101,6 +124,9 @@ struct ItemBufferRenderer::Impl {
     program = compileProgram("item buffer", kVertexShader, kFragmentShader);
     clipFromLocalLocation = glGetUniformLocation(program, "clipFromLocal");
     depthFromLocalLocation = glGetUniformLocation(program, "depthFromLocal");
+    idsOnlyProgram =
+        compileProgram("item buffer (ids only)", kIdsOnlyVertexShader, kIdsOnlyFragmentShader);
+    idsOnlyClipFromLocalLocation = glGetUniformLocation(idsOnlyProgram, "clipFromLocal");
 
     glGenVertexArrays(1, &vao);
     glGenBuffers(1, &vbo);
@@ -157,6 +183,7 @@ struct ItemBufferRenderer::Impl {
     glDeleteTextures(1, &idTexture);
     glDeleteBuffers(1, &vbo);
     glDeleteVertexArrays(1, &vao);
+    glDeleteProgram(idsOnlyProgram);
     glDeleteProgram(program);
   }
 };
@@ -274,7 +301,9 @@ void ItemBufferRenderer::render(const CameraView& view,
   if (m.options.readDepth) glClearBufferfv(GL_COLOR, 1, farDepth);
   glClearBufferfv(GL_DEPTH, 0, &clearDepth);
 
-  glUseProgram(m.program);
+  const bool depth = m.options.readDepth;
+  glUseProgram(depth ? m.program : m.idsOnlyProgram);
+  const GLint clipLocation = depth ? m.clipFromLocalLocation : m.idsOnlyClipFromLocalLocation;
   glBindVertexArray(m.vao);
   for (size_t k = 0; k < m.ranges.size(); ++k) {
     const DrawRange& r = m.ranges[k];
@@ -285,12 +314,14 @@ void ItemBufferRenderer::render(const CameraView& view,
             ? rasterClipFromLocal(view, size, worldFromLocal)
             : rasterClipFromLocal(view, m.grid.image, worldFromLocal, m.grid.ndcScale());
     if (outsideClipVolume(clip, r.bounds)) continue;
-    glm::dmat4 eyeFromLocal = eyeFromWorld * worldFromLocal;
-    // Row 2 of eyeFromLocal (glm is column-major), negated: depth = -z_eye.
-    glm::vec4 depthRow(-eyeFromLocal[0][2], -eyeFromLocal[1][2], -eyeFromLocal[2][2],
-                       -eyeFromLocal[3][2]);
-    glUniformMatrix4fv(m.clipFromLocalLocation, 1, GL_FALSE, &clip[0][0]);
-    glUniform4fv(m.depthFromLocalLocation, 1, &depthRow[0]);
+    glUniformMatrix4fv(clipLocation, 1, GL_FALSE, &clip[0][0]);
+    if (depth) {
+      glm::dmat4 eyeFromLocal = eyeFromWorld * worldFromLocal;
+      // Row 2 of eyeFromLocal (glm is column-major), negated: depth = -z_eye.
+      glm::vec4 depthRow(-eyeFromLocal[0][2], -eyeFromLocal[1][2], -eyeFromLocal[2][2],
+                         -eyeFromLocal[3][2]);
+      glUniform4fv(m.depthFromLocalLocation, 1, &depthRow[0]);
+    }
     glDrawArrays(GL_TRIANGLES, r.first, r.count);
   }
 

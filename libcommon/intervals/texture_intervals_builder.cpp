@@ -320,9 +320,48 @@ struct TextureIntervalsBuilder::Impl {
     addRendered(v, buffer, secondsSince(start), observer);
   }
 
+  // visible[i] = the samples of `ids` showing leaf i. Counted by runs of one id: a leaf covers
+  // many neighbouring samples of a row (the grid has s^2 a pixel), so one add a run instead of
+  // one a sample; the same sums.
+  void countVisibleSamples(const std::vector<uint32_t>& ids) {
+    std::fill(visible.begin(), visible.end(), 0);
+    const uint32_t n = uint32_t(hierarchy.size());
+    const size_t count = ids.size();
+    for (size_t k = 0; k < count;) {
+      const uint32_t id = ids[k];
+      size_t end = k + 1;
+      while (end < count && ids[end] == id) ++end;
+      if (id != kNoItem) {
+        if (id > n) throw Error(ExitCode::kInternal, "", "item buffer id out of range");
+        visible[id - 1] += long(end - k);
+      }
+      k = end;
+    }
+  }
+
   // Frame v.frame, whose item buffer `items` was rendered at v in `seconds`.
   void addRendered(const FrameView& v, const ItemBuffer& items, double seconds,
                    const std::function<void(const IntervalFrame&)>& observer) {
+    countVisibleSamples(items.id);
+    addCounted(v, &items, seconds, observer);
+  }
+
+  // visible[i] = counts[k] for leaves[k] (addVisibleSamples' contract), 0 elsewhere.
+  void setVisibleSamples(const std::vector<uint32_t>& leaves, const std::vector<uint32_t>& counts) {
+    if (leaves.size() != counts.size())
+      throw Error(ExitCode::kInternal, "", "visible samples: leaves and counts differ in number");
+    std::fill(visible.begin(), visible.end(), 0);
+    for (size_t k = 0; k < leaves.size(); ++k) {
+      if (leaves[k] >= uint32_t(hierarchy.size()) || !hierarchy.isLeaf(int(leaves[k])))
+        throw Error(ExitCode::kInternal, "", "visible samples: not a leaf of the subdivision");
+      visible[leaves[k]] = long(counts[k]);
+    }
+  }
+
+  // Frame v.frame, whose leaves' visible samples are in `visible` (item buffer `items`, or
+  // none when they were counted elsewhere).
+  void addCounted(const FrameView& v, const ItemBuffer* items, double seconds,
+                  const std::function<void(const IntervalFrame&)>& observer) {
     const int frame = v.frame;
     if (frames > 0 && frame <= lastFrame)
       throw Error(ExitCode::kInternal, "", "frames must be strictly increasing");
@@ -331,14 +370,7 @@ struct TextureIntervalsBuilder::Impl {
     const std::vector<glm::dmat4>& transforms = v.transforms;
     itemSeconds += seconds;
 
-    // Visible pixels per leaf, then summed up the tree (children come after parents).
-    std::fill(visible.begin(), visible.end(), 0);
-    const long n = long(hierarchy.size());
-    for (uint32_t id : items.id) {
-      if (id == kNoItem) continue;
-      if (long(id) > n) throw Error(ExitCode::kInternal, "", "item buffer id out of range");
-      ++visible[id - 1];
-    }
+    // Visible pixels per leaf summed up the tree (children come after parents).
     for (int i = hierarchy.size() - 1; i >= hierarchy.topCount(); --i)
       visible[hierarchy.node(i).parent] += visible[i];
 
@@ -413,7 +445,7 @@ struct TextureIntervalsBuilder::Impl {
       f.frame = frame;
       f.time = t;
       f.itemBufferSeconds = seconds;
-      f.itemBuffer = &items;
+      f.itemBuffer = items;
       f.visiblePixels = &visible;
       f.projectedArea = &area;
       f.areaInFrustum = &inFrustum;
@@ -582,6 +614,13 @@ const TextureIntervalsOptions& TextureIntervalsBuilder::options() const {
 void TextureIntervalsBuilder::addFrame(int frame,
                                        const std::function<void(const IntervalFrame&)>& observer) {
   impl_->addFrame(frame, observer);
+}
+void TextureIntervalsBuilder::addVisibleSamples(
+    int frame, const std::vector<uint32_t>& leaves, const std::vector<uint32_t>& counts,
+    double itemBufferSeconds, const std::function<void(const IntervalFrame&)>& observer) {
+  Impl& b = *impl_;
+  b.setVisibleSamples(leaves, counts);
+  b.addCounted(b.frameView(frame), nullptr, itemBufferSeconds, observer);
 }
 const std::vector<MovieExtent>& TextureIntervalsBuilder::movies() const {
   return impl_->movies;

@@ -111,8 +111,9 @@ struct TextureIntervalsOptions {
 struct IntervalFrame {
   int frame = 0;
   double time = 0.0;
-  double itemBufferSeconds = 0.0;          // render + readback
-  const ItemBuffer* itemBuffer = nullptr;  // of options.sampling's grid (sample_grid.h)
+  double itemBufferSeconds = 0.0;  // render + readback
+  // Of options.sampling's grid (sample_grid.h); nullptr for addVisibleSamples' frames.
+  const ItemBuffer* itemBuffer = nullptr;
   // Per dense node index: visible pixels, projected area of the whole patch (pixels, see
   // above) and the part of it inside the frustum. The areas are computed only where the
   // algorithm needs them (nodes with visible pixels; the frustum area of nodes whose movie
@@ -150,6 +151,13 @@ class TextureIntervalsBuilder {
   void addFrames(const std::vector<int>& frames, size_t renderers,
                  const std::function<void(const IntervalFrame&)>& observer = {},
                  const std::function<void()>& frameDone = {});
+  // The same as addFrame for a frame whose item buffer was counted elsewhere (a farm task,
+  // formats/visible_samples.h): leaves[k] (dense node indices of leaves, each once) showed
+  // counts[k] samples of the grid, every other leaf none. The observer sees itemBuffer nullptr.
+  // Throws rad::Error(kInternal) for a node that is not a leaf or lists of different sizes.
+  void addVisibleSamples(int frame, const std::vector<uint32_t>& leaves,
+                         const std::vector<uint32_t>& counts, double itemBufferSeconds,
+                         const std::function<void(const IntervalFrame&)>& observer = {});
   // Closes the movies still open (kWindow) and returns all, in id order: sorted by
   // (firstFrame, patch.packed()), MovieExtent::movie = the index (intervals.rti's ids).
   std::vector<MovieExtent> finish();

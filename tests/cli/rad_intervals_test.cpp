@@ -64,6 +64,37 @@ TEST(RadIntervalsCli, IdenticalRunsGiveIdenticalFiles) {
   EXPECT_EQ(fa, readWholeFile((b / "i.rti").string()));
 }
 
+TEST(RadIntervalsCli, WindowsMergedGiveTheOneRunsBytes) {
+  // The farm (docs/design.md §7): item buffers by windows of frames, then the sequential pass
+  // over their counts writes the one run's intervals.rti, provenance included. Uneven windows
+  // and a frame step, so a window's edge falls between frames of --frames.
+  fs::path d = freshDir("windows");
+  const std::string run = "cd " + d.string() + " && " + tool("rad-intervals") + " " + kScene +
+                          " --frames 0-23x2 --size 176x120";
+  ASSERT_EQ(runCommand(run + " -o i.rti").exitCode, 0);
+  const std::string whole = readWholeFile((d / "i.rti").string());
+  fs::remove(d / "i.rti");
+  for (const char* w : {"0-6 -o a.rvs", "7-17 -o b.rvs", "18-23 -o c.rvs"}) {
+    CommandResult r = runCommand(run + " --window " + w);
+    ASSERT_EQ(r.exitCode, 0) << w << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "i.rti"));  // a window writes its counts, not intervals
+  CommandResult merged = runCommand(run + " -o i.rti --merge c.rvs a.rvs b.rvs");
+  ASSERT_EQ(merged.exitCode, 0) << merged.err;
+  EXPECT_EQ(readWholeFile((d / "i.rti").string()), whole);
+
+  // A missing window, and a window of other parameters, are refused on one line.
+  CommandResult missing = runCommand(run + " -o i.rti --merge a.rvs c.rvs");
+  EXPECT_EQ(missing.exitCode, 2) << missing.err;
+  EXPECT_NE(missing.err.find("no file holds frame 8"), std::string::npos) << missing.err;
+  ASSERT_EQ(runCommand(run + " --max-level 1 --window 7-17 -o other.rvs").exitCode, 0);
+  CommandResult other = runCommand(run + " -o i.rti --merge a.rvs other.rvs c.rvs");
+  EXPECT_NE(other.exitCode, 0);
+  EXPECT_NE(other.err.find("other.rvs: made with another max-level"), std::string::npos)
+      << other.err;
+  EXPECT_EQ(countLines(other.err), 1) << other.err;
+}
+
 TEST(RadIntervalsCli, BadValuesAreUsageErrors) {
   fs::path d = freshDir("bad");
   for (std::string flags : {"--max-level -1", "--min-visible-fraction 2", "--size 0x5",

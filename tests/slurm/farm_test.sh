@@ -3,7 +3,8 @@
 # pipelines/slurm.mk on a real single-node Slurm cluster (tests/slurm/cluster.sh), SHARDS=4,
 # WAIT=1, against animation.mk's frames on this machine:
 #   1. with rad-global in 3 time windows and a merge (GLOBAL_WINDOWS=3), global.rlh is the single
-#      run's byte for byte, and every frame's pixels (EXR and PNG) are bit-identical to
+#      run's byte for byte, rad-intervals' item buffers are drawn in 3 windows and its movies
+#      decided from their counts (INTERVAL_WINDOWS=3), and every frame's pixels (EXR and PNG) are bit-identical to
 #      animation.mk's (the frame files differ only in their provenance, which records each
 #      task's own command line and paths); the movies of more than MOVIE_PIECE_KEYS=4 keys were
 #      baked in pieces and merged by the movies tasks themselves, no merge stage (issue 58),
@@ -67,7 +68,7 @@ same_frames() {
 }
 
 # 1. A whole run, rad-global in 3 time windows and their merge.
-make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 GLOBAL_WINDOWS=3 WAIT=1 \
+make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 GLOBAL_WINDOWS=3 INTERVAL_WINDOWS=3 WAIT=1 \
   MOVIE_PIECE_KEYS=4 2>"$work/farm.err" || fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
 same_frames "$work/local" "$work/farm"
 if grep -q "slurm.mk: movies-merge submitted" "$work/farm.err"; then

@@ -454,6 +454,31 @@ TEST(ItemBuffer, DeterministicAcrossRendersAndRenderers) {
   EXPECT_EQ(std::memcmp(a.depth.data(), c.depth.data(), a.depth.size() * sizeof(float)), 0);
 }
 
+TEST(ItemBuffer, IdsWithoutDepthAreTheIdsWithDepth) {
+  // readDepth false draws with a program of its own (no depth varying, no second output):
+  // rad-intervals counts those ids, so they must be the same samples' ids bit for bit, on the
+  // sample grid too, and switching the option on one renderer must not mix the programs.
+  RandomScene s = randomScene(400, 5);
+  ItemObject o;
+  for (const ItemTriangle& t : s.triangles) o.addTriangle(t.p[0], t.p[1], t.p[2], t.id);
+  const SampleGrid grid{{352, 240}, 3, 1};
+  ItemBufferRenderer r(grid);
+  r.setGeometry({o});
+  const ItemBuffer withDepth = r.render(s.view, {glm::dmat4(1.0)});
+  ItemBufferOptions idsOnly;
+  idsOnly.readDepth = false;
+  r.setOptions(idsOnly);
+  const ItemBuffer ids = r.render(s.view, {glm::dmat4(1.0)});
+  EXPECT_TRUE(ids.depth.empty());
+  ASSERT_EQ(ids.id.size(), withDepth.id.size());
+  EXPECT_TRUE(ids.id == withDepth.id);
+  EXPECT_LT(countId(ids, kNoItem), int(ids.id.size()));  // the scene is in view
+  r.setOptions({});
+  const ItemBuffer again = r.render(s.view, {glm::dmat4(1.0)});
+  EXPECT_TRUE(again.id == withDepth.id);
+  EXPECT_TRUE(again.depth == withDepth.depth);
+}
+
 TEST(ItemBuffer, FrameTime352x240With400Triangles) {
   const ImageSize size{352, 240};
   RandomScene s = randomScene(400, 5);

@@ -30,6 +30,28 @@ TextureIntervals intervalsRecord(const std::vector<MovieExtent>& extents,
   return iv;
 }
 
+// Whether any pixel centre of `samples` (a buffer of `grid`) shows a surface: pixelCentreSamples'
+// ids not all kNoItem, without making that buffer every frame.
+bool showsSurfaceAtPixelCentres(const ItemBuffer& samples, const SampleGrid& grid) {
+  for (int row = 0; row < grid.image.height; ++row) {
+    const uint32_t* line = samples.id.data() + size_t(grid.centre(row)) * samples.width;
+    for (int col = 0; col < grid.image.width; ++col)
+      if (line[grid.centre(col)] != kNoItem) return true;
+  }
+  return false;
+}
+
+// Item buffers drawn by one GL context a thread (TextureIntervalsBuilder::addFrames).
+size_t renderersForThisProcess() {
+  return std::clamp<size_t>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1, 4);
+}
+
+void finishSequence(IntervalSequence& run, TextureIntervalsBuilder& builder, const Scene& scene,
+                    int cameraNode, const std::vector<int>& frames,
+                    const TextureIntervalsOptions& options,
+                    std::chrono::steady_clock::time_point start);
+
 }  // namespace
 
 IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
@@ -51,25 +73,87 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
   TextureIntervalsBuilder builder(scene, cameraNode, built);
   const SampleGrid grid = options.sampling.grid(options.imageSize);
   run.setupSeconds = secondsSince(start);
-  // Item buffers drawn by one GL context a thread (TextureIntervalsBuilder::addFrames).
-  const size_t renderers = std::clamp<size_t>(
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1, 4);
   builder.addFrames(
-      frames, renderers,
+      frames, renderersForThisProcess(),
       [&](const IntervalFrame& fr) {
         run.itemSeconds.push_back(fr.itemBufferSeconds);
-        // The pixel centres: what the frame shows (the grid's margin lies outside it), and the
-        // pixel-sized buffer rad-diff --surfaces reads.
-        const ItemBuffer centres = pixelCentreSamples(*fr.itemBuffer, grid);
-        const std::vector<uint32_t>& ids = centres.id;
-        if (std::all_of(ids.begin(), ids.end(), [](uint32_t id) { return id == kNoItem; }))
-          run.emptyFrames.push_back(fr.frame);
+        // The pixel centres: what the frame shows (the grid's margin lies outside it).
+        if (!showsSurfaceAtPixelCentres(*fr.itemBuffer, grid)) run.emptyFrames.push_back(fr.frame);
         if (itemBuffersDir.empty()) return;
+        // The pixel-sized buffer rad-diff --surfaces reads.
+        const ItemBuffer centres = pixelCentreSamples(*fr.itemBuffer, grid);
         char name[32];
         std::snprintf(name, sizeof name, "/%04d.exr", fr.frame);
         writeItemBufferExr(itemBuffersDir + name, centres, fr.frame, fr.time, provenanceJson);
       },
       frameDone);
+  finishSequence(run, builder, scene, cameraNode, frames, options, start);
+  return run;
+}
+
+IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
+                                         const std::vector<int>& frames,
+                                         const TextureIntervalsOptions& options,
+                                         const std::vector<VisibleSamplesFrame>& counted,
+                                         const std::function<void()>& frameDone) {
+  if (counted.size() != frames.size())
+    throw Error(ExitCode::kInternal, "", "visible samples: not one record a frame");
+  IntervalSequence run;
+  const auto start = std::chrono::steady_clock::now();
+  TextureIntervalsOptions built = options;
+  built.itemBufferDepth = false;
+  TextureIntervalsBuilder builder(scene, cameraNode, built);
+  run.setupSeconds = secondsSince(start);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const VisibleSamplesFrame& c = counted[i];
+    if (c.frame != frames[i])
+      throw Error(ExitCode::kInternal, "", "visible samples: frames out of order");
+    builder.addVisibleSamples(c.frame, c.leaf, c.count, c.itemBufferSeconds);
+    run.itemSeconds.push_back(c.itemBufferSeconds);
+    if (c.empty) run.emptyFrames.push_back(c.frame);
+    if (frameDone) frameDone();
+  }
+  finishSequence(run, builder, scene, cameraNode, frames, options, start);
+  return run;
+}
+
+VisibleSamples computeVisibleSamples(const Scene& scene, int cameraNode,
+                                     const std::vector<int>& frames,
+                                     const TextureIntervalsOptions& options,
+                                     const nlohmann::json& parameters,
+                                     const std::function<void()>& frameDone) {
+  VisibleSamples out;
+  out.parameters = parameters;
+  TextureIntervalsOptions built = options;
+  built.itemBufferDepth = false;
+  TextureIntervalsBuilder builder(scene, cameraNode, built);
+  const SampleGrid grid = options.sampling.grid(options.imageSize);
+  const PatchHierarchy& ph = builder.hierarchy();
+  builder.addFrames(
+      frames, renderersForThisProcess(),
+      [&](const IntervalFrame& fr) {
+        VisibleSamplesFrame f;
+        f.frame = fr.frame;
+        f.empty = !showsSurfaceAtPixelCentres(*fr.itemBuffer, grid);
+        f.itemBufferSeconds = fr.itemBufferSeconds;
+        const std::vector<long>& visible = *fr.visiblePixels;
+        for (int i = 0; i < ph.size(); ++i)
+          if (visible[i] > 0 && ph.isLeaf(i)) {
+            f.leaf.push_back(uint32_t(i));
+            f.count.push_back(uint32_t(visible[i]));
+          }
+        out.frames.push_back(std::move(f));
+      },
+      frameDone);
+  return out;
+}
+
+namespace {
+
+void finishSequence(IntervalSequence& run, TextureIntervalsBuilder& builder, const Scene& scene,
+                    int cameraNode, const std::vector<int>& frames,
+                    const TextureIntervalsOptions& options,
+                    std::chrono::steady_clock::time_point start) {
   const std::vector<MovieExtent> extents = builder.finish();
   run.totalSeconds = secondsSince(start);
 
@@ -85,8 +169,9 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
   run.patchNodes = ph.size();
   run.itemBufferSeconds = builder.itemBufferSeconds();
   run.continuedOverGaps = builder.moviesContinuedOverGaps();
-  return run;
 }
+
+}  // namespace
 
 nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::string& output) {
   nlohmann::json report = summarizeTextureIntervals(ContainerReader::open(output));

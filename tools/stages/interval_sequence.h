@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/texture_intervals.h"
+#include "formats/visible_samples.h"
 #include "libcommon/intervals/texture_intervals_builder.h"
 #include "libcommon/scene/scene.h"
 
@@ -43,6 +44,22 @@ IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
                                          const std::string& itemBuffersDir,
                                          const std::string& provenanceJson,
                                          const std::function<void()>& frameDone = {});
+
+// The same from visible samples counted elsewhere (rad-intervals --merge of --window files):
+// counted[i] is frames[i]'s; no item buffer is drawn. The same intervals as the run above.
+IntervalSequence computeIntervalSequence(const Scene& scene, int cameraNode,
+                                         const std::vector<int>& frames,
+                                         const TextureIntervalsOptions& options,
+                                         const std::vector<VisibleSamplesFrame>& counted,
+                                         const std::function<void()>& frameDone = {});
+
+// rad-intervals --window: the visible samples of each of `frames`, from item buffers drawn as
+// the run above draws them; `parameters` (the run's provenance parameters) go into the record.
+VisibleSamples computeVisibleSamples(const Scene& scene, int cameraNode,
+                                     const std::vector<int>& frames,
+                                     const TextureIntervalsOptions& options,
+                                     const nlohmann::json& parameters,
+                                     const std::function<void()>& frameDone = {});
 
 // rad-intervals' --report: summarizeTextureIntervals of the file written at `output` (read
 // back, which also checks it) plus the run's counts (empty_frames: how many frames show no
