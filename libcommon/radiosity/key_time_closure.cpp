@@ -61,20 +61,48 @@ void KeyTimeSolver::computeClosure() {
   std::vector<int> leaves;
   for (size_t i = 0; i < N; ++i)
     if (s_.inTree(int(i), h_) && !s_.split[i]) leaves.push_back(int(i));
+  if (opt_.closedRooms) testClosedRooms(leaves);
   tbb::parallel_for(size_t(0), leaves.size(), [&](size_t li) { closeLeaf(leaves[li]); });
 }
 
-bool KeyTimeSolver::closedAt(int r) {
-  // Once per node and key: the refinement rounds ask again for the leaves they keep. A static
-  // node's answer is the same at every key (the static geometry alone decides it), so it is
-  // also taken over from the keys before (coherence).
-  if (closed_[size_t(r)] >= 0) return closed_[size_t(r)] != 0;
-  const ClosedNodeCache* before = moves(h_.node(r).id.top) ? nullptr : input_.reuseClosed;
-  const auto known =
-      before ? before->find(h_.node(r).id.packed()) : ClosedNodeCache::const_iterator();
-  const bool closed = before && known != before->end() ? known->second : castEscapeRays(r);
-  closed_[size_t(r)] = closed ? 1 : 0;
-  return closed;
+// A node is in a closed room when none of its escape rays leaves the scene and its parent is in
+// one: the rays of a leaf and of all its ancestors are pooled, so that a leaf seeing an opening
+// of form factor f goes unnoticed with probability (1 - f)^(64 (depth + 1)), not (1 - f)^64 (an
+// open room's far end, f of a few per cent, counted most of its floor leaves closed, and the
+// closure filled their rows to 1 as if no light left through the opening; issue 58). Each
+// chain is tested from its top-level patch down, one level at a time, and below an open node
+// no ray is cast. Once per node and key: the refinement rounds ask again for the nodes they
+// keep. A static node's answer is the same at every key (the static geometry alone decides
+// it, its ancestors' rays included), so it is also taken over from the keys before
+// (coherence).
+void KeyTimeSolver::testClosedRooms(const std::vector<int>& leaves) {
+  std::vector<std::vector<int>> byLevel;
+  for (int leaf : leaves)
+    for (int a = leaf; a >= 0 && closed_[size_t(a)] < 0; a = h_.node(a).parent) {
+      closed_[size_t(a)] = 2;  // collected; set below
+      const size_t level = size_t(h_.node(a).id.level());
+      if (byLevel.size() <= level) byLevel.resize(level + 1);
+      byLevel[level].push_back(a);
+    }
+  for (std::vector<int>& nodes : byLevel) {
+    std::sort(nodes.begin(), nodes.end());  // the order does not change the answers
+    tbb::parallel_for(size_t(0), nodes.size(), [&](size_t i) {
+      const int r = nodes[i];
+      const int parent = h_.node(r).parent;
+      bool closed = false;
+      if (parent < 0 || closed_[size_t(parent)] == 1) {
+        const ClosedNodeCache* before = moves(h_.node(r).id.top) ? nullptr : input_.reuseClosed;
+        const auto known =
+            before ? before->find(h_.node(r).id.packed()) : ClosedNodeCache::const_iterator();
+        closed = before && known != before->end() ? known->second : castEscapeRays(r);
+      }
+      closed_[size_t(r)] = closed ? 1 : 0;
+    });
+  }
+}
+
+bool KeyTimeSolver::closedAt(int r) const {
+  return closed_[size_t(r)] == 1;
 }
 
 bool KeyTimeSolver::castEscapeRays(int r) const {

@@ -87,10 +87,12 @@ class KeyTimeSolver {
   // Closure and exposure (key_time_closure.cpp).
   void computeClosure();
   // Whether leaf r is inside a closed room: none of kEscapeRays cosine-distributed rays from
-  // its points leaves the scene. A room's opening of form factor f goes unseen with probability
-  // (1 - f)^64 (f = 5 %: 4 %), and then brightens that leaf by at most f.
+  // its points, nor from those of any of its ancestors, leaves the scene (testClosedRooms). A
+  // room's opening of form factor f goes unseen with probability (1 - f)^(64 (depth + 1)) (f = 1
+  // %, a leaf two levels down: 14 %), and then brightens that leaf by at most f.
   static constexpr int kEscapeRays = 64;
-  bool closedAt(int r);
+  void testClosedRooms(const std::vector<int>& leaves);
+  bool closedAt(int r) const;
   bool castEscapeRays(int r) const;
   double leafToTop(int r, uint32_t q) const;
 
@@ -179,7 +181,7 @@ class KeyTimeSolver {
   // Per leaf: its chain's links whose top's share the closure replaces (link index, the top's
   // G_q / sum F V - 1 over the exposure of the node that gathers it).
   std::vector<std::vector<std::pair<size_t, double>>> topExcess_;
-  std::vector<int8_t> closed_;          // per dense node: closedAt once cast (0 or 1), else -1
+  std::vector<int8_t> closed_;          // per dense node: closedAt once tested (0 or 1), else -1
   std::vector<uint8_t> shooterEmits_;   // per link: its shooter's top-level patch emits
   std::vector<uint32_t> sweepShooter_;  // per adj_ entry (buildSweepLists)
   std::vector<double> sweepCoefficient_;
