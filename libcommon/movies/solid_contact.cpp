@@ -12,10 +12,13 @@ RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
     if (hit >= uint32_t(h.topCount())) return false;
     const InputPolygon& surface = h.top(int(hit));
     const int m = surface.material;
-    if (m >= 0 && m < int(scene.materials.size()) && scene.materials[size_t(m)].doubleSided)
-      return false;
-    return glm::dot(surface.local.transformed(scene.worldTransform(surface.node, t)).normal(), d) >
-           0.0;
+    const bool doubleSided =
+        m >= 0 && m < int(scene.materials.size()) && scene.materials[size_t(m)].doubleSided;
+    if (doubleSided && !surface.closedSolid) return false;
+    // The solid's outside: a closed solid's reversed copy faces in (closed_solid.h).
+    const glm::dvec3 n = surface.local.transformed(scene.worldTransform(surface.node, t)).normal();
+    const double outward = doubleSided && surface.backFace ? -1.0 : 1.0;
+    return outward * glm::dot(n, d) > 0.0;
   });
 }
 

@@ -20,7 +20,8 @@ namespace rad {
 // Where the ray from point p of top-level patch `top` (direction d, whose length bounds the
 // search) starts at time t: inside a touching solid (the first surface it meets is the back
 // of a one-sided patch), outside, or undecided (a front and such a back at one distance;
-// rayStart). A double-sided material's patch is never a back.
+// rayStart). A double-sided material's patch is a back only when its mesh is a closed solid
+// with faces out (InputPolygon::closedSolid), as in rad-global's exposure (closed_solid.h).
 RayStart coveredBySolid(const VisibilityScene& blockers, const Scene& scene,
                         const PatchHierarchy& h, uint32_t top, const glm::dvec3& p,
                         const glm::dvec3& d, double t);

@@ -5,6 +5,7 @@
 #include "libcommon/scene/scene.h"
 
 #include "libcommon/core/error.h"
+#include "libcommon/scene/closed_solid.h"
 #include "libcommon/scene/contact_cuts.h"
 #include "libcommon/scene/patch_hierarchy.h"
 
@@ -543,7 +544,11 @@ std::vector<InputPolygon> Scene::inputPolygons() const {
   size_t total = 0;
   for (int node : nodeList) {
     const size_t m = size_t(nodes[size_t(node)].mesh);
-    if (!merged[m]) perMesh[m] = meshPolygons(meshes[m], materials);
+    if (!merged[m]) {
+      perMesh[m] = meshPolygons(meshes[m], materials);
+      const bool solid = isClosedSolid(meshes[m].triangles);
+      for (InputPolygon& p : perMesh[m]) p.closedSolid = solid;
+    }
     merged[m] = 1;
     total += perMesh[m].size();
   }

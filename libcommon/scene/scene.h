@@ -157,6 +157,9 @@ struct InputPolygon {
   int node = -1;  // mesh node that places it in the world
   int material = -1;
   bool backFace = false;  // the reversed copy made for a doubleSided material
+  // Its mesh is a closed solid with faces out (closed_solid.h), so its winding tells inside from
+  // outside even when the material is doubleSided.
+  bool closedSolid = false;
 };
 
 // The shading normal of `p` at its (u,v) (the vertex normals interpolated with the weights of
