@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <set>
@@ -157,12 +159,19 @@ TEST_F(MoviePiecesCli, TwoTasksMergingAtOnceMergeEachMovieOnce) {
   }
   const std::string a = movies("--merge-pieces 3 --merge-ready --shard 0/2", out),
                     b = movies("--merge-pieces 3 --merge-ready --shard 1/2", out);
-  CommandResult both =
-      runCommand("( " + a + " & pid=$!; " + b + "; rb=$?; wait $pid && exit $rb )");
-  ASSERT_EQ(both.exitCode, 0) << both.err;
+  // Each task's messages to its own file: written at once to one pipe they interleave.
+  const std::string errA = path("merge-a.err"), errB = path("merge-b.err");
+  CommandResult both = runCommand("( " + a + " 2>'" + errA + "' & pid=$!; " + b + " 2>'" + errB +
+                                  "'; rb=$?; wait $pid && exit $rb )");
+  std::string said;
+  for (const std::string& f : {errA, errB}) {
+    std::ifstream in(f);
+    said += std::string(std::istreambuf_iterator<char>(in), {}) + "\n";
+  }
+  ASSERT_EQ(both.exitCode, 0) << said;
   long mergedSum = 0;
-  const std::regex said("rad-movies: merged ([0-9]+) movies");
-  for (auto it = std::sregex_iterator(both.err.begin(), both.err.end(), said);
+  const std::regex mergedLine("rad-movies: merged ([0-9]+) movies");
+  for (auto it = std::sregex_iterator(said.begin(), said.end(), mergedLine);
        it != std::sregex_iterator(); ++it)
     mergedSum += std::stol((*it)[1].str());
   long split = 0;
@@ -173,7 +182,7 @@ TEST_F(MoviePiecesCli, TwoTasksMergingAtOnceMergeEachMovieOnce) {
     ++split;
     EXPECT_TRUE(merged.at(name) == bytes) << name;
   }
-  EXPECT_EQ(mergedSum, split) << both.err;
+  EXPECT_EQ(mergedSum, split) << said;
 }
 
 // The cut by known cost (--piece-costs, movie_cut.h): an earlier run's report cuts only the
