@@ -17,7 +17,6 @@
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/radiosity/key_time_solver.h"
-#include "libcommon/scene/closed_solid.h"
 #include "libcommon/scene/emission_texture.h"
 
 namespace rad {
@@ -25,11 +24,9 @@ namespace rad {
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
                                                    const PatchHierarchy& hierarchy) {
   std::vector<SurfaceProperties> out(size_t(hierarchy.topCount()));
-  const std::vector<bool> closed = closedSolidMeshes(scene);
   for (int t = 0; t < hierarchy.topCount(); ++t) {
     const InputPolygon& top = hierarchy.top(t);
-    const int node = top.node, mesh = node >= 0 ? scene.nodes[size_t(node)].mesh : -1;
-    out[size_t(t)].closedSolid = mesh >= 0 && size_t(mesh) < closed.size() && closed[size_t(mesh)];
+    out[size_t(t)].closedSolid = top.closedSolid;  // set once per mesh by Scene::inputPolygons
     out[size_t(t)].backFace = top.backFace;
     int m = top.material;
     if (m >= 0 && m < int(scene.materials.size())) {

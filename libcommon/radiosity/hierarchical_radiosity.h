@@ -84,7 +84,7 @@ struct SurfaceProperties {
   }
 };
 // From the scene's materials (reflectance clamped to [0, 1]; the glTF default material is
-// white) and meshes (closedSolid).
+// white) and the tops' InputPolygon::closedSolid.
 std::vector<SurfaceProperties> surfacePropertiesOf(const Scene& scene,
                                                    const PatchHierarchy& hierarchy);
 

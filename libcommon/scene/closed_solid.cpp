@@ -37,11 +37,4 @@ bool isClosedSolid(const std::vector<MeshTriangle>& triangles) {
   return volume6 > 0.0;
 }
 
-std::vector<bool> closedSolidMeshes(const Scene& scene) {
-  std::vector<bool> out(scene.meshes.size(), false);
-  for (size_t m = 0; m < scene.meshes.size(); ++m)
-    out[m] = isClosedSolid(scene.meshes[m].triangles);
-  return out;
-}
-
 }  // namespace rad

@@ -24,7 +24,4 @@ namespace rad {
 // counter-clockwise fronts face out). Deterministic; O(n log n) in the triangles.
 bool isClosedSolid(const std::vector<MeshTriangle>& triangles);
 
-// isClosedSolid of every mesh of the scene, by Scene::meshes index.
-std::vector<bool> closedSolidMeshes(const Scene& scene);
-
 }  // namespace rad
