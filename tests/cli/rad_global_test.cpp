@@ -72,6 +72,13 @@ TEST(RadGlobal, CoherentFileEqualsNoCoherenceFile) {
   fs::remove_all(d);
 }
 
+// pipelines/scenes/make_hall.py OUT --triangles N; its exit code.
+int makeHall(const std::string& out, int triangles) {
+  return runCommand("python3 " + std::string(RAD_SOURCE_DIR) + "/pipelines/scenes/make_hall.py " +
+                    out + " --triangles " + std::to_string(triangles))
+      .exitCode;
+}
+
 // Issue 16: with clustering, on a generated 1k-triangle lecture hall whose car moves, the
 // cluster links between static clusters away from the car keep their values from key to key,
 // and the coherent file is still what --no-coherence computes, cluster irradiance included;
@@ -79,10 +86,7 @@ TEST(RadGlobal, CoherentFileEqualsNoCoherenceFile) {
 TEST(RadGlobal, ClusteredHallCoherentEqualsNoCoherence) {
   fs::path d = scratchDir();
   const std::string hall = (d / "hall.gltf").string();
-  ASSERT_EQ(runCommand("python3 " + std::string(RAD_SOURCE_DIR) +
-                       "/pipelines/scenes/make_hall.py " + hall + " --triangles 1000")
-                .exitCode,
-            0);
+  ASSERT_EQ(makeHall(hall, 1000), 0);
   const std::string base = tool("rad-global") + " " + hall + " --frames 0-8 --key-step 8";
   auto c =
       runCommand(base + " -o " + (d / "c.rlh").string() + " --report " + (d / "c.json").string());
@@ -119,10 +123,7 @@ TEST(RadGlobal, ClusteredHallCoherentEqualsNoCoherence) {
 TEST(RadGlobal, KeptWeakNearLinksAreTakenOverByTheNextKey) {
   fs::path d = scratchDir();
   const std::string hall = (d / "hall.gltf").string();
-  ASSERT_EQ(runCommand("python3 " + std::string(RAD_SOURCE_DIR) +
-                       "/pipelines/scenes/make_hall.py " + hall + " --triangles 1000")
-                .exitCode,
-            0);
+  ASSERT_EQ(makeHall(hall, 1000), 0);
   const std::string base =
       tool("rad-global") + " " + hall + " --frames 0-8 --key-step 8 --keep-weak-near-links";
   auto c =
