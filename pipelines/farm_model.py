@@ -9,14 +9,19 @@ the reports give rad-global's and rad-intervals' time, each movie's bake time (r
 its inputs: the report's total minus the pieces); ffmpeg is the rest of the run's wall time.
 Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core per task):
 
-  global || intervals   one task each (global: the sum of its key times; with --global-windows,
-                        W = min(N x C, keys) windows, each paying a from-scratch first key
-                        (key 0's time) and the rest coherent, then the merge; with
-                        --interval-windows (slurm.mk's INTERVAL_WINDOWS), rad-intervals'
-                        item buffers in W = min(N x C, frames) windows of frames, each paying
-                        the set-up and its frames' share of the per-frame time, then the pass
-                        over their counts: the set-up and --interval-merge-fraction of the
-                        per-frame time, what drawing no item buffer leaves of it)
+  global || intervals   one task each, the longer on the path (global: the sum of its key
+                        times; with --global-windows, W = min(N x C, keys) windows, each paying
+                        its reading, set-up and writing once, the per-key folding per key, a
+                        from-scratch first key and the rest coherent, then the merge; priced
+                        from the report's parts, or timed on two windows and their merge with
+                        --time-windows; with --interval-windows (slurm.mk's INTERVAL_WINDOWS),
+                        rad-intervals' item buffers in W = min(N x C, frames) windows of frames,
+                        each paying the set-up and its frames' share of the per-frame time,
+                        then the pass over their counts: the set-up and
+                        --interval-merge-fraction of the per-frame time, what drawing no item
+                        buffer leaves of it). slurm.mk's last window task runs each merge, so
+                        no latency before it; with --window-merge-stage a merge job's latency
+                        is on its own stage's path)
   movies                movie i in shard i % SHARDS; each shard pays the fixed cost once;
                         shards are list-scheduled on the N x C cores (longest first).
                         With --piece-keys K (slurm.mk's MOVIE_PIECE_KEYS, issue 58), a movie of
@@ -35,18 +40,20 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
                         (-c copy); the contact sheet decodes its eight frames. The three are
                         timed on the run's frames, one core each (video-seconds.json)
   + one scheduling latency per stage on the critical path (--latency, seconds; measured on the
-    local cluster: tests/slurm/cluster.sh): global (and its merge when windowed), movies (and,
-    with --merge-stage, their merges), compose, the mp4
+    local cluster: tests/slurm/cluster.sh): global || intervals, movies (and, with
+    --merge-stage, their merges), compose, the mp4
 
 The serial part is what no number of nodes shortens, the critical path on unlimited nodes: the
-longer of global and intervals (or, windowed, the slowest window and the merge), the fixed cost
+longer of global and intervals (or, windowed, the slowest window and its merge), the fixed cost
 of one movies and one compose task (scene loading), the longest single movie (with pieces: the
 longest piece with the merge its task does) and frame, ffmpeg and the latencies. The one-core time over it
 bounds the speed-up.
 
 usage: farm_model.py --scene SCENE [--frames 0-95] [--size 352x240] [--nodes 1,4,16,64]
-                     [--cores N] [--latency 1.0] [--global-windows] [--piece-keys K]
-                     [--merge-stage] [--video-segments] [--bin DIR] [--out DIR]
+                     [--cores N] [--latency 1.0] [--global-windows] [--time-windows]
+                     [--interval-windows] [--window-merge-stage] [--piece-keys K]
+                     [--piece-seconds T] [--merge-stage] [--video-segments] [--bin DIR]
+                     [--out DIR]
        farm_model.py --from DIR ...   (model an earlier one-core run in DIR, without running)
        farm_model.py --self-test      (the model's arithmetic on made-up pieces)
 """
