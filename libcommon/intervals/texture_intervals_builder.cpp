@@ -553,6 +553,10 @@ class ItemBufferPipeline {
     std::unique_ptr<ItemBufferRenderer> renderer;
     std::exception_ptr error;
     try {
+      // One upload at a time: each converts the objects to its own vertex array before the driver
+      // copies it, so uploads side by side held every worker's array at once (a floor of 10^6
+      // triangles has some 16 M leaf triangles; issue 58's memory bound).
+      std::lock_guard<std::mutex> one(uploading_);
       renderer = std::make_unique<ItemBufferRenderer>(size, itemOptions_);
       renderer->setGeometry(objects);
     } catch (...) {
@@ -593,6 +597,7 @@ class ItemBufferPipeline {
   std::vector<Slot> slots_;
   std::vector<std::thread> threads_;
   std::mutex mutex_;
+  std::mutex uploading_;  // held by the worker uploading the geometry (work)
   std::condition_variable changed_;
   size_t uploaded_ = 0;
   bool stop_ = false;
