@@ -49,7 +49,7 @@ class Report:
         self.duplicates = 0    # triangles dropped as exact copies of others
         self.reoriented = (0, 0)  # closed objects (and their triangles) turned outward
         self.luminaires = {}   # IES file -> [instances, flux down, flux up (lm), notes]
-        self.invisible = {}    # material name -> faces left out (mgf_material: invisible)
+        self.invisible = {}    # material name -> polygons left out (mgf_material: invisible)
         self.files = []
 
     def count(self, table, key, n=1):

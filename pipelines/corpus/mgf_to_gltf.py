@@ -103,7 +103,7 @@ def dropped_lines(summary):
     if degenerate:
         lines.append(f"{degenerate} faces without area skipped")
     for material, n in sorted(summary.get("invisible", {}).items()):
-        lines.append(f"{n} faces of {material} left out: it transmits everything and reflects nothing")
+        lines.append(f"{n} polygons of {material} left out: it transmits everything and reflects nothing")
     for ies, (placed, down, up, notes) in sorted(summary.get("luminaires", {}).items()):
         lines.append(f"IES luminaire {ies} ({placed} placed): its candela distribution; kept as diffuse emitters "
                      f"of its output, {down:.0f} lm facing down, {up:.0f} lm facing up, on its luminous opening"
