@@ -25,7 +25,7 @@ scenes of about 10k triangles (checked where the run is that size and the scene 
 |bias| <= 1 %. Scenes kept out of tuning are marked `held-out`.
 
 usage: corpus_bench.py [--bin DIR] [--out DIR] [--corpus DIR] [--scenes a,b|all|none] [--repo PATH]
-                       [--keep REGEX] [--generated contact,...] [--frames 0-95] [--eval-frame 48]
+                       [--mgf-repo PATH] [--keep REGEX] [--generated contact,...] [--frames 0-95] [--eval-frame 48]
                        [--size 352x240] [--spp 256] [--check]
   --keep    pass to scenes.py: only the objects whose name matches (a subset of each scene)
   --check   exit 1 unless every row has every figure (ctest `pipeline_corpus_bench_runs`)
@@ -92,6 +92,7 @@ def public_scenes(args):
         return []
     argv = ["fetch-and-convert", args.corpus] + names
     argv += ["--repo", args.repo] if args.repo else []
+    argv += ["--mgf-repo", args.mgf_repo] if args.mgf_repo else []
     argv += ["--keep", args.keep] if args.keep else []
     if scenes.main(argv) != 0:
         raise SystemExit("corpus_bench.py: %s: scenes.py fetch-and-convert failed" % args.corpus)
@@ -190,6 +191,7 @@ def main():
                     help="folder the public scenes are converted into")
     ap.add_argument("--scenes", default="all", help="public scenes, comma-separated, all or none")
     ap.add_argument("--repo", help="rpkCpp as a bare git directory or a checkout (scenes.py)")
+    ap.add_argument("--mgf-repo", help="RichardBruce/data as a bare git directory or a checkout (scenes.py)")
     ap.add_argument("--keep", metavar="REGEX", help="only the objects matching (scenes.py --keep)")
     ap.add_argument("--generated", default="", help="generated scenes: " + ", ".join(GENERATED))
     ap.add_argument("--frames", default="0-95")
