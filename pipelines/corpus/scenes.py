@@ -143,6 +143,22 @@ SCENES = {
         "mover": {"name": "moving_toilet", "match": r"^toilet(\.|$)",
                   "keys": [(0.0, (0.0, 0.0, 0.0)), (3.0, (0.2, 0.0, 0.0))]},
     },
+    "erw-table": {
+        "source": "mgf-data", "mgf": "mgf_scenes/ERW5/scene7.mgf", "needs": [], "up": "y", "qcd": 2,
+        "held_out": False,
+        "digest": "bdfb78629c356038cbb55ada7d880c1b694dacfd23c9a1045b84e03ff0a4a3c4",
+        "character": "Eurographics Rendering Workshop 1994 test scene 7 (Peter Shirley): a 6 x 6 x 3 m "
+                     "room, a table and four chairs of thin legs and slats, lit by one 10 cm fixture "
+                     "at the ceiling (L_e 1,760 W/m2/sr): one tiny bright lamp over a large room",
+        "yfov": 60.0,
+        "camera": [(0.0, (-2.6, 1.8, 2.6), (0.0, 1.2, 0.0)),
+                   (1.5, (-2.2, 1.8, 2.8), (0.0, 1.2, 0.0)),
+                   (3.0, (-1.8, 1.8, 2.9), (0.0, 1.2, 0.0))],
+        # The file has no objects: the chair east of the table, by its triangles.
+        "mover": {"name": "moving_chair", "match": r"^scene$",
+                  "triangles_within": ((0.40, -0.01, -0.30), (0.95, 0.85, 0.25)),
+                  "keys": [(0.0, (0.0, 0.0, 0.0)), (3.0, (0.3, 0.0, 0.0))]},
+    },
     "nrc-office": {
         # room.mgf's README: the room is material, room, furn and one lighting design together.
         "source": "mgf-data", "needs": ["mgf_scenes/nrcoff"], "up": "z", "qcd": 2,
