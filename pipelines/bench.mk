@@ -48,7 +48,8 @@
 #                                     [CORPUS_EVAL_FRAME=48] [CORPUS_SPP=256]
 #       issue 58's figures per scene (pipelines/corpus_bench.py): the public scenes of
 #       pipelines/corpus/scenes.py fetched and converted into CORPUS_DIR at benchmark time (never
-#       committed), and generated ones; triangles, key times at the link bound, links and cluster
+#       committed; copies of rpkCpp and RichardBruce/data from $RPKCPP_REPO and $MGF_DATA_REPO or
+#       the mirrors), and generated ones; triangles, key times at the link bound, links and cluster
 #       links, each stage's time and peak memory, RMSE / mean, bias, structured error and floor
 #       against two rad-reference renders (image_figures.py's figures), each row checked against
 #       the issue's goals, held-out scenes marked; out/corpus/corpus.csv

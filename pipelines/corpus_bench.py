@@ -13,6 +13,8 @@ buffers) over FRAMES at SIZE; then
                   all key times (rad-global's report)
   links, clusters patch links and cluster links at the largest key (the report)
   STAGE_s, _mb    each stage's wall seconds and peak RSS (MB of 10^6 bytes, the issue's unit)
+  cpu_s           the four stages' CPU seconds (user + system): on a machine shared with other
+                  work, what the wall seconds cannot say
   rmse, bias, struct, floor
                   at EVAL_FRAME against two rad-reference renders (seeds 0 and 1, SPP each),
                   through pipelines/image_figures.py's figures(): RMSE / mean and bias over
@@ -25,7 +27,7 @@ scenes of about 10k triangles (checked where the run is that size and the scene 
 |bias| <= 1 %. Scenes kept out of tuning are marked `held-out`.
 
 usage: corpus_bench.py [--bin DIR] [--out DIR] [--corpus DIR] [--scenes a,b|all|none] [--repo PATH]
-                       [--keep REGEX] [--generated contact,...] [--frames 0-95] [--eval-frame 48]
+                       [--mgf-repo PATH] [--keep REGEX] [--generated contact,...] [--frames 0-95] [--eval-frame 48]
                        [--size 352x240] [--spp 256] [--check]
   --keep    pass to scenes.py: only the objects whose name matches (a subset of each scene)
   --check   exit 1 unless every row has every figure (ctest `pipeline_corpus_bench_runs`)
@@ -52,7 +54,7 @@ GENERATED = {"contact": ("make_contact_scenes.py", ["--cols", "2", "--rows", "2"
 GOAL_SECONDS, GOAL_MB, GOAL_RMSE, GOAL_BIAS = 60.0, 600.0, 3.0, 1.0
 GOAL_FRAMES, GOAL_SIZE, GOAL_MAX_TRIANGLES = 96, "352x240", 15000
 COLUMNS = (("scene", "kind", "triangles", "keys", "keys_at_bound", "links", "cluster_links",
-            "seconds") + tuple(s + "_s" for s in STAGES) + tuple(s + "_mb" for s in STAGES)
+            "seconds", "cpu_s") + tuple(s + "_s" for s in STAGES) + tuple(s + "_mb" for s in STAGES)
            + ("rmse", "bias", "struct", "floor", "noise"))
 
 
@@ -92,6 +94,7 @@ def public_scenes(args):
         return []
     argv = ["fetch-and-convert", args.corpus] + names
     argv += ["--repo", args.repo] if args.repo else []
+    argv += ["--mgf-repo", args.mgf_repo] if args.mgf_repo else []
     argv += ["--keep", args.keep] if args.keep else []
     if scenes.main(argv) != 0:
         raise SystemExit("corpus_bench.py: %s: scenes.py fetch-and-convert failed" % args.corpus)
@@ -115,7 +118,7 @@ def measure(args, name, scene, kind, log):
     try:
         run = bench.pipeline(args.bin, scene, out, args.frames, args.size,
                              {"intervals": ["--item-buffers", items]}, log)
-        row["seconds"] = run["total"]
+        row["seconds"], row["cpu_s"] = run["total"], run["cpu_total"]
         for stage, (seconds, mib, _) in run["stages"].items():
             row[stage + "_s"], row[stage + "_mb"] = seconds, mib * 1048576 / 1e6
         row.update(link_figures(os.path.join(out, "global-report.json")))
@@ -154,16 +157,16 @@ def print_table(rows, args):
     print("corpus benchmark: frames %s at %s, error at frame %d against 2 x %d spp references "
           "(percent of the mean); MB = 10^6 bytes" % (args.frames, args.size, args.eval_frame,
                                                       args.spp))
-    print("%-12s %-8s %7s %6s %9s %9s %7s %25s %19s %6s %6s %6s %6s  %s" % (
-        "scene", "kind", "tris", "bound", "links", "clusters", "s", "s global/int/mov/comp",
+    print("%-12s %-8s %7s %6s %9s %9s %7s %7s %25s %19s %6s %6s %6s %6s  %s" % (
+        "scene", "kind", "tris", "bound", "links", "clusters", "s", "cpu s", "s global/int/mov/comp",
         "MB g/i/m/c", "rmse", "bias", "struct", "floor", "goals"))
     for r in rows:
         if "error" in r:
             print("%-12s %-8s %7d failed: %s" % (r["scene"], r["kind"], r["triangles"], r["error"]))
             continue
-        print("%-12s %-8s %7d %6s %9s %9s %7.1f %25s %19s %6s %6s %6s %6s  %s" % (
+        print("%-12s %-8s %7d %6s %9s %9s %7.1f %7.1f %25s %19s %6s %6s %6s %6s  %s" % (
             r["scene"], r["kind"], r["triangles"], "%d/%d" % (r["keys_at_bound"], r["keys"]),
-            r["links"], r["cluster_links"], r["seconds"],
+            r["links"], r["cluster_links"], r["seconds"], r["cpu_s"],
             "/".join("%.1f" % r[s + "_s"] for s in STAGES),
             "/".join("%.0f" % r[s + "_mb"] for s in STAGES),
             fmt(r.get("rmse")), fmt(r.get("bias")), fmt(r.get("struct")), fmt(r.get("floor")),
@@ -190,6 +193,7 @@ def main():
                     help="folder the public scenes are converted into")
     ap.add_argument("--scenes", default="all", help="public scenes, comma-separated, all or none")
     ap.add_argument("--repo", help="rpkCpp as a bare git directory or a checkout (scenes.py)")
+    ap.add_argument("--mgf-repo", help="RichardBruce/data as a bare git directory or a checkout (scenes.py)")
     ap.add_argument("--keep", metavar="REGEX", help="only the objects matching (scenes.py --keep)")
     ap.add_argument("--generated", default="", help="generated scenes: " + ", ".join(GENERATED))
     ap.add_argument("--frames", default="0-95")

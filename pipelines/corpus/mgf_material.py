@@ -12,6 +12,10 @@
   photometric units with RenderPark's white efficacy, 183.07 lm/W (the luminous efficacy of
   equal-energy white): L_e = ed / (pi * 183.07) W m^-2 sr^-1 in the colour given with ed.
   glTF stores it as emissiveFactor (largest channel 1) x KHR_materials_emissive_strength.
+- Invisible: a material that reflects and emits nothing and transmits everything (ts + td of
+  at least 0.999: Radiance's `illum` shells around lamps, converted to MGF as `ts 1 0`) would be
+  an opaque black surface here, hiding what it surrounds; the reader leaves its faces out and
+  reports them.
 - Sides: RenderPark forces every surface one-sided by default (-force-onesided), and so does
   this converter ('one'); 'mgf' keeps MGF's own rule (two-sided unless `sides 1`), 'two' makes
   every surface two-sided (glTF doubleSided).
@@ -39,6 +43,10 @@ class Material:
         self.td, self.td_xy = 0.0, neutral
         self.sides = 2
         self.ir = None
+
+    def invisible(self):
+        """Transmits everything, reflects and emits nothing (see the module's note)."""
+        return self.rd == 0.0 and self.rs == 0.0 and self.ed == 0.0 and self.ts + self.td >= MAX_REFLECTANCE
 
     def key(self):
         return tuple(sorted(self.__dict__.items()))

@@ -5,14 +5,16 @@ below are those of the MGF specification. Everything is in world coordinates: ea
 entity is placed by the transform in effect when it is given (vertices are not transformed when
 defined: MGF spec, entity v), then by the root transform (the scene's up axis and scale).
 
-Entities read: # c cxy cspec cct cmix m sides rd ed rs ts td ir v p n f o xf i sph cyl cone
-ring torus prism. Unknown entities are skipped and counted, as the MGF parser does (MGF
+Entities read: # c cxy cspec cct cmix m sides rd ed rs ts td ir v p n f o xf i ies sph cyl
+cone ring torus prism (ies: the luminaire's flux on diffuse emitting rectangles, see
+ies_luminaire.py). Unknown entities are skipped and counted, as the MGF parser does (MGF
 footnotes, "ignoring new entities"). Vertex normals (n) are read for rings and tori only; faces
 are flat (rad's radiosity elements are), so face normals are counted as dropped.
 """
 import os
 
 import held_out
+import ies_luminaire
 import mgf_colour
 import mgf_material
 import mgf_primitives
@@ -46,6 +48,8 @@ class Report:
         self.face_normals = 0  # faces whose vertices carry normals (ignored)
         self.duplicates = 0    # triangles dropped as exact copies of others
         self.reoriented = (0, 0)  # closed objects (and their triangles) turned outward
+        self.luminaires = {}   # IES file -> [instances, flux down, flux up (lm), notes]
+        self.invisible = {}    # material name -> polygons left out (mgf_material: invisible)
         self.files = []
 
     def count(self, table, key, n=1):
@@ -274,10 +278,55 @@ class _Reader:
             self.objects.pop()
             self.where = where
 
+    def on_ies(self, args, path):
+        """MGF spec, entity ies: `ies file [-m multiplier] [transform]`, the transform as an
+        enclosing xf. Each emitting rectangle gets its own material (ed in lm/m^2, neutral
+        colour, no reflectance), named after the file; the material in effect is kept. The exitance
+        is the flux over the opening's own area: a transform that scales (the NRC designs scale
+        to feet and back, net 1) would change the flux by its area factor."""
+        if not args:
+            self.fail("ies: expected a file name")
+        target = os.path.normpath(os.path.join(os.path.dirname(path), args[0]))
+        held_out.check(target)
+        rest, multiplier = args[1:], 1.0
+        if rest[:1] == ["-m"]:
+            if len(rest) < 2:
+                self.fail("ies: -m without a multiplier")
+            multiplier, rest = self.numbers(rest[1:2], 1)[0], rest[2:]
+        try:
+            with open(target, encoding="latin-1") as f:
+                lum = ies_luminaire.parse(f.read(), multiplier)
+        except OSError:
+            self.fail(f"ies {target}: no such file")
+        except ies_luminaire.IesError as e:
+            self.fail(f"ies {target}: {e}")
+        self.scene.report.files.append(target)
+        stem = os.path.splitext(os.path.basename(target))[0]
+        n = self.include_counts[stem] = self.include_counts.get(stem, 0) + 1
+        self.objects.append(stem if n == 1 else f"{stem}-{n}")
+        placed = self.combine(rest)
+        self.transforms.append(placed)
+        kept = (self.material, self.material_name)
+        for polygon, exitance in ies_luminaire.emitters(lum):
+            self.material = mgf_material.Material()
+            self.material.ed = exitance
+            self.material_name = f"{stem}_output"
+            self.emit([polygon])
+        self.material, self.material_name = kept
+        self.transforms.pop()
+        self.objects.pop()
+        entry = self.scene.report.luminaires.setdefault(target, [0, lum.flux_down, lum.flux_up, lum.notes])
+        entry[0] += len(placed)
+
     # ---- geometry ---------------------------------------------------------------------------
 
     def emit(self, polygons):
-        """Adds local-frame polygons under the current object and material, once per instance."""
+        """Adds local-frame polygons under the current object and material, once per instance;
+        none if the material is invisible (mgf_material), counted."""
+        if self.material.invisible():
+            self.scene.report.count(self.scene.report.invisible, self.material_name,
+                                    len(polygons) * len(self.transforms[-1]))
+            return
         node = "/".join(self.objects) or "scene"
         key = (self.material_name,) + self.material.key()
         if key not in self.scene.materials:
@@ -363,7 +412,7 @@ _HANDLERS = {
     "rs": lambda r, a, p: r.on_component(a, "rs"), "ts": lambda r, a, p: r.on_component(a, "ts"),
     "td": lambda r, a, p: r.on_component(a, "td"),
     "v": _Reader.on_v, "p": _Reader.on_p, "n": _Reader.on_n, "o": _Reader.on_o, "xf": _Reader.on_xf,
-    "i": _Reader.on_i, "f": _Reader.on_f, "sph": _Reader.on_sph, "cyl": _Reader.on_cyl,
+    "i": _Reader.on_i, "ies": _Reader.on_ies, "f": _Reader.on_f, "sph": _Reader.on_sph, "cyl": _Reader.on_cyl,
     "cone": _Reader.on_cone, "ring": _Reader.on_ring, "torus": _Reader.on_torus,
     "prism": _Reader.on_prism,
 }

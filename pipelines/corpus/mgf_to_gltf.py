@@ -69,7 +69,9 @@ def write(scene, gltf_path, sides="one", camera=None, movers=None, name=None):
     r = scene.report
     summary.update({"faces": r.faces, "primitives": r.primitives, "unknown_entities": r.unknown,
                     "faces_with_normals_ignored": r.face_normals, "files": len(r.files),
-                    "duplicates": r.duplicates, "reoriented": r.reoriented})
+                    "duplicates": r.duplicates, "reoriented": r.reoriented,
+                    "invisible": r.invisible,
+                    "luminaires": {os.path.basename(f): v for f, v in r.luminaires.items()}})
     return summary
 
 
@@ -100,6 +102,12 @@ def dropped_lines(summary):
     degenerate = summary["faces"].get("degenerate", 0)
     if degenerate:
         lines.append(f"{degenerate} faces without area skipped")
+    for material, n in sorted(summary.get("invisible", {}).items()):
+        lines.append(f"{n} polygons of {material} left out: it transmits everything and reflects nothing")
+    for ies, (placed, down, up, notes) in sorted(summary.get("luminaires", {}).items()):
+        lines.append(f"IES luminaire {ies} ({placed} placed): its candela distribution; kept as diffuse emitters "
+                     f"of its output, {down:.0f} lm facing down, {up:.0f} lm facing up, on its luminous opening"
+                     + "".join(f"; {n}" for n in notes))
     if summary["duplicates"]:
         lines.append(f"{summary['duplicates']} duplicate triangles (same corners and winding as another) dropped")
     if summary["reoriented"][0]:
