@@ -25,7 +25,9 @@
 #   make -f pipelines/bench.mk farm-model [FARM_SCENE=pipelines/scenes/cornell-moving.gltf] [FARM_FRAMES=0-95] [FARM_NODES=1,4,16,64] [FARM_FLAGS=--global-windows]
 #       one run of animation.mk on one core, then the wall time slurm.mk would take on N nodes
 #       of this machine's size, its critical path and the serial part (pipelines/farm_model.py);
-#       slurm.mk's default pieces and segments: FARM_FLAGS="--piece-keys 4 --video-segments"
+#       slurm.mk's default pieces and segments: FARM_FLAGS="--piece-keys 4 --video-segments";
+#       --time-windows also times rad-global in two windows and their merge (docs/results.md,
+#       "Window merges in the last window task")
 #   make -f pipelines/bench.mk furnace [FURNACE_RHO=0.5,0.9,0.99,0.999] [FURNACE_FLAGS="global=--eps 1e-4"]
 #       the closed furnace through the whole pipeline at each rho: frame mean against the exact
 #       L_e / (1 - rho), time and peak memory; out/furnace/

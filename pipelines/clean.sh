@@ -45,10 +45,10 @@ clean_part() {
       remove_matching "$out/frames" "[0-9]+\.(exr|png)|segment-[0-9]+-[0-9]+\.mp4|\.done|\.chunk-[0-9]+-of-[0-9]+|$temporaries"
       remove_folder "$out/frames" ;;
     global-windows)
-      remove_matching "$out/global-windows" "w[0-9]+\.rkw|w[0-9]+-report\.json|\.window-[0-9]+-of-[0-9]+|$temporaries"
+      remove_matching "$out/global-windows" "w[0-9]+\.rkw|w[0-9]+-report\.json|\.window-[0-9]+-of-[0-9]+|\.merge-lock|$temporaries"
       remove_folder "$out/global-windows" ;;
     interval-windows)
-      remove_matching "$out/interval-windows" "w[0-9]+\.rvs|\.window-[0-9]+-of-[0-9]+|$temporaries"
+      remove_matching "$out/interval-windows" "w[0-9]+\.rvs|\.window-[0-9]+-of-[0-9]+|\.merge-lock|$temporaries"
       remove_folder "$out/interval-windows" ;;
     logs)
       remove_matching "$out/logs" "[a-z-]+_[0-9]+\.(log|exit)(\.tmp)?"

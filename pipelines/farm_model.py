@@ -9,14 +9,19 @@ the reports give rad-global's and rad-intervals' time, each movie's bake time (r
 its inputs: the report's total minus the pieces); ffmpeg is the rest of the run's wall time.
 Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core per task):
 
-  global || intervals   one task each (global: the sum of its key times; with --global-windows,
-                        W = min(N x C, keys) windows, each paying a from-scratch first key
-                        (key 0's time) and the rest coherent, then the merge; with
-                        --interval-windows (slurm.mk's INTERVAL_WINDOWS), rad-intervals'
-                        item buffers in W = min(N x C, frames) windows of frames, each paying
-                        the set-up and its frames' share of the per-frame time, then the pass
-                        over their counts: the set-up and --interval-merge-fraction of the
-                        per-frame time, what drawing no item buffer leaves of it)
+  global || intervals   one task each, the longer on the path (global: the sum of its key
+                        times; with --global-windows, W = min(N x C, keys) windows, each paying
+                        its reading, set-up and writing once, the per-key folding per key, a
+                        from-scratch first key and the rest coherent, then the merge; priced
+                        from the report's parts, or timed on two windows and their merge with
+                        --time-windows; with --interval-windows (slurm.mk's INTERVAL_WINDOWS),
+                        rad-intervals' item buffers in W = min(N x C, frames) windows of frames,
+                        each paying the set-up and its frames' share of the per-frame time,
+                        then the pass over their counts: the set-up and
+                        --interval-merge-fraction of the per-frame time, what drawing no item
+                        buffer leaves of it). slurm.mk's last window task runs each merge, so
+                        no latency before it; with --window-merge-stage a merge job's latency
+                        is on its own stage's path)
   movies                movie i in shard i % SHARDS; each shard pays the fixed cost once;
                         shards are list-scheduled on the N x C cores (longest first).
                         With --piece-keys K (slurm.mk's MOVIE_PIECE_KEYS, issue 58), a movie of
@@ -35,18 +40,20 @@ Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core pe
                         (-c copy); the contact sheet decodes its eight frames. The three are
                         timed on the run's frames, one core each (video-seconds.json)
   + one scheduling latency per stage on the critical path (--latency, seconds; measured on the
-    local cluster: tests/slurm/cluster.sh): global (and its merge when windowed), movies (and,
-    with --merge-stage, their merges), compose, the mp4
+    local cluster: tests/slurm/cluster.sh): global || intervals, movies (and, with
+    --merge-stage, their merges), compose, the mp4
 
 The serial part is what no number of nodes shortens, the critical path on unlimited nodes: the
-longer of global and intervals (or, windowed, the slowest window and the merge), the fixed cost
+longer of global and intervals (or, windowed, the slowest window and its merge), the fixed cost
 of one movies and one compose task (scene loading), the longest single movie (with pieces: the
 longest piece with the merge its task does) and frame, ffmpeg and the latencies. The one-core time over it
 bounds the speed-up.
 
 usage: farm_model.py --scene SCENE [--frames 0-95] [--size 352x240] [--nodes 1,4,16,64]
-                     [--cores N] [--latency 1.0] [--global-windows] [--piece-keys K]
-                     [--merge-stage] [--video-segments] [--bin DIR] [--out DIR]
+                     [--cores N] [--latency 1.0] [--global-windows] [--time-windows]
+                     [--interval-windows] [--window-merge-stage] [--piece-keys K]
+                     [--piece-seconds T] [--merge-stage] [--video-segments] [--bin DIR]
+                     [--out DIR]
        farm_model.py --from DIR ...   (model an earlier one-core run in DIR, without running)
        farm_model.py --self-test      (the model's arithmetic on made-up pieces)
 """
@@ -55,6 +62,7 @@ import heapq
 import json
 import math
 import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -133,6 +141,75 @@ def time_video(run_dir):
     return out
 
 
+def time_global_windows(run_dir, args):
+    """rad-global of the one-core run in two windows and their merge, each on one core
+    (global-windows-seconds.json): a window task's seconds once (reading the scene, the set-up,
+    writing the window file) and per key beyond its solve (the mean of the two windows), the
+    second window's first key (from scratch, past key 0) and the merge task's total. The merged
+    file must be the run's global.rlh byte for byte."""
+    path = os.path.join(run_dir, "global-windows-seconds.json")
+    if os.path.exists(path):
+        return load(path)
+    bin_dir = os.path.abspath(args.bin)
+    out = subprocess.run(["make", "-s", "--no-print-directory", "-C", ROOT, "-f",
+                          os.path.join(HERE, "animation.mk"), "BIN=" + bin_dir,
+                          "SCENE=" + os.path.abspath(args.scene), "OUT=" + os.path.abspath(run_dir),
+                          "FRAMES=" + args.frames, "SIZE=" + args.size, "stage-commands"],
+                         capture_output=True, text=True)
+    cmd = [line.split("\t", 1)[1] for line in out.stdout.splitlines() if line.startswith("global\t")]
+    if out.returncode != 0 or not cmd:
+        fail("animation.mk stage-commands gave no global command: " + out.stderr.strip())
+    words = shlex.split(cmd[0])
+    scratch = os.path.join(run_dir, "global-windows-timing")
+    os.makedirs(scratch, exist_ok=True)
+
+    def run(extra, output, report):
+        w = list(words)
+        w[w.index("-o") + 1] = output
+        w[w.index("--report") + 1] = report
+        if subprocess.run(["taskset", "-c", "0"] + w + extra,
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
+            fail("%s failed" % " ".join(w + extra))
+        return load(report)
+    ranges = subprocess.run(words[:1] + words[1:] + ["--print-windows", "2"], capture_output=True,
+                            text=True).stdout.split()
+    if len(ranges) != 2:
+        fail("rad-global --print-windows 2 gave %r" % ranges)
+    reports, files = [], []
+    for j, r in enumerate(ranges):
+        files.append(os.path.join(scratch, "w%d.rkw" % j))
+        reports.append(run(["--window", r], files[-1], files[-1][:-4] + "-report.json"))
+    # The merge writes the run's own -o and --report (its provenance records the command line),
+    # so the run's files are moved aside while it runs, compared, and put back.
+    rlh, report = words[words.index("-o") + 1], words[words.index("--report") + 1]
+    for f in (rlh, report):
+        os.replace(f, f + ".one-run")
+    try:
+        if subprocess.run(["taskset", "-c", "0"] + words + ["--merge"] + files,
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
+            fail("rad-global --merge of %s failed" % " ".join(files))
+        m = load(report)
+        same = subprocess.run(["cmp", "-s", rlh, rlh + ".one-run"]).returncode == 0
+    finally:
+        for f in (rlh, report):
+            os.replace(f + ".one-run", f)
+    if not same:
+        fail("the merge of two windows differs from %s" % rlh)
+
+    def key_seconds(k):
+        return k["seconds_links"] + k["seconds_solve"] + k.get("seconds_coherence", 0.0)
+    base = [r["seconds"]["read"] + r["seconds"]["setup"] + r["seconds"]["write"] for r in reports]
+    per_key = [(r["seconds"]["total"] - b - sum(key_seconds(k) for k in r["key_times"]))
+               / len(r["key_times"]) for r, b in zip(reports, base)]
+    result = {"window_base": sum(base) / 2, "per_key": sum(per_key) / 2,
+              "scratch_key": key_seconds(reports[1]["key_times"][0]),
+              "merge": m["seconds"]["total"], "windows": ranges}
+    shutil.rmtree(scratch, ignore_errors=True)
+    with open(path, "w") as f:
+        json.dump(result, f)
+    return result
+
+
 def pieces(run_dir):
     """The one-core run's pieces: seconds of each stage part."""
     g = load(os.path.join(run_dir, "global-report.json"))
@@ -169,6 +246,11 @@ def pieces(run_dir):
         "frames": frames,
         "compose_fixed": c["seconds"] - sum(frames),
     }
+    if all(x in g["seconds"] for x in ("read", "setup", "merge", "write")):
+        p["global_parts"] = {x: g["seconds"][x] for x in ("read", "setup", "merge", "write")}
+    windows_path = os.path.join(run_dir, "global-windows-seconds.json")
+    if os.path.exists(windows_path):
+        p["global_windows"] = load(windows_path)
     with open(os.path.join(run_dir, "wall-seconds")) as f:
         wall = float(f.read())
     stages = p["global"] + p["intervals"] + m["seconds"]["total"] + c["seconds"]
@@ -185,22 +267,46 @@ def makespan(tasks, slots):
     return max(ends)
 
 
-def global_seconds(p, slots, windows):
+def window_costs(p):
+    """What a rad-global window task costs beside its keys' solves, and its merge:
+    (base, per_key, scratch, merge). base: reading the scene, the set-up and writing the window
+    file, once per task; per_key: what each key costs beyond its solve (folding its links into
+    the activity intervals, its records); scratch: the first key of a window past key 0, solved
+    from scratch; merge: the merge task. Measured when the run timed windows
+    (global-windows-seconds.json, time_global_windows); else from the one run's report (the
+    merge as its merge pass, reading and writing; every window's first key as long as key 0);
+    for a run without the report's seconds, its whole fixed cost for base and merge, as before."""
+    gw = p.get("global_windows")
+    if gw:
+        return gw["window_base"], gw["per_key"], gw["scratch_key"], gw["merge"]
+    sec = p.get("global_parts")
+    if not sec:
+        return p["global_fixed"], 0.0, p["keys"][0], p["global_fixed"]
+    base = sec["read"] + sec["setup"] + sec["write"]
+    per_key = max(0.0, p["global_fixed"] - base - sec["merge"]) / len(p["keys"])
+    return base, per_key, p["keys"][0], sec["read"] + sec["merge"] + sec["write"]
+
+
+def global_path(p, slots, windows, latency=0.0, merge_in_task=True):
+    """rad-global's time on the critical path: one task, or min(slots, keys) windows side by side,
+    each paying its fixed cost and a from-scratch first key, then the merge: run by the last
+    window task to end (slurm.mk's default: no scheduling latency between) or, merge_in_task
+    False, as a job of its own after one latency."""
     if not windows or slots <= 1:
         return p["global"]
     k = len(p["keys"])
     w = min(slots, k)
+    base, per_key, scratch, merge = window_costs(p)
     bounds = [k * j // w for j in range(w + 1)]
-    scratch = p["keys"][0]  # a window starts from scratch at its first key
-    slowest = max(p["global_fixed"] + scratch + sum(p["keys"][a + 1:b])
-                  for a, b in zip(bounds, bounds[1:]))
-    merge = p["global_fixed"]  # reading the windows and writing global.rlh
-    return slowest + merge
+    slowest = max(base + per_key * (b - a) + (p["keys"][0] if a == 0 else scratch)
+                  + sum(p["keys"][a + 1:b]) for a, b in zip(bounds, bounds[1:]))
+    return slowest + merge + (0.0 if merge_in_task else latency)
 
 
-def intervals_seconds(p, slots, windows, merge_fraction):
+def intervals_path(p, slots, windows, merge_fraction, latency=0.0, merge_in_task=True):
     """rad-intervals' time on the critical path: one task, or windows of frames side by side and
-    the pass over their counts (rad-intervals --window, --merge)."""
+    the pass over their counts (rad-intervals --window, --merge), run by the last window task or,
+    merge_in_task False, as a job of its own after one latency."""
     if not windows or slots <= 1:
         return p["intervals"]
     n = p["intervals_frames"]
@@ -209,7 +315,7 @@ def intervals_seconds(p, slots, windows, merge_fraction):
     largest = max(n * (j + 1) // w - n * j // w for j in range(w))
     slowest = p["intervals_fixed"] + per_frame * largest
     merge = p["intervals_fixed"] + per_frame * n * merge_fraction
-    return slowest + merge
+    return slowest + merge + (0.0 if merge_in_task else latency)
 
 
 def movie_pieces(p, piece_keys, piece_seconds=0.0):
@@ -298,7 +404,8 @@ def merges_in_tasks(p, pieces, merges, shards, shard_of=None):
 
 
 def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False, merge_stage=False,
-          piece_seconds=0.0, interval_windows=False, interval_merge_fraction=0.01):
+          piece_seconds=0.0, interval_windows=False, interval_merge_fraction=0.01,
+          window_merge_stage=False):
     slots = nodes * cores
     shards = slots
     movie_shards = [0.0] * shards
@@ -316,32 +423,35 @@ def model(p, nodes, cores, latency, windows, piece_keys=0, segments=False, merge
     encode = p["video_parts"]["mp4"] / n if segments else 0.0  # a segment's encode, per frame
     compose_tasks = [p["compose_fixed"] + sum(p["frames"][n * j // chunks:n * (j + 1) // chunks])
                      + encode * (n * (j + 1) // chunks - n * j // chunks) for j in range(chunks)]
-    g = global_seconds(p, slots, windows)
-    iv = intervals_seconds(p, slots, interval_windows, interval_merge_fraction)
+    g = global_path(p, slots, windows, latency, not window_merge_stage)
+    iv = intervals_path(p, slots, interval_windows, interval_merge_fraction, latency,
+                        not window_merge_stage)
     path = {
         "global || intervals": max(g, iv),
         "movies": makespan(movie_tasks, slots),
         "movie merge": merge,
         "compose": makespan(compose_tasks, slots),
         "mp4 + contact sheet": video_path(p, segments),
-        "scheduling": stage_boundaries((windows or interval_windows) and slots > 1,
-                                       merge_stage and merge) * latency,
+        "scheduling": stage_boundaries(merge_stage and merge) * latency,
     }
     return path, sum(path.values())
 
 
-def stage_boundaries(global_windows, movie_merge):
-    """The stages on the critical path, each started after one scheduling latency: global (and its
-    merge, when in windows; or rad-intervals' pass over its windows, taken as on the path too),
-    movies (and their merges when a stage of their own), compose, the mp4."""
-    return 4 + (1 if global_windows else 0) + (1 if movie_merge else 0)
+def stage_boundaries(movie_merge):
+    """The stages on the critical path, each started after one scheduling latency: global ||
+    intervals, movies (and their merges when a stage of their own), compose, the mp4. A window
+    merge run as a job of its own has its latency in its stage's path (global_path,
+    intervals_path), so that it counts only when that stage is the longer of the two."""
+    return 4 + (1 if movie_merge else 0)
 
 
 def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=False,
-                piece_seconds=0.0, interval_windows=False, interval_merge_fraction=0.01):
+                piece_seconds=0.0, interval_windows=False, interval_merge_fraction=0.01,
+                window_merge_stage=False):
     """The critical path with unlimited nodes: what no number of nodes shortens."""
-    g = global_seconds(p, len(p["keys"]), windows)
-    iv = intervals_seconds(p, p["intervals_frames"], interval_windows, interval_merge_fraction)
+    g = global_path(p, len(p["keys"]), windows, latency, not window_merge_stage)
+    iv = intervals_path(p, p["intervals_frames"], interval_windows, interval_merge_fraction,
+                        latency, not window_merge_stage)
     pieces, merges = movie_pieces(p, piece_keys, piece_seconds)
     if merge_stage:
         merge = merge_seconds(p, merges, max(1, len(merges)))
@@ -359,7 +469,7 @@ def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=F
         "movie merge": merge,
         "longest frame": max(p["frames"]) + encode,
         "ffmpeg": video_path(p, segments),
-        "scheduling": stage_boundaries(windows or interval_windows, merge_stage and merge) * latency,
+        "scheduling": stage_boundaries(merge_stage and merge) * latency,
     }
 
 
@@ -387,19 +497,50 @@ def self_test():
     check("movies on 16 cores: the longest movie", path["movies"], 0.5 + 3.0)
     serial = serial_part(p, 0.0, False)
     check("serial part", sum(serial.values()), 10.0 + 0.6 + 3.0 + 0.25 + 2.0)
+    # Windows with measured costs (time_global_windows): each window task pays 0.3 s once and
+    # 0.1 s a key beyond its solves, a window past key 0 starts with a 3 s key from scratch; the
+    # merge takes 0.25 s. Two windows of keys 4+2 | 2+2: 0.5 + 4 + 2 = 6.5 and 0.5 + 3 + 2 =
+    # 5.5, then the merge.
+    m = dict(p, global_windows={"window_base": 0.3, "per_key": 0.1, "scratch_key": 3.0,
+                                "merge": 0.25})
+    path, wall = model(m, 1, 2, 1.0, True)
+    check("measured windows, merged by the last window task", path["global || intervals"],
+          6.5 + 0.25)
+    path, wall = model(m, 1, 2, 1.0, True, window_merge_stage=True)
+    check("the merge as a job: one latency more", path["global || intervals"], 6.5 + 1.0 + 0.25)
+    check("a merge job is no stage of every path", path["scheduling"], 4.0)
+    # From the one run's report: read 0.1, set-up 0.1, merge pass 0.2, write 0.1 of a fixed
+    # 1.3 s leave 0.8 s for the 4 keys' folding, 0.2 s a key; windows of 2 keys: 0.3 + 0.4 +
+    # 4 + 2 and 0.3 + 0.4 + 4 (key 0's time) + 2; the merge 0.1 + 0.2 + 0.1.
+    e = dict(p, global_fixed=1.3, global_parts={"read": 0.1, "setup": 0.1, "merge": 0.2,
+                                                 "write": 0.1})
+    path, wall = model(e, 1, 2, 1.0, True)
+    check("windows from the one run's report", path["global || intervals"], 6.7 + 0.4)
     # rad-intervals in windows of frames: 10 frames of 2 s after 0.2 s of set-up, on 4 cores
     # windows of 2, 3, 2, 3 frames, then the pass over their counts (the set-up and 1 %).
     q = dict(p, intervals=20.2, **{"global": 1.0})
     path, wall = model(q, 2, 2, 1.0, False)
     check("intervals as one task", path["global || intervals"], 20.2)
     path, wall = model(q, 2, 2, 1.0, False, interval_windows=True)
-    check("intervals in four windows and the pass", path["global || intervals"],
-          0.2 + 3 * 2.0 + 0.2 + 0.01 * 20.0)
-    check("the pass is one more stage", path["scheduling"], 5.0)
+    check("intervals in four windows and the pass, in the last window task",
+          path["global || intervals"], 0.2 + 3 * 2.0 + 0.2 + 0.01 * 20.0)
+    check("the pass in a window task: no stage more", path["scheduling"], 4.0)
+    path, wall = model(q, 2, 2, 1.0, False, interval_windows=True, window_merge_stage=True)
+    check("the pass as a job: its latency on the intervals' path", path["global || intervals"],
+          0.2 + 3 * 2.0 + 1.0 + 0.2 + 0.01 * 20.0)
+    # The pass's latency counts only when rad-intervals is the longer: rad-global one task of
+    # 30 s is the path, whatever rad-intervals' windows and their merge job take.
+    r = dict(q, **{"global": 30.0})
+    path, wall = model(r, 2, 2, 1.0, False, interval_windows=True, window_merge_stage=True)
+    check("global longer: the intervals' merge latency off the path",
+          path["global || intervals"], 30.0)
+    check("global longer: four stages", path["scheduling"], 4.0)
+    check("global longer: serial part", serial_part(r, 1.0, False, interval_windows=True,
+                                                    window_merge_stage=True)["scheduling"], 4.0)
     serial = serial_part(q, 1.0, False, interval_windows=True)
     check("serial: a window of one frame and the pass", serial["global || intervals"],
           0.2 + 2.0 + 0.2 + 0.01 * 20.0)
-    check("serial: the pass's stage", serial["scheduling"], 5.0)
+    check("serial: no stage for the pass", serial["scheduling"], 4.0)
     # Pieces (issue 58): movie 3 (3 s, 6 keys, 1 s of planning) in pieces of at most 2 keys is
     # 3 pieces of 1 + 2/3 s each, the 4th to 6th pieces dealt: shards 3, 0, 1;
     # the merge reads and writes its 600 bytes at 0.0005 s a byte, after the fixed 0.5 s.
@@ -415,14 +556,14 @@ def self_test():
     check("movies on 4 shards: shard 0 holds movie 0 and a piece of movie 3",
           path["movies"], 0.5 + 1.0 + 1.0 + 2.0 / 3.0)
     check("a stage more", path["scheduling"], 5.0)
-    path, wall = model(p, 2, 2, 1.0, True, 2, merge_stage=True)
-    check("and one more for the global merge", path["scheduling"], 6.0)
+    path, wall = model(p, 2, 2, 1.0, True, 2, merge_stage=True, window_merge_stage=True)
+    check("and the global merge job's latency on its path", path["global || intervals"], 5.0)
     serial = serial_part(p, 0.0, False, 2, merge_stage=True)
     check("serial: the longest piece",
           serial["longest movie"], 1.0 + 2.0 / 3.0)
     check("serial merge", serial["movie merge"], 1.1)
     check("serial scheduling, windows and merges",
-          serial_part(p, 1.0, True, 2, merge_stage=True)["scheduling"], 6.0)
+          serial_part(p, 1.0, True, 2, merge_stage=True)["scheduling"], 5.0)
     # The merges in the piece tasks (slurm.mk's default): movie 3's pieces are units 3, 4, 5,
     # in shards 3, 0, 1 of 4; shard 1 holds its last piece and merges it (0.6 s) after its
     # second process's fixed cost (0.5 s); shards 3 and 0 pay that fixed cost too, for nothing
@@ -436,7 +577,7 @@ def self_test():
     serial = serial_part(p, 0.0, False, 2)
     check("serial: the last piece and its merge", serial["longest movie"], 1.0 + 2.0 / 3.0 + 0.6)
     check("serial: the merge's fixed cost", serial["movie merge"], 0.5)
-    check("serial scheduling, windows, no merge stage", serial_part(p, 1.0, True, 2)["scheduling"], 5.0)
+    check("serial scheduling, windows, no merge stage", serial_part(p, 1.0, True, 2)["scheduling"], 4.0)
     # Segments: each chunk of two frames encodes them (1 s for 4 frames: 0.5 s a chunk); then
     # the longer of the join (0.25 s) and the contact sheet (0.5 s).
     p["video_parts"] = {"mp4": 1.0, "contact": 0.5, "concat": 0.25}
@@ -484,6 +625,13 @@ def main():
     ap.add_argument("--interval-merge-fraction", type=float, default=0.01,
                     help="the pass over the windows' counts, as a fraction of rad-intervals' "
                     "per-frame time (docs/results.md, \"rad-intervals' item buffers by windows\")")
+    ap.add_argument("--window-merge-stage", action="store_true",
+                    help="rad-global's and rad-intervals' window merges as jobs of their own "
+                    "(slurm.mk before the last window task ran them)")
+    ap.add_argument("--time-windows", action="store_true",
+                    help="with --global-windows: also time rad-global in two windows and their "
+                    "merge on one core (global-windows-seconds.json), for the windows' fixed "
+                    "cost, a from-scratch key past key 0 and the merge")
     ap.add_argument("--merge-stage", action="store_true",
                     help="with --piece-keys: the merges as a stage of their own (slurm.mk before "
                     "the merges went into the piece tasks)")
@@ -503,6 +651,10 @@ def main():
         args.out = os.path.join(args.out, os.path.splitext(os.path.basename(args.scene))[0])
         measure(args)
         run_dir = args.out
+    if args.time_windows:
+        if not args.scene:
+            fail("--time-windows needs --scene (the run's scene) and the run's --frames")
+        time_global_windows(run_dir, args)
     p = pieces(run_dir)
     if args.video_segments:
         p["video_parts"] = time_video(run_dir)
@@ -528,13 +680,14 @@ def main():
         path, wall = model(p, nodes, args.cores, args.latency, args.global_windows,
                            args.piece_keys, args.video_segments, args.merge_stage,
                            args.piece_seconds, args.interval_windows,
-                           args.interval_merge_fraction)
+                           args.interval_merge_fraction, args.window_merge_stage)
         rows.append({"nodes": nodes, "wall": wall, "path": path})
         print("%6d %9.1f %8.1fx  %s" % (nodes, wall, one_core / wall,
                                         ", ".join("%s %.1f" % kv for kv in path.items())))
     serial = serial_part(p, args.latency, args.global_windows, args.piece_keys,
                          args.video_segments, args.merge_stage, args.piece_seconds,
-                         args.interval_windows, args.interval_merge_fraction)
+                         args.interval_windows, args.interval_merge_fraction,
+                         args.window_merge_stage)
     total = sum(serial.values())
     print("serial part (the critical path on unlimited nodes): %.1f s = %.1f %% of the one-core "
           "time, so the speed-up is at most %.1fx: %s"

@@ -8,13 +8,16 @@
 # parameter change submits exactly what animation.mk would run:
 #   rad-global and rad-intervals     one job each, side by side; with GLOBAL_WINDOWS=W, rad-global
 #                                    as an array over W time windows of FRAMES (`--window`) and
-#                                    a merge job (`--merge`), whose global.rlh is the one job's,
+#                                    their merge (`--merge`), whose global.rlh is the one job's,
 #                                    byte for byte
 #                                    With INTERVAL_WINDOWS=W (default 4), rad-intervals as an
 #                                    array drawing the item buffers of W contiguous windows of
 #                                    FRAMES (`--window`, each writing its frames' visible samples)
-#                                    and a job deciding the movies from them (`--merge`), whose
+#                                    and the pass deciding the movies from them (`--merge`), whose
 #                                    intervals.rti is the one job's, byte for byte
+#                                    Each merge is run by the window task that ends last
+#                                    (slurm-merge-ready.sh, under a lock), not by a job of its
+#                                    own: no scheduling latency between the windows and it
 #   rad-movies                       an array over `--shard i/SHARDS`; with MOVIE_PIECE_KEYS=K
 #                                    (the default), a movie of more than K keys is baked as
 #                                    pieces of at most K keys spread over the shards
@@ -102,6 +105,10 @@ INTERVAL_WINDOW_COUNT := $(words $(INTERVAL_WINDOW_LIST))
 INTERVAL_WINDOW_FILES := $(foreach i,$(shell seq 0 $$(($(INTERVAL_WINDOW_COUNT) - 1))),$(OUT)/interval-windows/w$(i).rvs)
 WINDOW_FILES := $(foreach i,$(shell seq 0 $$(($(WINDOW_COUNT) - 1))),$(OUT)/global-windows/w$(i).rkw)
 
+# In a window task of a split stage, after its window's stamp: the merge $(4) of the $(2) windows
+# in folder $(1) into $(3), run when this task finds them all done (slurm-merge-ready.sh).
+MERGE_READY = $(HERE)slurm-merge-ready.sh $(1) $(2) $(3) $(4)
+
 # Submits stage $(1): array indices $(2) (a shell word; empty: one task, numbered 0), after the
 # jobs this run submitted for the stages $(3), running the command $(4).
 submit = mkdir -p $(LOGS) && \
@@ -127,7 +134,9 @@ endif
 
 frames: $(OUT)/frames/.done
 
-# One job, or GLOBAL_WINDOWS time windows side by side and their merge (the same bytes).
+# One job, or GLOBAL_WINDOWS time windows side by side and their merge (the same bytes), run by
+# the window task that ends last (slurm-merge-ready.sh: no job, no scheduling latency for it);
+# a merge job of its own only when every window is done and the merge is not.
 $(OUT)/global.rlh: $(OUT)/scene.params $(OUT)/global.params $(BIN)/rad-global
 ifeq ($(WINDOW_COUNT),1)
 	@$(call submit,global,,,$(GLOBAL_CMD))
@@ -136,13 +145,15 @@ else
 	if [ -n "$$missing" ]; then \
 	  $(call submit,global,$$missing,,set -- $(WINDOWS) && shift $${SLURM_ARRAY_TASK_ID} && \
 	    $(call GLOBAL_WINDOW_CMD,$$1,$(OUT)/global-windows/w$${SLURM_ARRAY_TASK_ID}.rkw) && \
-	    touch $(OUT)/global-windows/.window-$${SLURM_ARRAY_TASK_ID}-of-$(WINDOW_COUNT)); \
-	fi && \
-	$(call submit,global-merge,,global,$(call GLOBAL_MERGE_CMD,$(WINDOW_FILES)))
+	    touch $(OUT)/global-windows/.window-$${SLURM_ARRAY_TASK_ID}-of-$(WINDOW_COUNT) && \
+	    $(call MERGE_READY,$(OUT)/global-windows,$(WINDOW_COUNT),$@,$(call GLOBAL_MERGE_CMD,$(WINDOW_FILES)))); \
+	else \
+	  $(call submit,global-merge,,,$(call GLOBAL_MERGE_CMD,$(WINDOW_FILES))); \
+	fi
 endif
 
 # One job, or INTERVAL_WINDOWS windows of item buffers side by side and the pass over their
-# counts (the same bytes).
+# counts (the same bytes), run by the window task that ends last, as rad-global's merge.
 $(OUT)/intervals.rti: $(OUT)/scene.params $(OUT)/intervals.params $(BIN)/rad-intervals
 ifeq ($(INTERVAL_WINDOW_COUNT),1)
 	@$(call submit,intervals,,,$(INTERVALS_CMD))
@@ -151,9 +162,11 @@ else
 	if [ -n "$$missing" ]; then \
 	  $(call submit,intervals,$$missing,,set -- $(INTERVAL_WINDOW_LIST) && shift $${SLURM_ARRAY_TASK_ID} && \
 	    $(call INTERVALS_WINDOW_CMD,$$1,$(OUT)/interval-windows/w$${SLURM_ARRAY_TASK_ID}.rvs) && \
-	    touch $(OUT)/interval-windows/.window-$${SLURM_ARRAY_TASK_ID}-of-$(INTERVAL_WINDOW_COUNT)); \
-	fi && \
-	$(call submit,intervals-merge,,intervals,$(call INTERVALS_MERGE_CMD,$(INTERVAL_WINDOW_FILES)))
+	    touch $(OUT)/interval-windows/.window-$${SLURM_ARRAY_TASK_ID}-of-$(INTERVAL_WINDOW_COUNT) && \
+	    $(call MERGE_READY,$(OUT)/interval-windows,$(INTERVAL_WINDOW_COUNT),$@,$(call INTERVALS_MERGE_CMD,$(INTERVAL_WINDOW_FILES)))); \
+	else \
+	  $(call submit,intervals-merge,,,$(call INTERVALS_MERGE_CMD,$(INTERVAL_WINDOW_FILES))); \
+	fi
 endif
 
 # The shards' stamps name the piece size (.pshardK-I-of-N), so that pieces of another size are

@@ -14,6 +14,7 @@
 #include "libcommon/core/error.h"
 #include "libcommon/core/stopwatch.h"
 #include "libcommon/intervals/projected_area.h"
+#include "libcommon/intervals/seen_subdivision.h"
 
 namespace rad {
 namespace {
@@ -23,10 +24,11 @@ namespace {
 // crosses the eye plane edge-on cannot have an unbounded area.
 constexpr double kGuardBand = 64.0;
 
-// Largest subdivision the builder makes: ~480 bytes per node (patch hierarchy, GL and item
-// geometry), so at most ~8 GB, issue 58's bound a stage: room for the million-triangle floor of
-// make_floor.py at the default --max-level 2 (the 2^21 of the 100k-triangle hall refused it).
-constexpr long kMaxNodes = 1L << 24;
+// Largest full subdivision the builder numbers. The item geometry of every leaf is drawn whether
+// or not its top is made (seen_subdivision.h), so this bounds the GL and item geometry's memory
+// (issue 58's bound of 8 GB a stage): room for the million-triangle floor of make_floor.py at the
+// default --max-level 2 (the 2^21 of the 100k-triangle hall refused it).
+constexpr uint64_t kMaxNodes = uint64_t(1) << 24;
 
 }  // namespace
 
@@ -77,14 +79,18 @@ struct TextureIntervalsBuilder::Impl {
   const Scene& scene;
   int cameraNode;
   TextureIntervalsOptions options;
-  PatchHierarchy hierarchy;
-  std::vector<int> meshNodes;   // scene mesh node of each item object
-  std::vector<int> nodeObject;  // per dense node: index into meshNodes
+  // The patch nodes, made for the tops a frame has shown (seen_subdivision.h); dense indices
+  // below are its hierarchy's.
+  SeenSubdivision subdivision;
+  std::vector<int> meshNodes;    // scene mesh node of each item object
+  std::vector<int> objectOfTop;  // per top-level patch: index into meshNodes
   std::unique_ptr<ItemBufferRenderer> renderer;
   bool uploaded = false;  // renderer has the geometry
   ItemBuffer buffer;      // addFrame's
+  // (leaf number, samples) of a frame's runs whose top was not made yet (countVisibleSamples).
+  std::vector<std::pair<uint64_t, long>> unmadeRuns;
 
-  // Per-frame state.
+  // Per-frame state, per dense node (grown as tops are made, growNodeState).
   std::vector<long> visible;
   std::vector<double> area, inFrustum;  // -1 = not computed this frame
   std::vector<glm::dmat4> clipFromObject, guardFromObject;
@@ -126,65 +132,60 @@ struct TextureIntervalsBuilder::Impl {
     if (cameraNode < 0 || cameraNode >= int(scene.nodes.size()) ||
         scene.nodes[cameraNode].camera < 0)
       throw inputError(scene.path, nodeLabel(scene, cameraNode) + " is not a camera");
-    hierarchy = PatchHierarchy(scene.inputPolygons());
-    // Nodes of the full subdivision: tops x (4^(L+1) - 1) / 3.
-    double nodes = hierarchy.topCount() * (std::pow(4.0, options.maxLevel + 1) - 1.0) / 3.0;
-    if (nodes > double(kMaxNodes))
-      throw Error(ExitCode::kUsage, "",
-                  "--max-level " + std::to_string(options.maxLevel) + ": " +
-                      std::to_string(hierarchy.topCount()) + " top-level patches would make " +
-                      std::to_string((long long)nodes) + " patch nodes (at most " +
-                      std::to_string(kMaxNodes) + "); use a smaller --max-level");
-    // Regular subdivision down to maxLevel: level by level, so dense indices grow with depth
-    // and every child comes after its parent.
-    hierarchy.reserve(size_t(nodes));
-    std::vector<int> level(hierarchy.topCount());
-    for (int i = 0; i < hierarchy.topCount(); ++i) level[i] = i;
-    for (int l = 0; l < options.maxLevel; ++l) {
-      std::vector<int> next;
-      next.reserve(level.size() * 4);
-      for (int i : level) {
-        int c = hierarchy.subdivide(i);
-        for (int k = 0; k < 4; ++k) next.push_back(c + k);
-      }
-      level.swap(next);
-    }
-    // One item object per mesh node that owns patches (scene order), leaves with id index+1.
+    subdivision = SeenSubdivision(scene.inputPolygons(), options.maxLevel, kMaxNodes);
+    const PatchHierarchy& h = subdivision.hierarchy();
+    // One item object per mesh node that owns patches (scene order).
     std::map<int, int> objectOf;
-    for (int t = 0; t < hierarchy.topCount(); ++t) objectOf.emplace(hierarchy.top(t).node, 0);
+    for (int t = 0; t < h.topCount(); ++t) objectOf.emplace(h.top(t).node, 0);
     for (auto& [node, obj] : objectOf) {
       obj = int(meshNodes.size());
       meshNodes.push_back(node);
     }
-    nodeObject.resize(hierarchy.size());
-    for (int i = 0; i < hierarchy.size(); ++i) nodeObject[i] = objectOf.at(hierarchy.topOf(i).node);
+    objectOfTop.resize(size_t(h.topCount()));
+    for (int t = 0; t < h.topCount(); ++t) objectOfTop[t] = objectOf.at(h.top(t).node);
     // The GL context is made here, so that a machine without one fails before any frame; the
     // geometry goes to it with the first addFrame (addFrames' renderers have their own).
     renderer = std::make_unique<ItemBufferRenderer>(grid(), itemBufferOptions());
-    visible.assign(hierarchy.size(), 0);
-    area.assign(hierarchy.size(), 0.0);
-    inFrustum.assign(hierarchy.size(), 0.0);
-    openMovie.assign(hierarchy.size(), -1);
-    openBelow.assign(hierarchy.size(), 0);
+    growNodeState();
   }
 
-  // The leaves as item objects (one per mesh node, ids dense index + 1): made for each renderer and
-  // dropped once uploaded, so that they are not held through the frames.
+  const PatchHierarchy& hierarchy() const { return subdivision.hierarchy(); }
+  int objectOf(int node) const { return objectOfTop[hierarchy().node(node).id.top]; }
+
+  // The per-node state sized to the nodes made, new nodes without samples or movies.
+  void growNodeState() {
+    const size_t n = size_t(hierarchy().size());
+    visible.resize(n, 0);
+    area.resize(n, -1.0);
+    inFrustum.resize(n, -1.0);
+    openMovie.resize(n, -1);
+    openBelow.resize(n, 0);
+  }
+
+  // The leaves of the full subdivision as item objects (one per mesh node, ids leaf number + 1,
+  // seen_subdivision.h), made or not: a top no frame has shown yet may show in the next one, and
+  // hides what lies behind it. Made for each renderer and dropped once uploaded, so that they are
+  // not held through the frames. In each object, leaves in number order (the order the draw
+  // breaks depth ties in).
   std::vector<ItemObject> itemObjects() const {
+    const PatchHierarchy& h = subdivision.hierarchy();
     std::vector<ItemObject> objects(meshNodes.size());
     // Exact sizes first: at a million triangles the leaves' triangles are gigabytes, and growing
     // them by doubling held up to twice that (issue 58).
+    const size_t leavesPerTop = size_t(1) << (2 * options.maxLevel);
     std::vector<size_t> triangles(meshNodes.size(), 0);
-    for (int i = 0; i < hierarchy.size(); ++i)
-      if (hierarchy.isLeaf(i))
-        triangles[nodeObject[i]] += size_t(hierarchy.node(i).local.count - 2);
+    for (int t = 0; t < h.topCount(); ++t)
+      triangles[objectOfTop[t]] += leavesPerTop * size_t(h.top(t).local.count - 2);
     for (size_t k = 0; k < objects.size(); ++k) {
       objects[k].triangles.reserve(triangles[k]);
       objects[k].ids.reserve(triangles[k]);
     }
-    for (int i = 0; i < hierarchy.size(); ++i)
-      if (hierarchy.isLeaf(i))
-        objects[nodeObject[i]].addPolygon(hierarchy.node(i).local, uint32_t(i + 1));
+    const uint64_t firstLeaf = subdivision.fullNodeCount() - leavesPerTop * h.topCount();
+    for (int t = 0; t < h.topCount(); ++t) {
+      uint64_t number = firstLeaf + uint64_t(t) * leavesPerTop;
+      for (const Polygon& leaf : subdivision.leafPolygons(t))
+        objects[objectOfTop[t]].addPolygon(leaf, uint32_t(number++ + 1));
+    }
     return objects;
   }
 
@@ -202,18 +203,18 @@ struct TextureIntervalsBuilder::Impl {
   // Whole-patch projected area (header: clipped at the near and far planes only).
   double wholeArea(int i) {
     if (area[i] < 0.0) {
-      const Polygon& p = hierarchy.node(i).local;
-      area[i] = kGuardBand * kGuardBand *
-                projectedAreaPixels(guardFromObject[nodeObject[i]], options.imageSize, p.v.data(),
-                                    p.count);
+      const Polygon& p = hierarchy().node(i).local;
+      area[i] =
+          kGuardBand * kGuardBand *
+          projectedAreaPixels(guardFromObject[objectOf(i)], options.imageSize, p.v.data(), p.count);
     }
     return area[i];
   }
   double areaInFrustum(int i) {
     if (inFrustum[i] < 0.0) {
-      const Polygon& p = hierarchy.node(i).local;
-      inFrustum[i] = projectedAreaPixels(clipFromObject[nodeObject[i]], options.imageSize,
-                                         p.v.data(), p.count);
+      const Polygon& p = hierarchy().node(i).local;
+      inFrustum[i] =
+          projectedAreaPixels(clipFromObject[objectOf(i)], options.imageSize, p.v.data(), p.count);
     }
     return inFrustum[i];
   }
@@ -240,28 +241,28 @@ struct TextureIntervalsBuilder::Impl {
     const bool tiny =
         double(visible[i]) < 4.0 * options.minSize * options.minSize * samplesPerPixel() &&
         textureSideFor(area[i], 0, options) <= 4 * options.minSize;
-    if (enough || tiny || hierarchy.isLeaf(i)) {
+    if (enough || tiny || hierarchy().isLeaf(i)) {
       chosen.push_back(i);
       return;
     }
-    int c = hierarchy.node(i).firstChild;
+    int c = hierarchy().node(i).firstChild;
     for (int k = 0; k < 4; ++k) choose(c + k);
   }
 
   // True when an ancestor or a descendant of node i is chosen this frame.
   bool relativeChosen(int i, const std::vector<char>& isChosen) const {
-    for (int p = hierarchy.node(i).parent; p >= 0; p = hierarchy.node(p).parent)
+    for (int p = hierarchy().node(i).parent; p >= 0; p = hierarchy().node(p).parent)
       if (isChosen[p]) return true;
     // Descendants: dense indices of a subtree are not contiguous, so walk it.
     std::vector<int> stack;
-    if (!hierarchy.isLeaf(i)) stack.push_back(i);
+    if (!hierarchy().isLeaf(i)) stack.push_back(i);
     while (!stack.empty()) {
       int n = stack.back();
       stack.pop_back();
-      int c = hierarchy.node(n).firstChild;
+      int c = hierarchy().node(n).firstChild;
       for (int k = 0; k < 4; ++k) {
         if (isChosen[c + k]) return true;
-        if (!hierarchy.isLeaf(c + k)) stack.push_back(c + k);
+        if (!hierarchy().isLeaf(c + k)) stack.push_back(c + k);
       }
     }
     return false;
@@ -295,13 +296,13 @@ struct TextureIntervalsBuilder::Impl {
 
   // The texture size of node i this frame, from `current` (0 x 0: a new movie; TextureShape).
   TextureSize sizeFor(int i, TextureSize current) const {
-    return textureSizeFor(area[i], textureShapeOf(hierarchy.node(i).local), current, options);
+    return textureSizeFor(area[i], textureShapeOf(hierarchy().node(i).local), current, options);
   }
   static TextureSize sizeOf(const MovieExtent& m) { return {m.width, m.height}; }
 
   int openNew(int node, int frame, TextureSize size) {
     MovieExtent m;
-    m.patch = hierarchy.node(node).id;
+    m.patch = hierarchy().node(node).id;
     m.firstFrame = m.lastFrame = frame;
     m.width = size.width;
     m.height = size.height;
@@ -322,21 +323,35 @@ struct TextureIntervalsBuilder::Impl {
 
   // visible[i] = the samples of `ids` showing leaf i. Counted by runs of one id: a leaf covers
   // many neighbouring samples of a row (the grid has s^2 a pixel), so one add a run instead of
-  // one a sample; the same sums.
+  // one a sample; the same sums. The tops first shown here are made after the pass (in top order,
+  // whatever order the buffer shows them in), and their runs added then.
   void countVisibleSamples(const std::vector<uint32_t>& ids) {
     std::fill(visible.begin(), visible.end(), 0);
-    const uint32_t n = uint32_t(hierarchy.size());
+    unmadeRuns.clear();
     const size_t count = ids.size();
     for (size_t k = 0; k < count;) {
       const uint32_t id = ids[k];
       size_t end = k + 1;
       while (end < count && ids[end] == id) ++end;
       if (id != kNoItem) {
-        if (id > n) throw Error(ExitCode::kInternal, "", "item buffer id out of range");
-        visible[id - 1] += long(end - k);
+        const uint64_t number = uint64_t(id) - 1;
+        if (!subdivision.isLeafNumber(number))
+          throw Error(ExitCode::kInternal, "", "item buffer id out of range");
+        const int node = subdivision.nodeOfLeafNumber(number);
+        if (node >= 0)
+          visible[node] += long(end - k);
+        else
+          unmadeRuns.push_back({number, long(end - k)});
       }
       k = end;
     }
+    if (unmadeRuns.empty()) return;
+    std::vector<int> tops;
+    for (const auto& run : unmadeRuns) tops.push_back(subdivision.topOfLeafNumber(run.first));
+    subdivision.make(std::move(tops));
+    growNodeState();
+    for (const auto& [number, samples] : unmadeRuns)
+      visible[subdivision.nodeOfLeafNumber(number)] += samples;
   }
 
   // Frame v.frame, whose item buffer `items` was rendered at v in `seconds`.
@@ -346,16 +361,25 @@ struct TextureIntervalsBuilder::Impl {
     addCounted(v, &items, seconds, observer);
   }
 
-  // visible[i] = counts[k] for leaves[k] (addVisibleSamples' contract), 0 elsewhere.
+  // visible[leaf numbered leaves[k]] = counts[k] (addVisibleSamples' contract), 0 elsewhere;
+  // the tops first shown are made first, as countVisibleSamples makes them.
   void setVisibleSamples(const std::vector<uint32_t>& leaves, const std::vector<uint32_t>& counts) {
     if (leaves.size() != counts.size())
       throw Error(ExitCode::kInternal, "", "visible samples: leaves and counts differ in number");
-    std::fill(visible.begin(), visible.end(), 0);
-    for (size_t k = 0; k < leaves.size(); ++k) {
-      if (leaves[k] >= uint32_t(hierarchy.size()) || !hierarchy.isLeaf(int(leaves[k])))
+    std::vector<int> unmade;
+    for (uint32_t number : leaves) {
+      if (!subdivision.isLeafNumber(number))
         throw Error(ExitCode::kInternal, "", "visible samples: not a leaf of the subdivision");
-      visible[leaves[k]] = long(counts[k]);
+      const int top = subdivision.topOfLeafNumber(number);
+      if (!subdivision.made(top)) unmade.push_back(top);
     }
+    if (!unmade.empty()) {
+      subdivision.make(std::move(unmade));
+      growNodeState();
+    }
+    std::fill(visible.begin(), visible.end(), 0);
+    for (size_t k = 0; k < leaves.size(); ++k)
+      visible[subdivision.nodeOfLeafNumber(leaves[k])] = long(counts[k]);
   }
 
   // Frame v.frame, whose leaves' visible samples are in `visible` (item buffer `items`, or
@@ -371,8 +395,8 @@ struct TextureIntervalsBuilder::Impl {
     itemSeconds += seconds;
 
     // Visible pixels per leaf summed up the tree (children come after parents).
-    for (int i = hierarchy.size() - 1; i >= hierarchy.topCount(); --i)
-      visible[hierarchy.node(i).parent] += visible[i];
+    for (int i = hierarchy().size() - 1; i >= hierarchy().topCount(); --i)
+      visible[hierarchy().node(i).parent] += visible[i];
 
     // Projected areas, computed only where needed (nodes with visible pixels, closing movies):
     // a frame then costs O(visible nodes), not O(all nodes).
@@ -391,13 +415,13 @@ struct TextureIntervalsBuilder::Impl {
     // Representation of each top-level patch.
     std::fill(openBelow.begin(), openBelow.end(), 0);
     for (int node : openList)
-      for (int p = hierarchy.node(node).parent; p >= 0 && !openBelow[p];
-           p = hierarchy.node(p).parent)
+      for (int p = hierarchy().node(node).parent; p >= 0 && !openBelow[p];
+           p = hierarchy().node(p).parent)
         openBelow[p] = 1;
     chosen.clear();
-    for (int top = 0; top < hierarchy.topCount(); ++top) choose(top);
+    for (int top = 0; top < hierarchy().topCount(); ++top) choose(top);
     std::sort(chosen.begin(), chosen.end());
-    std::vector<char> isChosen(hierarchy.size(), 0);
+    std::vector<char> isChosen(hierarchy().size(), 0);
     for (int i : chosen) isChosen[i] = 1;
 
     continueOverGaps(frame, isChosen);
@@ -529,6 +553,10 @@ class ItemBufferPipeline {
     std::unique_ptr<ItemBufferRenderer> renderer;
     std::exception_ptr error;
     try {
+      // One upload at a time: each converts the objects to its own vertex array before the driver
+      // copies it, so uploads side by side held every worker's array at once (a floor of 10^6
+      // triangles has some 16 M leaf triangles; issue 58's memory bound).
+      std::lock_guard<std::mutex> one(uploading_);
       renderer = std::make_unique<ItemBufferRenderer>(size, itemOptions_);
       renderer->setGeometry(objects);
     } catch (...) {
@@ -569,6 +597,7 @@ class ItemBufferPipeline {
   std::vector<Slot> slots_;
   std::vector<std::thread> threads_;
   std::mutex mutex_;
+  std::mutex uploading_;  // held by the worker uploading the geometry (work)
   std::condition_variable changed_;
   size_t uploaded_ = 0;
   bool stop_ = false;
@@ -606,7 +635,21 @@ TextureIntervalsBuilder::TextureIntervalsBuilder(const Scene& scene, int cameraN
 TextureIntervalsBuilder::~TextureIntervalsBuilder() = default;
 
 const PatchHierarchy& TextureIntervalsBuilder::hierarchy() const {
-  return impl_->hierarchy;
+  return impl_->hierarchy();
+}
+int TextureIntervalsBuilder::nodeOfItem(uint32_t id) const {
+  const SeenSubdivision& s = impl_->subdivision;
+  if (id == kNoItem || !s.isLeafNumber(uint64_t(id) - 1)) return -1;
+  return s.nodeOfLeafNumber(uint64_t(id) - 1);
+}
+uint64_t TextureIntervalsBuilder::numberOf(int node) const {
+  return impl_->subdivision.numberOf(node);
+}
+uint64_t TextureIntervalsBuilder::fullNodeCount() const {
+  return impl_->subdivision.fullNodeCount();
+}
+int TextureIntervalsBuilder::topsSeen() const {
+  return impl_->subdivision.topsMade();
 }
 const TextureIntervalsOptions& TextureIntervalsBuilder::options() const {
   return impl_->options;

@@ -3,7 +3,9 @@
 // buffer"; docs/design.md §6.2 rad-intervals).
 //
 // Each top-level patch is subdivided regularly down to maxLevel; every leaf is rendered into
-// an item buffer with its own id. Per frame:
+// an item buffer with its own id (its number + 1, seen_subdivision.h). A top's nodes are made
+// when a frame first shows one of its leaves: a top no frame shows gets no movie (issue 58). Per
+// frame:
 //  * visible pixels per node = sum over the leaves below it;
 //  * projected area per node (projected_area.h, occlusion ignored), twice: the part inside the
 //    frustum (zero: the node left the frustum), and the whole patch's image, clipped only at
@@ -114,7 +116,8 @@ struct IntervalFrame {
   double itemBufferSeconds = 0.0;  // render + readback
   // Of options.sampling's grid (sample_grid.h); nullptr for addVisibleSamples' frames.
   const ItemBuffer* itemBuffer = nullptr;
-  // Per dense node index: visible pixels, projected area of the whole patch (pixels, see
+  // Per dense node index of the builder's hierarchy (the tops, and the subtrees of the tops shown
+  // so far): visible pixels, projected area of the whole patch (pixels, see
   // above) and the part of it inside the frustum. The areas are computed only where the
   // algorithm needs them (nodes with visible pixels; the frustum area of nodes whose movie
   // closed) and are -1 elsewhere.
@@ -136,10 +139,20 @@ class TextureIntervalsBuilder {
   TextureIntervalsBuilder(const TextureIntervalsBuilder&) = delete;
   TextureIntervalsBuilder& operator=(const TextureIntervalsBuilder&) = delete;
 
+  // The tops and the subtrees made so far (seen_subdivision.h): a top's subtree is made by the
+  // first frame that shows it, so a dense index names a node only within this builder.
   const PatchHierarchy& hierarchy() const;
   const TextureIntervalsOptions& options() const;
-  // Item id of a leaf = dense node index + 1; kNoItem = nothing.
-  static int nodeOfItem(uint32_t id) { return int(id) - 1; }
+  // Dense index of the leaf an item id shows: -1 for kNoItem, an id out of range, or a leaf whose
+  // top no frame added so far has shown. Item id = the leaf's number + 1.
+  int nodeOfItem(uint32_t id) const;
+  // The number of dense node i in the full subdivision (seen_subdivision.h): what item ids (+1)
+  // and visible samples files name.
+  uint64_t numberOf(int node) const;
+  // Nodes of the full subdivision to maxLevel (intervals.rti's patch_nodes), and the tops whose
+  // subtrees were made (those some frame showed; hierarchy().size() nodes in all).
+  uint64_t fullNodeCount() const;
+  int topsSeen() const;
 
   // Processes one frame; frames must be strictly increasing. With a step between frames, a
   // movie is taken to cover the skipped frames between two frames where it is chosen.
@@ -152,9 +165,9 @@ class TextureIntervalsBuilder {
                  const std::function<void(const IntervalFrame&)>& observer = {},
                  const std::function<void()>& frameDone = {});
   // The same as addFrame for a frame whose item buffer was counted elsewhere (a farm task,
-  // formats/visible_samples.h): leaves[k] (dense node indices of leaves, each once) showed
+  // formats/visible_samples.h): leaves[k] (numbers of leaves, seen_subdivision.h, each once) showed
   // counts[k] samples of the grid, every other leaf none. The observer sees itemBuffer nullptr.
-  // Throws rad::Error(kInternal) for a node that is not a leaf or lists of different sizes.
+  // Throws rad::Error(kInternal) for a number that is not a leaf's or lists of different sizes.
   void addVisibleSamples(int frame, const std::vector<uint32_t>& leaves,
                          const std::vector<uint32_t>& counts, double itemBufferSeconds,
                          const std::function<void(const IntervalFrame&)>& observer = {});

@@ -95,6 +95,33 @@ TEST(RadIntervalsCli, WindowsMergedGiveTheOneRunsBytes) {
   EXPECT_EQ(countLines(other.err), 1) << other.err;
 }
 
+// A floor of furnished rooms (issue 58): the camera sees one classroom and the corridor, so most
+// tops no frame shows get no patch nodes below them (the report's patch_nodes_made against the
+// full subdivision's patch_nodes, which intervals.rti still records), and the windows merged
+// still give the one run's bytes.
+TEST(RadIntervalsCli, FloorOfRoomsSubdividesOnlyTheTopsSeen) {
+  fs::path d = freshDir("floor");
+  const std::string make = "python3 " RAD_SOURCE_DIR "/pipelines/scenes/make_floor.py " +
+                           (d / "floor.gltf").string() + " --triangles 10000";
+  ASSERT_EQ(runCommand(make).exitCode, 0);
+  const std::string run = "cd " + d.string() + " && " + tool("rad-intervals") +
+                          " floor.gltf --frames 0-40x8 --size 176x120";
+  CommandResult r = runCommand(run + " -o i.rti --report report.json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  nlohmann::json rep = nlohmann::json::parse(readWholeFile((d / "report.json").string()));
+  const long tops = rep["top_patches"], seen = rep["top_patches_seen"];
+  EXPECT_EQ(rep["patch_nodes"].get<long>(), 21 * tops);
+  EXPECT_EQ(rep["patch_nodes_made"].get<long>(), tops + 20 * seen);
+  EXPECT_GT(seen, 0);
+  EXPECT_LT(4 * seen, tops) << "most rooms are out of sight";
+  const std::string whole = readWholeFile((d / "i.rti").string());
+  fs::remove(d / "i.rti");  // the merge records the same command line
+  ASSERT_EQ(runCommand(run + " --window 0-16 -o a.rvs").exitCode, 0);
+  ASSERT_EQ(runCommand(run + " --window 17-40 -o b.rvs").exitCode, 0);
+  ASSERT_EQ(runCommand(run + " -o i.rti --report report.json --merge a.rvs b.rvs").exitCode, 0);
+  EXPECT_TRUE(readWholeFile((d / "i.rti").string()) == whole) << "the merge's bytes differ";
+}
+
 TEST(RadIntervalsCli, BadValuesAreUsageErrors) {
   fs::path d = freshDir("bad");
   for (std::string flags : {"--max-level -1", "--min-visible-fraction 2", "--size 0x5",

@@ -4,7 +4,8 @@
 # WAIT=1, against animation.mk's frames on this machine:
 #   1. with rad-global in 3 time windows and a merge (GLOBAL_WINDOWS=3), global.rlh is the single
 #      run's byte for byte, rad-intervals' item buffers are drawn in 3 windows and its movies
-#      decided from their counts (INTERVAL_WINDOWS=3), and every frame's pixels (EXR and PNG) are bit-identical to
+#      decided from their counts (INTERVAL_WINDOWS=3), each merge run once by the window task
+#      that ended last (no merge job), and every frame's pixels (EXR and PNG) are bit-identical to
 #      animation.mk's (the frame files differ only in their provenance, which records each
 #      task's own command line and paths); the movies of more than MOVIE_PIECE_KEYS=4 keys were
 #      baked in pieces and merged by the movies tasks themselves, no merge stage (issue 58),
@@ -71,9 +72,14 @@ same_frames() {
 make -s -f pipelines/slurm.mk "${common[@]}" "OUT=$work/farm" SHARDS=4 GLOBAL_WINDOWS=3 INTERVAL_WINDOWS=3 WAIT=1 \
   MOVIE_PIECE_KEYS=4 2>"$work/farm.err" || fail "slurm.mk WAIT=1 failed: $(tail -1 "$work/farm.err")"
 same_frames "$work/local" "$work/farm"
-if grep -q "slurm.mk: movies-merge submitted" "$work/farm.err"; then
-  fail "a merge stage was submitted: the movies tasks merge their pieces themselves"
+if grep -q "slurm.mk: \(movies\|global\|intervals\)-merge submitted" "$work/farm.err"; then
+  fail "a merge job was submitted: the window and movies tasks merge themselves: $(grep -- '-merge submitted' "$work/farm.err")"
 fi
+# rad-global's and rad-intervals' merges ran once each, in the window task that ended last.
+for stage in global intervals; do
+  n=$(cat "$work"/farm/logs/${stage}_*.log | grep -c "^slurm-merge-ready: every window .* merging" || true)
+  [ "$n" = 1 ] || fail "$stage's windows were merged $n times by their tasks (expected once: logs/${stage}_*.log)"
+done
 merged=$(cat "$work"/farm/logs/movies_*.log | sed -n 's/^rad-movies: merged \([0-9]*\) movies.*/\1/p' |
   awk '{n += $1} END {print n + 0}')
 [ "$merged" -gt 0 ] || fail "no movie was baked in pieces and merged by a movies task (logs/movies_*.log)"

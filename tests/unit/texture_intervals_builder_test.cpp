@@ -337,6 +337,44 @@ TEST(TextureIntervalsBuilder, ZoomThatDoublesResolutionResizes) {
   EXPECT_EQ(mine[1].end, MovieEnd::kWindow);
 }
 
+// A room no frame shows (issue 58: most rooms of a floor): behind a wall that fills the view, and
+// behind the camera. Its tops get no nodes below them (before, every top was subdivided to
+// maxLevel, 21 nodes a top at level 2), and the movies are those of the scene without it: the
+// item buffers draw its leaves all the same, so they hide what they hid.
+TEST(TextureIntervalsBuilder, TopsNoFrameShowsAreNotSubdivided) {
+  auto scene = [](bool withHiddenRoom) {
+    TestScene s;
+    s.addRect("wall", -20.0, -20.0, 20.0, 20.0, -10.0);
+    int box = s.addRect("box", -1.0, -1.0, 1.0, 1.0, -5.0);
+    s.move(box, {-2.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, 0.5);
+    if (withHiddenRoom)
+      for (int k = 0; k < 40; ++k) {
+        const double x = -8.0 + 0.4 * k;
+        s.addRect("behind the wall", x, -1.0, x + 0.3, 1.0, -15.0);
+        s.addRect("behind the camera", x, -1.0, x + 0.3, 1.0, 5.0);
+      }
+    return s;
+  };
+  TextureIntervalsOptions o;
+  o.imageSize = kSize;
+  TestScene with = scene(true), without = scene(false);
+  TextureIntervalsBuilder b(with.scene, with.camera, o);
+  TextureIntervalsBuilder reference(without.scene, without.camera, o);
+  for (int f = 0; f < 12; ++f) {
+    b.addFrame(f);
+    reference.addFrame(f);
+  }
+  const int tops = b.hierarchy().topCount();
+  ASSERT_EQ(tops, 82);
+  EXPECT_EQ(b.fullNodeCount(), uint64_t(tops) * 21u);
+  EXPECT_EQ(b.topsSeen(), 2) << "the wall and the box";
+  EXPECT_EQ(b.hierarchy().size(), tops + 2 * 20);
+  // The wall and the box come first: the same top indices, so the same patch ids.
+  std::vector<MovieExtent> movies = b.finish(), expected = reference.finish();
+  ASSERT_FALSE(expected.empty());
+  EXPECT_EQ(movies, expected);
+}
+
 // A rectangle mostly (60 %) outside the frustum has a visible fraction below theta: it is
 // represented by its children inside the frustum; the children wholly outside get nothing.
 TEST(TextureIntervalsBuilder, PatchHalfOutsideTheFrustumIsRepresentedByChildren) {
@@ -561,8 +599,9 @@ long checkInvariants(const Scene& scene, int camera, const std::vector<int>& fra
       for (uint32_t id : f.itemBuffer->id) {
         if (id == kNoItem) continue;
         int covering = 0;
-        for (int n = TextureIntervalsBuilder::nodeOfItem(id); n >= 0; n = h.node(n).parent)
-          covering += isChosen[n];
+        const int leaf = b.nodeOfItem(id);
+        ASSERT_GE(leaf, 0) << "frame " << f.frame << ": id " << id << " shows no leaf made";
+        for (int n = leaf; n >= 0; n = h.node(n).parent) covering += isChosen[n];
         ASSERT_EQ(covering, 1) << "frame " << f.frame << " leaf " << id - 1;
         ++pixels;
       }
@@ -906,12 +945,15 @@ TEST(TextureIntervalsBuilder, ItemBufferIdsAgreeWithEmbreeRayCasts) {
   int checked = 0, framesChecked = 0;
   for (int frame : {0, 11, 23, 47, 95}) {
     b.addFrame(frame, [&](const IntervalFrame& f) {
+      // The leaves made, by their item ids; the tops not made (no frame showed them yet) whole,
+      // with an id no item buffer holds.
       std::vector<ItemTriangle> world;
       for (int i = 0; i < h.size(); ++i) {
+        const bool unmadeTop = h.node(i).parent < 0 && h.isLeaf(i) && o.maxLevel > 0;
         if (!h.isLeaf(i)) continue;
+        const uint32_t id = unmadeTop ? ~uint32_t(0) : uint32_t(b.numberOf(i) + 1);
         Polygon p = h.node(i).local.transformed(scene.worldTransform(h.topOf(i).node, f.time));
-        for (int k = 1; k + 1 < p.count; ++k)
-          world.push_back({{p.v[0], p.v[k], p.v[k + 1]}, uint32_t(i + 1)});
+        for (int k = 1; k + 1 < p.count; ++k) world.push_back({{p.v[0], p.v[k], p.v[k + 1]}, id});
       }
       EmbreeCaster caster(world);
       CameraView view = scene.cameraAt(camera, f.time);

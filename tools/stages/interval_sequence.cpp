@@ -129,6 +129,7 @@ VisibleSamples computeVisibleSamples(const Scene& scene, int cameraNode,
   TextureIntervalsBuilder builder(scene, cameraNode, built);
   const SampleGrid grid = options.sampling.grid(options.imageSize);
   const PatchHierarchy& ph = builder.hierarchy();
+  const int maxLevel = options.maxLevel;
   builder.addFrames(
       frames, renderersForThisProcess(),
       [&](const IntervalFrame& fr) {
@@ -136,12 +137,17 @@ VisibleSamples computeVisibleSamples(const Scene& scene, int cameraNode,
         f.frame = fr.frame;
         f.empty = !showsSurfaceAtPixelCentres(*fr.itemBuffer, grid);
         f.itemBufferSeconds = fr.itemBufferSeconds;
+        // The leaves of the full subdivision by number (the tops made are a builder's own).
         const std::vector<long>& visible = *fr.visiblePixels;
+        std::vector<std::pair<uint32_t, uint32_t>> leaves;
         for (int i = 0; i < ph.size(); ++i)
-          if (visible[i] > 0 && ph.isLeaf(i)) {
-            f.leaf.push_back(uint32_t(i));
-            f.count.push_back(uint32_t(visible[i]));
-          }
+          if (visible[i] > 0 && ph.node(i).id.level() == maxLevel)
+            leaves.push_back({uint32_t(builder.numberOf(i)), uint32_t(visible[i])});
+        std::sort(leaves.begin(), leaves.end());
+        for (const auto& [leaf, count] : leaves) {
+          f.leaf.push_back(leaf);
+          f.count.push_back(count);
+        }
         out.frames.push_back(std::move(f));
       },
       frameDone);
@@ -160,13 +166,15 @@ void finishSequence(IntervalSequence& run, TextureIntervalsBuilder& builder, con
   run.intervals = intervalsRecord(extents, frames, options);
   const PatchHierarchy& ph = builder.hierarchy();
   run.metadata = {{"top_patches", ph.topCount()},
-                  {"patch_nodes", ph.size()},
+                  {"patch_nodes", long(builder.fullNodeCount())},
                   {"max_level", options.maxLevel},
                   {"camera", scene.nodes[cameraNode].name},
                   {"frame_step", frames.size() > 1 ? frames[1] - frames[0] : 1}};
   run.frames = builder.framesAdded();
   run.topPatches = ph.topCount();
-  run.patchNodes = ph.size();
+  run.patchNodes = long(builder.fullNodeCount());
+  run.topPatchesSeen = builder.topsSeen();
+  run.patchNodesMade = ph.size();
   run.itemBufferSeconds = builder.itemBufferSeconds();
   run.continuedOverGaps = builder.moviesContinuedOverGaps();
 }
@@ -182,6 +190,8 @@ nlohmann::json intervalSequenceReport(const IntervalSequence& run, const std::st
   report["image_size"] = {run.intervals.imageWidth, run.intervals.imageHeight};
   report["top_patches"] = run.topPatches;
   report["patch_nodes"] = run.patchNodes;
+  report["top_patches_seen"] = run.topPatchesSeen;
+  report["patch_nodes_made"] = run.patchNodesMade;
   report["hidden_gaps_continued"] = run.continuedOverGaps;
   report["item_buffer_ms_per_frame"] = 1e3 * run.itemBufferSeconds / n;
   // The first frame pays for shader compilation and driver warm-up: the median is the figure.

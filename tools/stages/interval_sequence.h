@@ -27,7 +27,11 @@ struct IntervalSequence {
   // scene): their final frames would be black, which the tool warns about.
   std::vector<int> emptyFrames;
   int topPatches = 0;
-  int patchNodes = 0;
+  long patchNodes = 0;  // of the full subdivision to --max-level, which the item buffers draw
+  // The tops some frame showed, and the nodes made for them (seen_subdivision.h): the others
+  // have no visible sample, so no movie and no level to choose.
+  int topPatchesSeen = 0;
+  long patchNodesMade = 0;
   double itemBufferSeconds = 0.0;   // total render + readback
   long continuedOverGaps = 0;       // hidden gaps a movie was kept over (--hidden-gap)
   std::vector<double> itemSeconds;  // per frame, in frame order
