@@ -164,8 +164,10 @@ class GoodLinkGather {
   double partialShare_;
   // The small partial links left on the link's one V sum to at most this many shares
   // (selectPartialLinks): each misplaces little, but a receiver with many of them (a floor
-  // seeing the ceiling past many table edges) misplaces their sum.
-  static constexpr double kPartialSumShares = 10.0;
+  // seeing the ceiling past many table edges) misplaces their sum, and two receiver nodes side by
+  // side that keep different links step by it along their border: a seam between coplanar
+  // patches (issue 56; docs/results.md, "Seams from the small partial links").
+  static constexpr double kPartialSumShares = 2.5;
   // Per partial link, what its receiver chain carries (selectPartialLinks' total): the scale of
   // the tiles' visibility test.
   std::vector<double> linkGather_;

@@ -21,7 +21,7 @@ void addSampleParameters(ParameterTable<O>& t) {
   t.add("gather-partial-share", &O::gatherPartialShare,
         "gather: a partly occluded link takes its visibility per texel when B F (1 - V) is at "
         "least this share of what the texel gathers, or when the smaller ones left on their V "
-        "would sum to more than 10 shares (smaller: more links per texel, slower)",
+        "would sum to more than 2.5 shares (smaller: more links per texel, slower)",
         Check::range(0.0, 1.0), Group::kQuality);
   t.add("moving-shadow-key-step", &O::movingShadowKeyStep,
         "frames between key textures of a movie whose bad links' shadows move (a moving "

@@ -109,7 +109,7 @@ struct TextureMovieBakerOptions {
   int gatherRays = 16;
   // --gather-partial-share: a partly occluded gathered link takes its visibility per texel when its
   // risk, B F (1 - V), is at least this share of what the texel gathers, or when the smaller ones
-  // left on their V would sum to more than 10 shares; and a far one interpolated over a tile goes
+  // left on their V would sum to more than 2.5 shares; and a far one interpolated over a tile goes
   // per texel where the tile's middle misses by this share (good_link_gather.h). A smaller share
   // sends more links per texel: more accurate and slower; the final setting uses 0.001.
   double gatherPartialShare = 0.002;

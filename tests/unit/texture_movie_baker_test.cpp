@@ -1149,10 +1149,13 @@ TEST(TextureMovieBaker, GatheredVisibilityFollowsThePenumbraPerTexel) {
 // Partial links each below --gather-partial-share of what a texel gathers kept the link's one
 // V, however many there were: the 10k hall's floor under the desks' front edges, which sees
 // the ceiling's many patches past the desk tops, came out 9 % too bright in a strip. Those left
-// on their V now sum to at most 10 shares per receiver node; the others take V per texel from a
-// quarter of the rays. The slab's penumbra under a ceiling of 16 x 32 separate tiles: mean
-// error 0.0745 before (every floor node's links to the tiles below the share on their own),
-// 0.0194 now; 0.190 with one V per node.
+// on their V sum to at most kPartialSumShares (2.5) shares per receiver node; the others take V
+// per texel from a quarter of the rays. The slab's penumbra under a ceiling of 16 x 32 separate
+// tiles: mean error 0.0745 with every floor node's links to the tiles below the share on their
+// own, 0.0229 with 10 shares kept, 0.0110 with 2.5; 0.107 with one V per node. Ten shares let
+// two receiver nodes side by side keep links that misplace up to 2 % of their light each: a
+// step along their border (table-static-static's floor under the table, docs/results.md
+// "Seams from the small partial links").
 TEST(TextureMovieBaker, ManySmallPartialLinksTakeTheirVisibilityPerTexelTogether) {
   TextureMovieBakerOptions o;
   GoodLinkGatherStats stats;
@@ -1164,7 +1167,7 @@ TEST(TextureMovieBaker, ManySmallPartialLinksTakeTheirVisibilityPerTexelTogether
       "%.4f), %ld partial links, %ld with a quarter of the rays\n",
       error, perNode, stats.partialLinks, stats.partialLinksFewRays);
   EXPECT_GT(stats.partialLinksFewRays, 0);
-  EXPECT_LT(error, 0.03);
+  EXPECT_LT(error, 0.015);
 }
 
 // A box standing on the floor (touching it, one-sided faces) under an emitting ceiling: the
