@@ -140,7 +140,8 @@ int run(const rad::ComposeOptions& given, const std::string& preset, int argc, c
   rad::addInput(provenance, o.scene);
   provenance.inputs.push_back(std::move(globalInput));
   rad::addInput(provenance, intervalsReader);
-  rad::addMoviesInput(provenance, intervals, o.movies, c.frames);
+  rad::UsedMovies movies = rad::readUsedMovies(intervals, o.movies, c.frames);
+  rad::addMoviesInput(provenance, o.movies, movies);
   rad::requireMoviesMadeFrom(provenance.inputs.back(), scene);
   warnAboutDifferences(c, given.camera, o.intervals, intervalsReader, intervals);
 
@@ -149,8 +150,9 @@ int run(const rad::ComposeOptions& given, const std::string& preset, int argc, c
     if (rad::stderrIsTerminal()) std::fprintf(stderr, "\r\033[K");
     std::cerr << kTool << ": " << message << "\n";
   };
-  rad::ComposeSequenceReport report = rad::composeSequence(
-      scene, solution, intervals, c, provenance, warn, [&]() { progress.advance(); });
+  rad::ComposeSequenceReport report =
+      rad::composeSequence(scene, solution, intervals, c, provenance, std::move(movies), warn,
+                           [&]() { progress.advance(); });
   progress.done();
   if (o.autoExposure)
     std::cerr << kTool << ": auto exposure " << report.exposureEV << " EV for all frames\n";
