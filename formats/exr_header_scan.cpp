@@ -14,6 +14,7 @@
 #include <cstring>
 #include <optional>
 
+#include "formats/checksum.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -177,6 +178,7 @@ class Scanner {
     ExrHeaderScan scan;
     scan.headerBytes = pos_;
     scan.fileBytes = bytes_.fileBytes();
+    scan.headerHash = fnv1a64(bytes_.at(0), size_t(pos_));
     uint64_t chunks = 0;
     for (size_t p = 0; p < headers.size(); ++p) {
       // A single-part file's type is in its version flags (a "type" attribute may repeat it).

@@ -45,6 +45,10 @@ struct ExrHeaderScan {
   std::vector<ExrScannedPart> parts;
   uint64_t headerBytes = 0;  // magic, version and headers: where the offset tables start
   uint64_t fileBytes = 0;
+  // FNV-1a 64 (formats/checksum.h) of the bytes [0, headerBytes): every attribute of every part.
+  // For a rad file whose parts carry rad.pixelChecksum it names the content without reading the
+  // pixels (rad-compose's movies input, formats/frame_image.md).
+  uint64_t headerHash = 0;
 };
 
 // The most a part's decoded bytes may exceed its file's size by, per OpenEXR compression

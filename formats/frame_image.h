@@ -4,7 +4,7 @@
 // with --half; values above 65504 are clamped there), row 0 = top; uncompressed unless
 // --compression says otherwise (ZIP saves little of noise-free float radiance, for much of
 // rad-compose's time).
-// String/int/double attributes: rad.format "frame 2.1", rad.pixelChecksum
+// String/int/double attributes: rad.format "frame 2.2", rad.pixelChecksum
 // (formats/pixel_checksum.h), rad.frame, rad.time, rad.units, rad.exposureEV (what the PNG used),
 // rad.coveredPixels, rad.moviePixels, rad.fallbackPixels and rad.provenance
 // (Provenance::toJson().dump()). Readable with exrheader / oiiotool / rad-inspect.
@@ -26,7 +26,7 @@
 namespace rad {
 
 constexpr int kFrameImageMajor = 2;
-constexpr int kFrameImageMinor = 1;
+constexpr int kFrameImageMinor = 2;
 
 struct FrameImageInfo {
   int frame = 0;

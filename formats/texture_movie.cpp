@@ -521,8 +521,10 @@ TextureMovie readTextureMovie(const std::string& path) {
 
 TextureMovie readTextureMovieHeaders(const std::string& path, MovieFileKind kind) {
   return readingExr(path, [&] {
-    scanExrFile(path);
-    return readHeaders(CoreExrFile(path).ctx, path, kind);
+    const uint64_t headerHash = scanExrFile(path).headerHash;
+    TextureMovie m = readHeaders(CoreExrFile(path).ctx, path, kind);
+    m.headerHash = headerHash;
+    return m;
   });
 }
 

@@ -51,6 +51,9 @@ struct TextureMovie {
   // Read from the file: each part's rad.pixelChecksum (formats/pixel_checksum.h), which the
   // readers verify against the pixels they decode. Writers compute their own.
   std::vector<uint64_t> keyChecksums;
+  // Set by readTextureMovieHeaders (else 0): ExrHeaderScan::headerHash of the file, every part's
+  // header, so with keyChecksums its whole content, without reading the pixels.
+  uint64_t headerHash = 0;
   // A piece's place in its movie (keyFrames, keyTimes and keys are then the piece's); a whole
   // movie's count is 0.
   TextureMoviePiece piece;

@@ -6,7 +6,8 @@ serial part that bounds the speed-up.
 It runs animation.mk once on one core (taskset), so that every piece's time is a one-core time:
 the reports give rad-global's and rad-intervals' time, each movie's bake time (rad-movies
 `movie_seconds`), each frame's compose time, and each tool's fixed cost (reading the scene and
-its inputs: the report's total minus the pieces); ffmpeg is the rest of the run's wall time.
+its inputs: the report's total minus the pieces; rad-compose's also its seconds_inputs, read
+before the frame loop); ffmpeg is the rest of the run's wall time.
 Then, as slurm.mk runs it on N nodes of C cores with SHARDS = N x C (one core per task):
 
   global || intervals   one task each, the longer on the path (global: the sum of its key
@@ -66,6 +67,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -244,7 +246,10 @@ def pieces(run_dir):
         "movie_bytes": movie_bytes,
         "write_per_byte": m["seconds"].get("write", 0.0) / max(1, sum(movie_bytes.values())),
         "frames": frames,
-        "compose_fixed": c["seconds"] - sum(frames),
+        # Every compose chunk reads the scene, global.rlh, intervals.rti and its movies' headers
+        # before its first frame (the report's seconds_inputs; older reports have none and their
+        # chunks were charged the frame loop's fixed part alone).
+        "compose_fixed": c.get("seconds_inputs", 0.0) + c["seconds"] - sum(frames),
     }
     if all(x in g["seconds"] for x in ("read", "setup", "merge", "write")):
         p["global_parts"] = {x: g["seconds"][x] for x in ("read", "setup", "merge", "write")}
@@ -253,7 +258,7 @@ def pieces(run_dir):
         p["global_windows"] = load(windows_path)
     with open(os.path.join(run_dir, "wall-seconds")) as f:
         wall = float(f.read())
-    stages = p["global"] + p["intervals"] + m["seconds"]["total"] + c["seconds"]
+    stages = p["global"] + p["intervals"] + m["seconds"]["total"] + c["seconds"] + c.get("seconds_inputs", 0.0)
     p["video"] = max(0.0, wall - stages)  # ffmpeg (mp4 and contact sheet) and process starts
     p["wall"] = wall
     return p
@@ -473,6 +478,28 @@ def serial_part(p, latency, windows, piece_keys=0, segments=False, merge_stage=F
     }
 
 
+def self_test_reports(check):
+    """pieces() on made-up reports (part of --self-test)."""
+    # A run's reports: compose's fixed cost takes what rad-compose reads before its frame loop
+    # (seconds_inputs: 1.5 s), beside the loop's own 0.5 s; before, the 1.5 s was in no chunk.
+    with tempfile.TemporaryDirectory() as run:
+        reports = {"global-report.json": {"seconds": {"total": 3.0}, "key_times": [
+                       {"seconds_links": 1.0, "seconds_solve": 1.0}]},
+                   "intervals-report.json": {"total_seconds": 1.0, "setup_seconds": 0.5,
+                                             "frames": 2},
+                   "movies-report.json": {"seconds": {"total": 2.0}, "movie_seconds": [[0, 1.5]]},
+                   "compose-report.json": {"seconds": 1.0, "seconds_inputs": 1.5,
+                                           "frames": [{"seconds": 0.25}, {"seconds": 0.25}]}}
+        for name, value in reports.items():
+            with open(os.path.join(run, name), "w") as f:
+                json.dump(value, f)
+        with open(os.path.join(run, "wall-seconds"), "w") as f:
+            f.write("10.0")
+        r = pieces(run)
+        check("compose fixed: inputs and the loop's own", r["compose_fixed"], 1.5 + 0.5)
+        check("video: the wall beside the stages", r["video"], 10.0 - 3.0 - 1.0 - 2.0 - 2.5)
+
+
 def self_test():
     """The model's arithmetic on made-up pieces (ctest pipeline_farm_model_arithmetic)."""
     def check(what, got, want):
@@ -598,6 +625,7 @@ def self_test():
           path["movies"], 0.5 + 2.0 + 0.5 + 0.6)
     serial = serial_part(p, 0.0, False, 0, piece_seconds=1.5)
     check("serial by cost: the last piece and its merge", serial["longest movie"], 2.0 + 0.6)
+    self_test_reports(check)
     print("farm_model.py: self-test passed")
     return 0
 

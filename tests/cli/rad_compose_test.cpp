@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "formats/checksum.h"
 #include "formats/frame_image.h"
 #include "formats/link_hierarchy.h"
 #include "formats/provenance.h"
@@ -264,6 +265,44 @@ TEST_F(RadCompose, BitIdenticalAcrossRuns) {
   ASSERT_EQ(runCommand(command(out)).exitCode, 0);
   for (const auto& [name, bytes] : first)
     EXPECT_TRUE(readWholeFile((fs::path(out) / name).string()) == bytes) << name;
+}
+
+// The frames' movies input (formats/frame_image.md, frame 2.2): FNV-1a 64 over the header hashes
+// of the movies the frames use, each the FNV-1a 64 of the file's bytes before its chunk offset
+// tables, so that a compose task reads no pixels of keys its frames do not show (issue 58: every
+// farm chunk hashed every movie file's bytes). Before, it was each whole file's hash.
+TEST_F(RadCompose, MoviesInputHashIsOfTheUsedMoviesHeaders) {
+  auto moviesHash = [&](const std::string& frames) {
+    const std::string out = (dir / ("frames" + frames)).string();
+    CommandResult r = runCommand(command(out, "--frames " + frames));
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    FrameExr e = readFrameExr(framePath(out, frames == "2-3" ? 2 : 0, ".exr"));
+    nlohmann::json prov = nlohmann::json::parse(e.attributes["rad.provenance"]);
+    EXPECT_EQ(prov["inputs"][3]["history"]["tool"], "rad-movies");
+    return prov["inputs"][3]["hash"].get<std::string>();
+  };
+  // Movie 2: 2 parts of 3x2 texels, one chunk per scan line (uncompressed): after its headers,
+  // 4 offsets of 8 bytes and 4 chunks of part number, y and size (4 bytes each) and 3 channels x 3
+  // floats.
+  auto headerHash = [&](uint32_t id) {
+    const std::string bytes = readWholeFile(textureMoviePath((dir / "movies").string(), id));
+    const size_t headers = bytes.size() - 4 * 8 - 4 * (12 + 3 * 3 * 4);
+    return formatFnv1a64(fnv1a64(bytes.data(), headers));
+  };
+  const std::string expected = headerHash(2);
+  const std::string got = moviesHash("2-3");
+  EXPECT_EQ(got, formatFnv1a64(fnv1a64(expected.data(), expected.size()))) << got;
+
+  // Other pixels in a key: another rad.pixelChecksum in its header, another hash.
+  TextureMovie m2 = constantMovie(2, {kWallTop, 1}, 2, 3, kWallKey1);
+  m2.keyFrames = {2, 3};
+  m2.keyTimes = {2 / kFps, 3 / kFps};
+  m2.keys.push_back(m2.keys[0]);
+  m2.keys[1][0] += 1.0f;
+  writeTextureMovie(textureMoviePath((dir / "movies").string(), 2), m2);
+  EXPECT_NE(moviesHash("2-3"), got);
+  // Frames 0-1 use movies 0 and 1, not 2.
+  EXPECT_NE(moviesHash("0-1"), got);
 }
 
 TEST_F(RadCompose, UnwritableOutputIsOneLineExit3) {

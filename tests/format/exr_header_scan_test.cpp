@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/checksum.h"
 #include "formats/exr_image.h"
 #include "formats/exr_info.h"
 #include "formats/frame_image.h"
@@ -158,6 +159,22 @@ TEST_F(ExrHeaderScanTest, AcceptsWhatRadWrites) {
   s = scanExrFile(path("m.exr"));
   ASSERT_EQ(s.parts.size(), 2u);
   EXPECT_EQ(s.parts[1].chunks, 3u);
+}
+
+// headerHash is FNV-1a 64 of the bytes before the offset tables (rad-compose's movies input,
+// formats/frame_image.md): a movie with other pixels has another rad.pixelChecksum in its header
+// and so another hash; readTextureMovieHeaders carries it.
+TEST_F(ExrHeaderScanTest, HeaderHashIsOfTheHeadersBytes) {
+  writeTextureMovie(path("m.exr"), sampleMovie());
+  const ExrHeaderScan s = scanExrFile(path("m.exr"));
+  const std::vector<uint8_t> bytes = bytesOf(path("m.exr"));
+  ASSERT_LT(s.headerBytes, bytes.size());
+  EXPECT_EQ(s.headerHash, fnv1a64(bytes.data(), size_t(s.headerBytes)));
+  EXPECT_EQ(readTextureMovieHeaders(path("m.exr")).headerHash, s.headerHash);
+  TextureMovie other = sampleMovie();
+  other.keys[1][5] = 7.0f;
+  writeTextureMovie(path("o.exr"), other);
+  EXPECT_NE(scanExrFile(path("o.exr")).headerHash, s.headerHash);
 }
 
 TEST_F(ExrHeaderScanTest, AttributeLargerThanTheFile) {

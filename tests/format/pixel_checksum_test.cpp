@@ -254,7 +254,7 @@ TEST_F(PixelChecksum, FrameChecksumIsOfTheDecodedValuesWhateverTheStorage) {
   const FrameExr half = readFrameExr(path("half.exr"));
   EXPECT_NE(half.rgb, f.rgb);  // rounded to half
   EXPECT_EQ(stored(path("half.exr")), formatFnv1a64(rgbPixelChecksum(half.rgb.data(), 12, 9)));
-  EXPECT_EQ(half.attributes.at("rad.format"), "frame 2.1");
+  EXPECT_EQ(half.attributes.at("rad.format"), "frame 2.2");
 }
 
 TEST_F(PixelChecksum, EveryCorruptedPixelByteAndTruncationOfAMovieIsCaught) {
@@ -320,7 +320,7 @@ TEST_F(PixelChecksum, OlderFramesAreRefusedForeignFilesRead) {
   writeFrameExr(file, f, FrameImageInfo{}, false);
   std::vector<char> bytes = bytesOf(file);
   std::string text(bytes.begin(), bytes.end());
-  const size_t at = text.find("frame 2.1");
+  const size_t at = text.find("frame 2.2");
   ASSERT_NE(at, std::string::npos);
   bytes[at + 6] = '1';
   bytes[at + 8] = '0';

@@ -6,6 +6,7 @@
 // in the defaults they give, calls the loop and reports.
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -114,6 +115,7 @@ std::vector<int> emptyFrames(const rad::ComposeSequenceReport& report) {
 }
 
 int run(const rad::ComposeOptions& given, const std::string& preset, int argc, char** argv) {
+  const auto start = std::chrono::steady_clock::now();
   rad::ComposeOptions o = given;
   rad::Scene scene = rad::readGltfScene(o.scene);
   // Of global.rlh only the radiosity (fallback pixels, auto exposure) is kept, and the file's bytes
@@ -140,17 +142,24 @@ int run(const rad::ComposeOptions& given, const std::string& preset, int argc, c
   rad::addInput(provenance, o.scene);
   provenance.inputs.push_back(std::move(globalInput));
   rad::addInput(provenance, intervalsReader);
-  rad::addMoviesInput(provenance, intervals, o.movies, c.frames);
+  rad::UsedMovies movies = rad::readUsedMovies(intervals, o.movies, c.frames);
+  rad::addMoviesInput(provenance, o.movies, movies);
   rad::requireMoviesMadeFrom(provenance.inputs.back(), scene);
   warnAboutDifferences(c, given.camera, o.intervals, intervalsReader, intervals);
+
+  // What every farm chunk pays before its first frame (pipelines/farm_model.py's compose_fixed):
+  // the scene, global.rlh, intervals.rti and the used movies' headers read, the provenance made.
+  const double inputSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   rad::Progress progress(kTool, long(c.frames.size()));
   auto warn = [&](const std::string& message) {
     if (rad::stderrIsTerminal()) std::fprintf(stderr, "\r\033[K");
     std::cerr << kTool << ": " << message << "\n";
   };
-  rad::ComposeSequenceReport report = rad::composeSequence(
-      scene, solution, intervals, c, provenance, warn, [&]() { progress.advance(); });
+  rad::ComposeSequenceReport report =
+      rad::composeSequence(scene, solution, intervals, c, provenance, std::move(movies), warn,
+                           [&]() { progress.advance(); });
   progress.done();
   if (o.autoExposure)
     std::cerr << kTool << ": auto exposure " << report.exposureEV << " EV for all frames\n";
@@ -161,6 +170,7 @@ int run(const rad::ComposeOptions& given, const std::string& preset, int argc, c
   if (!o.report.empty()) {
     nlohmann::json j = report.toJson();
     j["empty_frames"] = empty.size();
+    j["seconds_inputs"] = inputSeconds;
     j["provenance"] = provenance.toJson();
     j["peak_memory_mb"] = rad::peakMemoryMb();  // of the process (getrusage), issue 16
     rad::writeTextFile(o.report, j.dump(1) + "\n");

@@ -15,6 +15,7 @@
 #include "libcommon/compose/frame_composer.h"
 #include "libcommon/radiosity/global_solution.h"
 #include "libcommon/scene/scene.h"
+#include "tools/stages/used_movies.h"
 
 namespace rad {
 
@@ -56,7 +57,9 @@ struct ComposeSequenceReport {
   nlohmann::json toJson() const;
 };
 
-// Composes and writes every frame. `warn` gets one message per frame with fallback pixels
+// Composes and writes every frame; `movies` are readUsedMovies(intervals, options.moviesDir,
+// options.frames), whose headers the streams open with. `warn` gets one message per frame with
+// fallback pixels
 // ("frame 12: 37 pixels fell back to the global solution"); `progress` is called after each
 // frame. Throws rad::inputError for a missing or inconsistent movie file (patch, frames or
 // size differing from `intervals`), rad::outputError when FRAMES_DIR or a frame cannot be
@@ -64,18 +67,8 @@ struct ComposeSequenceReport {
 ComposeSequenceReport composeSequence(const Scene& scene, const GlobalSolution& solution,
                                       const TextureIntervals& intervals,
                                       const ComposeSequenceOptions& options,
-                                      const Provenance& provenance,
+                                      const Provenance& provenance, UsedMovies movies,
                                       const std::function<void(const std::string&)>& warn,
                                       const std::function<void()>& progress = {});
-
-}  // namespace rad
-
-namespace rad {
-
-// Records MOVIES_DIR as one provenance input: its hash is FNV-1a 64 over the content hashes of
-// the movie files the frames use (in movie id order), its history the provenance of the first
-// of them (rad-movies'). Throws rad::inputError(movie path, ...) when one cannot be read.
-void addMoviesInput(Provenance& provenance, const TextureIntervals& intervals,
-                    const std::string& moviesDir, const std::vector<int>& frames);
 
 }  // namespace rad
