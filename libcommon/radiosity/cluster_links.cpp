@@ -17,11 +17,6 @@ double maxComponent(const glm::dvec3& v) {
   return std::max(v.x, std::max(v.y, v.z));
 }
 
-uint64_t clusterLinkSeed(ClusterRef r, ClusterRef s) {
-  return splitMix64(splitMix64(uint64_t(int64_t(r)) ^ 0x636c757374657221ull) ^
-                    uint64_t(int64_t(s)));
-}
-
 }  // namespace
 
 ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& world,
@@ -452,23 +447,6 @@ void ClusterLinks::evaluate() {
   listsValid_ = false;
 }
 
-template <class U>
-uint32_t ClusterLinks::drawFacingMember(ClusterRef end, const ClusterBounds& other,
-                                        const std::vector<double>& prefix, U u) const {
-  if (!isCluster(end)) return uint32_t(end);
-  const ClusterNode& n = tree_.node(clusterIndex(end));
-  const double lo = prefix[n.first], hi = prefix[n.first + n.count];
-  uint32_t j = 0;
-  for (int t = 0; t < kFacingTries; ++t) {
-    const double target = lo + u(t) * (hi - lo);
-    auto it =
-        std::upper_bound(prefix.begin() + n.first + 1, prefix.begin() + n.first + n.count, target);
-    j = tree_.members()[size_t(it - prefix.begin()) - 1];
-    if (mayFace(j, other)) break;
-  }
-  return j;
-}
-
 bool ClusterLinks::mayFace(uint32_t t, const ClusterBounds& box) const {
   const glm::dvec3& n = normal_[t];
   double farthest = 0.0;  // the largest n . x over the box
@@ -516,28 +494,6 @@ bool ClusterLinks::near(ClusterRef r, ClusterRef s) const {
   return !(glm::length(S.centre() - R.centre()) > separation_ * (R.radius() + S.radius()));
 }
 
-bool ClusterLinks::facingMembers(ClusterRef end, ClusterRef other, size_t most,
-                                 std::vector<uint32_t>& out) const {
-  const ClusterBounds& box = bounds(other);
-  if (!isCluster(end)) {
-    if (mayFace(uint32_t(end), box)) out.push_back(uint32_t(end));
-    return true;
-  }
-  const ClusterNode& n = tree_.node(clusterIndex(end));
-  for (uint32_t i = n.first; i < n.first + n.count; ++i)
-    if (mayFace(tree_.members()[i], box)) {
-      if (out.size() == most) return false;
-      out.push_back(tree_.members()[i]);
-    }
-  return true;
-}
-
-bool ClusterLinks::tooManyPairsToTest(ClusterRef r, ClusterRef s) const {
-  std::vector<uint32_t> a, b;
-  if (!facingMembers(r, s, kTestedMemberPairs, a)) return true;
-  return !a.empty() && !facingMembers(s, r, kTestedMemberPairs / a.size(), b);
-}
-
 void ClusterLinks::countInto(LinkCensus& census) const {
   auto sizeOf = [&](ClusterRef r, ClusterRef s) {
     return size_t(LinkCensus::sizeClass(std::max(memberCount(r), memberCount(s))));
@@ -550,51 +506,12 @@ void ClusterLinks::countInto(LinkCensus& census) const {
   }
   for (const NearLinkTest& t : nearTests_) {
     LinkCensus::BySize& kind = t.blocked ? census.nearDropped
-                               : visibility_ && tooManyPairsToTest(t.receiver, t.shooter)
+                               : visibility_ && tooManyPairsToTest(t.receiver, t.shooter) &&
+                                       !sampleTested(t.receiver, t.shooter)
                                    ? census.nearUntested
                                    : census.nearRefined;
     ++kind[sizeOf(t.receiver, t.shooter)];
   }
-}
-
-bool ClusterLinks::blocked(ClusterRef r, ClusterRef s) const {
-  if (!visibility_) return false;
-  std::vector<uint32_t> a, b;
-  if (!facingMembers(r, s, kTestedMemberPairs, a)) return false;
-  if (a.empty()) return true;  // nothing of r faces s
-  if (!facingMembers(s, r, kTestedMemberPairs / a.size(), b)) return false;
-  // One ray between the centroids of each pair that face each other there first: where the
-  // ends see each other (most near links of an open room), one of them gets through.
-  for (const uint32_t i : a)
-    for (const uint32_t j : b) {
-      const glm::dvec3 d = centroid_[j] - centroid_[i];
-      if (glm::dot(normal_[i], d) > 0.0 && glm::dot(normal_[j], d) < 0.0 &&
-          !visibility_->occluded(centroid_[i], centroid_[j], i, j))
-        return false;
-    }
-  const uint64_t seed = splitMix64(clusterLinkSeed(r, s) ^ 0x626c6f636b6564ull);  // "blocked"
-  for (const uint32_t i : a)
-    for (const uint32_t j : b) {
-      const Polygon &p = world_[i], &q = world_[j];
-      if (!mutuallyFacing(p, facingPlane(p), q, facingPlane(q))) continue;  // they exchange nothing
-      // Points of each in front of the other's plane: every ray between them carries energy.
-      const uint64_t pairSeed = splitMix64(seed ^ (uint64_t(i) << 32 | j));
-      const std::vector<glm::dvec3> x =
-          VisibilityScene::samplePointsInFront(p, q.v[0], normal_[j], rays_, pairSeed);
-      const std::vector<glm::dvec3> y =
-          VisibilityScene::samplePointsInFront(q, p.v[0], normal_[i], rays_, splitMix64(pairSeed));
-      // y's strata in a random order against x's (a Fisher-Yates shuffle): pairing stratum k with
-      // stratum k would test the same few of the stratum pairs every time.
-      std::vector<int> order(static_cast<size_t>(rays_));
-      for (int k = 0; k < rays_; ++k) order[size_t(k)] = k;
-      const uint64_t shuffle = splitMix64(pairSeed ^ 0x73687566666c65ull);
-      for (int k = rays_ - 1; k > 0; --k)
-        std::swap(order[size_t(k)],
-                  order[size_t(std::min(k, int(uniformOpen01(shuffle, uint64_t(k)) * (k + 1))))]);
-      for (int k = 0; k < rays_; ++k)
-        if (!visibility_->occluded(x[size_t(k)], y[size_t(order[size_t(k)])], i, j)) return false;
-    }
-  return true;
 }
 
 void ClusterLinks::evaluateLink(ClusterLink& l) {

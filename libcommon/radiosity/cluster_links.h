@@ -14,14 +14,17 @@
 //    top-level patches times the lights, which is quadratic in a hall whose lights grow with
 //    its floor;
 //  * the two bounding spheres come closer than their radii (the point approximation below
-//    does not hold): near geometry ends as patch links, unless S holds no emitter, R and S
-//    have few members, and the rays of every pair of their members that face each other are
-//    blocked (blocked): such a link carries nothing and is dropped, not refined. Boards of a
-//    shelf, boxes in a row: their tops are near each other by their spheres, and most pairs of
-//    them cannot see each other (a board between); refining every such pair down to top-level
-//    patches made their all-pairs links, 96 % of them with V = 0 (issue 58), which the patch
-//    links' own oracle never refines either. A light's links are refined as before: the second
-//    pass takes their shadows per texel;
+//    does not hold): near geometry ends as patch links, unless S holds no emitter and R and S
+//    cannot see each other (blocked): such a link carries nothing and is dropped, not refined.
+//    Ends with few members: the rays of every pair of their members that face each other are
+//    blocked. Boards of a shelf, boxes in a row: their tops are near each other by their
+//    spheres, and most pairs of them cannot see each other (a board between); refining every
+//    such pair down to top-level patches made their all-pairs links, 96 % of them with V = 0
+//    (issue 58), which the patch links' own oracle never refines either. Larger ends whose
+//    boxes do not meet: a fixed number of rays between members drawn by area are all blocked
+//    (sampledBlocked, whose contract bounds a false answer). Furniture of neighbouring rooms
+//    behind one wall is near by its spheres, and was refined down to every pair of members.
+//    A light's links are refined as before: the second pass takes their shadows per texel;
 //  * or its power bound exceeds eps Phi: $\max B_S \, V \, \min(A_R \tilde F, A_S)$ with
 //    $\tilde F = \min(1, A_S / (\pi d_{min}^2))$, d_min the gap between the spheres (Smits et
 //    al. §3's bound on a cluster-to-cluster transfer).
@@ -135,6 +138,12 @@ struct ClusterLinkCache {
 inline uint32_t clusterLinkEnd(ClusterRef r, size_t topCount) {
   return isCluster(r) ? uint32_t(topCount + size_t(clusterIndex(r))) : uint32_t(r);
 }
+// The seed of the link r <- s's random draws (its rays, its blocked test): a function of its ends
+// alone, so that every run and thread count draws the same.
+inline uint64_t clusterLinkSeed(ClusterRef r, ClusterRef s) {
+  return splitMix64(splitMix64(uint64_t(int64_t(r)) ^ 0x636c757374657221ull) ^
+                    uint64_t(int64_t(s)));
+}
 
 class ClusterLinks {
  public:
@@ -178,6 +187,9 @@ class ClusterLinks {
   bool radiosityKnown() const { return radiosityKnown_; }
   // fateOf keeps near links that cannot carry eps Phi (RadiosityOptions::keepWeakNearLinks).
   void keepWeakNearLinks(bool on) { keepWeakNear_ = on; }
+  // Rays of the blocked test of near links between large ends (sampledBlocked; RadiosityOptions::
+  // nearBlockRays); 0: such links are refined untested.
+  void nearBlockRays(int n) { nearBlockRays_ = std::max(0, n); }
   // Per top: the sum of its cluster links' form factors H_i / B_S over the exposed part, as
   // gather weighs them (its row sum's cluster part).
   std::vector<double> rowSums(const std::vector<double>& exposure);
@@ -230,17 +242,36 @@ class ClusterLinks {
   // that face each other (mayFace, then mutuallyFacing), `rays` rays between stratified points
   // of a in front of b's plane and of b in front of a's (every ray carries energy) are all
   // blocked: what the patch link a <- b would find before its oracle left it unrefined at V = 0.
-  // Not tested (false) for ends with more than kTestedMemberPairs such pairs, or without a
-  // visibility scene: the visible part of two large clusters can be a few of their members (a
-  // cubby's two sides, within clusters of the whole shelf), which rays between random members
-  // of the two miss (tried: near cluster links with V = 0.6 dropped).
+  // Ends with more than kTestedMemberPairs such pairs take sampledBlocked instead. False without
+  // a visibility scene.
   bool blocked(ClusterRef r, ClusterRef s) const;
   static constexpr int kTestedMemberPairs = 16;
+  // blocked for ends of any size (rooms behind a wall, a cabinet's two sides): n =
+  // nearBlockRays_ rays, each between a member of r drawn by area among those facing s's box
+  // (the draw stratified: every facing member with 1/n of r's area is drawn at least once) and
+  // one of s drawn the same way among those facing it, both points in front of the other's
+  // plane; true when all n are blocked. Contract, the error of a false answer (a gap the rays
+  // miss): where a share p of such pairs sees through, all n rays are blocked with probability
+  // (1 - p)^n, under 5 % for p >= 3 / n, so a link dropped here has, at 95 % confidence, an open
+  // share of its pairs under 3 / n; the light it would carry is that share of its unoccluded
+  // transfer, weighted by the pairs' kernel. The kernel is what area draws cannot bound where
+  // the ends interlock (a cubby's two sides within clusters of the whole shelf: near pairs with
+  // a large kernel see each other while most pairs do not; tried in issue 58's first round:
+  // near cluster links with V = 0.6 dropped), so only ends whose bounding boxes are apart
+  // (boxesApart: no pair closer than the boxes' gap) are tested; others answer false (refined).
+  // False too when fewer than n of kDrawsPerRay n draws make a pair that carries energy.
+  bool sampledBlocked(ClusterRef r, ClusterRef s) const;
+  static constexpr int kDrawsPerRay = 2;
+  // Whether the bounding boxes of r and s are apart along some axis (they do not meet).
+  bool boxesApart(ClusterRef r, ClusterRef s) const;
+  // Whether sampledBlocked tests the ends r and s (a visibility scene, rays, boxes apart).
+  bool sampleTested(ClusterRef r, ClusterRef s) const;
   // The member tops of `end` whose plane has some of `other`'s box in front (the others see
   // none of it) into `out`; false when there are more than `most` (blocked does not test).
   bool facingMembers(ClusterRef end, ClusterRef other, size_t most,
                      std::vector<uint32_t>& out) const;
-  // Whether blocked(r, s) takes more member pairs than it tests (it then answers false).
+  // Whether blocked(r, s) takes more member pairs than it tests one by one (sampledBlocked
+  // then answers).
   bool tooManyPairsToTest(ClusterRef r, ClusterRef s) const;
   size_t memberCount(ClusterRef r) const {
     return isCluster(r) ? tree_.node(clusterIndex(r)).count : 1;
@@ -329,6 +360,7 @@ class ClusterLinks {
   std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
   bool radiosityKnown_ = false;                // setRadiosity or gather has run
   bool keepWeakNear_ = false;                  // keepWeakNearLinks
+  int nearBlockRays_ = 0;                      // nearBlockRays
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
   std::vector<ClusterLink> links_;
@@ -372,5 +404,23 @@ class ClusterLinks {
   template <class Sum, class Term>
   Sum overExposedPart(size_t t, const std::vector<double>& exposure, Term term) const;
 };
+
+// In the header: both the links' rays (cluster_links.cpp) and the blocked test draw with it.
+template <class U>
+inline uint32_t ClusterLinks::drawFacingMember(ClusterRef end, const ClusterBounds& other,
+                                               const std::vector<double>& prefix, U u) const {
+  if (!isCluster(end)) return uint32_t(end);
+  const ClusterNode& n = tree_.node(clusterIndex(end));
+  const double lo = prefix[n.first], hi = prefix[n.first + n.count];
+  uint32_t j = 0;
+  for (int t = 0; t < kFacingTries; ++t) {
+    const double target = lo + u(t) * (hi - lo);
+    auto it =
+        std::upper_bound(prefix.begin() + n.first + 1, prefix.begin() + n.first + n.count, target);
+    j = tree_.members()[size_t(it - prefix.begin()) - 1];
+    if (mayFace(j, other)) break;
+  }
+  return j;
+}
 
 }  // namespace rad

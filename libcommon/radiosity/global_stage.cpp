@@ -100,6 +100,11 @@ void addLinkParameters(ParameterTable<GlobalOptions>& t) {
       "shadow-ray pairs per member top of a cluster link's receiver, for that top's own "
       "visibility; 0: each member takes its facing group's visibility",
       Check::range(0, 64));
+  t.add(
+      "near-block-rays", [](GlobalOptions& g) -> int& { return radiosity(g).nearBlockRays; },
+      "rays of the blocked test of a near cluster link between large ends: dropped when all "
+      "are blocked (rooms behind a wall), else refined; 0: such links are refined untested",
+      Check::range(0, 1024));
 }
 
 // The switches that exist to compare against a baseline.

@@ -93,6 +93,7 @@ KeySolution KeyTimeSolver::run() {
                                                opt_.lightClusterShare, opt_.clusterMemberRays,
                                                opt_.isotropicClusters, input_.reuseClusterLinks);
     clusters_->keepWeakNearLinks(opt_.keepWeakNearLinks);
+    clusters_->nearBlockRays(opt_.nearBlockRays);
     if (input_.expectedClusterLinks > 0)
       clusters_->expectLinks(withMargin(input_.expectedClusterLinks));
   } else {

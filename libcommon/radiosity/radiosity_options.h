@@ -100,6 +100,12 @@ struct RadiosityOptions {
   // (ClusterLinks.ExposedFloorMatchesAllPairsAtTheDefaultSeparation); on, packed small objects
   // (shelves of binders, keyboards) stop filling the link bound.
   bool keepWeakNearLinks = false;
+  // Rays of the blocked test of a near cluster link without a light whose ends have more facing
+  // member pairs than are tested one by one (cluster_links.h, sampledBlocked): the link is
+  // dropped when all of them are blocked; a link with a share p of its member pairs open is
+  // dropped with probability (1 - p)^n. 0: such links are refined untested (furniture of
+  // neighbouring rooms behind a wall then fills the link bound).
+  int nearBlockRays = 64;
 };
 
 }  // namespace rad

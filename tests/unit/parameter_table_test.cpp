@@ -49,6 +49,7 @@ TEST(ParameterTable, GlobalProvenanceKeysAreUnchanged) {
                                             "light-cluster-share",
                                             "max-links",
                                             "min-area",
+                                            "near-block-rays",
                                             "no-closed-rooms",
                                             "no-closure",
                                             "no-clustering",
