@@ -23,6 +23,7 @@ sys.path.insert(0, CORPUS)
 
 import ies_luminaire  # noqa: E402
 import mgf_to_gltf  # noqa: E402
+from corpus_test_floor import FLOOR_MGF  # noqa: E402
 
 BIN = None
 WHITE_EFFICACY = 183.07
@@ -38,21 +39,7 @@ def ies_text(vertical, horizontal, candela, width=0.5, length=1.0, height=0.0, u
 
 COSINE = ies_text(list(range(0, 91, 5)), [0], [[1000.0 * math.cos(math.radians(t)) for t in range(0, 91, 5)]])
 
-MGF = """
-m grey =
-\tc
-\trd 0.5
-v f0 =
-\tp -5 -5 0
-v f1 =
-\tp 5 -5 0
-v f2 =
-\tp 5 5 0
-v f3 =
-\tp -5 5 0
-o floor
-f f0 f1 f2 f3
-o
+MGF = FLOOR_MGF + """
 # Two luminaires 1 m apart, 3 m up, each twice the file's candelas.
 ies lum.ies -m 2 -t 1 2 3 -a 2 -t 1 0 0
 """

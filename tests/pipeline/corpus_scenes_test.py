@@ -19,23 +19,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(ROOT, "pipelines", "corpus"))
 
 import scenes  # noqa: E402
+from corpus_test_floor import FLOOR_MGF  # noqa: E402
 
-ROOM = """
-m grey =
-\tc
-\trd 0.5
-v f0 =
-\tp -5 -5 0
-v f1 =
-\tp 5 -5 0
-v f2 =
-\tp 5 5 0
-v f3 =
-\tp -5 5 0
-o floor
-f f0 f1 f2 f3
-o
-"""
+ROOM = FLOOR_MGF
 
 # A unit quad at x = 2 and its mirror image at x = -2, in one object (as MGF's -my arrays make).
 FURN = """
