@@ -99,11 +99,19 @@ void GoodLinksByReceiver::smoothClusterIrradiance(const GlobalSolution& s) {
 // patch links (which their texels gather themselves), its cluster light is several times theirs
 // and its patch links' correspondingly less. Smoothed, such a top loses what its neighbours'
 // patch links carry (dark streaks beside the lights of a tiled ceiling). So the top's corners
-// are shifted by what its own value lies beyond a band of kClusterBand around their mean, times
-// its exposure (a mostly covered top's own value is noisy, see above): within the band (the
-// spread of the cluster links' visibility estimates across a wall) the light stays continuous;
-// beyond it the top keeps all but the band of its own mean (the mean of the bilinear or
-// barycentric interpolation over the top's (u,v) is its corners' mean).
+// are shifted, times its exposure (a mostly covered top's own value is noisy, see above), by
+//   shift(d) = 0 for |d| <= band, d - band^2 / d beyond it,
+// d = own - mean of its corners, band = kClusterBand * max(own, mean) (the non-negative
+// garrote of wavelet shrinkage). Within the band (the spread of the cluster links' visibility
+// estimates across a wall) the light stays continuous across shared edges; the shift is
+// continuous in d (0 at |d| = band) so that a top crossing the band from one key to the next
+// does not jump; and far beyond it the top keeps its own mean but for band^2 / |d|, which
+// vanishes as |d| grows. Subtracting the whole band (soft thresholding) had cost a top far from
+// its neighbours a tenth of its light: a sliver lit through cluster links among large
+// tops lit through bad pairs (cluster light 0), whose corners' mean lies halfway to 0. The mean
+// of the bilinear or barycentric interpolation over the top's (u,v) is its corners' mean, so
+// the shift moves the top's mean by exactly shift (paper §3.1: the energy of good links is
+// rendered with linear interpolation; the cluster links are the good ones here).
 void GoodLinksByReceiver::keepOwnClusterLight(const GlobalSolution& s) {
   const std::vector<InputPolygon>& tops = s.hierarchy.tops();
   const size_t T = tops.size(), K = size_t(s.keyCount());
@@ -119,7 +127,7 @@ void GoodLinksByReceiver::keepOwnClusterLight(const GlobalSolution& s) {
       glm::dvec3 shift(0.0);
       for (int ch = 0; ch < 3; ++ch) {
         const double d = own[ch] - mean[ch], band = kClusterBand * std::max(own[ch], mean[ch]);
-        shift[ch] = d > band ? d - band : d < -band ? d + band : 0.0;
+        shift[ch] = std::abs(d) > band ? d - band * band / d : 0.0;
       }
       for (int c = 0; c < count; ++c) corner[c] += glm::vec3(e * shift);
     }

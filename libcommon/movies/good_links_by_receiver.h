@@ -50,7 +50,7 @@ struct GoodLinksByReceiver {
   // degrees; the plain mean where all of them are covered). The gather interpolates it over the
   // top, so that a wall of tiles whose clusters link differently shades smoothly instead of in
   // steps of one value per tile. A top whose own value lies beyond kClusterBand of its corners'
-  // mean keeps it but for the band (keepOwnClusterLight).
+  // mean keeps it but for band^2 / distance, continuous at the band (keepOwnClusterLight).
   std::vector<glm::vec3> clusterCorners;
   // Per top, its planar surface (planar_surfaces.h): the seed of the shooter points of the
   // per-texel visibility, so that coplanar receivers take the same points.

@@ -1533,28 +1533,32 @@ TEST(TextureMovieBaker, ClusterIrradianceRaisesTheGatheredLayerByItsValueAtEvery
   EXPECT_EQ(bake(ramp, GoodLayer::kGouraud).keys, gouraud.keys);
 }
 
-// floorUnderCeiling with its floor two unit quads side by side (x in [0, 1] and [1, 2]).
-FloorUnderCeiling floorWithTwoTiles() {
+// floorUnderCeiling with its floor two quads side by side, x in [0, split] and [split, split +
+// 1] (by default two unit quads), y in [0, 1].
+FloorUnderCeiling floorWithTwoTiles(double split = 1.0) {
   FloorUnderCeiling f = floorUnderCeiling();
   Mesh& floor = f.scene.meshes[size_t(f.scene.nodes[size_t(f.floor)].mesh)];
+  const double end = split + 1.0;
   MeshTriangle a1, a2, b1, b2;
-  a1.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 0, 0), glm::dvec3(1, 1, 0)};
-  a2.p = {glm::dvec3(0, 0, 0), glm::dvec3(1, 1, 0), glm::dvec3(0, 1, 0)};
-  b1.p = {glm::dvec3(1, 0, 0), glm::dvec3(2, 0, 0), glm::dvec3(2, 1, 0)};
-  b2.p = {glm::dvec3(1, 0, 0), glm::dvec3(2, 1, 0), glm::dvec3(1, 1, 0)};
+  a1.p = {glm::dvec3(0, 0, 0), glm::dvec3(split, 0, 0), glm::dvec3(split, 1, 0)};
+  a2.p = {glm::dvec3(0, 0, 0), glm::dvec3(split, 1, 0), glm::dvec3(0, 1, 0)};
+  b1.p = {glm::dvec3(split, 0, 0), glm::dvec3(end, 0, 0), glm::dvec3(end, 1, 0)};
+  b2.p = {glm::dvec3(split, 0, 0), glm::dvec3(end, 1, 0), glm::dvec3(split, 1, 0)};
   a1.material = a2.material = b1.material = b2.material = 0;
   floor.triangles = {a1, a2, b1, b2};
   return f;
 }
 
 // The two floor tiles' cluster-light rise at every texel of their whole-top movies (their tops
-// gathering `left` and `right` through cluster links), against their (u,v) point's x.
+// gathering `left` and `right` through cluster links), against their (u,v) point's x; the
+// tiles split at x = split (floorWithTwoTiles).
 struct TileRise {
   std::vector<double> x;
   std::vector<glm::dvec3> rise;
 };
-std::array<TileRise, 2> clusterRiseOfTwoTiles(const glm::vec3& left, const glm::vec3& right) {
-  FloorUnderCeiling f = floorWithTwoTiles();
+std::array<TileRise, 2> clusterRiseOfTwoTiles(const glm::vec3& left, const glm::vec3& right,
+                                              double split = 1.0) {
+  FloorUnderCeiling f = floorWithTwoTiles(split);
   Scene& s = f.scene;
   GlobalSolution g = solveWithGoodLinksOnly(s, {0.0});
   g.topClusterIrradiance.clear();
@@ -1567,10 +1571,10 @@ std::array<TileRise, 2> clusterRiseOfTwoTiles(const glm::vec3& left, const glm::
   std::array<TileRise, 2> out;
   for (int t : tiles)
     clustered.topClusterIrradiance[size_t(t)] =
-        g.hierarchy.top(t).local.centroid().x > 1.0 ? right : left;
+        g.hierarchy.top(t).local.centroid().x > split ? right : left;
   clustered.validate("test");
   for (int t : tiles) {
-    TileRise& r = out[g.hierarchy.top(t).local.centroid().x > 1.0 ? 1 : 0];
+    TileRise& r = out[g.hierarchy.top(t).local.centroid().x > split ? 1 : 0];
     MovieExtent m = wholeTopMovie(t, 0);
     TextureMovieBaker plain(s, g, kFps, {}), with(s, clustered, kFps, {});
     const BakedMovie a = plain.bake(m), b = with.bake(m);
@@ -1605,22 +1609,48 @@ TEST(TextureMovieBaker, ClusterIrradianceIsContinuousAcrossCoplanarTops) {
   EXPECT_LT(worst, 1e-6);
 }
 
+// The mean rise of each of the two tiles' texels (clusterRiseOfTwoTiles).
+std::array<glm::dvec3, 2> meanRiseOfTwoTiles(const std::array<TileRise, 2>& r) {
+  std::array<glm::dvec3, 2> mean{};
+  for (int side = 0; side < 2; ++side) {
+    for (const glm::dvec3& v : r[size_t(side)].rise) mean[size_t(side)] += v;
+    mean[size_t(side)] /= double(r[size_t(side)].rise.size());
+  }
+  return mean;
+}
+
 // A top whose cluster light lies far from its neighbours' (the global pass linked its far
-// surfaces through cluster links, theirs through patch links) keeps its own mean but for the
-// band: tiles gathering c and 3 c. Smoothed as within the band, the left tile's mean rise was
-// 1.5 c and the right one's 2.5 c (the 10k hall's ceiling tiles beside the lights: dark
-// streaks); now c + 0.15 c and 3 c - 0.3 c (kClusterBand of the larger of the two means).
+// surfaces through cluster links, theirs through patch links) keeps its own mean but for
+// band^2 / d (GoodLinksByReceiver::keepOwnClusterLight): tiles gathering c and 3 c, whose shared
+// corners take the mean 2 c, so that the left tile's corners mean 1.5 c (d = -0.5 c, band =
+// 0.15 c) and the right one's 2.5 c (d = 0.5 c, band = 0.3 c). Smoothed as within the band,
+// the left tile's mean rise was 1.5 c and the right one's 2.5 c (the 10k hall's ceiling tiles
+// beside the lights: dark streaks); less the whole band, 1.15 c and 2.7 c; now
+// c + 0.0225 / 0.5 c = 1.045 c and 3 c - 0.09 / 0.5 c = 2.82 c.
 TEST(TextureMovieBaker, ClusterIrradianceFarFromItsNeighboursKeepsItsOwnMean) {
   const glm::vec3 c(0.125f, 0.25f, 0.0625f);
-  const std::array<TileRise, 2> r = clusterRiseOfTwoTiles(c, 3.0f * c);
-  for (int side = 0; side < 2; ++side) {
-    glm::dvec3 mean(0.0);
-    for (const glm::dvec3& v : r[size_t(side)].rise) mean += v;
-    mean /= double(r[size_t(side)].rise.size());
-    for (int ch = 0; ch < 3; ++ch) {
-      const double expected = side == 0 ? 1.15 * c[ch] : 2.7 * c[ch];
-      EXPECT_NEAR(mean[ch], expected, 1e-6 * c[ch]) << (side == 0 ? "left" : "right");
-    }
+  const std::array<glm::dvec3, 2> mean = meanRiseOfTwoTiles(clusterRiseOfTwoTiles(c, 3.0f * c));
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_NEAR(mean[0][ch], 1.045 * c[ch], 1e-6 * c[ch]) << "left";
+    EXPECT_NEAR(mean[1][ch], 2.82 * c[ch], 1e-6 * c[ch]) << "right";
+  }
+}
+
+// A sliver lit through cluster links beside a large tile lit through bad pairs (cluster light
+// 0; the bathroom countertop's facets, issue 58): the sliver [0, 0.05] x [0, 1] gathers c, its
+// neighbour [0.05, 1.05] x [0, 1] (20 times its area) 0. The shared corners take the
+// area-weighted mean c / 21, so the sliver's corners mean 11 c / 21 (d = 10 c / 21, band =
+// 0.1 c) and the sliver keeps c - 0.01 * 21 / 10 c = 0.979 c; less the whole band it kept 0.9 c.
+// The large tile (corners' mean c / 42, own 0, d = -c / 42 beyond its band of c / 420) drops
+// to band^2 / |d| = c / 4200.
+TEST(TextureMovieBaker, ClusterIrradianceOfASliverAmongDarkerTopsKeepsItsOwnMean) {
+  const glm::vec3 c(0.125f, 0.25f, 0.0625f);
+  const std::array<glm::dvec3, 2> mean =
+      meanRiseOfTwoTiles(clusterRiseOfTwoTiles(c, glm::vec3(0.0f), 0.05));
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_NEAR(mean[0][ch], 0.979 * c[ch], 1e-6 * c[ch]) << "sliver";
+    EXPECT_GT(mean[0][ch], 0.975 * c[ch]) << "the sliver keeps its own cluster light";
+    EXPECT_NEAR(mean[1][ch], c[ch] / 4200.0, 1e-6 * c[ch]) << "its large neighbour";
   }
 }
 
