@@ -22,6 +22,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 CORPUS = os.path.join(ROOT, "pipelines", "corpus")
 sys.path.insert(0, CORPUS)
 
+import corpus_test_common  # noqa: E402
 import mgf_colour  # noqa: E402
 import mgf_to_gltf  # noqa: E402
 
@@ -311,9 +312,4 @@ class HeldOutTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    args = sys.argv[1:]
-    if "--bin" in args:
-        i = args.index("--bin")
-        BIN = args[i + 1]
-        del args[i:i + 2]
-    unittest.main(argv=[sys.argv[0]] + args, verbosity=2)
+    corpus_test_common.main(sys.modules[__name__])

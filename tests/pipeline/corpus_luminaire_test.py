@@ -23,7 +23,8 @@ sys.path.insert(0, CORPUS)
 
 import ies_luminaire  # noqa: E402
 import mgf_to_gltf  # noqa: E402
-from corpus_test_floor import FLOOR_MGF  # noqa: E402
+import corpus_test_common  # noqa: E402
+from corpus_test_common import FLOOR_MGF  # noqa: E402
 
 BIN = None
 WHITE_EFFICACY = 183.07
@@ -134,9 +135,4 @@ class ShellTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    args = sys.argv[1:]
-    if "--bin" in args:
-        i = args.index("--bin")
-        BIN = args[i + 1]
-        del args[i:i + 2]
-    unittest.main(argv=[sys.argv[0]] + args, verbosity=2)
+    corpus_test_common.main(sys.modules[__name__])

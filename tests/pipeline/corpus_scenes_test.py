@@ -19,7 +19,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(ROOT, "pipelines", "corpus"))
 
 import scenes  # noqa: E402
-from corpus_test_floor import FLOOR_MGF  # noqa: E402
+from corpus_test_common import FLOOR_MGF  # noqa: E402
 
 ROOM = FLOOR_MGF
 
