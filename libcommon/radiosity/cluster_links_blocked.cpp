@@ -11,6 +11,9 @@
 #include "libcommon/radiosity/link_form_factor.h"
 
 namespace rad {
+namespace {
+constexpr uint64_t kShuffleSalt = 0x73687566666c65ull;  // "shuffle"
+}  // namespace
 
 bool ClusterLinks::facingMembers(ClusterRef end, ClusterRef other, size_t most,
                                  std::vector<uint32_t>& out) const {
@@ -49,13 +52,8 @@ bool ClusterLinks::sampledBlocked(ClusterRef r, ClusterRef s) const {
   if (!sampleTested(r, s)) return false;
   const int n = nearBlockRays_;
   const uint64_t seed = splitMix64(clusterLinkSeed(r, s) ^ 0x6e656172626c6bull);  // "nearblk"
-  // s's strata in a random order against r's (a Fisher-Yates shuffle), as blocked() pairs them.
-  std::vector<int> order(size_t(n), 0);
-  for (int k = 0; k < n; ++k) order[size_t(k)] = k;
-  const uint64_t shuffle = splitMix64(seed ^ 0x73687566666c65ull);
-  for (int k = n - 1; k > 0; --k)
-    std::swap(order[size_t(k)],
-              order[size_t(std::min(k, int(uniformOpen01(shuffle, uint64_t(k)) * (k + 1))))]);
+  // s's strata in a random order against r's, as blocked() pairs them.
+  const std::vector<int> order = permutation(n, splitMix64(seed ^ kShuffleSalt));
   // Counters of draw i: 0, 1 the strata's jitter of r's and s's member, 2-5 the points, then
   // kFacingTries retries of each member.
   constexpr uint64_t kPerDraw = 6 + 2 * kFacingTries;
@@ -106,14 +104,9 @@ bool ClusterLinks::blocked(ClusterRef r, ClusterRef s) const {
           VisibilityScene::samplePointsInFront(p, q.v[0], normal_[j], rays_, pairSeed);
       const std::vector<glm::dvec3> y =
           VisibilityScene::samplePointsInFront(q, p.v[0], normal_[i], rays_, splitMix64(pairSeed));
-      // y's strata in a random order against x's (a Fisher-Yates shuffle): pairing stratum k with
-      // stratum k would test the same few of the stratum pairs every time.
-      std::vector<int> order(static_cast<size_t>(rays_));
-      for (int k = 0; k < rays_; ++k) order[size_t(k)] = k;
-      const uint64_t shuffle = splitMix64(pairSeed ^ 0x73687566666c65ull);
-      for (int k = rays_ - 1; k > 0; --k)
-        std::swap(order[size_t(k)],
-                  order[size_t(std::min(k, int(uniformOpen01(shuffle, uint64_t(k)) * (k + 1))))]);
+      // y's strata in a random order against x's: pairing stratum k with stratum k would test
+      // the same few of the stratum pairs every time.
+      const std::vector<int> order = permutation(rays_, splitMix64(pairSeed ^ kShuffleSalt));
       for (int k = 0; k < rays_; ++k)
         if (!visibility_->occluded(x[size_t(k)], y[size_t(order[size_t(k)])], i, j)) return false;
     }

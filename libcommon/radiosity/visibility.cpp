@@ -34,6 +34,16 @@ double uniformOpen01(std::uint64_t seed, std::uint64_t counter) {
   return (static_cast<double>(r >> 11) + 0.5) * 0x1.0p-53;
 }
 
+std::vector<int> permutation(int k, std::uint64_t seed) {
+  std::vector<int> p(k);
+  std::iota(p.begin(), p.end(), 0);
+  for (int i = k - 1; i > 0; --i) {
+    int j = std::min(i, static_cast<int>(uniformOpen01(seed, i) * (i + 1)));
+    std::swap(p[i], p[j]);
+  }
+  return p;
+}
+
 namespace {
 
 const char* embreeErrorName(RTCError e) {
@@ -87,17 +97,6 @@ enum Stream : std::uint64_t { kJitterA = 1, kJitterB = 2, kPermuteA = 3, kPermut
 
 std::uint64_t streamSeed(std::uint64_t seed, Stream s) {
   return splitMix64(seed ^ (0xD1B54A32D192ED03ull * static_cast<std::uint64_t>(s)));
-}
-
-// Uniformly random permutation of 0..k-1 (Fisher-Yates, counter-based).
-std::vector<int> permutation(int k, std::uint64_t seed) {
-  std::vector<int> p(k);
-  std::iota(p.begin(), p.end(), 0);
-  for (int i = k - 1; i > 0; --i) {
-    int j = std::min(i, static_cast<int>(uniformOpen01(seed, i) * (i + 1)));
-    std::swap(p[i], p[j]);
-  }
-  return p;
 }
 
 // k stratified points in the open unit square.

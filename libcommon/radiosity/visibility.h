@@ -211,5 +211,7 @@ double pointVisibilityOfKernels(const double* kernel, int k, std::uint64_t open,
 std::uint64_t splitMix64(std::uint64_t x);
 // Uniform double in the open interval (0, 1) from (seed, counter).
 double uniformOpen01(std::uint64_t seed, std::uint64_t counter);
+// Uniformly random permutation of 0..k-1 (Fisher-Yates, counter-based, from (seed, i)).
+std::vector<int> permutation(int k, std::uint64_t seed);
 
 }  // namespace rad
