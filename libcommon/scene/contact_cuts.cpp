@@ -6,6 +6,7 @@
 #include "libcommon/scene/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace rad {
@@ -126,23 +127,69 @@ void attributesAt(const InputPolygon& source, const glm::dvec3& x, glm::dvec2& u
   normal = source.normal[0] == glm::dvec3(0.0) ? glm::dvec3(0.0) : shadingNormalAt(source, at);
 }
 
-// A convex piece of `source` as quads and at most one triangle: (0,1,2,3), (0,3,4,5), ...
+// Whether quad (a, b, c, d) is a parallelogram to 5 % of its longest edge (its diagonals' midpoints
+// that close), the rule of Scene::inputPolygons' merge: only then is its bilinear (u,v) map, by
+// which the texels are placed and rad-compose looks them up, the plane homography by which the
+// shadow masks are rendered (transmittance.h) to second order in the departure. A trapezoid cut
+// from a triangle had its masks taken at the homography's points, which crowd towards its short
+// edge: the bathroom countertop's quads cut along the backsplash (an edge of 1 cm against one of
+// 18 cm) took the shadow of the mirror cabinet behind them over whole triangles (docs/results.md,
+// "Contact cuts made trapezoids"; issue 56 found the same for trapezoids merged from a fan).
+bool parallelogram(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                   const glm::dvec3& d) {
+  const double scale =
+      std::max({glm::length(b - a), glm::length(c - b), glm::length(d - c), glm::length(a - d)});
+  return glm::length((a + c) - (b + d)) <= 0.05 * scale;
+}
+
+// Piece `corners` (indices into `piece`, CCW) as one polygon of source. A triangle starts at its
+// corner opposite the longest edge, as Scene::inputPolygons roots every triangle (docs/design.md
+// §4: its texel grid runs along the two edges of its widest corner).
+void emitPolygon(const InputPolygon& source, const Outline& piece, std::array<size_t, 4> corners,
+                 int count, std::vector<InputPolygon>& out) {
+  if (count == 3) {
+    int root = 0;
+    double longest = -1.0;
+    for (int k = 0; k < 3; ++k) {
+      const double opposite =
+          glm::length(piece[corners[size_t((k + 2) % 3)]] - piece[corners[size_t((k + 1) % 3)]]);
+      if (opposite > longest * (1.0 + 1e-9)) longest = opposite, root = k;
+    }
+    std::rotate(corners.begin(), corners.begin() + root, corners.begin() + 3);
+  }
+  InputPolygon q = source;
+  q.local.count = count;
+  q.local.v = {};
+  q.uv = {};
+  q.normal = {};
+  for (int k = 0; k < count; ++k) {
+    const glm::dvec3& x = piece[corners[size_t(k)]];
+    q.local.v[size_t(k)] = x;
+    attributesAt(source, x, q.uv[size_t(k)], q.normal[size_t(k)]);
+  }
+  out.push_back(q);
+}
+
+// A convex piece of `source` as quads and at most one triangle: (0,1,2,3), (0,3,4,5), ...; a quad
+// that is not a parallelogram as two triangles split along its shorter diagonal.
 void emitPiece(const InputPolygon& source, const Outline& piece, std::vector<InputPolygon>& out) {
   for (size_t first = 1; first + 1 < piece.size();) {
     const size_t count = std::min<size_t>(3, piece.size() - first);  // vertices after v0
-    InputPolygon q = source;
-    q.local.count = int(count) + 1;
-    q.local.v = {};
-    q.uv = {};
-    q.normal = {};
-    for (size_t k = 0; k <= count; ++k) {
-      const glm::dvec3 x = k == 0 ? piece[0] : piece[first + k - 1];
-      q.local.v[k] = x;
-      attributesAt(source, x, q.uv[k], q.normal[k]);
+    const size_t b = first, c = first + 1, d = first + 2;
+    if (count < 3) {
+      emitPolygon(source, piece, {0, b, c, 0}, 3, out);
+      break;
     }
-    out.push_back(q);
+    if (parallelogram(piece[0], piece[b], piece[c], piece[d])) {
+      emitPolygon(source, piece, {0, b, c, d}, 4, out);
+    } else if (glm::length(piece[c] - piece[0]) <= glm::length(piece[d] - piece[b])) {
+      emitPolygon(source, piece, {0, b, c, 0}, 3, out);
+      emitPolygon(source, piece, {0, c, d, 0}, 3, out);
+    } else {
+      emitPolygon(source, piece, {0, b, d, 0}, 3, out);
+      emitPolygon(source, piece, {b, c, d, 0}, 3, out);
+    }
     first += count - 1;
-    if (count < 3) break;
   }
 }
 

@@ -18,11 +18,12 @@ struct InputPolygon;
 // squared error, the gap's ceiling too bright and the ceiling beside the lamp too dark). So B is
 // cut into B ∩ A's outline and, per edge k of A, B ∩ outside(edge k) ∩ inside(edge k + 1) (a
 // pinwheel: convex pieces that reach B's boundary without slivers along A's edge lines), each piece
-// then split into quads and a triangle. B's radiosity falls towards the outline over a few gaps on
-// either side, so B is cut the same way along rims kRimGaps gaps wide outside and inside the
-// outline too, whose own movies resolve that fall (the outline alone does not lower the error).
-// Pieces keep B's node, material, face and uv map; the union of the pieces is B. Order and result
-// are deterministic.
+// then split into parallelograms and triangles (a quad that is not a parallelogram would take its
+// shadow masks at points other than its texels', transmittance.h). B's radiosity falls towards the
+// outline over a few gaps on either side, so B is cut the same way along rims kRimGaps gaps wide
+// outside and inside the outline too, whose own movies resolve that fall (the outline alone does
+// not lower the error). Pieces keep B's node, material, face and uv map; the union of the pieces is
+// B. Order and result are deterministic.
 inline constexpr double kContactGap = 0.02;
 inline constexpr double kRimGaps = 2.0;
 std::vector<InputPolygon> cutAtContacts(const Scene& scene, std::vector<InputPolygon> polygons);
