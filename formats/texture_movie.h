@@ -122,9 +122,8 @@ class TextureMovieWriter {
   bool collapse_ = false, diverged_ = false, committed_ = false;
   size_t next_ = 0, texelFloats_ = 0;
   std::vector<uint64_t> checksums_;  // of the parts written, by part
-  uint64_t headersEnd_ = 0;          // bytes of the file before the first chunk table
   std::vector<float> key0_;          // held while the movie may be constant
-  struct File;                       // AtomicFile + OpenEXR multi-part output
+  struct File;                       // AtomicFile + the EXR writer (scanline_exr_writer.h)
   std::unique_ptr<File> file_;
 };
 // What a reader expects a file to be: a whole movie, or a piece of one. Each refuses the other
