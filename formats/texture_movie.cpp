@@ -24,6 +24,7 @@
 #include "formats/exr_image.h"
 #include "formats/pixel_checksum.h"
 #include "formats/scanline_exr_writer.h"
+#include "formats/uncompressed_exr_part.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
@@ -457,11 +458,26 @@ TextureMovie readTextureMovie(const std::string& path) {
   return stream.movie();
 }
 
+namespace {
+
+// ExrHeaderScan's end of the headers if every part is one uncompressed chunk a scan line, else 0
+// (TextureMovie::uncompressedTablesAt).
+uint64_t uncompressedTablesAt(const ExrHeaderScan& scan) {
+  for (const ExrScannedPart& p : scan.parts)
+    if (p.type != "scanlineimage" || p.compression != 0 || p.chunks != uint64_t(p.height) ||
+        p.height != scan.parts[0].height)
+      return 0;
+  return scan.headerBytes;
+}
+
+}  // namespace
+
 TextureMovie readTextureMovieHeaders(const std::string& path, MovieFileKind kind) {
   return readingExr(path, [&] {
-    const uint64_t headerHash = scanExrFile(path).headerHash;
+    const ExrHeaderScan scan = scanExrFile(path);
     TextureMovie m = readHeaders(CoreExrFile(path).ctx, path, kind);
-    m.headerHash = headerHash;
+    m.headerHash = scan.headerHash;
+    m.uncompressedTablesAt = uncompressedTablesAt(scan);
     return m;
   });
 }
@@ -540,9 +556,11 @@ struct TextureMovieStream::Reader {
 
 TextureMovieStream::TextureMovieStream(std::string path, MovieFileKind kind)
     : path_(std::move(path)) {
-  readingExr(path_, [&] { return scanExrFile(path_); });
+  const ExrHeaderScan scan = readingExr(path_, [&] { return scanExrFile(path_); });
   open();
+  startExr();
   movie_ = readHeaders(reader_->ctx, path_, kind);
+  movie_.uncompressedTablesAt = uncompressedTablesAt(scan);
   movie_.keys.assign(movie_.keyTimes.size(), {});
 }
 
@@ -550,11 +568,7 @@ TextureMovieStream::TextureMovieStream(std::string path, TextureMovie headers)
     : path_(std::move(path)), movie_(std::move(headers)) {
   open();
   movie_.keys.assign(movie_.keyTimes.size(), {});
-  int parts = 0;
-  checkExr(exr_get_count(reader_->ctx, &parts), path_, "part count");
-  if (size_t(parts) != movie_.keyTimes.size())
-    throw inputError(path_, "changed since its headers were read: " + std::to_string(parts) +
-                                " parts, not " + std::to_string(movie_.keyTimes.size()));
+  if (movie_.uncompressedTablesAt == 0) startExr();
 }
 
 void TextureMovieStream::open() {
@@ -564,12 +578,21 @@ void TextureMovieStream::open() {
   if (reader_->fd < 0 || ::fstat(reader_->fd, &st) != 0)
     throw inputError(path_, std::string("cannot open: ") + std::strerror(errno));
   reader_->fileSize = int64_t(st.st_size);
+}
+
+void TextureMovieStream::startExr() {
+  if (reader_->ctx) return;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.error_handler_fn = quietExrError;  // errors become rad::inputError, not stderr lines
   init.user_data = reader_.get();
   init.read_fn = &Reader::read;
   init.size_fn = &Reader::size;
   checkExr(exr_start_read(&reader_->ctx, path_.c_str(), &init), path_, "cannot open");
+  int parts = 0;
+  checkExr(exr_get_count(reader_->ctx, &parts), path_, "part count");
+  if (size_t(parts) != movie_.keyTimes.size() && !movie_.keyTimes.empty())
+    throw inputError(path_, "changed since its headers were read: " + std::to_string(parts) +
+                                " parts, not " + std::to_string(movie_.keyTimes.size()));
 }
 
 TextureMovieStream::~TextureMovieStream() = default;
@@ -577,8 +600,27 @@ TextureMovieStream::~TextureMovieStream() = default;
 void TextureMovieStream::load(size_t k) {
   if (!movie_.keys[k].empty()) return;
   const int part = int(k), w = movie_.width, h = movie_.height;
+  std::vector<float> px;
+  const uint64_t at = movie_.uncompressedTablesAt;
+  if (at == 0 || !readUncompressedRgbPart(reader_->fd, uncompressedPartTableAt(at, part, h),
+                                          movie_.keyTimes.size() > 1, part, w, h, px)) {
+    startExr();
+    decodeWithOpenExr(k, px);
+  }
+  requirePixelChecksum(movie_.keyChecksums[k], rgbPixelChecksum(px.data(), w, h), path_,
+                       "part " + std::to_string(k));
+  for (float v : px)
+    if (!std::isfinite(v))
+      throw inputError(path_, "non-finite irradiance in part " + std::to_string(k));
+  movie_.keys[k] = std::move(px);
+  ++keysRead_;
+}
+
+// Key k through OpenEXR's core decoder, any compression and layout.
+void TextureMovieStream::decodeWithOpenExr(size_t k, std::vector<float>& px) {
+  const int part = int(k), w = movie_.width, h = movie_.height;
   exr_context_t ctx = reader_->ctx;
-  std::vector<float> px(size_t(w) * size_t(h) * 3);
+  px.assign(size_t(w) * size_t(h) * 3, 0.0f);
   int32_t linesPerChunk = 0;
   checkExr(exr_get_scanlines_per_chunk(ctx, part, &linesPerChunk), path_, "part header");
   if (linesPerChunk < 1) throw inputError(path_, "part " + std::to_string(k) + ": no scanlines");
@@ -619,13 +661,6 @@ void TextureMovieStream::load(size_t k) {
     checkExr(exr_decoding_run(ctx, part, &decoder), path_, "decoding");
   }
   reader_->dropWindow();
-  requirePixelChecksum(movie_.keyChecksums[k], rgbPixelChecksum(px.data(), w, h), path_,
-                       "part " + std::to_string(k));
-  for (float v : px)
-    if (!std::isfinite(v))
-      throw inputError(path_, "non-finite irradiance in part " + std::to_string(k));
-  movie_.keys[k] = std::move(px);
-  ++keysRead_;
 }
 
 const std::vector<float>& TextureMovieStream::key(size_t k) {
