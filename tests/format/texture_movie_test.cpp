@@ -6,6 +6,7 @@
 // the same headers and pixels.
 #include "formats/texture_movie.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -24,6 +25,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "formats/exr_header_scan.h"
+#include "formats/uncompressed_exr_part.h"
 #include "libcommon/core/error.h"
 
 namespace fs = std::filesystem;
@@ -502,11 +505,16 @@ TEST_F(TextureMovieFormat, ConstantPieceKeepsOneKeyAndItsKeyCount) {
   EXPECT_EQ(r.piece.movieKeys, 10);
 }
 
-// The file OpenEXR's MultiPartOutputFile writes from `path`'s headers and pixels, as bytes.
-std::string rewrittenByOpenExr(const std::string& path, const std::string& out) {
+// The file OpenEXR's MultiPartOutputFile writes from `path`'s headers (with `compression`) and
+// pixels, as bytes.
+std::string rewrittenByOpenExr(const std::string& path, const std::string& out,
+                               Imf::Compression compression = Imf::NO_COMPRESSION) {
   Imf::MultiPartInputFile in(path.c_str());
   std::vector<Imf::Header> headers;
-  for (int p = 0; p < in.parts(); ++p) headers.push_back(in.header(p));
+  for (int p = 0; p < in.parts(); ++p) {
+    headers.push_back(in.header(p));
+    headers.back().compression() = compression;
+  }
   const Imath::Box2i dw = headers[0].dataWindow();
   const int w = dw.max.x + 1, h = dw.max.y + 1;
   std::vector<std::vector<float>> pixels(headers.size(), std::vector<float>(size_t(w) * h * 3));
@@ -553,6 +561,36 @@ TEST_F(TextureMovieFormat, WriterWritesTheBytesOfOpenExrsOwnWriter) {
   writeTextureMovie(dir() + "/piece.exr", piece);
   EXPECT_EQ(rewrittenByOpenExr(dir() + "/piece.exr", dir() + "/imf-piece.exr"),
             bytesOf(dir() + "/piece.exr"));
+}
+
+TEST_F(TextureMovieFormat, UncompressedPartsAreReadWithoutOpenExrAndOtherLayoutsWithIt) {
+  const TextureMovie m = sampleMovie(3);
+  const std::string path = dir() + "/m.exr";
+  writeTextureMovie(path, m);
+  const ExrHeaderScan scan = scanExrFile(path);
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  std::vector<float> px;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(readUncompressedRgbPart(fd, uncompressedPartTableAt(scan.headerBytes, k, m.height),
+                                        true, k, m.width, m.height, px));
+    EXPECT_EQ(px, m.keys[size_t(k)]) << "key " << k;
+  }
+  // The wrong part's table, or a single-part leader, is refused (the leaders disagree).
+  EXPECT_FALSE(readUncompressedRgbPart(fd, uncompressedPartTableAt(scan.headerBytes, 1, m.height),
+                                       true, 0, m.width, m.height, px));
+  EXPECT_FALSE(readUncompressedRgbPart(fd, uncompressedPartTableAt(scan.headerBytes, 0, m.height),
+                                       false, 0, m.width, m.height, px));
+  ::close(fd);
+  EXPECT_GT(readTextureMovieHeaders(path).uncompressedTablesAt, 0u);
+  // ZIP (any writer's choice): read through OpenEXR, the same keys.
+  const std::string zip = dir() + "/zip.exr";
+  rewrittenByOpenExr(path, zip, Imf::ZIP_COMPRESSION);
+  const TextureMovie headers = readTextureMovieHeaders(zip);
+  EXPECT_EQ(headers.uncompressedTablesAt, 0u);
+  TextureMovieStream stream(zip, headers);
+  for (size_t k = 0; k < 3; ++k) EXPECT_EQ(stream.key(k), m.keys[k]) << "key " << k;
+  EXPECT_EQ(readTextureMovie(zip).keys, m.keys);
 }
 
 }  // namespace
