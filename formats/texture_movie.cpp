@@ -16,15 +16,6 @@
 #include <tuple>
 #include <utility>
 
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfDoubleAttribute.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfIntAttribute.h>
-#include <OpenEXR/ImfMultiPartOutputFile.h>
-#include <OpenEXR/ImfOutputPart.h>
-#include <OpenEXR/ImfPartType.h>
-#include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/openexr.h>
 
 #include "formats/atomic_file.h"
@@ -32,24 +23,11 @@
 #include "formats/exr_header_scan.h"
 #include "formats/exr_image.h"
 #include "formats/pixel_checksum.h"
+#include "formats/scanline_exr_writer.h"
+#include "formats/uncompressed_exr_part.h"
 #include "libcommon/core/error.h"
 
 namespace rad {
-
-namespace {
-
-// R, G, B slices over interleaved float RGB texels, row-major from the data window's origin.
-Imf::FrameBuffer rgbFrameBuffer(float* rgb, int width) {
-  Imf::FrameBuffer fb;
-  const size_t xs = 3 * sizeof(float), ys = size_t(width) * xs;
-  char* base = reinterpret_cast<char*>(rgb);
-  fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-  fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-  fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
-  return fb;
-}
-
-}  // namespace
 
 void TextureMovie::keysAround(double t, size_t& k0, size_t& k1) const {
   if (keyTimes.size() == 1 || t <= keyTimes.front()) {
@@ -110,62 +88,56 @@ std::string formatVersion(const TextureMoviePiece& piece) {
                                std::to_string(kTextureMovieMinor);
 }
 
-// The part headers of a movie with the given keys (key frames/times of the parts).
-std::vector<Imf::Header> movieHeaders(const TextureMovie& m, const std::vector<int>& keyFrames,
-                                      const std::vector<double>& keyTimes) {
-  // Reserved and moved in: a reallocation would copy every header made so far, attribute by
-  // attribute.
-  std::vector<Imf::Header> headers;
-  headers.reserve(keyFrames.size());
+// The part headers' rad attributes (and name, type) of a movie with the given keys (key
+// frames/times of the parts); ScanlineExrWriter adds the standard ones.
+std::vector<std::vector<ExrAttribute>> movieHeaders(const TextureMovie& m,
+                                                    const std::vector<int>& keyFrames,
+                                                    const std::vector<double>& keyTimes) {
+  using A = ExrAttribute;
+  std::vector<std::vector<ExrAttribute>> headers(keyFrames.size());
   for (size_t k = 0; k < keyFrames.size(); ++k) {
-    Imf::Header h(m.width, m.height);
-    // Uncompressed: ZIP keeps most of the bytes of the movies' float irradiance and costs much of
-    // rad-movies' time.
-    h.compression() = Imf::NO_COMPRESSION;
-    h.lineOrder() = Imf::INCREASING_Y;
-    for (const char* c : {"R", "G", "B"}) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
     char name[32];
     std::snprintf(name, sizeof name, "key%04zu", k);
-    h.setName(name);
-    h.setType(Imf::SCANLINEIMAGE);
-    h.insert("rad.format", Imf::StringAttribute(formatVersion(m.piece)));
-    h.insert("rad.movie", Imf::IntAttribute(int(m.movie)));
-    h.insert("rad.patch", Imf::StringAttribute(m.patch.toString()));
-    h.insert("rad.patchPacked", Imf::StringAttribute(std::to_string(m.patch.packed())));
-    h.insert("rad.level", Imf::IntAttribute(m.patch.level()));
-    h.insert("rad.firstFrame", Imf::IntAttribute(m.firstFrame));
-    h.insert("rad.lastFrame", Imf::IntAttribute(m.lastFrame));
-    h.insert("rad.keyCount", Imf::IntAttribute(int(keyFrames.size())));
-    h.insert("rad.keyIndex", Imf::IntAttribute(int(k)));
-    h.insert("rad.keyFrame", Imf::IntAttribute(keyFrames[k]));
-    h.insert("rad.keyTime", Imf::DoubleAttribute(keyTimes[k]));
-    h.insert("rad.units", Imf::StringAttribute("irradiance W/m^2"));
+    std::vector<ExrAttribute>& h = headers[k];
+    h = {A::text("name", name),
+         A::text("type", "scanlineimage"),
+         A::text("rad.format", formatVersion(m.piece)),
+         A::integer("rad.movie", int(m.movie)),
+         A::text("rad.patch", m.patch.toString()),
+         A::text("rad.patchPacked", std::to_string(m.patch.packed())),
+         A::integer("rad.level", m.patch.level()),
+         A::integer("rad.firstFrame", m.firstFrame),
+         A::integer("rad.lastFrame", m.lastFrame),
+         A::integer("rad.keyCount", int(keyFrames.size())),
+         A::integer("rad.keyIndex", int(k)),
+         A::integer("rad.keyFrame", keyFrames[k]),
+         A::real("rad.keyTime", keyTimes[k]),
+         A::text("rad.units", "irradiance W/m^2")};
     if (m.piece.isPiece()) {  // texture_movie_piece.md
-      h.insert("rad.pieceIndex", Imf::IntAttribute(m.piece.index));
-      h.insert("rad.pieceCount", Imf::IntAttribute(m.piece.count));
-      h.insert("rad.pieceFirstKey", Imf::IntAttribute(m.piece.firstKey));
-      h.insert("rad.pieceKeys", Imf::IntAttribute(m.piece.keys));
-      h.insert("rad.movieKeyCount", Imf::IntAttribute(m.piece.movieKeys));
+      h.push_back(A::integer("rad.pieceIndex", m.piece.index));
+      h.push_back(A::integer("rad.pieceCount", m.piece.count));
+      h.push_back(A::integer("rad.pieceFirstKey", m.piece.firstKey));
+      h.push_back(A::integer("rad.pieceKeys", m.piece.keys));
+      h.push_back(A::integer("rad.movieKeyCount", m.piece.movieKeys));
     }
     if (k == 0 && !m.provenanceJson.empty())
-      h.insert("rad.provenance", Imf::StringAttribute(m.provenanceJson));
-    // The pixels are not known yet when the headers are written (keys stream in): a
+      h.push_back(A::text("rad.provenance", m.provenanceJson));
+    // The pixels are not known yet when the headers are laid out (keys stream in): a
     // placeholder of the checksum's length, filled in by commit() (fillInChecksums).
-    h.insert(kPixelChecksumAttribute, Imf::StringAttribute(kPixelChecksumPlaceholder));
-    headers.push_back(std::move(h));
+    h.push_back(A::text(kPixelChecksumAttribute, kPixelChecksumPlaceholder));
   }
   return headers;
 }
 
 }  // namespace
 
-// Member order matters: the OpenEXR file is closed (its chunk tables written) before the
+// Member order matters: the EXR writer is done (headers and chunk tables written) before the
 // stream hands its last bytes to the temporary, and both before the AtomicFile renames or
 // removes it.
 struct TextureMovieWriter::File {
   AtomicFile atomic;
   std::unique_ptr<ExrFileStream> stream;
-  std::unique_ptr<Imf::MultiPartOutputFile> exr;
+  std::unique_ptr<ScanlineExrWriter> exr;
   File(const std::string& path, AtomicFile::Durability d) : atomic(path, d) {}
 };
 
@@ -195,34 +167,18 @@ TextureMovieWriter::~TextureMovieWriter() = default;
 void TextureMovieWriter::open(size_t parts) {
   std::vector<int> frames(meta_.keyFrames.begin(), meta_.keyFrames.begin() + long(parts));
   std::vector<double> times(meta_.keyTimes.begin(), meta_.keyTimes.begin() + long(parts));
-  std::vector<Imf::Header> headers = movieHeaders(meta_, frames, times);
   if (!file_) file_ = std::make_unique<File>(path_, durability_);
   file_->exr.reset();
   file_->stream.reset();
   file_->stream = std::make_unique<ExrFileStream>(file_->atomic.tempPath(), path_);
-  try {
-    file_->exr = std::make_unique<Imf::MultiPartOutputFile>(*file_->stream, headers.data(),
-                                                            int(headers.size()));
-    headersEnd_ = file_->stream->tellp();
-    checksums_.assign(parts, 0);
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw outputError(path_, e.what());
-  }
+  file_->exr = std::make_unique<ScanlineExrWriter>(*file_->stream, meta_.width, meta_.height,
+                                                   movieHeaders(meta_, frames, times));
+  checksums_.assign(parts, 0);
 }
 
 void TextureMovieWriter::writePart(size_t k, const std::vector<float>& rgb) {
-  try {
-    Imf::OutputPart part(*file_->exr, int(k));
-    part.setFrameBuffer(rgbFrameBuffer(const_cast<float*>(rgb.data()), meta_.width));
-    part.writePixels(meta_.height);
-    checksums_[k] = rgbPixelChecksum(rgb.data(), meta_.width, meta_.height);
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw outputError(path_, e.what());
-  }
+  file_->exr->writePart(k, rgb.data());
+  checksums_[k] = rgbPixelChecksum(rgb.data(), meta_.width, meta_.height);
 }
 
 void TextureMovieWriter::writeKey(size_t k, const std::vector<float>& rgb) {
@@ -264,14 +220,9 @@ size_t TextureMovieWriter::commit() {
     open(1);
     writePart(0, key0_);
   }
-  try {
-    file_->exr.reset();  // writes the chunk tables
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw outputError(path_, e.what());
-  }
   fillInChecksums();
+  file_->exr->finish();  // writes the headers and chunk tables
+  file_->exr.reset();
   file_->stream->close();
   file_->atomic.commit();
   committed_ = true;
@@ -279,20 +230,8 @@ size_t TextureMovieWriter::commit() {
 }
 
 void TextureMovieWriter::fillInChecksums() {
-  // The placeholders are found by walking the headers written (the layout of OpenEXR headers
-  // is fixed by the file format), not by searching for their text.
-  const std::vector<char> headers = file_->stream->readBack(0, size_t(headersEnd_));
-  const std::vector<uint64_t> at =
-      exrStringAttributeOffsets(headers, int(checksums_.size()), kPixelChecksumAttribute);
-  if (at.size() != checksums_.size())
-    throw Error(ExitCode::kInternal, path_, "texture movie part without a checksum placeholder");
-  for (size_t k = 0; k < at.size(); ++k) {
-    const std::string value = formatFnv1a64(checksums_[k]);
-    if (at[k] + value.size() > headers.size() ||
-        std::string(headers.data() + at[k], value.size()) != kPixelChecksumPlaceholder)
-      throw Error(ExitCode::kInternal, path_, "texture movie checksum placeholder not found");
-    file_->stream->overwrite(at[k], value);
-  }
+  for (size_t k = 0; k < checksums_.size(); ++k)
+    file_->exr->setText(k, kPixelChecksumAttribute, formatFnv1a64(checksums_[k]));
 }
 
 void writeTextureMovie(const std::string& path, const TextureMovie& m) {
@@ -519,11 +458,26 @@ TextureMovie readTextureMovie(const std::string& path) {
   return stream.movie();
 }
 
+namespace {
+
+// ExrHeaderScan's end of the headers if every part is one uncompressed chunk a scan line, else 0
+// (TextureMovie::uncompressedTablesAt).
+uint64_t uncompressedTablesAt(const ExrHeaderScan& scan) {
+  for (const ExrScannedPart& p : scan.parts)
+    if (p.type != "scanlineimage" || p.compression != 0 || p.chunks != uint64_t(p.height) ||
+        p.height != scan.parts[0].height)
+      return 0;
+  return scan.headerBytes;
+}
+
+}  // namespace
+
 TextureMovie readTextureMovieHeaders(const std::string& path, MovieFileKind kind) {
   return readingExr(path, [&] {
-    const uint64_t headerHash = scanExrFile(path).headerHash;
+    const ExrHeaderScan scan = scanExrFile(path);
     TextureMovie m = readHeaders(CoreExrFile(path).ctx, path, kind);
-    m.headerHash = headerHash;
+    m.headerHash = scan.headerHash;
+    m.uncompressedTablesAt = uncompressedTablesAt(scan);
     return m;
   });
 }
@@ -602,9 +556,11 @@ struct TextureMovieStream::Reader {
 
 TextureMovieStream::TextureMovieStream(std::string path, MovieFileKind kind)
     : path_(std::move(path)) {
-  readingExr(path_, [&] { return scanExrFile(path_); });
+  const ExrHeaderScan scan = readingExr(path_, [&] { return scanExrFile(path_); });
   open();
+  startExr();
   movie_ = readHeaders(reader_->ctx, path_, kind);
+  movie_.uncompressedTablesAt = uncompressedTablesAt(scan);
   movie_.keys.assign(movie_.keyTimes.size(), {});
 }
 
@@ -612,11 +568,7 @@ TextureMovieStream::TextureMovieStream(std::string path, TextureMovie headers)
     : path_(std::move(path)), movie_(std::move(headers)) {
   open();
   movie_.keys.assign(movie_.keyTimes.size(), {});
-  int parts = 0;
-  checkExr(exr_get_count(reader_->ctx, &parts), path_, "part count");
-  if (size_t(parts) != movie_.keyTimes.size())
-    throw inputError(path_, "changed since its headers were read: " + std::to_string(parts) +
-                                " parts, not " + std::to_string(movie_.keyTimes.size()));
+  if (movie_.uncompressedTablesAt == 0) startExr();
 }
 
 void TextureMovieStream::open() {
@@ -626,12 +578,21 @@ void TextureMovieStream::open() {
   if (reader_->fd < 0 || ::fstat(reader_->fd, &st) != 0)
     throw inputError(path_, std::string("cannot open: ") + std::strerror(errno));
   reader_->fileSize = int64_t(st.st_size);
+}
+
+void TextureMovieStream::startExr() {
+  if (reader_->ctx) return;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.error_handler_fn = quietExrError;  // errors become rad::inputError, not stderr lines
   init.user_data = reader_.get();
   init.read_fn = &Reader::read;
   init.size_fn = &Reader::size;
   checkExr(exr_start_read(&reader_->ctx, path_.c_str(), &init), path_, "cannot open");
+  int parts = 0;
+  checkExr(exr_get_count(reader_->ctx, &parts), path_, "part count");
+  if (size_t(parts) != movie_.keyTimes.size() && !movie_.keyTimes.empty())
+    throw inputError(path_, "changed since its headers were read: " + std::to_string(parts) +
+                                " parts, not " + std::to_string(movie_.keyTimes.size()));
 }
 
 TextureMovieStream::~TextureMovieStream() = default;
@@ -639,8 +600,27 @@ TextureMovieStream::~TextureMovieStream() = default;
 void TextureMovieStream::load(size_t k) {
   if (!movie_.keys[k].empty()) return;
   const int part = int(k), w = movie_.width, h = movie_.height;
+  std::vector<float> px;
+  const uint64_t at = movie_.uncompressedTablesAt;
+  if (at == 0 || !readUncompressedRgbPart(reader_->fd, uncompressedPartTableAt(at, part, h),
+                                          movie_.keyTimes.size() > 1, part, w, h, px)) {
+    startExr();
+    decodeWithOpenExr(k, px);
+  }
+  requirePixelChecksum(movie_.keyChecksums[k], rgbPixelChecksum(px.data(), w, h), path_,
+                       "part " + std::to_string(k));
+  for (float v : px)
+    if (!std::isfinite(v))
+      throw inputError(path_, "non-finite irradiance in part " + std::to_string(k));
+  movie_.keys[k] = std::move(px);
+  ++keysRead_;
+}
+
+// Key k through OpenEXR's core decoder, any compression and layout.
+void TextureMovieStream::decodeWithOpenExr(size_t k, std::vector<float>& px) {
+  const int part = int(k), w = movie_.width, h = movie_.height;
   exr_context_t ctx = reader_->ctx;
-  std::vector<float> px(size_t(w) * size_t(h) * 3);
+  px.assign(size_t(w) * size_t(h) * 3, 0.0f);
   int32_t linesPerChunk = 0;
   checkExr(exr_get_scanlines_per_chunk(ctx, part, &linesPerChunk), path_, "part header");
   if (linesPerChunk < 1) throw inputError(path_, "part " + std::to_string(k) + ": no scanlines");
@@ -681,13 +661,6 @@ void TextureMovieStream::load(size_t k) {
     checkExr(exr_decoding_run(ctx, part, &decoder), path_, "decoding");
   }
   reader_->dropWindow();
-  requirePixelChecksum(movie_.keyChecksums[k], rgbPixelChecksum(px.data(), w, h), path_,
-                       "part " + std::to_string(k));
-  for (float v : px)
-    if (!std::isfinite(v))
-      throw inputError(path_, "non-finite irradiance in part " + std::to_string(k));
-  movie_.keys[k] = std::move(px);
-  ++keysRead_;
 }
 
 const std::vector<float>& TextureMovieStream::key(size_t k) {

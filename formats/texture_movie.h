@@ -54,6 +54,11 @@ struct TextureMovie {
   // Set by readTextureMovieHeaders (else 0): ExrHeaderScan::headerHash of the file, every part's
   // header, so with keyChecksums its whole content, without reading the pixels.
   uint64_t headerHash = 0;
+  // Set by the readers from their header scan: where the chunk tables start (the headers' end)
+  // when every part is an uncompressed scan-line image of one chunk a line, the layout
+  // rad-movies writes, so that TextureMovieStream reads a key without OpenEXR's decoder
+  // (uncompressed_exr_part.h); else 0.
+  uint64_t uncompressedTablesAt = 0;
   // A piece's place in its movie (keyFrames, keyTimes and keys are then the piece's); a whole
   // movie's count is 0.
   TextureMoviePiece piece;
@@ -122,9 +127,8 @@ class TextureMovieWriter {
   bool collapse_ = false, diverged_ = false, committed_ = false;
   size_t next_ = 0, texelFloats_ = 0;
   std::vector<uint64_t> checksums_;  // of the parts written, by part
-  uint64_t headersEnd_ = 0;          // bytes of the file before the first chunk table
   std::vector<float> key0_;          // held while the movie may be constant
-  struct File;                       // AtomicFile + OpenEXR multi-part output
+  struct File;                       // AtomicFile + the EXR writer (scanline_exr_writer.h)
   std::unique_ptr<File> file_;
 };
 // What a reader expects a file to be: a whole movie, or a piece of one. Each refuses the other
@@ -148,7 +152,8 @@ class TextureMovieStream {
   // stays open until destruction); throws rad::inputError(path, ...).
   explicit TextureMovieStream(std::string path, MovieFileKind kind = MovieFileKind::kWhole);
   // The same with the headers already read and checked (readTextureMovieHeaders of `path`):
-  // only the part count is checked against the file opened.
+  // the file is opened, and OpenEXR's reader started (the part count checked against it) only
+  // if a key is not in the uncompressed layout.
   TextureMovieStream(std::string path, TextureMovie headers);
   ~TextureMovieStream();
   TextureMovieStream(const TextureMovieStream&) = delete;
@@ -169,6 +174,8 @@ class TextureMovieStream {
  private:
   void load(size_t k);
   void open();
+  void startExr();  // OpenEXR's core context over the open file, once
+  void decodeWithOpenExr(size_t k, std::vector<float>& px);
   void loadAround(double t, size_t& k0, size_t& k1);
   std::string path_;
   struct Reader;  // OpenEXR core context, open for the stream's lifetime

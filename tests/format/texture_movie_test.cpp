@@ -2,14 +2,20 @@
 // constant movies; interpolation between keys; truncated, corrupted, non-movie and
 // future-version files give one-line errors naming the file, never a crash; the streaming
 // TextureMovieWriter writes writeTextureMovie's bytes, detects constant movies and leaves
-// nothing behind when it fails.
+// nothing behind when it fails; its files are byte for byte those OpenEXR's own writer makes of
+// the same headers and pixels.
 #include "formats/texture_movie.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputPart.h>
 #include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
 #include <OpenEXR/ImfStringAttribute.h>
 
 #include <algorithm>
@@ -19,6 +25,8 @@
 #include <fstream>
 #include <iterator>
 
+#include "formats/exr_header_scan.h"
+#include "formats/uncompressed_exr_part.h"
 #include "libcommon/core/error.h"
 
 namespace fs = std::filesystem;
@@ -495,6 +503,94 @@ TEST_F(TextureMovieFormat, ConstantPieceKeepsOneKeyAndItsKeyCount) {
   EXPECT_EQ(r.keyFrames.size(), 1u);
   EXPECT_EQ(r.piece.keys, 4);
   EXPECT_EQ(r.piece.movieKeys, 10);
+}
+
+// The file OpenEXR's MultiPartOutputFile writes from `path`'s headers (with `compression`) and
+// pixels, as bytes.
+std::string rewrittenByOpenExr(const std::string& path, const std::string& out,
+                               Imf::Compression compression = Imf::NO_COMPRESSION) {
+  Imf::MultiPartInputFile in(path.c_str());
+  std::vector<Imf::Header> headers;
+  for (int p = 0; p < in.parts(); ++p) {
+    headers.push_back(in.header(p));
+    headers.back().compression() = compression;
+  }
+  const Imath::Box2i dw = headers[0].dataWindow();
+  const int w = dw.max.x + 1, h = dw.max.y + 1;
+  std::vector<std::vector<float>> pixels(headers.size(), std::vector<float>(size_t(w) * h * 3));
+  const auto frameBuffer = [&](std::vector<float>& px) {
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(px.data());
+    const size_t xs = 3 * sizeof(float), ys = size_t(w) * xs;
+    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, base + 4, xs, ys));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 8, xs, ys));
+    return fb;
+  };
+  for (int p = 0; p < in.parts(); ++p) {
+    Imf::InputPart part(in, p);
+    part.setFrameBuffer(frameBuffer(pixels[size_t(p)]));
+    part.readPixels(0, h - 1);
+  }
+  {
+    Imf::MultiPartOutputFile file(out.c_str(), headers.data(), int(headers.size()));
+    for (int p = 0; p < int(headers.size()); ++p) {
+      Imf::OutputPart part(file, p);
+      part.setFrameBuffer(frameBuffer(pixels[size_t(p)]));
+      part.writePixels(h);
+    }
+  }
+  return bytesOf(out);
+}
+
+TEST_F(TextureMovieFormat, WriterWritesTheBytesOfOpenExrsOwnWriter) {
+  TextureMovie m = sampleMovie(4);
+  writeTextureMovie(dir() + "/multi.exr", m);
+  const std::string ours = bytesOf(dir() + "/multi.exr");
+  EXPECT_GT(ours.size(), 1000u);
+  EXPECT_EQ(rewrittenByOpenExr(dir() + "/multi.exr", dir() + "/imf-multi.exr"), ours);
+  // One key: a single-part file (no part numbers, no chunkCount).
+  writeTextureMovie(dir() + "/single.exr", sampleMovie(1));
+  EXPECT_EQ(rewrittenByOpenExr(dir() + "/single.exr", dir() + "/imf-single.exr"),
+            bytesOf(dir() + "/single.exr"));
+  // A piece (more attributes) of a wider movie.
+  TextureMovie piece = sampleMovie(3);
+  piece.width = 17;
+  for (std::vector<float>& key : piece.keys) key.resize(size_t(17) * 3 * 3, 2.5f);
+  piece.piece = TextureMoviePiece{1, 3, 3, 3, 9};
+  writeTextureMovie(dir() + "/piece.exr", piece);
+  EXPECT_EQ(rewrittenByOpenExr(dir() + "/piece.exr", dir() + "/imf-piece.exr"),
+            bytesOf(dir() + "/piece.exr"));
+}
+
+TEST_F(TextureMovieFormat, UncompressedPartsAreReadWithoutOpenExrAndOtherLayoutsWithIt) {
+  const TextureMovie m = sampleMovie(3);
+  const std::string path = dir() + "/m.exr";
+  writeTextureMovie(path, m);
+  const ExrHeaderScan scan = scanExrFile(path);
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  std::vector<float> px;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(readUncompressedRgbPart(fd, uncompressedPartTableAt(scan.headerBytes, k, m.height),
+                                        true, k, m.width, m.height, px));
+    EXPECT_EQ(px, m.keys[size_t(k)]) << "key " << k;
+  }
+  // The wrong part's table, or a single-part leader, is refused (the leaders disagree).
+  EXPECT_FALSE(readUncompressedRgbPart(fd, uncompressedPartTableAt(scan.headerBytes, 1, m.height),
+                                       true, 0, m.width, m.height, px));
+  EXPECT_FALSE(readUncompressedRgbPart(fd, uncompressedPartTableAt(scan.headerBytes, 0, m.height),
+                                       false, 0, m.width, m.height, px));
+  ::close(fd);
+  EXPECT_GT(readTextureMovieHeaders(path).uncompressedTablesAt, 0u);
+  // ZIP (any writer's choice): read through OpenEXR, the same keys.
+  const std::string zip = dir() + "/zip.exr";
+  rewrittenByOpenExr(path, zip, Imf::ZIP_COMPRESSION);
+  const TextureMovie headers = readTextureMovieHeaders(zip);
+  EXPECT_EQ(headers.uncompressedTablesAt, 0u);
+  TextureMovieStream stream(zip, headers);
+  for (size_t k = 0; k < 3; ++k) EXPECT_EQ(stream.key(k), m.keys[k]) << "key " << k;
+  EXPECT_EQ(readTextureMovie(zip).keys, m.keys);
 }
 
 }  // namespace
