@@ -125,11 +125,12 @@ void addBaselineParameters(ParameterTable<GlobalOptions>& t) {
       "root cluster's self-link of a cluster hierarchy over them",
       Group::kBaseline);
   t.addFlag(
-      "keep-weak-near-links",
-      [](GlobalOptions& g) -> bool& { return radiosity(g).keepWeakNearLinks; }, true,
-      "keep a near cluster link that cannot carry eps times the power (its bound with form "
-      "factor 1) instead of refining it: fewer links among packed small objects, a less "
-      "exact transfer between near clusters");
+      "refine-weak-near-links",
+      [](GlobalOptions& g) -> bool& { return radiosity(g).keepWeakNearLinks; }, false,
+      "refine every near cluster link without a light down to its member pairs, also one "
+      "that cannot carry eps times the power (its bound with form factor 1), instead of "
+      "keeping it: packed small objects then fill the link bound",
+      Group::kBaseline);
   t.addFlag(
       "isotropic-clusters",
       [](GlobalOptions& g) -> bool& { return radiosity(g).isotropicClusters; }, true,

@@ -124,8 +124,7 @@ TEST(RadGlobal, KeptWeakNearLinksAreTakenOverByTheNextKey) {
   fs::path d = scratchDir();
   const std::string hall = (d / "hall.gltf").string();
   ASSERT_EQ(makeHall(hall, 1000), 0);
-  const std::string base =
-      tool("rad-global") + " " + hall + " --frames 0-8 --key-step 8 --keep-weak-near-links";
+  const std::string base = tool("rad-global") + " " + hall + " --frames 0-8 --key-step 8";
   auto c =
       runCommand(base + " -o " + (d / "c.rlh").string() + " --report " + (d / "c.json").string());
   ASSERT_EQ(c.exitCode, 0) << c.err;
