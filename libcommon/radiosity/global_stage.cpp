@@ -88,6 +88,13 @@ void addLinkParameters(ParameterTable<GlobalOptions>& t) {
       "of their bounding radii apart; larger is more accurate and slower",
       Check::range(1.0, 1e6));
   t.add(
+      "weak-near-ambient-share",
+      [](GlobalOptions& g) -> double& { return radiosity(g).weakNearAmbientShare; },
+      "before the first solve, judge which near cluster links are too weak to refine by this "
+      "share of the ambient radiosity (the emitted power over the area's absorption) instead "
+      "of by the lights' alone",
+      Check::range(0.0, 1e6));
+  t.add(
       "light-cluster-share",
       [](GlobalOptions& g) -> double& { return radiosity(g).lightClusterShare; },
       "a link from a light stays a cluster link (smooth light, no per-texel shadows) while "

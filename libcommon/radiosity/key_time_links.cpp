@@ -24,9 +24,10 @@ namespace {
 // The first round's estimate of each top's B (ClusterLinks::estimateRadiosity): its emission
 // and its reflectance times the ambient irradiance of a closed room, the emitted power over
 // the whole area's absorption, $E_{amb} = \Phi / (A (1 - \bar\rho))$ (Cohen, Chen, Wallace,
-// Greenberg 1988, the ambient term; $\bar\rho$ the area-weighted mean of the largest channel).
-// The mean, not a bound: a top near a light is brighter, and the links judged weak by the
-// estimate are judged again by the solved B at the next round (fateOf).
+// Greenberg 1988, the ambient term; $\bar\rho$ the area-weighted mean of the largest channel),
+// `power` being the share of Phi asked for (RadiosityOptions::weakNearAmbientShare). Not a
+// bound: a top near a light is brighter, and the links judged weak by the estimate are judged
+// again by the solved B at the next round (fateOf).
 std::vector<glm::dvec3> ambientRadiosity(const std::vector<SurfaceProperties>& surfaces,
                                          const std::vector<double>& area, double power) {
   double absorbing = 0.0;
@@ -59,8 +60,8 @@ size_t KeyTimeSolver::refineClusterLinks() {
       glm::dvec3 emitted(0.0);
       for (int t = 0; t < h_.topCount(); ++t)
         emitted += s_.area[size_t(t)] * surfaces_[size_t(t)].emission;
-      clusters_->estimateRadiosity(
-          ambientRadiosity(surfaces_, s_.area, maxComponent(emitted) + lampPower()));
+      clusters_->estimateRadiosity(ambientRadiosity(
+          surfaces_, s_.area, opt_.weakNearAmbientShare * (maxComponent(emitted) + lampPower())));
     }
   }
   const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs, overBudget);

@@ -1412,7 +1412,7 @@ TEST(ClusterLinks, ExposedFloorMatchesAllPairsAtTheDefaultSeparation) {
 // a round: in the exposed-floor room it was still refining at the last round
 // (RadiosityOptions::maxRefineRounds), where the rule off settles in a few, and the floor came
 // out darker than ExposedFloorMatchesAllPairsAtTheDefaultSeparation's bound. Judged by the
-// ambient estimate of B
+// share of the ambient B
 // (ClusterLinks::estimateRadiosity) the first round keeps only the links that stay weak.
 TEST(ClusterLinks, KeptWeakNearLinksLetTheRefinementSettle) {
   const ExposedFloorRoom room;

@@ -60,7 +60,8 @@ TEST(ParameterTable, GlobalProvenanceKeysAreUnchanged) {
                                             "rays",
                                             "refine-weak-near-links",
                                             "shadow-eps-share",
-                                            "tol"}));
+                                            "tol",
+                                            "weak-near-ambient-share"}));
   EXPECT_EQ(GlobalOptions{}.toJson().at("no-coherence"), false);
   EXPECT_EQ(GlobalOptions{}.toJson().at("oracle"), "both");
 }
