@@ -1411,9 +1411,9 @@ TEST(ClusterLinks, ExposedFloorMatchesAllPairsAtTheDefaultSeparation) {
 // bright, the next round refines their links, and the refinement follows the light one bounce
 // a round: in the exposed-floor room it was still refining at the last round
 // (RadiosityOptions::maxRefineRounds), where the rule off settles in a few, and the floor came
-// out darker than ExposedFloorMatchesAllPairsAtTheDefaultSeparation's bound. Judged by the
-// share of the ambient B
-// (ClusterLinks::estimateRadiosity) the first round keeps only the links that stay weak.
+// out darker than ExposedFloorMatchesAllPairsAtTheDefaultSeparation's bound. Judged by a share
+// of the ambient B (ClusterLinks::estimateRadiosity, RadiosityOptions::weakNearAmbientShare),
+// the first round keeps few of the near links that the light makes strong.
 TEST(ClusterLinks, KeptWeakNearLinksLetTheRefinementSettle) {
   const ExposedFloorRoom room;
   VisibilityScene vis(visibilityTrianglesOf(room.polys));
