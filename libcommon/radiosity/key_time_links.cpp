@@ -394,7 +394,9 @@ size_t KeyTimeSolver::refine(std::vector<LinkIndex> work) {
       const int node = splits[j];
       if (node < 0) continue;
       const LinkIndex li = work[j];
-      if (s_.links.size() + 4 > opt_.maxLinks) {  // the memory bound: stop refining
+      // The memory bound, on the patch and the cluster links together (refineClusterLinks):
+      // stop refining. The kept weak near links stay cluster links to the key's end.
+      if (s_.links.size() + (clusters_ ? clusters_->size() : 0) + 4 > opt_.maxLinks) {
         s_.linkCapReached = true;
         evaluateNewLinks();  // this generation's links, made before the bound, get F~ and V
         return count;
