@@ -181,9 +181,12 @@ ClusterLinks::Fate ClusterLinks::fateOf(const ClusterLink& l, double epsAbs) con
     // the shooter's radius, formFactor). Refining such links down to every pair of members
     // that face each other made, among packed small objects (binders on shelves, keyboards'
     // keys), links quadratic in the objects within the separation of each other (issue 58).
-    // Without the shooters' radiosity (setRadiosity) the separation alone decides. Opt-in
-    // (keepWeakNearLinks): the kept links' point estimate is rough between near ends.
-    if (keepWeakNear_ && radiosityKnown_ && !(bv * std::min(R.area, S.area) > epsAbs))
+    // Without the shooters' radiosity (setRadiosity) the separation alone decides. Before the
+    // first solve the shooter's B is taken as at least its estimate (estimateRadiosity), so
+    // that the first round keeps only the links that its light will not make strong.
+    // (keepWeakNearLinks, on by default.)
+    const double weakBv = std::max(bv, estimatedRadiosity(l.shooter) * l.visibility);
+    if (keepWeakNear_ && radiosityKnown_ && !(weakBv * std::min(R.area, S.area) > epsAbs))
       return Fate::kKeep;
     const size_t T = emission_.size();
     const uint8_t* known =
@@ -769,16 +772,26 @@ void ClusterLinks::buildReceiverLists(const std::vector<double>& exposure) {
 // patch. Six axis bins with squared direction weights (an estimate of the same projection that
 // leaves out how each group's area is oriented) come out darker than the exact sums of B F V over
 // the shooters' members with the links' V; the groups' projected areas come closer to them.
-void ClusterLinks::setRadiosity(const std::vector<glm::dvec3>& topB) {
-  for (size_t t = 0; t < topMaxB_.size(); ++t) topMaxB_[t] = maxComponent(topB[t]);
+void ClusterLinks::maxOverMembers(const std::vector<glm::dvec3>& topB, std::vector<double>& top,
+                                  std::vector<double>& cluster) const {
+  top.resize(emission_.size());
+  cluster.resize(size_t(tree_.size()));
+  for (size_t t = 0; t < top.size(); ++t) top[t] = maxComponent(topB[t]);
   for (int c = tree_.size(); c-- > 0;) {  // sub-clusters (higher indices) first
     double maxB = 0.0;
     for (ClusterRef r : tree_.node(c).children)
-      maxB = std::max(maxB,
-                      isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)]);
-    clusterMaxB_[size_t(c)] = maxB;
+      maxB = std::max(maxB, isCluster(r) ? cluster[size_t(clusterIndex(r))] : top[size_t(r)]);
+    cluster[size_t(c)] = maxB;
   }
+}
+
+void ClusterLinks::setRadiosity(const std::vector<glm::dvec3>& topB) {
+  maxOverMembers(topB, topMaxB_, clusterMaxB_);
   radiosityKnown_ = true;
+}
+
+void ClusterLinks::estimateRadiosity(const std::vector<glm::dvec3>& topB) {
+  maxOverMembers(topB, topEstimateB_, clusterEstimateB_);
 }
 
 void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector<double>& exposure,
@@ -791,6 +804,8 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector
   };
   std::vector<GroupRadiosity> groups(size_t(tree_.size()));
   setRadiosity(topB);
+  std::vector<double>().swap(topEstimateB_);  // the solved B from now on (estimateRadiosity)
+  std::vector<double>().swap(clusterEstimateB_);
   for (int c = tree_.size(); c-- > 0;) {  // sub-clusters (higher indices) first
     GroupRadiosity& g = groups[size_t(c)];
     g.power.fill(glm::dvec3(0.0));

@@ -185,6 +185,12 @@ class ClusterLinks {
   // separation alone (fateOf).
   void setRadiosity(const std::vector<glm::dvec3>& topB);
   bool radiosityKnown() const { return radiosityKnown_; }
+  // An estimate of the tops' radiosity `topB` before the first solve (per top), which fateOf
+  // judges weak near links by, with the known B, until the first gather drops it. Without it
+  // the first round knows only the lights' B, keeps every near link without a light, and the
+  // refinement then follows the light one bounce a round and does not settle within
+  // RadiosityOptions::maxRefineRounds (docs/results.md, "Weak near links kept by default").
+  void estimateRadiosity(const std::vector<glm::dvec3>& topB);
   // fateOf keeps near links that cannot carry eps Phi (RadiosityOptions::keepWeakNearLinks).
   void keepWeakNearLinks(bool on) { keepWeakNear_ = on; }
   // Rays of the blocked test of near links between large ends (sampledBlocked; RadiosityOptions::
@@ -287,6 +293,14 @@ class ClusterLinks {
   double maxRadiosity(ClusterRef r) const {
     return isCluster(r) ? clusterMaxB_[size_t(clusterIndex(r))] : topMaxB_[size_t(r)];
   }
+  // estimateRadiosity's largest over r's tops; 0 once dropped (or never given).
+  double estimatedRadiosity(ClusterRef r) const {
+    if (topEstimateB_.empty()) return 0.0;
+    return isCluster(r) ? clusterEstimateB_[size_t(clusterIndex(r))] : topEstimateB_[size_t(r)];
+  }
+  // The largest over each top's channels, and over each cluster's tops, of `topB`.
+  void maxOverMembers(const std::vector<glm::dvec3>& topB, std::vector<double>& top,
+                      std::vector<double>& cluster) const;
   void evaluateLink(ClusterLink& l);
   // Draws of a link end's member for one ray pair until one faces the other end (evaluateLink).
   static constexpr int kFacingTries = 8;
@@ -363,6 +377,8 @@ class ClusterLinks {
   int nearBlockRays_ = 0;                      // nearBlockRays
   std::vector<double> memberAreaPrefix_;       // over tree_.members(), for area sampling
   std::vector<double> memberPowerPrefix_;      // the same of area x emission (lights' V)
+  // estimateRadiosity's, as clusterMaxB_ and topMaxB_, until a gather.
+  std::vector<double> clusterEstimateB_, topEstimateB_;
   std::vector<ClusterLink> links_;
   std::vector<NearLinkTest> nearTests_;  // nearTests()
   // The links' V at their receivers' members (ClusterLink::memberVisibility); a refined link's

@@ -88,6 +88,13 @@ void addLinkParameters(ParameterTable<GlobalOptions>& t) {
       "of their bounding radii apart; larger is more accurate and slower",
       Check::range(1.0, 1e6));
   t.add(
+      "weak-near-ambient-share",
+      [](GlobalOptions& g) -> double& { return radiosity(g).weakNearAmbientShare; },
+      "before the first solve, judge which near cluster links are too weak to refine by this "
+      "share of the ambient radiosity (the emitted power over the area's absorption) instead "
+      "of by the lights' alone",
+      Check::range(0.0, 1e6));
+  t.add(
       "light-cluster-share",
       [](GlobalOptions& g) -> double& { return radiosity(g).lightClusterShare; },
       "a link from a light stays a cluster link (smooth light, no per-texel shadows) while "
@@ -125,11 +132,12 @@ void addBaselineParameters(ParameterTable<GlobalOptions>& t) {
       "root cluster's self-link of a cluster hierarchy over them",
       Group::kBaseline);
   t.addFlag(
-      "keep-weak-near-links",
-      [](GlobalOptions& g) -> bool& { return radiosity(g).keepWeakNearLinks; }, true,
-      "keep a near cluster link that cannot carry eps times the power (its bound with form "
-      "factor 1) instead of refining it: fewer links among packed small objects, a less "
-      "exact transfer between near clusters");
+      "refine-weak-near-links",
+      [](GlobalOptions& g) -> bool& { return radiosity(g).keepWeakNearLinks; }, false,
+      "refine every near cluster link without a light down to its member pairs, also one "
+      "that cannot carry eps times the power (its bound with form factor 1), instead of "
+      "keeping it: packed small objects then fill the link bound",
+      Group::kBaseline);
   t.addFlag(
       "isotropic-clusters",
       [](GlobalOptions& g) -> bool& { return radiosity(g).isotropicClusters; }, true,

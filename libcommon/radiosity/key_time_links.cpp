@@ -19,6 +19,30 @@
 #include "libcommon/radiosity/visibility.h"
 
 namespace rad {
+namespace {
+
+// The first round's estimate of each top's B (ClusterLinks::estimateRadiosity): its emission
+// and its reflectance times the ambient irradiance of a closed room, the emitted power over
+// the whole area's absorption, $E_{amb} = \Phi / (A (1 - \bar\rho))$ (Cohen, Chen, Wallace,
+// Greenberg 1988, the ambient term; $\bar\rho$ the area-weighted mean of the largest channel),
+// `power` being the share of Phi asked for (RadiosityOptions::weakNearAmbientShare). Not a
+// bound: a top near a light is brighter, and the links judged weak by the estimate are judged
+// again by the solved B at the next round (fateOf).
+std::vector<glm::dvec3> ambientRadiosity(const std::vector<SurfaceProperties>& surfaces,
+                                         const std::vector<double>& area, double power) {
+  double absorbing = 0.0;
+  for (size_t t = 0; t < surfaces.size(); ++t) {
+    const glm::dvec3& rho = surfaces[t].reflectance;
+    absorbing += area[t] * (1.0 - std::max(rho.x, std::max(rho.y, rho.z)));
+  }
+  const double ambient = absorbing > 0.0 ? power / absorbing : 0.0;
+  std::vector<glm::dvec3> B(surfaces.size());
+  for (size_t t = 0; t < surfaces.size(); ++t)
+    B[t] = surfaces[t].emission + surfaces[t].reflectance * ambient;
+  return B;
+}
+
+}  // namespace
 
 // Cluster links (cluster_links.h): one round of their refinement with this round's B and
 // threshold (all the way down to patch pairs when refinement is off: the all-pairs linking);
@@ -30,7 +54,16 @@ size_t KeyTimeSolver::refineClusterLinks() {
   bool overBudget = false;
   // The first round's B (the lights' emission, 0 elsewhere), so that near links are judged by
   // what they can carry from the start (cluster_links.h).
-  if (!clusters_->radiosityKnown()) clusters_->setRadiosity(B_);
+  if (!clusters_->radiosityKnown()) {
+    clusters_->setRadiosity(B_);
+    if (opt_.keepWeakNearLinks) {
+      glm::dvec3 emitted(0.0);
+      for (int t = 0; t < h_.topCount(); ++t)
+        emitted += s_.area[size_t(t)] * surfaces_[size_t(t)].emission;
+      clusters_->estimateRadiosity(ambientRadiosity(
+          surfaces_, s_.area, opt_.weakNearAmbientShare * (maxComponent(emitted) + lampPower())));
+    }
+  }
   const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs, overBudget);
   if (overBudget || s_.links.size() + clusters_->size() + pairs.size() > opt_.maxLinks)
     s_.linkCapReached = true;
@@ -54,11 +87,11 @@ size_t KeyTimeSolver::refineClusterLinks() {
     }
   clusters_->evaluate();
   // The previous key's cluster links go after the first round, for the peak (most links are
-  // made at it). Not with keepWeakNearLinks: the first round, knowing only the lights' B,
-  // keeps every near link without a light, and the links below them are made at the later
-  // rounds, which would then compute every one of them afresh at every key (paper §4.2's
-  // coherence lost for them; docs/results.md, "Near cluster links kept"): the cache is held to
-  // the key's end.
+  // made at it). Not with keepWeakNearLinks: the first round keeps the near links that are
+  // weak by the estimate of B (estimateRadiosity), some of which the solved B refines at the
+  // later rounds, and the links below them would then be computed afresh at every key (paper
+  // §4.2's coherence lost for them; docs/results.md, "Near cluster links kept"): the cache is
+  // held to the key's end.
   if (input_.releaseClusterLinks && clusters_->reusing() && !opt_.keepWeakNearLinks) {
     clusters_->forgetReuse();
     input_.releaseClusterLinks();
@@ -361,7 +394,9 @@ size_t KeyTimeSolver::refine(std::vector<LinkIndex> work) {
       const int node = splits[j];
       if (node < 0) continue;
       const LinkIndex li = work[j];
-      if (s_.links.size() + 4 > opt_.maxLinks) {  // the memory bound: stop refining
+      // The memory bound, on the patch and the cluster links together (refineClusterLinks):
+      // stop refining. The kept weak near links stay cluster links to the key's end.
+      if (s_.links.size() + (clusters_ ? clusters_->size() : 0) + 4 > opt_.maxLinks) {
         s_.linkCapReached = true;
         evaluateNewLinks();  // this generation's links, made before the bound, get F~ and V
         return count;

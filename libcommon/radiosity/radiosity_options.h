@@ -95,11 +95,18 @@ struct RadiosityOptions {
   // what faces them, not a quarter) come out far too dark with isotropic ends.
   bool isotropicClusters = false;
   // Keep a near cluster link without a light whose bound with F = 1 cannot carry eps Phi,
-  // instead of refining it (cluster_links.h, fateOf). Off by default: the kept links' point
-  // estimate moves an exposed floor away from all pairs
-  // (ClusterLinks.ExposedFloorMatchesAllPairsAtTheDefaultSeparation); on, packed small objects
-  // (shelves of binders, keyboards) stop filling the link bound.
-  bool keepWeakNearLinks = false;
+  // instead of refining it (cluster_links.h, fateOf); the first round judges it by an estimate
+  // of the shooters' B (ClusterLinks::estimateRadiosity). Off (--refine-weak-near-links): every
+  // near link is refined down to its member pairs, and packed small objects (shelves of
+  // binders, keyboards, a room's chairs) fill the link bound.
+  bool keepWeakNearLinks = true;
+  // --weak-near-ambient-share: the first round judges the near links' weakness by this share
+  // of the ambient radiosity (ClusterLinks::estimateRadiosity; key_time_links.cpp). The mean
+  // ambient B overestimates the B of packed, mostly shadowed parts (binders' sides), whose
+  // links it refines at once; 0 judges by the lights' B alone, which keeps every near link
+  // in the first round and leaves the refinement unsettled (docs/results.md, "Weak near links
+  // kept by default", for the range that holds both).
+  double weakNearAmbientShare = 0.1;
   // Rays of the blocked test of a near cluster link without a light whose ends have more facing
   // member pairs than are tested one by one (cluster_links.h, sampledBlocked): the link is
   // dropped when all of them are blocked; a link with a share p of its member pairs open is

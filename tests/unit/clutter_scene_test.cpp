@@ -45,7 +45,6 @@ size_t total(const LinkCensus::BySize& s) {
 TEST(ClutterScene, NearLinksThatCannotCarryEpsPhiAreKept) {
   RadiosityOptions options;
   options.maxLinks = 75000;
-  options.keepWeakNearLinks = true;
   const ClutterSolve s(options);
   const LinkCensus& c = s.solution.linkCensus;
   const size_t nearMet = total(c.nearRefined) + total(c.nearUntested) + total(c.nearDropped);
@@ -61,7 +60,6 @@ TEST(ClutterScene, NearLinksThatCannotCarryEpsPhiAreKept) {
 // patch links and the room absorbed what it emitted to 0.3 %.
 TEST(ClutterScene, AClosedRoomAbsorbsWhatItIsLitWith) {
   RadiosityOptions options;
-  options.keepWeakNearLinks = true;
   const ClutterSolve s(options);
   const double share = s.absorbedShare();
   std::cout << "absorbed / emitted " << share << "\n";

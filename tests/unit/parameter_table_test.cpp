@@ -44,7 +44,6 @@ TEST(ParameterTable, GlobalProvenanceKeysAreUnchanged) {
                                             "fps",
                                             "frames",
                                             "isotropic-clusters",
-                                            "keep-weak-near-links",
                                             "key-step",
                                             "light-cluster-share",
                                             "max-links",
@@ -59,8 +58,10 @@ TEST(ParameterTable, GlobalProvenanceKeysAreUnchanged) {
                                             "partial-power-share",
                                             "partial-threshold",
                                             "rays",
+                                            "refine-weak-near-links",
                                             "shadow-eps-share",
-                                            "tol"}));
+                                            "tol",
+                                            "weak-near-ambient-share"}));
   EXPECT_EQ(GlobalOptions{}.toJson().at("no-coherence"), false);
   EXPECT_EQ(GlobalOptions{}.toJson().at("oracle"), "both");
 }
