@@ -5,6 +5,7 @@
 // run.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -68,13 +69,21 @@ class LinkIntervals {
       };
       return bits(a) < bits(b);
     });
-    // The new links counted first, so that the merged vector is allocated once at its size.
-    size_t fresh = 0;
+    // The new links counted first, so that the merged vector is allocated once at its size, and
+    // the rows this key may start (at most), so that the rows grow once: grown row by row, the
+    // copy of every row made so far at each step set rad-global's peak at key 0, which makes
+    // nearly every row.
+    size_t fresh = 0, newRows = 0;
     for (size_t i = 0, j = 0; i < values.size(); ++i) {
       while (j < links_.size() && links_[j].first < values[i].link) ++j;
       const bool known = j < links_.size() && links_[j].first == values[i].link;
-      fresh += !known && (i == 0 || values[i - 1].link != values[i].link) ? 1 : 0;
+      const bool repeated = i > 0 && values[i - 1].link == values[i].link;
+      fresh += !known && !repeated ? 1 : 0;
+      newRows +=
+          !known || repeated || !continues(rows_[links_[j].second.last], key, values[i]) ? 1 : 0;
     }
+    if (rows_.size() + newRows > rows_.capacity())
+      rows_.reserve(std::max(rows_.size() + newRows, rows_.size() + rows_.size() / 8 + 1024));
     std::vector<std::pair<uint64_t, LinkRows>> merged;
     merged.reserve(links_.size() + fresh);
     size_t j = 0;
@@ -89,11 +98,16 @@ class LinkIntervals {
     links_.swap(merged);
   }
 
+  // Whether the value v at key `key` goes on the run of row r (else it starts a row).
+  static bool continues(const Row& r, uint32_t key, const KeyValue& v) {
+    return r.lastKey + 1 == key && r.refined == v.refined;
+  }
+
   // The link's value at key `key` (`fresh`: its first).
   void add(LinkRows& lr, bool fresh, uint32_t key, float fv, float visibility, bool refined) {
     if (!fresh) {
       Row& r = rows_[lr.last];
-      if (r.lastKey + 1 == key && r.refined == refined) {  // the run goes on
+      if (r.lastKey + 1 == key && r.refined == refined) {  // the run goes on (continues)
         r.lastKey = key;
         r.visibilityChanged |= visibility != r.firstVisibility;
         r.constant &= fv == r.firstFv && visibility == r.firstVisibility;
@@ -134,6 +148,8 @@ class LinkIntervals {
   }
   const Row& row(uint32_t i) const { return rows_[i]; }
   size_t rowCount() const { return rows_.size(); }
+  // The rows' allocated room: addKey grows it at most once a key, to at least what the key starts.
+  size_t rowCapacity() const { return rows_.capacity(); }
   // The samples a row contributes to GlobalSolution::linkSample*.
   static uint32_t sampleCount(const Row& r) { return r.constant ? 1 : r.valueCount; }
   // Every key of the row has the bits of its first value (no per-key values kept).

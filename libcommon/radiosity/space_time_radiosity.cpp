@@ -248,6 +248,10 @@ class KeyTimePass {
     for (size_t k = first_; k <= last_; ++k) {
       KeySolution s = solveKey(k, prev);
       const size_t r = k - first_;
+      // After the last key no key takes over its values: what only the next key's coherence
+      // caches read goes before the fold, whose sort and rows are rad-global's peak at the end of
+      // a run (of one key: the whole run's).
+      if (k == last_) releaseCoherenceState(s);
       foldLinks(s, uint32_t(r));
       std::vector<glm::dvec3> b = pushedDown(s, h_);
       records_[r].radiosity.assign(b.begin(), b.end());
@@ -262,6 +266,18 @@ class KeyTimePass {
         s.rayPairs.shrink_to_fit();
       prev = std::move(s);
     }
+  }
+
+  // The parts of a key's solution that only the next key's solve reads (solveKey's caches and
+  // reserves), freed.
+  static void releaseCoherenceState(KeySolution& s) {
+    std::vector<LinkRayPair>().swap(s.rayPairs);
+    std::vector<uint32_t>().swap(s.rayPairStart);
+    std::vector<ClusterLink>().swap(s.clusterLinkValues);
+    std::vector<uint8_t>().swap(s.clusterMemberVisibility);
+    std::vector<NearLinkTest>().swap(s.clusterNearTests);
+    decltype(s.leafTopFormFactor)().swap(s.leafTopFormFactor);
+    std::vector<uint64_t>().swap(s.coveredPoints);
   }
 
   KeyPassResult take() {
