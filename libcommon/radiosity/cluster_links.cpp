@@ -63,25 +63,26 @@ ClusterLinks::ClusterLinks(const ClusterTree& tree, const std::vector<Polygon>& 
     memberAreaPrefix_[i + 1] = memberAreaPrefix_[i] + area[m[i]];
     memberPowerPrefix_[i + 1] = memberPowerPrefix_[i] + area[m[i]] * topEmission[m[i]];
   }
-  clusterFacing_.resize(size_t(tree.size()));
+  // Each cluster's facing cells (facingCellOf), from its members' normals, areas and centroids.
+  facingStart_.assign(size_t(tree.size()) + 1, 0);
   for (int c = 0; c < tree.size(); ++c) {
     const ClusterNode& n = tree.node(c);
-    std::array<glm::dvec3, 6> normalArea{}, moment{};
-    std::array<double, 6> groupArea{};
+    std::array<glm::dvec3, kFacingCells> normalArea{}, moment{};
+    std::array<double, kFacingCells> cellArea{};
     for (uint32_t i = n.first; i < n.first + n.count; ++i) {
       const uint32_t j = m[i];
-      const glm::dvec3& nj = normal_[j];
-      const int g = facingGroupOf(nj);
-      normalArea[size_t(g)] += area[j] * nj;
-      moment[size_t(g)] += area[j] * centroid_[j];
-      groupArea[size_t(g)] += area[j];
+      const size_t g = size_t(facingCellOf(normal_[j]));
+      normalArea[g] += area[j] * normal_[j];
+      moment[g] += area[j] * centroid_[j];
+      cellArea[g] += area[j];
     }
-    FacingGroups& f = clusterFacing_[size_t(c)];
-    for (size_t g = 0; g < 6; ++g)
-      if (groupArea[g] > 0.0)
-        f.group[size_t(f.count++)] = {glm::vec3(normalArea[g]), glm::vec3(moment[g] / groupArea[g]),
-                                      int(g), float(groupArea[g])};
+    for (size_t g = 0; g < size_t(kFacingCells); ++g)
+      if (cellArea[g] > 0.0)
+        facingCells_.push_back({glm::vec3(normalArea[g]), glm::vec3(moment[g] / cellArea[g]),
+                                int(g) / (kFacingCells / 6), float(cellArea[g])});
+    facingStart_[size_t(c) + 1] = uint32_t(facingCells_.size());
   }
+  facingCells_.shrink_to_fit();
   // Every top's plane; a cluster's when its members are parallel (MemberPlanes): normals within
   // about a milliradian of the first's, which with rounding is the tolerance of a box on it.
   topPlanes_.resize(T);
@@ -109,6 +110,20 @@ int ClusterLinks::facingGroupOf(const glm::dvec3& n) {
   for (int k = 1; k < 3; ++k)
     if (std::abs(n[k]) > std::abs(n[axis])) axis = k;
   return axis * 2 + (n[axis] < 0.0 ? 1 : 0);
+}
+
+// Within a facing cell every member's normal has the same sign on each axis and the same order
+// of its components' magnitudes, so the cell's members all face a receiver or all face away
+// except where the receiver's direction lies within the cell's narrow band of grazing angles:
+// the signed normal sum N_g of a cell does not cancel as that of a facing group of six did (a
+// group's members 90 degrees apart, a sphere's cap seen from its side: 0.55 of its true
+// projected area).
+int ClusterLinks::facingCellOf(const glm::dvec3& n) {
+  const int group = facingGroupOf(n);
+  const int axis = group / 2, u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const int signs = (n[u] < 0.0 ? 2 : 0) + (n[v] < 0.0 ? 1 : 0);
+  const int order = std::abs(n[u]) < std::abs(n[v]) ? 1 : 0;
+  return group * 8 + signs * 2 + order;
 }
 
 // Whether a link between r and s may carry energy: not when an end whose member patches all
@@ -633,7 +648,7 @@ uint8_t ClusterLinks::visibilityAtMember(const ClusterLink& l, uint32_t t) const
 }
 
 // F(top t <- S) of a link at t's centroid: H_i / B_S of the transfer at the top of
-// cluster_links.h, summed over S's facing groups (a top-level patch shooter is its own group).
+// cluster_links.h, summed over S's facing cells (a top-level patch shooter is its own cell).
 double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t, double exposure) const {
   const double radius = isCluster(l.shooter) ? clusterRadius_[size_t(clusterIndex(l.shooter))]
                                              : topRadius_[size_t(l.shooter)];
@@ -660,10 +675,10 @@ double ClusterLinks::formFactor(const ClusterLink& l, uint32_t t, double exposur
   };
   double sum = 0.0;
   if (isCluster(l.shooter)) {
-    const FacingGroups& f = clusterFacing_[size_t(clusterIndex(l.shooter))];
-    for (int g = 0; g < f.count; ++g)
-      sum += group(glm::dvec3(f.group[size_t(g)].normalArea), double(f.group[size_t(g)].area),
-                   glm::dvec3(f.group[size_t(g)].centre));
+    const size_t c = size_t(clusterIndex(l.shooter));
+    for (uint32_t g = facingStart_[c]; g < facingStart_[c + 1]; ++g)
+      sum += group(glm::dvec3(facingCells_[g].normalArea), double(facingCells_[g].area),
+                   glm::dvec3(facingCells_[g].centre));
   } else {
     const size_t s = size_t(l.shooter);
     sum = group(area_[s] * normal_[s], area_[s], centroid_[s]);
@@ -831,11 +846,11 @@ void ClusterLinks::gather(const std::vector<glm::dvec3>& topB, const std::vector
       return;
     }
     const GroupRadiosity& g = groups[size_t(clusterIndex(l.shooter))];
-    const FacingGroups& f = clusterFacing_[size_t(clusterIndex(l.shooter))];
+    const size_t c = size_t(clusterIndex(l.shooter));
     glm::dvec3 num(0.0);
     double den = 0.0;
-    for (int k = 0; k < f.count; ++k) {
-      const FacingGroup& fg = f.group[size_t(k)];
+    for (uint32_t k = facingStart_[c]; k < facingStart_[c + 1]; ++k) {
+      const FacingGroup& fg = facingCells_[k];
       const double w =
           isotropic_ ? double(fg.area)
                      : std::max(0.0, -glm::dot(glm::dvec3(fg.normalArea), glm::dvec3(l.direction)));

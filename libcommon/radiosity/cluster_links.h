@@ -35,18 +35,25 @@
 // (centroid x_i, normal n_i), the irradiance from S is
 //   $H_i = \frac{B_S V_{RS}}{\pi} \sum_g \frac{\max(0, -N_g \cdot d_{gi}) \max(0, n_i \cdot
 //   d_{gi})}{|d_{gi}|^4}$,  $d_{gi} = c_g - x_i$,
-// over S's facing groups g: its member patches grouped by their normal's dominant axis and sign
-// (six at most), each with its area-weighted normal sum $N_g = \sum_{j \in g} A_j n_j$ and
-// area centroid c_g. Both cosines are taken from each member i of R to each group's own centre.
+// over S's facing cells g: its member patches grouped by their normal's dominant axis and sign
+// (the facing group, six at most), then by the signs of the two other components and which of
+// them is larger (48 cells at most), each with its area-weighted normal sum
+// $N_g = \sum_{j \in g} A_j n_j$ and area centroid c_g. $\max(0, -N_g \cdot d)$ is the cell's
+// projected area towards the receiver where all its members face it or all face away; a facing
+// group's members can be 90 degrees apart, and its N_g cancelled between those that face a
+// receiver and those that do not (a sphere's cap seen from its side, the faces of boxes turned
+// differently about one axis: the cluster's light too dark, issue 58). Both cosines are taken
+// from each member i of R to each cell's own centre.
 // One point and one direction for all of S, from R's centre, is first order wrong where a link is
 // seen at a grazing angle (a wall's tiles seen from the perpendicular wall beside them) and leaves
 // every cluster link of an open room dark against the exact point-to-polygon sums
 // (ClusterLinks.ExposedFloorMatchesAllPairsAtTheDefaultSeparation). B_S is S's radiosity as R sees
-// it: its facing groups' area-average radiosities B_g weighted by the groups' projected areas
-// towards R, $B_S = \sum_g \max(0, -N_g \cdot \omega) B_g / \sum_g \max(0, -N_g \cdot \omega)$, ω
-// the link's direction (gather), as the transfer above weighs the groups; and V_RS the
-// kernel-weighted share of k shadow-ray pairs between points of R's and S's patches that are
-// unoccluded, each end's patch drawn by area among those that may face the other end
+// it: its facing groups' area-average radiosities B_g weighted by their cells' projected areas
+// towards R, $B_S = \sum_g \max(0, -N_g \cdot \omega) B_{a(g)} / \sum_g \max(0, -N_g \cdot
+// \omega)$ over the cells g, a(g) a cell's facing group, ω the link's direction (gather), as the
+// transfer above weighs the cells; and V_RS the kernel-weighted share of k shadow-ray pairs
+// between points of R's and S's patches that are unoccluded, each end's patch drawn by area
+// among those that may face the other end
 // (evaluateLink). At a member i of a cluster R, V is i's own: the kernel-weighted open share of a
 // few more pairs from points of i to S's tops (visibilityAtMember; one V for a wall's tiles had
 // given its upper tiles, open to the seats' clusters, the V of its lower ones, hidden behind the
@@ -57,7 +64,7 @@
 //
 // Isotropic clusters (the option; Smits, Arvo, Greenberg 1994 §3): a cluster end is taken as
 // emitting and receiving alike in every direction, as if its members' orientations were
-// unknown: a shooter cluster's group g shows its area A_g / 4 (the mean projected area of a
+// unknown: a shooter cluster's cell g shows its area A_g / 4 (the mean projected area of a
 // surface over all directions) instead of max(0, -N_g . d) / |d|, B_S is its groups' area
 // average, and a member of a receiver cluster takes 1/4 (the mean of max(0, cos) over the
 // sphere) instead of its own cosine. A top-level patch end stays oriented.
@@ -356,20 +363,22 @@ class ClusterLinks {
   }
   std::vector<ClusterBounds> clusterBounds_, topBounds_;
   std::vector<double> clusterRadius_, topRadius_;  // of the bounding spheres
-  // A cluster's facing groups (see the top of this file), the non-empty ones first.
+  // A cluster's facing cells (see the top of this file): its members grouped by facingCellOf.
   struct FacingGroup {
     glm::vec3 normalArea{0.0f};  // N_g
     glm::vec3 centre{0.0f};      // c_g
-    int axisSign = 0;            // facingGroupOf its members' normals
+    int axisSign = 0;            // facingGroupOf its members' normals (the cell's facing group)
     float area = 0.0f;           // A_g, the sum of its members' areas
   };
   // A top's facing group by its normal: the dominant axis and its sign, 2 axis + (n < 0).
   static int facingGroupOf(const glm::dvec3& n);
-  struct FacingGroups {
-    std::array<FacingGroup, 6> group;
-    int count = 0;
-  };
-  std::vector<FacingGroups> clusterFacing_;
+  // A top's facing cell, one of kFacingCells: its facing group split by the signs of the two
+  // other components and by which of them is larger (the 48 cells of the cube's symmetry).
+  static int facingCellOf(const glm::dvec3& n);
+  static constexpr int kFacingCells = 48;
+  // Cluster c's non-empty cells, in cell order: facingCells_[facingStart_[c], facingStart_[c + 1]).
+  std::vector<FacingGroup> facingCells_;
+  std::vector<uint32_t> facingStart_;
   std::vector<double> clusterEmission_;
   std::vector<double> clusterMaxB_, topMaxB_;  // max over channels and members, last gather
   bool radiosityKnown_ = false;                // setRadiosity or gather has run
