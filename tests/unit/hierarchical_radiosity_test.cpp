@@ -1226,15 +1226,9 @@ TEST(ClusterLinks, EachMemberOfAReceiverClusterTakesItsOwnVisibility) {
   EXPECT_LT(byMember, 0.1);
 }
 
-// Isotropic clusters (--isotropic-clusters): a cluster shows A / 4 in every direction. A sphere
-// does (Cauchy: its projected area is pi r^2 = A / 4); a flat panel seen face-on shows all of
-// A. Seen by a small tile 10 m away, the tile's irradiance through its cluster link against the
-// exact point-to-polygon sum over the shooter's tops: a sphere of 512 triangles (radius 0.5),
-// isotropic 0.993, oriented 1.008; a panel of 8 x 8 tiles (1 m^2) face-on, oriented 0.971 (the
-// point approximation at 10 times its radius), isotropic a quarter of that.
-TEST(ClusterLinks, IsotropicClustersShowAQuarterOfTheirAreaInEveryDirection) {
+// A sphere about the origin of 512 triangles facing out: the octahedron's faces split 3 times.
+std::vector<Polygon> tessellatedSphere(double radius) {
   std::vector<Polygon> sphere;
-  const double radius = 0.5;
   std::function<void(glm::dvec3, glm::dvec3, glm::dvec3, int)> facet =
       [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, int level) {
         if (level == 0) {
@@ -1255,6 +1249,18 @@ TEST(ClusterLinks, IsotropicClustersShowAQuarterOfTheirAreaInEveryDirection) {
   for (int sx : {-1, 1})
     for (int sy : {-1, 1})
       for (int sz : {-1, 1}) facet({double(sx), 0, 0}, {0, double(sy), 0}, {0, 0, double(sz)}, 3);
+  return sphere;
+}
+
+// Isotropic clusters (--isotropic-clusters): a cluster shows A / 4 in every direction. A sphere
+// does (Cauchy: its projected area is pi r^2 = A / 4); a flat panel seen face-on shows all of
+// A. Seen by a small tile 10 m away, the tile's irradiance through its cluster link against the
+// exact point-to-polygon sum over the shooter's tops: a sphere of 512 triangles (radius 0.5),
+// isotropic 0.993, oriented 1.008; a panel of 8 x 8 tiles (1 m^2) face-on, oriented 0.971 (the
+// point approximation at 10 times its radius), isotropic a quarter of that.
+TEST(ClusterLinks, IsotropicClustersShowAQuarterOfTheirAreaInEveryDirection) {
+  const double radius = 0.5;
+  const std::vector<Polygon> sphere = tessellatedSphere(radius);
   ASSERT_EQ(sphere.size(), 512u);
   std::vector<Polygon> panel;  // x = 0, facing +x
   addTileGrid(panel, {0, -0.5, -0.5}, {0, 0.125, 0}, {0, 0, 0.125}, 8, 8, false);
@@ -1318,27 +1324,7 @@ TEST(ClusterLinks, TurnedAndCurvedShootersShowTheirWholeProjectedArea) {
       }
       boxes.push_back(p);
     }
-  std::vector<Polygon> sphere;
-  std::function<void(glm::dvec3, glm::dvec3, glm::dvec3, int)> facet =
-      [&](glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, int level) {
-        if (level == 0) {
-          Polygon p;
-          p.count = 3;
-          p.v = {0.5 * a, 0.5 * b, 0.5 * c, glm::dvec3(0.0)};
-          if (glm::dot(p.normal(), p.centroid()) < 0.0) std::swap(p.v[1], p.v[2]);
-          sphere.push_back(p);
-          return;
-        }
-        const glm::dvec3 ab = glm::normalize(a + b), bc = glm::normalize(b + c),
-                         ca = glm::normalize(c + a);
-        facet(a, ab, ca, level - 1);
-        facet(ab, b, bc, level - 1);
-        facet(ca, bc, c, level - 1);
-        facet(ab, bc, ca, level - 1);
-      };
-  for (int sx : {-1, 1})
-    for (int sy : {-1, 1})
-      for (int sz : {-1, 1}) facet({double(sx), 0, 0}, {0, double(sy), 0}, {0, 0, double(sz)}, 3);
+  const std::vector<Polygon> sphere = tessellatedSphere(0.5);
   // The irradiance of a 0.1 m tile at `at`, facing the origin, from `shooter` (B = 1) through
   // the cluster links, over the exact sum.
   auto ratio = [&](std::vector<Polygon> polys, glm::dvec3 at) {
