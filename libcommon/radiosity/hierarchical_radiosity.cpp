@@ -180,7 +180,8 @@ void KeyTimeSolver::setThresholds() {
     }
   contactDistance_ =
       h_.topCount() > 0 ? VisibilityScene::kSegmentEpsilon * glm::length(hi - lo) : 0.0;
-  epsAbs_ = opt_.eps * (maxComponent(emitted) + lampPower());
+  emittedPower_ = maxComponent(emitted) + lampPower();
+  epsAbs_ = opt_.eps * emittedPower_;
   refineOn_ = opt_.refine && epsAbs_ > 0.0;
   stopChange_ = opt_.tol * std::max(1.0 - rhoMax, 1e-6);
 }

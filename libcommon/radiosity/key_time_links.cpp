@@ -56,13 +56,9 @@ size_t KeyTimeSolver::refineClusterLinks() {
   // what they can carry from the start (cluster_links.h).
   if (!clusters_->radiosityKnown()) {
     clusters_->setRadiosity(B_);
-    if (opt_.keepWeakNearLinks) {
-      glm::dvec3 emitted(0.0);
-      for (int t = 0; t < h_.topCount(); ++t)
-        emitted += s_.area[size_t(t)] * surfaces_[size_t(t)].emission;
-      clusters_->estimateRadiosity(ambientRadiosity(
-          surfaces_, s_.area, opt_.weakNearAmbientShare * (maxComponent(emitted) + lampPower())));
-    }
+    if (opt_.keepWeakNearLinks)
+      clusters_->estimateRadiosity(
+          ambientRadiosity(surfaces_, s_.area, opt_.weakNearAmbientShare * emittedPower_));
   }
   const size_t refined = clusters_->refine(epsAbs_, !refineOn_, budget, pairs, overBudget);
   if (overBudget || s_.links.size() + clusters_->size() + pairs.size() > opt_.maxLinks)

@@ -161,7 +161,8 @@ class KeyTimeSolver {
   KeySolution s_;
   std::vector<glm::dvec3> B_;  // per dense node: radiosity (W/m^2), area average of a parent
   size_t evaluated_ = 0;       // links [0, evaluated_) have their estimate and visibility
-  double epsAbs_ = 0;          // eps * Phi
+  double emittedPower_ = 0;    // Phi: the lights' power (largest channel) and the lamps'
+  double epsAbs_ = 0;          // eps * Phi, raised to eps times the power carried
   bool refineOn_ = false;
   double stopChange_ = 0;  // tol * (1 - rho_max)
   std::vector<size_t> adjStart_;

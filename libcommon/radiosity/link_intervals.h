@@ -80,7 +80,9 @@ class LinkIntervals {
       const bool repeated = i > 0 && values[i - 1].link == values[i].link;
       fresh += !known && !repeated ? 1 : 0;
       newRows +=
-          !known || repeated || !continues(rows_[links_[j].second.last], key, values[i]) ? 1 : 0;
+          !known || repeated || !continues(rows_[links_[j].second.last], key, values[i].refined)
+              ? 1
+              : 0;
     }
     if (rows_.size() + newRows > rows_.capacity())
       rows_.reserve(std::max(rows_.size() + newRows, rows_.size() + rows_.size() / 8 + 1024));
@@ -98,16 +100,16 @@ class LinkIntervals {
     links_.swap(merged);
   }
 
-  // Whether the value v at key `key` goes on the run of row r (else it starts a row).
-  static bool continues(const Row& r, uint32_t key, const KeyValue& v) {
-    return r.lastKey + 1 == key && r.refined == v.refined;
+  // Whether a value at key `key`, refined or not, goes on the run of row r (else it starts a row).
+  static bool continues(const Row& r, uint32_t key, bool refined) {
+    return r.lastKey + 1 == key && r.refined == refined;
   }
 
   // The link's value at key `key` (`fresh`: its first).
   void add(LinkRows& lr, bool fresh, uint32_t key, float fv, float visibility, bool refined) {
     if (!fresh) {
       Row& r = rows_[lr.last];
-      if (r.lastKey + 1 == key && r.refined == refined) {  // the run goes on (continues)
+      if (continues(r, key, refined)) {  // the run goes on
         r.lastKey = key;
         r.visibilityChanged |= visibility != r.firstVisibility;
         r.constant &= fv == r.firstFv && visibility == r.firstVisibility;
